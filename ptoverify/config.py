@@ -1,0 +1,289 @@
+"""Configuration: frozen dataclasses, TOML loading, validation, paper defaults.
+
+The configuration format is the one in ``shared/DESIGN.md``::
+
+    name = "paper"
+    [plant]
+    bandwidth_hz = 30.0      # or a = 188.49... (rad/s); exactly one of the two
+    w_max = 300.0            # mm/s
+    sample_time = 0.002      # s
+    position_range = 50.0    # mm
+    [pd]
+    kp = 356.0
+    kd = 1.15
+    [pto]
+    d = 0.5                  # mm
+    k1 = 323.0
+    k2 = 3.6
+
+Every rejection is a :class:`~ptoverify.errors.ConfigError` whose message
+names the key and the value.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from ptoverify.errors import ConfigError
+
+__all__ = ["Plant", "PDGains", "PTOSettings", "Config", "paper_config", "load_config",
+           "config_from_mapping"]
+
+
+@dataclass(frozen=True)
+class Plant:
+    """Plant of eq. (1), sampled with zero-order hold.
+
+    Attributes
+    ----------
+    a : float
+        Velocity-loop bandwidth [rad/s]; x2' = -a x2 + a u.
+    w_max : float
+        Velocity saturation |u| <= w_max [mm/s] (the paper's omega_m).
+    sample_time : float
+        Sampling period T [s].
+    position_range : float
+        Half-width of the position envelope [mm].
+    """
+
+    a: float
+    w_max: float
+    sample_time: float
+    position_range: float
+
+    @property
+    def T(self) -> float:  # noqa: N802 - the paper's symbol
+        """Sampling period T [s] (alias of ``sample_time``)."""
+        return self.sample_time
+
+
+@dataclass(frozen=True)
+class PDGains:
+    """Gains of the PD law u = kp (r - x1) - kd x2.
+
+    Attributes
+    ----------
+    kp : float
+        Proportional gain [1/s].
+    kd : float
+        Derivative gain on velocity [-].
+    """
+
+    kp: float = 356.0
+    kd: float = 1.15
+
+
+@dataclass(frozen=True)
+class PTOSettings:
+    """Settings of the PTO law, eq. (35).
+
+    Attributes
+    ----------
+    d : float
+        Half-width of the linear zone |x1| < d [mm].
+    k1 : float
+        Linear-zone position gain of eq. (34) [1/s].
+    k2 : float
+        Linear-zone velocity gain of eq. (34) [-].
+    """
+
+    d: float = 0.5
+    k1: float = 323.0
+    k2: float = 3.6
+
+
+@dataclass(frozen=True)
+class Config:
+    """A full configuration: plant, PD gains and PTO settings.
+
+    Attributes
+    ----------
+    name : str
+        Name of the configuration (names the report folder).
+    plant : Plant
+        The plant and its sampling.
+    pd : PDGains
+        PD gains.
+    pto : PTOSettings
+        PTO settings.
+    bandwidth_hz : float or None
+        The bandwidth as given in Hz, when the file gave it in Hz.
+    """
+
+    name: str
+    plant: Plant
+    pd: PDGains = field(default_factory=PDGains)
+    pto: PTOSettings = field(default_factory=PTOSettings)
+    bandwidth_hz: float | None = None
+
+    def with_plant(self, **changes: float) -> Config:
+        """Return a copy with plant fields replaced (``a``, ``w_max``...)."""
+        return replace(self, plant=replace(self.plant, **changes), bandwidth_hz=None
+                       if "a" in changes else self.bandwidth_hz)
+
+    def to_mapping(self) -> dict[str, Any]:
+        """Return the configuration as a plain dict (the TOML layout)."""
+        p = self.plant
+        plant: dict[str, Any] = {}
+        if self.bandwidth_hz is not None:
+            plant["bandwidth_hz"] = self.bandwidth_hz
+        else:
+            plant["a"] = p.a
+        plant.update(w_max=p.w_max, sample_time=p.sample_time, position_range=p.position_range)
+        return {"name": self.name, "plant": plant,
+                "pd": {"kp": self.pd.kp, "kd": self.pd.kd},
+                "pto": {"d": self.pto.d, "k1": self.pto.k1, "k2": self.pto.k2}}
+
+
+PAPER_MAPPING: dict[str, Any] = {
+    "name": "paper",
+    "plant": {"bandwidth_hz": 30.0, "w_max": 300.0, "sample_time": 0.002,
+              "position_range": 50.0},
+    "pd": {"kp": 356.0, "kd": 1.15},
+    "pto": {"d": 0.5, "k1": 323.0, "k2": 3.6},
+}
+
+_SECTIONS = {
+    "plant": ({"w_max", "sample_time", "position_range"}, {"bandwidth_hz", "a"}),
+    "pd": ({"kp", "kd"}, set()),
+    "pto": ({"d", "k1", "k2"}, set()),
+}
+
+
+def paper_config() -> Config:
+    """Return the paper's Section 6 configuration (the default).
+
+    Examples
+    --------
+    >>> cfg = paper_config()
+    >>> round(cfg.plant.a, 4), cfg.plant.w_max, cfg.pto.d
+    (188.4956, 300.0, 0.5)
+    """
+    return config_from_mapping(PAPER_MAPPING)
+
+
+def _number(section: str, key: str, value: Any) -> float:
+    where = f"{section}.{key}"
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ConfigError(f"config key '{where}' must be a number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ConfigError(f"config key '{where}' must be finite, got {value!r}")
+    return value
+
+
+def _positive(section: str, key: str, value: float) -> None:
+    if value <= 0:
+        raise ConfigError(f"config key '{section}.{key}' must be > 0, got {value!r}")
+
+
+def _section(data: dict[str, Any], name: str) -> dict[str, float]:
+    if name not in data:
+        raise ConfigError(f"config section '[{name}]' is missing")
+    raw = data[name]
+    if not isinstance(raw, dict):
+        raise ConfigError(f"config key '{name}' must be a table [{name}], got {raw!r}")
+    required, optional = _SECTIONS[name]
+    for key in raw:
+        if key not in required | optional:
+            raise ConfigError(f"unknown config key '{name}.{key}'")
+    for key in sorted(required):
+        if key not in raw:
+            raise ConfigError(f"config key '{name}.{key}' is missing")
+    return {key: _number(name, key, value) for key, value in raw.items()}
+
+
+def config_from_mapping(data: dict[str, Any]) -> Config:
+    """Validate a parsed TOML mapping and build a :class:`Config`.
+
+    Parameters
+    ----------
+    data : dict
+        The mapping, in the TOML layout of ``shared/DESIGN.md``.
+
+    Returns
+    -------
+    Config
+        The validated configuration.
+
+    Raises
+    ------
+    ConfigError
+        On unknown keys, missing sections or keys, non-numbers, NaN,
+        infinities and out-of-range values; the message names the key.
+    """
+    for key in data:
+        if key not in {"name", *_SECTIONS}:
+            raise ConfigError(f"unknown config key '{key}'")
+    name = data.get("name", "custom")
+    if not isinstance(name, str) or not name or not all(c.isalnum() or c in "-_." for c in name) \
+            or name.startswith("."):
+        raise ConfigError(f"config key 'name' must be a non-empty word of letters, digits, "
+                          f"'-', '_' or '.', got {name!r}")
+    plant = _section(data, "plant")
+    pd = _section(data, "pd")
+    pto = _section(data, "pto")
+    has_hz, has_a = "bandwidth_hz" in plant, "a" in plant
+    if has_hz == has_a:
+        raise ConfigError("config section '[plant]' needs exactly one of 'plant.bandwidth_hz' "
+                          "and 'plant.a'")
+    bandwidth_hz = plant.get("bandwidth_hz")
+    if has_hz:
+        _positive("plant", "bandwidth_hz", plant["bandwidth_hz"])
+        a = 2.0 * math.pi * plant["bandwidth_hz"]
+    else:
+        _positive("plant", "a", plant["a"])
+        a = plant["a"]
+    for key in ("w_max", "sample_time", "position_range"):
+        _positive("plant", key, plant[key])
+    if pto["d"] < 0:
+        raise ConfigError(f"config key 'pto.d' must be >= 0, got {pto['d']!r}")
+    if pto["d"] > plant["position_range"]:
+        raise ConfigError(f"config key 'pto.d' must be <= plant.position_range "
+                          f"({plant['position_range']!r}), got {pto['d']!r}")
+    return Config(
+        name=name,
+        plant=Plant(a=a, w_max=plant["w_max"], sample_time=plant["sample_time"],
+                    position_range=plant["position_range"]),
+        pd=PDGains(kp=pd["kp"], kd=pd["kd"]),
+        pto=PTOSettings(d=pto["d"], k1=pto["k1"], k2=pto["k2"]),
+        bandwidth_hz=bandwidth_hz,
+    )
+
+
+def load_config(path: str | Path | None) -> Config:
+    """Load and validate a TOML configuration file.
+
+    Parameters
+    ----------
+    path : str, Path or None
+        The file; None gives :func:`paper_config`.
+
+    Returns
+    -------
+    Config
+        The validated configuration.
+
+    Raises
+    ------
+    ConfigError
+        When the file is missing, unreadable, not TOML, or invalid.
+    """
+    if path is None:
+        return paper_config()
+    path = Path(path)
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise ConfigError(f"config file '{path}' does not exist") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"config file '{path}' cannot be read: {exc}") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"config file '{path}' is not valid TOML: {exc}") from None
+    return config_from_mapping(data)

@@ -1,0 +1,374 @@
+"""Switching function, switching curves and the roots of eqs. (22), (26), (31).
+
+The curves through the origin under a constant input of level omega are
+
+* x2 <= 0 (fourth quadrant, input +omega):  a x1 + x2 + omega ln(1 - x2/omega) = 0
+  -- l1 for omega = w_max (eq. 9), l1* for omega0 (eq. 13), eq. (28) for omega_c;
+* x2 >= 0 (second quadrant, input -omega):  a x1 + x2 - omega ln(1 + x2/omega) = 0
+  -- l2 (eq. 11), l2* (eq. 14), eq. (33).
+
+Both branches are one function, :func:`level_residual`::
+
+    s(x1, x2; omega) = a x1 + sgn(x2) * omega * h(|x2| / omega),   h(r) = r - ln(1 + r)
+
+computed with a series for small r so that it is exact to round-off near the
+origin.  ``s > 0`` lies right of (above) the curve, ``s < 0`` left of (below).
+With omega = w_max it is the switching function of the time-optimal law.
+
+Roots.  Eq. (22), ln(1+y) = y - b0, and eqs. (26)/(31), ln(1+z) = k z, are
+solved in closed form with the Lambert W function (the paper uses bisection):
+
+* (22): y = -1 - W_{-1}(-e^{-1-b0})  (y > 0; the W_0 branch gives y in (-1, 0));
+* (26), (31): z = -1 - W(-k e^{-k}) / k, branch W_{-1} for 0 < k < 1 (z > 0)
+  and W_0 for k > 1 (-1 < z < 0); z = 0 is the trivial root.
+
+Near the branch point -1/e the argument of W loses half the digits, so the
+functions here take m = 1 - k (which callers form without cancellation, e.g.
+m = -a x1 / x2) and polish the Lambert-W value with Newton steps on the
+well-conditioned forms h(y) = b0 and m = 1 - u/(e^u - 1), u = ln(1 + z).
+The bisection solvers are kept as the independent reference.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.special import lambertw
+
+__all__ = [
+    "h", "level_residual", "switching_function", "level_curve_x1",
+    "root_22", "root_k", "omega_c", "bisect", "root_22_bisect", "root_k_bisect",
+]
+
+Array = NDArray[np.float64]
+
+# Taylor coefficients of h(r) = r - ln(1 + r) = sum_{n>=2} (-1)^n r^n / n
+_H_SERIES = np.array([(-1.0) ** n / n for n in range(2, 26)])
+# of E2(u) = e^u - 1 - u = sum_{n>=2} u^n / n!
+_E2_SERIES = np.array([1.0 / np.prod(np.arange(1, n + 1, dtype=float)) for n in range(2, 22)])
+
+
+def _series(x: Array, coef: Array, lowest: int) -> Array:
+    """Evaluate sum_j coef[j] x^(lowest + j) by Horner's rule."""
+    acc = np.zeros_like(x)
+    for c in coef[::-1]:
+        acc = acc * x + c
+    return acc * x**lowest
+
+
+def h(r: ArrayLike) -> Array:
+    """Return h(r) = r - ln(1 + r), exact to round-off near r = 0.
+
+    Parameters
+    ----------
+    r : array_like
+        Argument, r > -1.
+
+    Returns
+    -------
+    ndarray
+        h(r) >= 0.
+
+    Examples
+    --------
+    >>> float(h(1e-10))
+    5e-21
+    """
+    r = np.asarray(r, dtype=float)
+    small = np.abs(r) < 0.2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        direct = r - np.log1p(r)
+    return np.where(small, _series(np.where(small, r, 0.0), _H_SERIES, 2), direct)
+
+
+def _e2(u: Array) -> Array:
+    """Return e^u - 1 - u, exact to round-off near u = 0."""
+    small = np.abs(u) < 0.5
+    with np.errstate(over="ignore"):
+        direct = np.expm1(u) - u
+    return np.where(small, _series(np.where(small, u, 0.0), _E2_SERIES, 2), direct)
+
+
+def level_residual(x1: ArrayLike, x2: ArrayLike, a: float, omega: ArrayLike) -> Array:
+    """Residual of the level-omega curve through the origin, eqs. (9), (11), (13), (14).
+
+    Parameters
+    ----------
+    x1, x2 : array_like
+        State [mm], [mm/s].
+    a : float
+        Bandwidth [rad/s].
+    omega : array_like
+        Input level of the curve [mm/s], omega > 0.
+
+    Returns
+    -------
+    ndarray
+        a x1 + sgn(x2) omega h(|x2|/omega) [mm/s]: zero on the curve, positive
+        right of it, negative left of it.
+    """
+    x1, x2, omega = (np.asarray(v, dtype=float) for v in (x1, x2, omega))
+    return a * x1 + np.sign(x2) * omega * h(np.abs(x2) / omega)
+
+
+def switching_function(x1: ArrayLike, x2: ArrayLike, a: float, w_max: float) -> Array:
+    """Switching function of the time-optimal law, curves l1 (eq. 9) and l2 (eq. 11).
+
+    Parameters
+    ----------
+    x1, x2 : array_like
+        State [mm], [mm/s].
+    a : float
+        Bandwidth [rad/s].
+    w_max : float
+        Velocity saturation [mm/s].
+
+    Returns
+    -------
+    ndarray
+        sigma [mm/s]: > 0 in S_N (u = -w_max), < 0 in S_P (u = +w_max), 0 on l1 - o - l2.
+
+    Examples
+    --------
+    >>> float(switching_function(1.0, 0.0, 188.5, 300.0))
+    188.5
+    """
+    return level_residual(x1, x2, a, w_max)
+
+
+def level_curve_x1(x2: ArrayLike, a: float, omega: ArrayLike) -> Array:
+    """Position x1 on the level-omega curve through the origin at velocity x2.
+
+    Parameters
+    ----------
+    x2 : array_like
+        Velocity [mm/s]; x2 < 0 gives l1-type points (eq. 9, 13, 28), x2 > 0
+        l2-type points (eq. 11, 14, 33).
+    a : float
+        Bandwidth [rad/s].
+    omega : array_like
+        Input level [mm/s].
+
+    Returns
+    -------
+    ndarray
+        x1 [mm] such that ``level_residual(x1, x2, a, omega) == 0``.
+    """
+    x2, omega = np.asarray(x2, dtype=float), np.asarray(omega, dtype=float)
+    return -np.sign(x2) * omega * h(np.abs(x2) / omega) / a
+
+
+def _lambertw_real(x: Array, branch: int) -> Array:
+    with np.errstate(all="ignore"):
+        return np.real(lambertw(x, branch))
+
+
+def root_22(b0: ArrayLike, branch: int = -1) -> Array:
+    """Root y of eq. (22), ln(1 + y) = y - b0, in closed form.
+
+    Parameters
+    ----------
+    b0 : array_like
+        b0 >= 0 (eq. 21).
+    branch : {-1, 0}
+        -1: the root y >= 0, y = -1 - W_{-1}(-e^{-1-b0}); 0: the root in (-1, 0].
+
+    Returns
+    -------
+    ndarray
+        y*, NaN where b0 < 0 or not finite.
+
+    Examples
+    --------
+    >>> y = float(root_22(1.0))
+    >>> abs(y - np.log1p(y) - 1.0) < 1e-15
+    True
+    """
+    if branch not in (-1, 0):
+        raise ValueError("branch must be -1 or 0")
+    b0 = np.asarray(b0, dtype=float)
+    ok = np.isfinite(b0) & (b0 >= 0)
+    bb = np.where(ok, b0, 1.0)
+    sign = 1.0 if branch == -1 else -1.0
+    # initial u = ln(1 + y): branch-point series where W is ill-conditioned
+    with np.errstate(all="ignore"):
+        y_w = -1.0 - _lambertw_real(-np.exp(-1.0 - bb), branch)
+        u = np.where(bb < 1e-3, sign * np.sqrt(2.0 * bb) * (1.0 + sign * np.sqrt(2.0 * bb) / 3.0),
+                     np.log1p(np.maximum(y_w, -1.0 + 1e-300)))
+        big = ~np.isfinite(u)                        # e^{-1-b0} underflowed: y ~ b0 + ln(1+b0)
+        u = np.where(big & (sign > 0), np.log1p(bb + np.log1p(bb)), u)
+        u = np.where(big & (sign < 0), -bb - 1.0, u)
+        if branch == 0:
+            u = np.maximum(u, -bb - 1.0)             # y > -1: e^u - 1 - u = b0 => u > -b0 - 1
+        for _ in range(4):                           # Newton on E2(u) = b0; E2'(u) = e^u - 1
+            du = (_e2(u) - bb) / np.expm1(u)
+            u = np.where(u != 0.0, u - du, u)
+    y = np.expm1(u)
+    return np.where(ok, np.where(bb == 0.0, 0.0, y), np.nan)
+
+
+def _m_of_u(u: Array) -> Array:
+    """Return m = 1 - u / (e^u - 1) = E2(u) / (e^u - 1), exact near u = 0."""
+    with np.errstate(all="ignore"):
+        series = u / 2.0 - u * u / 12.0 + u**4 / 720.0
+        return np.where(np.abs(u) < 1e-4, series, _e2(u) / np.expm1(u))
+
+
+def root_k(m: ArrayLike) -> Array:
+    """Non-trivial root z of eqs. (26)/(31), ln(1 + z) = k z, with m = 1 - k.
+
+    Parameters
+    ----------
+    m : array_like
+        m = 1 - k.  For eq. (31), m = -a x1 / x2; for eq. (26),
+        m = -a x10 / x20 (eqs. 25, 30).
+
+    Returns
+    -------
+    ndarray
+        z* > 0 for 0 < m < 1 (k in (0, 1), branch W_{-1}); -1 < z* < 0 for m < 0
+        (k > 1, branch W_0); 0 for m = 0 (double root); NaN for m >= 1 or not
+        finite (no non-trivial root).
+
+    Examples
+    --------
+    >>> z = float(root_k(0.5))
+    >>> abs(np.log1p(z) - 0.5 * z) < 1e-15
+    True
+    """
+    m = np.asarray(m, dtype=float)
+    ok = np.isfinite(m) & (m < 1.0)
+    mm = np.where(ok, m, 0.5)
+    k = 1.0 - mm
+    with np.errstate(all="ignore"):
+        z_w = np.where(mm > 0, -1.0 - _lambertw_real(-k * np.exp(-k), -1) / k,
+                       -1.0 - _lambertw_real(-k * np.exp(-k), 0) / k)
+        u = np.log1p(np.maximum(z_w, -1.0 + 1e-300))
+        u = np.where(np.abs(mm) < 1e-3, 2.0 * mm * (1.0 + mm / 3.0), u)   # series u = 2m + 2m^2/3
+        u = np.where(np.isfinite(u), u, np.where(mm > 0, -np.log(k) + np.log(-np.log(k) + 1), -1.0))
+        near1 = mm >= 0.5                                    # k small: work with k, not m
+        for _ in range(6):                                   # Newton on m(u) = m
+            em1 = np.expm1(u)
+            dm = (u * np.exp(u) - em1) / em1**2              # m'(u) = -k'(u)
+            dm = np.where(np.abs(u) < 1e-4, 0.5 - u / 6.0, dm)
+            res = np.where(near1, k - u / em1, _m_of_u(u) - mm)
+            u = u - res / dm
+    z = np.expm1(u)
+    z = np.where(mm == 0.0, 0.0, z)
+    return np.where(ok, z, np.nan)
+
+
+def omega_c(x1: ArrayLike, x2: ArrayLike, a: float) -> Array:
+    """Level omega_c of the curve through the state, eqs. (28)-(33).
+
+    In the fourth quadrant (x1 > 0, x2 < 0) omega_c solves
+    a x1 + x2 + omega_c ln(1 - x2/omega_c) = 0 (eq. 28) via eqs. (30)-(32);
+    in the second quadrant the mirror image (eq. 33).
+
+    Parameters
+    ----------
+    x1, x2 : array_like
+        State [mm], [mm/s].
+    a : float
+        Bandwidth [rad/s].
+
+    Returns
+    -------
+    ndarray
+        omega_c [mm/s] > 0.  +inf where x1 x2 >= 0 with x2 != 0 (no curve of
+        finite level, the limit omega -> inf), 0 where m = -a x1/x2 >= 1
+        (the limit omega -> 0, including x2 = 0, x1 != 0); NaN at the origin.
+
+    Examples
+    --------
+    >>> wc = float(omega_c(0.1, -100.0, 188.5))
+    >>> abs(188.5 * 0.1 - 100.0 + wc * np.log1p(100.0 / wc)) < 1e-10
+    True
+    """
+    x1, x2 = np.broadcast_arrays(np.asarray(x1, dtype=float), np.asarray(x2, dtype=float))
+    with np.errstate(all="ignore"):
+        m = -a * x1 / x2
+        w = root_k(np.where((m > 0) & (m < 1), m, 0.5))
+        wc = np.abs(x2) / w
+    wc = np.where((m > 0) & (m < 1), wc, np.where(m >= 1, 0.0, np.inf))
+    wc = np.where((x2 == 0) & (x1 != 0), 0.0, wc)
+    return np.where((x1 == 0) & (x2 == 0), np.nan, wc)
+
+
+def bisect(f, lo: ArrayLike, hi: ArrayLike, tol: float = 0.0, max_iter: int = 2000) -> Array:
+    """Vectorized bisection for a sign change of f on [lo, hi].
+
+    Parameters
+    ----------
+    f : callable
+        Vectorized function; f(lo) and f(hi) must differ in sign.
+    lo, hi : array_like
+        Brackets.
+    tol : float
+        Stop when hi - lo <= tol (0: until the bracket stops shrinking).
+    max_iter : int
+        Iteration cap.
+
+    Returns
+    -------
+    ndarray
+        Midpoint of the final bracket.
+    """
+    lo, hi = np.broadcast_arrays(np.asarray(lo, dtype=float).copy(),
+                                 np.asarray(hi, dtype=float).copy())
+    lo, hi = lo.copy(), hi.copy()
+    f_lo = np.sign(f(lo))
+    for _ in range(max_iter):
+        mid = 0.5 * (lo + hi)
+        active = (hi - lo > tol) & (mid > lo) & (mid < hi)
+        if not np.any(active):
+            break
+        f_mid = np.sign(f(mid))
+        left = (f_mid == f_lo) & active
+        lo = np.where(left, mid, lo)
+        hi = np.where(active & ~left, mid, hi)
+    return 0.5 * (lo + hi)
+
+
+def root_22_bisect(b0: ArrayLike, tol: float = 0.0) -> Array:
+    """Positive root of eq. (22) by bisection (the paper's method; reference).
+
+    Parameters
+    ----------
+    b0 : array_like
+        b0 > 0.
+    tol : float
+        Bracket width at which to stop; 0 bisects to the last bit.
+
+    Returns
+    -------
+    ndarray
+        y* > 0.
+    """
+    b0 = np.asarray(b0, dtype=float)
+    return bisect(lambda y: h(y) - b0, np.zeros_like(b0), 2.0 * b0 + 2.0, tol)
+
+
+def root_k_bisect(m: ArrayLike, tol: float = 0.0) -> Array:
+    """Non-trivial root of eqs. (26)/(31) by bisection (reference for :func:`root_k`).
+
+    Parameters
+    ----------
+    m : array_like
+        m = 1 - k, with m < 1 and m != 0.
+    tol : float
+        Bracket width at which to stop; 0 bisects to the last bit.
+
+    Returns
+    -------
+    ndarray
+        z* (> 0 for 0 < m < 1, in (-1, 0) for m < 0).
+    """
+    m = np.asarray(m, dtype=float)
+    k = 1.0 - m
+    pos = m > 0
+    lo = np.where(pos, m, -1.0)             # phi(m) = m^2 - h(m) > 0 for 0 < m < 1
+    hi = np.where(pos, 1.0 / np.where(pos, k, 1.0) ** 2 + 1.0, 0.0)
+    # phi(z) = ln(1+z) - k z = m z - h(z): > 0 between 0 and z* for m > 0; the first form
+    # is exact for small k, the second for small m
+    return bisect(lambda z: np.where(m >= 0.5, np.log1p(z) - k * z, m * z - h(z)), lo, hi, tol)
