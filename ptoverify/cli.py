@@ -211,7 +211,43 @@ def _cmd_derive(args: argparse.Namespace) -> int:
     return 0
 
 
+# ---------------------------------------------------------------- check
+def _add_check(sub) -> None:
+    p = sub.add_parser(
+        "check", help="run the verification gates (for CI)",
+        description="Run every verification as a gate: pass, fail or unverified (a reference "
+                    "that could not be computed). Exit 0 when all pass, 1 otherwise.",
+        epilog="example:\n  ptoverify check\n  ptoverify check --json --config my_axis.toml")
+    p.add_argument("--gate", action="append", default=None, metavar="NAME",
+                   help="run only this gate (repeatable)")
+    p.set_defaults(handler=_cmd_check)
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    from ptoverify.checks import GATES, run_checks, summarize
+
+    cfg = _config(args)
+    if args.gate:
+        unknown = [g for g in args.gate if g not in GATES]
+        if unknown:
+            raise InputError(f"unknown gate '{unknown[0]}' (choose from {', '.join(GATES)})")
+    results = run_checks(cfg, args.gate)
+    summary = summarize(results)
+    if args.json:
+        print_json({"config": cfg.name, "checks": [r.to_json() for r in results],
+                    "summary": summary})
+    else:
+        for r in results:
+            measured = "-" if r.measured is None else f"{r.measured:.3g}"
+            limit = "-" if r.limit is None else f"{r.limit:.3g}"
+            print(f"{r.status.upper():<10} {r.name:<40} {measured:>10} <= {limit:<10} {r.detail}")
+        print(f"{summary['pass']}/{summary['total']} passed, {summary['fail']} failed, "
+              f"{summary['unverified']} unverified")
+    return 0 if summary["ok"] else 1
+
+
 COMMANDS: list[tuple[str, Callable[[Any], None]]] = [
+    ("check", _add_check),
     ("mintime", _add_mintime),
     ("simulate", _add_simulate),
     ("derive", _add_derive),
