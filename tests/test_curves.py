@@ -104,3 +104,13 @@ def test_switching_function_sign_convention(paper_cfg):
     x2 = -100.0
     x1 = level_curve_x1(x2, p.a, p.w_max)
     assert abs(switching_function(x1, x2, p.a, p.w_max)) < 1e-12
+
+
+def test_root_k_against_scipy_lambertw():
+    """Our W_{-1} iteration against scipy's Lambert W, away from the branch point."""
+    from scipy.special import lambertw
+
+    m = np.linspace(0.01, 0.99, 500)
+    k = 1 - m
+    ref = -1 - np.real(lambertw(-k * np.exp(-k), -1)) / k
+    assert_allclose(root_k(m), ref, rtol=1e-12, err_msg="z = -1 - W_{-1}(-k e^{-k}) / k")
