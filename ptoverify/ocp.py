@@ -237,7 +237,8 @@ class TwoPhaseOCP:
 
 # ---------------------------------------------------------------- collocation
 @lru_cache(maxsize=None)
-def _collocation_solver(intervals: int, degree: int, max_iter: int, tol: float) -> ca.Function:
+def _collocation_solver(intervals: int, degree: int, max_iter: int, tol: float,
+                        control: str) -> ca.Function:
     """Build the Radau collocation NLP once per (N, degree, options).
 
     Decision vector: [tau_f, v_0..v_{N-1}, Z (2 x (N (degree + 1) + 1)) column-major];
@@ -257,25 +258,26 @@ def _collocation_solver(intervals: int, degree: int, max_iter: int, tol: float) 
         C[r, :] = [dcoef(t) for t in roots]
 
     tau_f = ca.MX.sym("tau_f")
-    v = ca.MX.sym("v", n)
+    nu = degree if control == "points" else 1
+    v = ca.MX.sym("v", n * nu)
     Z = ca.MX.sym("Z", 2, n * (degree + 1) + 1)
     p = ca.MX.sym("p", 2)
     h = 1.0 / n
     # one interval as an SX function, mapped over the grid (small, fast graph)
     zs = ca.SX.sym("zs", 2, degree + 1)
-    vs = ca.SX.sym("vs")
+    vs = ca.SX.sym("vs", nu)
     ts = ca.SX.sym("ts")
     res = []
     for j in range(1, degree + 1):
         zp = ca.mtimes(zs, C[:, j])
-        f = ca.vertcat(zs[1, j], -zs[1, j] + vs)
+        f = ca.vertcat(zs[1, j], -zs[1, j] + vs[j - 1 if nu > 1 else 0])
         res.append(zp - h * ts * f)
     end = ca.mtimes(zs, D)
     interval = ca.Function("interval", [zs, vs, ts], [ca.vertcat(*res), end])
     imap = interval.map(n)
     blocks = ca.horzsplit(Z[:, : n * (degree + 1)], degree + 1)
     Zk = ca.horzcat(*blocks)
-    coll, ends = imap(Zk, v.T, ca.repmat(tau_f, 1, n))
+    coll, ends = imap(Zk, ca.reshape(v, nu, n), ca.repmat(tau_f, 1, n))
     starts = ca.horzcat(*[b[:, 0] for b in blocks[1:]], Z[:, -1])
     g = ca.vertcat(Z[:, 0] - p, ca.vec(coll), ca.vec(ends - starts), Z[:, -1])
     x = ca.vertcat(tau_f, v, ca.vec(Z))
@@ -339,26 +341,38 @@ class CollocationOCP:
     """
 
     def __init__(self, plant: Plant, intervals: int = 100, degree: int = 3,
-                 max_iter: int = 500, tol: float = 1e-10, warm_start: bool = True):
+                 max_iter: int = 500, tol: float = 1e-10, warm_start: bool = True,
+                 control: str = "points"):
         if intervals < 1:
             raise InputError(f"intervals must be positive, got {intervals}")
+        if control not in ("points", "interval"):
+            raise InputError(f"control must be 'points' or 'interval', got {control!r}")
         self.plant = plant
         self.intervals = int(intervals)
         self.degree = int(degree)
+        self.control = control
         self.warm_start = warm_start
         self._solver = _collocation_solver(self.intervals, self.degree, int(max_iter),
-                                           float(tol))
+                                           float(tol), control)
         self._prev: dict[str, NDArray] | None = None
         n, d = self.intervals, self.degree
+        self._nu = n * d if control == "points" else n
         self._nz = n * (d + 1) + 1
-        self._nx = 1 + n + 2 * self._nz
+        self._nx = 1 + self._nu + 2 * self._nz
+        roots = np.array(ca.collocation_points(d, "radau"))
+        if control == "points":   # u_kj held for b_j h: same impulse as the quadrature
+            edges = np.cumsum(radau_weights(roots))
+            self._grid = (np.arange(n)[:, None] + edges[None, :]).ravel() / n
+            self._grid = np.concatenate([[0.0], self._grid])
+        else:
+            self._grid = np.linspace(0.0, 1.0, n + 1)
 
     def _cold_guess(self, z1: float, z2: float, tau_lb: float) -> NDArray[np.float64]:
         """Straight line from the state to the origin, zero input, t_f a rough estimate."""
         s = np.linspace(1.0, 0.0, self._nz)
         Z = np.vstack([z1 * s, z2 * s])
         tau = max(2.0 * tau_lb, 1.0 + math.sqrt(abs(z1)) + math.log1p(abs(z2)))
-        return np.concatenate([[tau], np.zeros(self.intervals), Z.ravel(order="F")])
+        return np.concatenate([[tau], np.zeros(self._nu), Z.ravel(order="F")])
 
     def solve(self, x1: float, x2: float) -> OCPResult:
         """Solve from the state (x1 [mm], x2 [mm/s]).
@@ -383,8 +397,8 @@ class CollocationOCP:
         lbx = np.full(self._nx, -np.inf)
         ubx = np.full(self._nx, np.inf)
         lbx[0] = tau_lb
-        lbx[1:1 + self.intervals] = -1.0
-        ubx[1:1 + self.intervals] = 1.0
+        lbx[1:1 + self._nu] = -1.0
+        ubx[1:1 + self._nu] = 1.0
         kwargs = {}
         if self.warm_start and self._prev is not None:
             x0 = self._prev["x"].copy()
@@ -401,14 +415,37 @@ class CollocationOCP:
             self._prev = {"x": xs, "lam_x": np.asarray(sol["lam_x"]).ravel(),
                           "lam_g": np.asarray(sol["lam_g"]).ravel()}
         t_f = xs[0] / a
-        u = w * xs[1:1 + self.intervals]
-        t = np.linspace(0.0, t_f, self.intervals + 1)
+        u = w * xs[1:1 + self._nu]
+        t = t_f * self._grid
         end = resimulate(t, u, x1, x2, a)
         side, t_sw = _locate_switch(t, u / w)
         return OCPResult(t_f=float(t_f) if ok else math.nan, t_switch=t_sw if ok else math.nan,
                          status=status, success=ok, iterations=it, side=side,
                          solve_time_s=elapsed, t=t, u=u, resim_end=end,
                          resim_error=float(math.hypot(end[0], end[1] / a)))
+
+
+def radau_weights(roots: NDArray) -> NDArray[np.float64]:
+    """Quadrature weights b_j = int_0^1 l_j(s) ds of the collocation points (Radau IIA b).
+
+    Parameters
+    ----------
+    roots : ndarray
+        Collocation points in (0, 1].
+
+    Returns
+    -------
+    ndarray
+        Weights, summing to 1.
+    """
+    b = np.zeros(len(roots))
+    for j, rj in enumerate(roots):
+        poly = np.poly1d([1.0])
+        for m, rm in enumerate(roots):
+            if m != j:
+                poly *= np.poly1d([1.0, -rm]) / (rj - rm)
+        b[j] = np.polyint(poly)(1.0)
+    return b
 
 
 def _locate_switch(t: NDArray, v: NDArray) -> tuple[float, float]:
