@@ -295,7 +295,7 @@ def discrete_min_steps(x1: float, x2: float, plant: Plant, n_max: int = 20000,
         return DiscreteMinTime(-1, math.nan, np.zeros(0), status, (x1, x2), tf, solves)
 
     if n0 > n_max:
-        return fail("not_found")
+        return fail(f"not_found: N* > n_max = {n_max}")
     lo, hi, u_hi, step = n0 - 1, n0, None, 1
     while True:                               # exponential search for a feasible N
         ok, u, st = reach.feasible(x1, x2, hi)
@@ -307,7 +307,7 @@ def discrete_min_steps(x1: float, x2: float, plant: Plant, n_max: int = 20000,
             break
         lo, hi, step = hi, hi + step, 2 * step
         if hi > n_max:
-            return fail("not_found")
+            return fail(f"not_found: N* > n_max = {n_max}")
     while hi - lo > 1:                        # bisection: lo infeasible, hi feasible
         mid = (lo + hi) // 2
         ok, u, st = reach.feasible(x1, x2, mid)

@@ -122,16 +122,25 @@ def _scaled_flow(z1, z2, v, tau):
     return z1 + v * tau + (z2 - v) * g, z2 - (z2 - v) * g
 
 
+def _tau_lower_bound(z1: float, z2: float) -> float:
+    """Valid lower bound on a t_f (dimensionless), see :class:`CollocationOCP`."""
+    return max(abs(z1) / max(abs(z2), 1.0), math.log1p(abs(z2)), 1e-9)
+
+
 # ---------------------------------------------------------------- two-phase
 @lru_cache(maxsize=None)
 def _two_phase_solver(max_iter: int, tol: float) -> ca.Function:
-    """Build the two-phase NLP once: variables (tau1, tau2), parameters (z1, z2, s)."""
+    """Build the two-phase NLP once: variables (tau1, tau2), parameters (z1, z2, s, scale).
+
+    The end-state constraints are divided by ``scale`` = 1 + |z1| + |z2| so that
+    the tolerance is relative to the size of the state (round-off grows with it).
+    """
     w = ca.SX.sym("tau", 2)
-    p = ca.SX.sym("p", 3)
+    p = ca.SX.sym("p", 4)
     z1, z2, s = p[0], p[1], p[2]
     y1, y2 = _scaled_flow(z1, z2, -s, w[0])
     y1, y2 = _scaled_flow(y1, y2, s, w[1])
-    nlp = {"x": w, "p": p, "f": w[0] + w[1], "g": ca.vertcat(y1, y2)}
+    nlp = {"x": w, "p": p, "f": w[0] + w[1], "g": ca.vertcat(y1, y2) / p[3]}
     opts = {**_IPOPT_QUIET, "ipopt.max_iter": max_iter, "ipopt.tol": tol,
             "ipopt.constr_viol_tol": tol, "ipopt.mu_strategy": "adaptive",
             "ipopt.bound_relax_factor": 0.0}
@@ -179,13 +188,13 @@ class TwoPhaseOCP:
         """Initial durations: previous solution if any, else a rough estimate."""
         if s in self._warm:
             return self._warm[s][0]
-        # rest-to-rest double-integrator estimate in tau, independent of the closed form
-        tau = 1.0 + math.sqrt(abs(z1)) + math.log1p(abs(z2))
-        return np.array([tau, tau])
+        # the valid lower bound of CollocationOCP for the first arc, a unit second arc;
+        # independent of the closed form
+        return np.array([1.0 + _tau_lower_bound(z1, z2), 1.0])
 
     def _solve_side(self, z1: float, z2: float, s: float) -> tuple[NDArray, str, bool, int]:
         x0 = self._guess(z1, z2, s)
-        sol = self._solver(x0=x0, p=[z1, z2, s], lbx=0.0, ubx=np.inf, lbg=0.0, ubg=0.0)
+        sol = self._solver(x0=x0, p=[z1, z2, s, 1.0 + abs(z1) + abs(z2)], lbx=0.0, ubx=np.inf, lbg=0.0, ubg=0.0)
         status, ok, it = _stats(self._solver)
         tau = np.asarray(sol["x"]).ravel()
         if ok:
@@ -393,7 +402,7 @@ class CollocationOCP:
             return _origin_result()
         a, w = self.plant.a, self.plant.w_max
         z1, z2 = a * x1 / w, x2 / w
-        tau_lb = max(abs(z1) / max(abs(z2), 1.0), math.log1p(abs(z2)), 1e-9)
+        tau_lb = _tau_lower_bound(z1, z2)
         lbx = np.full(self._nx, -np.inf)
         ubx = np.full(self._nx, np.inf)
         lbx[0] = tau_lb
