@@ -110,11 +110,13 @@ def _add_mintime(sub) -> None:
     p.set_defaults(handler=_cmd_mintime)
 
 
-def mintime_result(cfg: Config, x1: float, x2: float, intervals: int) -> dict[str, Any]:
+def mintime_result(cfg: Config, x1: float, x2: float, intervals: int,
+                   max_iter: int | None = None) -> dict[str, Any]:
     """Compute the ``mintime`` JSON object (DESIGN.md keys plus status keys).
 
     A reference whose solver did not converge (or an N* search that failed) is
     reported as null with its status in ``<name>_status``: unverified, never truth.
+    ``max_iter`` caps IPOPT's iterations (default: the solvers' own caps).
     """
     from ptoverify.mintime import discrete_min_steps, min_time
     from ptoverify.ocp import CollocationOCP, TwoPhaseOCP
@@ -125,8 +127,9 @@ def mintime_result(cfg: Config, x1: float, x2: float, intervals: int) -> dict[st
         raise InputError(f"state ({x1:g}, {x2:g}) is far outside the envelope "
                          f"(|x1| <= {limit:g} mm, |x2| <= {1e3 * plant.w_max:g} mm/s accepted)")
     mt = min_time(x1, x2, plant)
-    tp = TwoPhaseOCP(plant).solve(x1, x2)
-    co = CollocationOCP(plant, intervals=intervals).solve(x1, x2)
+    caps = {} if max_iter is None else {"max_iter": max_iter}
+    tp = TwoPhaseOCP(plant, **caps).solve(x1, x2)
+    co = CollocationOCP(plant, intervals=intervals, **caps).solve(x1, x2)
     dm = discrete_min_steps(x1, x2, plant)
 
     def verified(value: float, ok: bool) -> float | None:

@@ -292,7 +292,7 @@ def _collocation_solver(intervals: int, degree: int, max_iter: int, tol: float,
     x = ca.vertcat(tau_f, v, ca.vec(Z))
     nlp = {"x": x, "p": p, "f": tau_f, "g": g}
     opts = {**_IPOPT_QUIET, "ipopt.max_iter": max_iter, "ipopt.tol": tol,
-            "ipopt.mu_strategy": "adaptive", "expand": True}
+            "ipopt.mu_strategy": "adaptive", "ipopt.bound_relax_factor": 0.0, "expand": True}
     return ca.nlpsol(f"radau{n}", "ipopt", nlp, opts)
 
 
@@ -522,7 +522,7 @@ def _slope(logn: NDArray, loge: NDArray) -> float:
 
 
 def convergence_study(plant: Plant, states, intervals=(10, 20, 40, 80, 100, 200, 400),
-                      degree: int = 3) -> ConvergenceStudy:
+                      degree: int = 3, control: str = "points") -> ConvergenceStudy:
     """Collocation t_f error vs N and the observed order of convergence.
 
     Parameters
@@ -551,7 +551,8 @@ def convergence_study(plant: Plant, states, intervals=(10, 20, 40, 80, 100, 200,
     ok = np.zeros(tf.shape, dtype=bool)
     profiles = {}
     for j, n in enumerate(ns):
-        ocp = CollocationOCP(plant, intervals=int(n), degree=degree, warm_start=False)
+        ocp = CollocationOCP(plant, intervals=int(n), degree=degree, warm_start=False,
+                             control=control)
         for i, (x1, x2) in enumerate(states):
             r = ocp.solve(x1, x2)
             tf[i, j], rs[i, j], ok[i, j] = r.t_f, r.resim_error, r.success
