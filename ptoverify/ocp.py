@@ -345,12 +345,16 @@ class CollocationOCP:
     tol : float
         IPOPT tolerance.
     warm_start : bool
-        Start each solve from the previous solution (scaled to the new
-        state's time bound) instead of the cold guess.
+        Start each solve from the previous converged solution (primal and
+        dual) instead of the cold guess (a straight line to the origin, zero
+        input).  Off by default: on random states it saved no time (median
+        13.5 vs 11.5 iterations, N = 100) and it makes a result depend on the
+        order of the calls; with it, a single-arc state after a two-arc one took
+        239 iterations against 97 cold.
     """
 
     def __init__(self, plant: Plant, intervals: int = 100, degree: int = 3,
-                 max_iter: int = 500, tol: float = 1e-10, warm_start: bool = True,
+                 max_iter: int = 500, tol: float = 1e-10, warm_start: bool = False,
                  control: str = "points"):
         if intervals < 1:
             raise InputError(f"intervals must be positive, got {intervals}")
