@@ -180,8 +180,8 @@ class ZOHReach:
             m = np.arange(max(n, 2 * self._gen.shape[1]), dtype=float)
             p12, p22 = self._powers(m)
             b1, b2 = self._bd
-            a, w = self.plant.a, self.plant.w_max
-            self._gen = np.vstack([a * (b1 + p12 * b2), p22 * b2])   # times w / (w, w/a)
+            a = self.plant.a
+            self._gen = np.vstack([a * (b1 + p12 * b2), p22 * b2])  # diag(a/w, 1/w) Ad^m Bd w
         return self._gen[:, n - 1::-1] if n > 0 else np.zeros((2, 0))
 
     def free(self, x1: float, x2: float, n: int) -> NDArray[np.float64]:

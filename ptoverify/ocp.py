@@ -123,7 +123,7 @@ def _scaled_flow(z1, z2, v, tau):
 
 
 def _tau_lower_bound(z1: float, z2: float) -> float:
-    """Valid lower bound on a t_f (dimensionless), see :class:`CollocationOCP`."""
+    """Return a valid lower bound on a t_f (dimensionless); see :class:`CollocationOCP`."""
     return max(abs(z1) / max(abs(z2), 1.0), math.log1p(abs(z2)), 1e-9)
 
 
@@ -185,7 +185,7 @@ class TwoPhaseOCP:
         self._warm: dict[float, tuple[NDArray, NDArray]] = {}
 
     def _guess(self, z1: float, z2: float, s: float) -> NDArray[np.float64]:
-        """Initial durations: previous solution if any, else a rough estimate."""
+        """Return initial durations: the previous solution, else a rough estimate."""
         if s in self._warm:
             return self._warm[s][0]
         # the valid lower bound of CollocationOCP for the first arc, a unit second arc;
@@ -194,7 +194,8 @@ class TwoPhaseOCP:
 
     def _solve_side(self, z1: float, z2: float, s: float) -> tuple[NDArray, str, bool, int]:
         x0 = self._guess(z1, z2, s)
-        sol = self._solver(x0=x0, p=[z1, z2, s, 1.0 + abs(z1) + abs(z2)], lbx=0.0, ubx=np.inf, lbg=0.0, ubg=0.0)
+        p = [z1, z2, s, 1.0 + abs(z1) + abs(z2)]
+        sol = self._solver(x0=x0, p=p, lbx=0.0, ubx=np.inf, lbg=0.0, ubg=0.0)
         status, ok, it = _stats(self._solver)
         tau = np.asarray(sol["x"]).ravel()
         if ok:
