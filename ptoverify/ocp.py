@@ -491,6 +491,8 @@ class ConvergenceStudy:
         Initial states [mm], [mm/s].
     t_f_exact : ndarray, shape (S,)
         Closed-form minimum times [s].
+    t_switch_exact : ndarray, shape (S,)
+        Closed-form switch times [s].
     t_f : ndarray, shape (S, M)
         Collocation t_f [s] (NaN where IPOPT failed).
     rel_error : ndarray, shape (S, M)
@@ -510,6 +512,7 @@ class ConvergenceStudy:
     intervals: NDArray[np.int64]
     states: NDArray[np.float64]
     t_f_exact: NDArray[np.float64]
+    t_switch_exact: NDArray[np.float64]
     t_f: NDArray[np.float64]
     rel_error: NDArray[np.float64]
     resim_error: NDArray[np.float64]
@@ -550,7 +553,8 @@ def convergence_study(plant: Plant, states, intervals=(10, 20, 40, 80, 100, 200,
 
     states = np.atleast_2d(np.asarray(states, dtype=float))
     ns = np.asarray(intervals, dtype=int)
-    exact = np.asarray(min_time(states[:, 0], states[:, 1], plant).t_f, dtype=float)
+    mt = min_time(states[:, 0], states[:, 1], plant)
+    exact = np.asarray(mt.t_f, dtype=float)
     tf = np.full((len(states), len(ns)), np.nan)
     rs = np.full_like(tf, np.nan)
     ok = np.zeros(tf.shape, dtype=bool)
@@ -574,6 +578,7 @@ def convergence_study(plant: Plant, states, intervals=(10, 20, 40, 80, 100, 200,
     cent_n = cent_n - np.nanmean(cent_n, axis=1, keepdims=True)
     m = np.isfinite(cent_e) & np.isfinite(cent_n)
     order = float(-(cent_e[m] @ cent_n[m]) / (cent_n[m] @ cent_n[m])) if m.sum() > 1 else math.nan
-    return ConvergenceStudy(intervals=ns, states=states, t_f_exact=exact, t_f=tf,
+    return ConvergenceStudy(intervals=ns, states=states, t_f_exact=exact,
+                            t_switch_exact=np.asarray(mt.t_switch, dtype=float), t_f=tf,
                             rel_error=rel, resim_error=rs, order_per_state=per_state,
                             order=order, success=ok, profiles=profiles)

@@ -192,3 +192,14 @@ def test_convergence_study_order():
     assert study.rel_error.shape == (2, 4)
     # the smeared switch limits collocation to about second order in t_f
     assert 1.0 < study.order < 4.0, study.order_per_state
+
+
+def test_convergence_figures(tmp_path):
+    from ptoverify.plots_ocp import plot_convergence, plot_switch_profiles
+
+    study = convergence_study(PLANTS["paper"], [(5.0, 0.0)], intervals=(10, 20))
+    ax = plot_convergence(study)
+    assert len(ax.get_lines()) == 2
+    ax = plot_switch_profiles(study, 0)
+    ax.figure.savefig(tmp_path / "switch.png")
+    assert (tmp_path / "switch.png").stat().st_size > 0
