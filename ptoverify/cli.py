@@ -117,6 +117,11 @@ def mintime_result(cfg: Config, x1: float, x2: float, intervals: int,
     A reference whose solver did not converge (or an N* search that failed) is
     reported as null with its status in ``<name>_status``: unverified, never truth.
     ``max_iter`` caps IPOPT's iterations (default: the solvers' own caps).
+
+    States beyond 1000 x the envelope (|x1| > 1000 position_range or
+    |x2| > 1000 w_max) are rejected (InputError, exit 2).  Inside that, every
+    number is computed; N* is searched up to 20000 samples and is null with
+    ``discrete_status`` "not_found: ..." beyond.
     """
     from ptoverify.mintime import discrete_min_steps, min_time
     from ptoverify.ocp import CollocationOCP, TwoPhaseOCP

@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Plant
 from ptoverify.curves import h, switching_function
+from ptoverify.errors import InputError
 
 __all__ = ["MinTime", "min_time", "DiscreteMinTime", "ZOHReach", "discrete_min_steps",
            "discrete_min_steps_batch"]
@@ -284,6 +285,8 @@ def discrete_min_steps(x1: float, x2: float, plant: Plant, n_max: int = 20000,
     ('optimal', True)
     """
     x1, x2 = float(x1), float(x2)
+    if not (math.isfinite(x1) and math.isfinite(x2)):
+        raise InputError(f"state ({x1}, {x2}) is not finite")
     tf = float(min_time(x1, x2, plant).t_f)
     if x1 == 0.0 and x2 == 0.0:
         return DiscreteMinTime(0, 0.0, np.zeros(0), "origin", (0.0, 0.0), 0.0, 0)

@@ -21,7 +21,10 @@ Both problems are written in the dimensionless variables of eq. (1)::
 so that one NLP (one ``nlpsol`` and one set of CasADi functions) serves every
 plant and every state: the state enters as a parameter, the plant only through
 the scaling.  The solvers are built once per process and per option set
-(cached with :func:`functools.lru_cache`); the classes hold a warm start.
+(cached with :func:`functools.lru_cache`).  The two-phase solver starts from
+its previous solution (warm; the 2x2 system has one solution, so the result
+does not depend on the start); collocation starts cold by default (see
+:class:`CollocationOCP`) so that a result does not depend on call order.
 
 A solve that IPOPT does not finish with ``Solve_Succeeded`` returns
 ``success=False`` and the IPOPT status in ``status``; such a number is
@@ -160,8 +163,9 @@ class TwoPhaseOCP:
         The plant (a [rad/s], w_max [mm/s]).
     side : {"switching", "both"}
         ``"switching"``: s = sign of the switching function (eqs. 9, 11), one
-        solve; ``"both"``: solve s = +1 and s = -1 and keep the converged one
-        with the smaller t_f (two solves; the wrong side is infeasible).
+        solve, and the other side only if that one fails (a state within
+        round-off of a curve); ``"both"``: solve s = +1 and s = -1 and keep the
+        converged one with the smaller t_f (the wrong side is infeasible).
     max_iter : int
         IPOPT iteration cap (1 forces a failure, for tests).
     tol : float
@@ -221,15 +225,15 @@ class TwoPhaseOCP:
         a, w = self.plant.a, self.plant.w_max
         z1, z2 = a * x1 / w, x2 / w
         start = time.perf_counter()
-        if self.side == "switching":
-            sigma = float(switching_function(x1, x2, a, w))
-            sides = [1.0 if sigma > 0 or (sigma == 0 and x2 < 0) else -1.0]
-        else:
-            sides = [1.0, -1.0]
+        sigma = float(switching_function(x1, x2, a, w))
+        first = 1.0 if sigma > 0 or (sigma == 0 and x2 < 0) else -1.0
+        sides = [first, -first]
         best = None
         iterations = 0
         statuses = []
         for s in sides:
+            if self.side == "switching" and best is not None:
+                break                       # the other side only if the first one failed
             tau, status, ok, it = self._solve_side(z1, z2, s)
             iterations += it
             statuses.append(status)

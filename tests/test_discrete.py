@@ -18,9 +18,12 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from ptoverify.config import Plant, paper_config
+from ptoverify.errors import InputError
 from ptoverify.mintime import (
     ZOHReach,
     discrete_min_steps,
@@ -134,3 +137,19 @@ def test_batch_matches_single():
     batch = discrete_min_steps_batch(states[:, 0], states[:, 1], plant)
     single = [discrete_min_steps(x1, x2, plant).steps for x1, x2 in states]
     assert [b.steps for b in batch] == single
+
+
+@settings(max_examples=60, deadline=None)
+@given(x1=st.floats(-60.0, 60.0), x2=st.floats(-900.0, 900.0))
+def test_property_not_faster_than_continuous(x1, x2):
+    plant = PLANTS["paper"]
+    d = discrete_min_steps(x1, x2, plant)
+    assert d.success, d.status
+    assert d.time_s >= float(min_time(x1, x2, plant).t_f) * (1 - 1e-12)
+    e1, e2 = simulate(x1, x2, d.u, plant)
+    assert abs(e1) <= 1e-9 and abs(e2) <= 1e-6
+
+
+def test_non_finite_state_rejected():
+    with pytest.raises(InputError):
+        discrete_min_steps(float("nan"), 0.0, PLANTS["paper"])
