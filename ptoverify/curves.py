@@ -265,7 +265,7 @@ def root_k(m: ArrayLike) -> Array:
 
 
 def _u_of_m_positive(m: Array) -> Array:
-    """u = ln(1 + z*) = -k - W_{-1}(-k e^{-k}) for 0 < m < 1, k = 1 - m.
+    """U = ln(1 + z*) = -k - W_{-1}(-k e^{-k}) for 0 < m < 1, k = 1 - m.
 
     W_{-1} is evaluated by its own iteration on the equivalent equation
     F(u) = u - k (e^u - 1) = 0 (u = -k - W): a start from the branch-point series
@@ -296,7 +296,7 @@ def _u_of_m_positive(m: Array) -> Array:
 
 
 def _u_of_m_negative(m: Array) -> Array:
-    """u = ln(1 + z*) for m < 0 (k > 1, W_0 branch), scipy's W_0 polished by Newton."""
+    """U = ln(1 + z*) for m < 0 (k > 1, W_0 branch), scipy's W_0 polished by Newton."""
     k = 1.0 - m
     with np.errstate(all="ignore"):
         z_w = -1.0 - _lambertw_real(-k * np.exp(-k), 0) / k

@@ -52,7 +52,7 @@ class Reference:
     duration: float
 
     def r(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Reference position [mm] at times t [s]."""
+        """Return the reference position [mm] at times t [s]."""
         if self.name == "step":
             return np.full_like(t, self.amplitude)
         if self.name == "ramp":
@@ -60,7 +60,7 @@ class Reference:
         return self.amplitude * np.sin(2.0 * math.pi * self.rate * t)
 
     def r_dot(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Reference velocity [mm/s] at times t [s] (0 for the step, right-continuous)."""
+        """Return the reference velocity [mm/s] at times t [s] (0 for the step)."""
         if self.name == "step":
             return np.zeros_like(t)
         if self.name == "ramp":

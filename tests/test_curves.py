@@ -18,7 +18,6 @@ from ptoverify.curves import (
 from ptoverify.plant import flow
 
 
-
 def test_h_against_mpmath():
     r = np.concatenate([10 ** np.linspace(-150, 3, 400), -(10 ** np.linspace(-150, -1e-3, 300))])
     # below ~1e-154, h = r^2/2 underflows: not an admissible range
