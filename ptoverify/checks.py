@@ -193,7 +193,97 @@ def _odd_symmetry(cfg: Config) -> CheckResult:
                     "max |u(x) + u(-x)| [mm/s] over 100,000 states for every law")
 
 
-def run_checks(cfg: Config, names: list[str] | None = None) -> list[CheckResult]:
+# ------------------------------------------------------------ ground-truth gates
+_OPTIONS: dict[str, Any] = {"max_iter": None}
+
+
+def _solver_caps() -> dict[str, int]:
+    """IPOPT iteration cap set by ``run_checks(max_iter=...)`` (none by default)."""
+    return {} if _OPTIONS["max_iter"] is None else {"max_iter": _OPTIONS["max_iter"]}
+
+
+def _gt_states(cfg: Config, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    return _random_states(cfg, n, seed, 0.95)
+
+
+@gate("mintime-closed-form-vs-two-phase")
+def _two_phase(cfg: Config) -> CheckResult:
+    """CasADi two-phase OCP (IPOPT) against the closed-form minimum time."""
+    from ptoverify.mintime import min_time
+    from ptoverify.ocp import TwoPhaseOCP
+
+    x1, x2 = _gt_states(cfg, 30, 21)
+    ocp = TwoPhaseOCP(cfg.plant, **_solver_caps())
+    mt = min_time(x1, x2, cfg.plant)
+    worst = 0.0
+    for i in range(len(x1)):
+        res = ocp.solve(float(x1[i]), float(x2[i]))
+        if not res.success:
+            return CheckResult("mintime-closed-form-vs-two-phase", UNVERIFIED, None, 1e-9,
+                               f"IPOPT did not converge at ({x1[i]:.4g}, {x2[i]:.4g}): "
+                               f"{res.status}")
+        worst = max(worst, abs(res.t_f - mt.t_f[i]) / mt.t_f[i])
+    return _at_most("mintime-closed-form-vs-two-phase", worst, 1e-9,
+                    "max relative t_f difference, two-phase OCP vs closed form, 30 random "
+                    "states in the envelope; limit 1e-9: IPOPT's tolerance on an exact flow")
+
+
+@gate("mintime-closed-form-vs-collocation")
+def _collocation(cfg: Config) -> CheckResult:
+    """CasADi Radau collocation (N = 100) against the closed-form minimum time."""
+    from ptoverify.mintime import min_time
+    from ptoverify.ocp import CollocationOCP
+
+    x1, x2 = _gt_states(cfg, 8, 22)
+    ocp = CollocationOCP(cfg.plant, intervals=100, **_solver_caps())
+    mt = min_time(x1, x2, cfg.plant)
+    worst = 0.0
+    for i in range(len(x1)):
+        res = ocp.solve(float(x1[i]), float(x2[i]))
+        if not res.success:
+            return CheckResult("mintime-closed-form-vs-collocation", UNVERIFIED, None, 5e-4,
+                               f"IPOPT did not converge at ({x1[i]:.4g}, {x2[i]:.4g}): "
+                               f"{res.status}")
+        worst = max(worst, abs(res.t_f - mt.t_f[i]) / mt.t_f[i])
+    return _at_most("mintime-closed-form-vs-collocation", worst, 5e-4,
+                    "max relative t_f difference, Radau-3 collocation with N = 100 vs closed "
+                    "form, 8 random states; limit 5e-4: the discretisation smears the switch "
+                    "over one interval (observed order ~2)")
+
+
+@gate("discrete-limit-consistency")
+def _discrete(cfg: Config) -> CheckResult:
+    """N*: N* T >= t_f*, the sequence reaches the origin, N* - 1 is infeasible."""
+    from ptoverify.mintime import ZOHReach, discrete_min_steps, min_time
+
+    x1, x2 = _gt_states(cfg, 25, 23)
+    reach = ZOHReach(cfg.plant)
+    worst_gap = math.inf
+    for i in range(len(x1)):
+        dm = discrete_min_steps(float(x1[i]), float(x2[i]), cfg.plant)
+        if not dm.success:
+            return CheckResult("discrete-limit-consistency", UNVERIFIED, None, 0.0,
+                               f"N* search failed at ({x1[i]:.4g}, {x2[i]:.4g}): {dm.status}")
+        t_f = float(min_time(x1[i], x2[i], cfg.plant).t_f)
+        ok_prev, _, _ = reach.feasible(float(x1[i]), float(x2[i]), dm.steps - 1)
+        if ok_prev:
+            return CheckResult("discrete-limit-consistency", FAIL, None, 0.0,
+                               f"N* - 1 = {dm.steps - 1} steps feasible at "
+                               f"({x1[i]:.4g}, {x2[i]:.4g})")
+        if abs(dm.end[0]) > 1e-9 or abs(dm.end[1]) > 1e-6:
+            return CheckResult("discrete-limit-consistency", FAIL, None, 0.0,
+                               f"N* sequence ends at {dm.end} from ({x1[i]:.4g}, {x2[i]:.4g})")
+        worst_gap = min(worst_gap, (dm.time_s - t_f) / cfg.plant.T)
+    res = CheckResult("discrete-limit-consistency", PASS if worst_gap >= 0 else FAIL,
+                      worst_gap, 0.0,
+                      "min over 25 states of (N* T - t_f*) / T, which theory keeps >= 0; every "
+                      "N* sequence ends within 1e-9 mm, 1e-6 mm/s of the origin and N* - 1 "
+                      "samples are infeasible")
+    return res
+
+
+def run_checks(cfg: Config, names: list[str] | None = None,
+               max_iter: int | None = None) -> list[CheckResult]:
     """Run the gates (all, or the named ones) in registration order.
 
     Parameters
@@ -202,12 +292,19 @@ def run_checks(cfg: Config, names: list[str] | None = None) -> list[CheckResult]
         Configuration under test.
     names : list of str, optional
         Only these gates.
+    max_iter : int, optional
+        Cap on IPOPT iterations (to exercise the fail-closed path: a capped solver
+        that does not converge makes its gate ``unverified``).
 
     Returns
     -------
     list of CheckResult
     """
-    return [fn(cfg) for name, fn in GATES.items() if names is None or name in names]
+    _OPTIONS["max_iter"] = max_iter
+    try:
+        return [fn(cfg) for name, fn in GATES.items() if names is None or name in names]
+    finally:
+        _OPTIONS["max_iter"] = None
 
 
 def summarize(results: list[CheckResult]) -> dict[str, Any]:

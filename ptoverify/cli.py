@@ -257,6 +257,9 @@ def _add_check(sub) -> None:
         epilog="example:\n  ptoverify check\n  ptoverify check --json --config my_axis.toml")
     p.add_argument("--gate", action="append", default=None, metavar="NAME",
                    help="run only this gate (repeatable)")
+    p.add_argument("--max-iter", type=positive_int, default=None, metavar="N",
+                   help="cap IPOPT iterations (a solver that then fails makes its gate "
+                        "unverified, and the run fails)")
     p.set_defaults(handler=_cmd_check)
 
 
@@ -268,7 +271,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
         unknown = [g for g in args.gate if g not in GATES]
         if unknown:
             raise InputError(f"unknown gate '{unknown[0]}' (choose from {', '.join(GATES)})")
-    results = run_checks(cfg, args.gate)
+    results = run_checks(cfg, args.gate, max_iter=args.max_iter)
     summary = summarize(results)
     if args.json:
         print_json({"config": cfg.name, "checks": [r.to_json() for r in results],
