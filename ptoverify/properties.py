@@ -83,6 +83,9 @@ class LawProperties:
         Largest overshoot of the rest states [mm].
     zone_samples : int
         Samples that used the switching zone (ZONE_P / ZONE_N).
+    entered_linear_from_bang : int
+        States whose last sample before the linear zone was a bang region
+        (they reached the linear zone without passing through the zone).
     max_entry_speed : float
         Largest |x2| at the first sample inside the linear zone, over the states
         that start outside it [mm/s].
@@ -109,6 +112,7 @@ class LawProperties:
     overshoots: int
     max_overshoot_mm: float
     zone_samples: int
+    entered_linear_from_bang: int
     max_entry_speed: float
     band: float
 
@@ -214,6 +218,8 @@ def law_properties(law: Law, cfg: Config, *, n1: int = 101, n2: int = 101, rest:
     never = first_in < 0
     t_lin = np.where(never, np.inf, first_in * T)
     entered = first_in > 0                         # started outside, entered later
+    prev = R[np.maximum(first_in - 1, 0), np.arange(x1.size)]
+    from_bang = entered & ((prev == Region.BANG_P) | (prev == Region.BANG_N))
     entry = np.where(entered, np.abs(X2[np.maximum(first_in, 0), np.arange(x1.size)]), 0.0)
     chat = (R[1:-1] != R[:-2]) & (R[1:-1] != R[2:]) & (R[:-2] == R[2:])
     osc = _oscillating(X1[-window:], band)
@@ -229,7 +235,8 @@ def law_properties(law: Law, cfg: Config, *, n1: int = 101, n2: int = 101, rest:
         chattering=int(chat.sum()), states_chattering=int(chat.any(axis=0).sum()),
         max_abs_u=max_u, u_within_limit=bool(max_u <= w),
         overshoots=int((over > band).sum()), max_overshoot_mm=float(max(over.max(), 0.0)),
-        zone_samples=int(zone.sum()), max_entry_speed=float(entry.max()), band=band)
+        zone_samples=int(zone.sum()), entered_linear_from_bang=int(from_bang.sum()),
+        max_entry_speed=float(entry.max()), band=band)
 
 
 def all_properties(cfg: Config, laws: tuple[str, ...] = ("to", "pd", "pto", "pto-printed"),
