@@ -123,7 +123,7 @@ class LawProperties:
 
 def initial_grid(cfg: Config, n1: int = 101, n2: int = 101,
                  rest: int = 200) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Initial states: an n1 x n2 envelope grid plus ``rest`` states at rest.
+    """Return initial states: an n1 x n2 envelope grid plus ``rest`` states at rest.
 
     Parameters
     ----------
