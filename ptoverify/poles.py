@@ -68,6 +68,14 @@ class LoopPoles:
         max |python-control - numpy| over the sorted sampled poles [-].
     gain_margin, phase_margin_deg, stability_margin : float
         Margins of the sampled loop broken at the plant input [-], [deg], [-].
+        The gain margin includes the phase crossover at the Nyquist frequency
+        z = -1, where L is real; python-control 0.10 does not report a crossover
+        at that end point (see ``gain_margin_python_control``).
+    gain_margin_python_control : float
+        ``control.stability_margins`` as returned [-].
+    gain_margin_eig : float
+        Independent gain margin: the scale g of K at which max |eig(Ad - g Bd K)|
+        reaches 1 (bisection) [-].
     phase_crossover, gain_crossover : float
         Their frequencies [rad/s].
     stable_continuous, stable_sampled : bool
@@ -89,6 +97,8 @@ class LoopPoles:
     numpy_sampled_poles: list[list[float]]
     pole_mismatch: float
     gain_margin: float
+    gain_margin_python_control: float
+    gain_margin_eig: float
     phase_margin_deg: float
     stability_margin: float
     phase_crossover: float
@@ -104,6 +114,24 @@ class LoopPoles:
 
 def _plant(a: float) -> tuple[np.ndarray, np.ndarray]:
     return np.array([[0.0, 1.0], [0.0, -a]]), np.array([[0.0], [a]])
+
+
+def _scale_margin(Ad: np.ndarray, Bd: np.ndarray, K: np.ndarray) -> float:  # noqa: N803
+    """Scale g of K at which the sampled loop reaches |z| = 1 (inf beyond 1e6)."""
+    def radius(g: float) -> float:
+        return float(np.abs(np.linalg.eigvals(Ad - g * Bd @ K)).max())
+
+    if radius(1.0) >= 1:
+        return float("nan")
+    lo, hi = 1.0, 2.0
+    while radius(hi) < 1:
+        lo, hi = hi, 2.0 * hi
+        if hi > 1e6:
+            return math.inf
+    while hi - lo > 1e-12 * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if radius(mid) < 1 else (lo, mid)
+    return hi
 
 
 def sampled_spectral_radius(a: float, T: float, k_x1: float, k_x2: float) -> float:  # noqa: N803
@@ -164,6 +192,8 @@ def loop_poles(name: str, a: float, T: float, k_x1: float, k_x2: float) -> LoopP
     # epsw: the plant's integrator puts a pole of L at z = 1; frequencies below
     # 1e-3 rad/s are static gain, not a crossover (avoids a spurious gm at w = 0)
     gm, pm, sm, wpc, wgc, _ = ct.stability_margins(loop, epsw=1e-3)
+    l_nyq = complex(loop(-1.0))                            # L at the Nyquist frequency
+    gm_nyq = -1.0 / l_nyq.real if l_nyq.real < 0 else math.inf
     Ad_n, Bd_n = zoh_matrices(a, T)
     p_n = np.linalg.eigvals(Ad_n - Bd_n @ K)
     mismatch = float(np.abs(np.sort_complex(ct.poles(cl_d)) - np.sort_complex(p_n)).max())
@@ -173,7 +203,9 @@ def loop_poles(name: str, a: float, T: float, k_x1: float, k_x2: float) -> LoopP
         continuous_zeta=[float(v) for v in zeta_c], sampled_poles=_pairs(p_d),
         sampled_moduli=[float(v) for v in np.abs(p_d)], sampled_wn=[float(v) for v in wn_d],
         sampled_zeta=[float(v) for v in zeta_d], numpy_sampled_poles=_pairs(p_n),
-        pole_mismatch=mismatch, gain_margin=float(gm), phase_margin_deg=float(pm),
+        pole_mismatch=mismatch, gain_margin=float(min(gm, gm_nyq)),
+        gain_margin_python_control=float(gm), gain_margin_eig=_scale_margin(Ad_n, Bd_n, K),
+        phase_margin_deg=float(pm),
         stability_margin=float(sm), phase_crossover=float(wpc), gain_crossover=float(wgc),
         stable_continuous=bool(np.all(np.real(p_c) < 0)),
         stable_sampled=bool(np.all(np.abs(p_d) < 1)),
