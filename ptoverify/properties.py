@@ -42,7 +42,8 @@ from ptoverify.curves import switching_function
 from ptoverify.laws import Law, Region, make_law
 from ptoverify.simulate import simulate_batch
 
-__all__ = ["LawProperties", "initial_grid", "default_steps", "law_properties", "all_properties"]
+__all__ = ["LawProperties", "initial_grid", "default_steps", "law_properties", "all_properties",
+           "zone_outcome"]
 
 
 @dataclass(frozen=True)
@@ -258,3 +259,43 @@ def all_properties(cfg: Config, laws: tuple[str, ...] = ("to", "pd", "pto", "pto
         Law name -> :class:`LawProperties`.
     """
     return {name: law_properties(make_law(name, cfg), cfg, **kwargs) for name in laws}
+
+
+def zone_outcome(cfg: Config, *, n1: int = 41, n2: int = 41, rest: int = 40) -> dict:
+    """Judge the PTO variants by their closed-loop outcome (what the zone was for).
+
+    Two questions, per law (``pto``: corrected zone; ``pto-printed``):
+
+    * does the sampled state enter the zone (or reach the linear zone on the
+      right side of l1/l2) before it crosses l1/l2?  Yes when there is no
+      stride-over and no crossing into the linear zone;
+    * does it reach the linear zone slowly enough to settle without overshoot?
+      Yes when no rest state overshoots by more than the band and no state
+      oscillates.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+    n1, n2, rest : int
+        Grid sizes (a coarser grid than :func:`law_properties`' default).
+
+    Returns
+    -------
+    dict
+        Per law: ``enters_zone_before_crossing``, ``settles_without_overshoot``,
+        and the counts behind them.
+    """
+    out = {}
+    for name in ("pto", "pto-printed"):
+        p = law_properties(make_law(name, cfg), cfg, n1=n1, n2=n2, rest=rest)
+        out[name] = {
+            "note": p.note, "states": p.states,
+            "enters_zone_before_crossing": p.stride_overs == 0 and p.crossings_into_linear == 0,
+            "settles_without_overshoot": p.overshoots == 0 and p.limit_cycles == 0,
+            "stride_overs": p.stride_overs, "crossings_into_linear": p.crossings_into_linear,
+            "entered_linear_from_bang": p.entered_linear_from_bang,
+            "zone_samples": p.zone_samples, "overshoots": p.overshoots,
+            "max_overshoot_mm": p.max_overshoot_mm, "limit_cycles": p.limit_cycles,
+            "max_entry_speed": p.max_entry_speed}
+    return out
