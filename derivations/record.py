@@ -148,7 +148,7 @@ class Judgement:
     verdict : str
         ``verified``, ``erratum`` or ``unchecked``.
     symbolic : bool or None
-        True: the difference simplified to 0; False: proved nonzero; None: cannot prove.
+        True: the difference simplified to 0; None: cannot prove (never a disproof).
     n_points : int
         Admissible points at which both sides evaluated to real numbers.
     max_rel_err : float
@@ -168,7 +168,12 @@ class Judgement:
 
 
 def _symbolic_zero(diff: sp.Expr) -> bool | None:
-    """Try to prove diff == 0: simplify, then log-expanded simplify, then equals."""
+    """Try to prove diff == 0: simplify, then log-expanded simplify.
+
+    Returns True when proved and None otherwise: a failure to simplify to 0 (or a
+    ``False`` from ``equals``, which tests at points that may lie outside the
+    admissible set or on another Lambert-W branch) is never taken as a disproof.
+    """
     if diff == 0:
         return True
     try:
@@ -177,10 +182,7 @@ def _symbolic_zero(diff: sp.Expr) -> bool | None:
             return True
         # expand_log(force=True) is valid on the admissible set, where log arguments are > 0
         s2 = sp.simplify(sp.expand_log(s, force=True))
-        if s2 == 0:
-            return True
-        eq = s2.equals(0)
-        return None if eq is None else bool(eq)
+        return True if s2 == 0 else None
     except Exception:  # noqa: BLE001 - any failure of the CAS means "cannot prove"
         return None
 
@@ -228,7 +230,7 @@ def judge(printed: Any, derived: Any, sampler: Sampler, n: int = N_POINTS,
     Judgement
         ``verified`` if every admissible point agrees within ``RTOL``; ``erratum``
         with the worst point if any disagrees; ``unchecked`` if fewer than 200
-        points could be evaluated or the symbolic proof contradicts the numbers.
+        points could be evaluated or a symbolic proof of equality contradicts the numbers.
 
     Examples
     --------
@@ -245,9 +247,8 @@ def judge(printed: Any, derived: Any, sampler: Sampler, n: int = N_POINTS,
     sym: bool | None = True
     if symbolic:
         for p, d in zip(p_t, d_t):
-            r = _symbolic_zero(sp.sympify(p - d))
-            if r is not True:
-                sym = r if sym is True or r is False else sym
+            if _symbolic_zero(sp.sympify(p - d)) is not True:
+                sym = None
     else:
         sym = None
     pts = sampler(np.random.default_rng(seed), n)
@@ -279,11 +280,11 @@ def judge(printed: Any, derived: Any, sampler: Sampler, n: int = N_POINTS,
         return Judgement("unchecked", sym, n_ok, worst_err, None,
                          f"only {n_ok} admissible points evaluated (need {N_POINTS})")
     ok = worst_err <= RTOL
-    if ok and sym is not False:
+    if ok:
         how = "proved symbolically and" if sym else "symbolic proof inconclusive;"
         return Judgement("verified", sym, n_ok, worst_err, None,
                          f"{how} agrees at {n_ok} random points (max rel. err {worst_err:.1e})")
-    if not ok and sym is not True:
+    if not sym:
         return Judgement("erratum", sym, n_ok, worst_err, worst,
                          f"differs at random points (max rel. diff {worst_err:.3g})")
     return Judgement("unchecked", sym, n_ok, worst_err, worst,
