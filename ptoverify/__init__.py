@@ -1,0 +1,18 @@
+"""ptoverify: a verification suite for a proximate time-optimal (PTO) control law.
+
+Plant (eq. 1): x1' = x2, x2' = -a x2 + a u, |u| <= w_max, sampled every T with ZOH.
+
+Catalogue
+---------
+config      Plant, PDGains, PTOSettings, Config; TOML loading and validation; paper defaults
+plant       flow (eq. 7), step (one-sample map, eq. 15), zoh_matrices
+curves      switching_function, level_residual (eqs. 9, 11, 13, 14, 28, 33), Lambert-W roots
+            root_22 (eq. 22), root_k (eqs. 26, 31), omega_c (eq. 32), bisection references
+mintime     min_time: closed-form minimum time and switch time from any state
+laws        Law, Region; to_law (eq. 12), pd_law; make_law(name, cfg)
+simulate    simulate (sampled closed loop on step/ramp/sine), simulate_batch
+cli         the ``ptoverify`` command line
+errors      InputError (exit 2), ConfigError, SolverError
+"""
+
+__version__ = "0.1.0"

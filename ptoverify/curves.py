@@ -204,6 +204,15 @@ def root_22(b0: ArrayLike, branch: int = -1) -> Array:
             du = (_e2(u) - bb) / np.expm1(u)
             u = np.where(u != 0.0, u - du, u)
     y = np.expm1(u)
+    if branch == -1:
+        # for large b0, e^u amplifies the rounding of u by u: finish with the contraction
+        # y = b0 + ln(1 + y) (factor 1/(1 + y) < 0.05 per step), exact to round-off
+        large = bb > 20.0
+        if np.any(large):
+            yl = np.where(large, y, 21.0)
+            for _ in range(12):
+                yl = bb + np.log1p(yl)
+            y = np.where(large, yl, y)
     return np.where(ok, np.where(bb == 0.0, 0.0, y), np.nan)
 
 
@@ -371,4 +380,8 @@ def root_k_bisect(m: ArrayLike, tol: float = 0.0) -> Array:
     hi = np.where(pos, 1.0 / np.where(pos, k, 1.0) ** 2 + 1.0, 0.0)
     # phi(z) = ln(1+z) - k z = m z - h(z): > 0 between 0 and z* for m > 0; the first form
     # is exact for small k, the second for small m
-    return bisect(lambda z: np.where(m >= 0.5, np.log1p(z) - k * z, m * z - h(z)), lo, hi, tol)
+    def phi(z):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(m >= 0.5, np.log1p(z) - k * z, m * z - h(z))
+
+    return bisect(phi, lo, hi, tol)

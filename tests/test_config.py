@@ -1,0 +1,86 @@
+import math
+
+import pytest
+
+from ptoverify.config import config_from_mapping, load_config, paper_config
+from ptoverify.errors import ConfigError
+
+GOOD = """name = "paper"
+[plant]
+bandwidth_hz = 30.0
+w_max = 300.0
+sample_time = 0.002
+position_range = 50.0
+[pd]
+kp = 356.0
+kd = 1.15
+[pto]
+d = 0.5
+k1 = 323.0
+k2 = 3.6
+"""
+
+
+def test_paper_defaults_match_design():
+    cfg = paper_config()
+    assert cfg.plant.a == pytest.approx(2 * math.pi * 30.0, rel=1e-15)
+    assert (cfg.plant.w_max, cfg.plant.sample_time, cfg.plant.position_range) == (300, 0.002, 50)
+    assert (cfg.pd.kp, cfg.pd.kd, cfg.pto.d, cfg.pto.k1, cfg.pto.k2) == (356, 1.15, 0.5, 323, 3.6)
+
+
+def test_load_good_file_equals_defaults(tmp_path):
+    f = tmp_path / "c.toml"
+    f.write_text(GOOD)
+    assert load_config(f) == paper_config()
+
+
+def test_a_instead_of_hz(tmp_path):
+    f = tmp_path / "c.toml"
+    f.write_text(GOOD.replace("bandwidth_hz = 30.0", "a = 30.0"))
+    assert load_config(f).plant.a == 30.0
+
+
+@pytest.mark.parametrize("old,new,key", [
+    ("w_max = 300.0", "w_max = 0.0", "plant.w_max"),
+    ("w_max = 300.0", "w_max = -1.0", "plant.w_max"),
+    ("sample_time = 0.002", "sample_time = 0", "plant.sample_time"),
+    ("bandwidth_hz = 30.0", "bandwidth_hz = -30.0", "plant.bandwidth_hz"),
+    ("bandwidth_hz = 30.0", "a = 0.0", "plant.a"),
+    ("bandwidth_hz = 30.0", "bandwidth_hz = 30.0\na = 3.0", "exactly one"),
+    ("bandwidth_hz = 30.0", "", "exactly one"),
+    ("d = 0.5", "d = -0.5", "pto.d"),
+    ("d = 0.5", "d = 51.0", "pto.d"),
+    ("kp = 356.0", "kp = nan", "pd.kp"),
+    ("kp = 356.0", "kp = inf", "pd.kp"),
+    ("kp = 356.0", 'kp = "356"', "pd.kp"),
+    ("kp = 356.0", "kp = true", "pd.kp"),
+    ("kd = 1.15", "kd = 1.15\nki = 2.0", "pd.ki"),
+    ("[pto]", "[pto2]", "pto2"),
+    ("k2 = 3.6", "", "pto.k2"),
+    ('name = "paper"', 'name = "../x"', "name"),
+])
+def test_rejections_name_the_key(tmp_path, old, new, key):
+    f = tmp_path / "c.toml"
+    f.write_text(GOOD.replace(old, new))
+    with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
+        load_config(f)
+
+
+def test_missing_section():
+    with pytest.raises(ConfigError, match=r"\[pd\]"):
+        config_from_mapping({"name": "x", "plant": {"a": 1.0, "w_max": 1.0, "sample_time": 1.0,
+                                                    "position_range": 1.0}, "pto": {}})
+
+
+def test_missing_file_and_not_toml(tmp_path):
+    with pytest.raises(ConfigError, match="does not exist"):
+        load_config(tmp_path / "nope.toml")
+    f = tmp_path / "bad.toml"
+    f.write_text("this is [not toml")
+    with pytest.raises(ConfigError, match="not valid TOML"):
+        load_config(f)
+
+
+def test_roundtrip_mapping():
+    cfg = paper_config()
+    assert config_from_mapping(cfg.to_mapping()) == cfg
