@@ -14,7 +14,7 @@ import numpy as np
 import sympy as sp
 
 from derivations.printed import SYMBOLS, printed, printed_text
-from derivations.record import EquationRecord, Judgement, judge
+from derivations.record import EquationRecord, Judgement
 
 __all__ = ["S", "flow", "flow_T", "switch_curve_x1", "uniform", "record_from", "rhs",
            "combine"]

@@ -112,7 +112,7 @@ def parse(text: str) -> sp.Basic:
 
 
 def printed(id_: str) -> tuple[sp.Basic, ...]:
-    """Parsed printed form of an equation, always as a tuple.
+    """Return the parsed printed form of an equation, as a tuple.
 
     Parameters
     ----------
@@ -128,7 +128,7 @@ def printed(id_: str) -> tuple[sp.Basic, ...]:
 
 
 def printed_text(id_: str) -> str:
-    """Printed form as one string ('; ' between the parts of a tuple).
+    """Return the printed form as one string ('; ' between the parts of a tuple).
 
     Parameters
     ----------

@@ -293,7 +293,7 @@ def _rec_mintime() -> EquationRecord:
 
 @lru_cache(maxsize=None)
 def records() -> tuple[EquationRecord, ...]:
-    """Records of eqs. (3)-(12) and the minimum-time closed form.
+    """Build the records of eqs. (3)-(12) and the minimum-time closed form.
 
     Returns
     -------

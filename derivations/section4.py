@@ -571,7 +571,7 @@ def _rec_lambert() -> list[EquationRecord]:
 
 @lru_cache(maxsize=None)
 def records() -> tuple[EquationRecord, ...]:
-    """Records of eqs. (13)-(35) and the extras 15inv, 19c, 22c, 22W, 26W, 31W.
+    """Build the records of eqs. (13)-(35) and 15inv, 19c, 22c, 22W, 26W, 31W.
 
     Returns
     -------

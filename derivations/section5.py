@@ -127,7 +127,8 @@ def _rec_37_39() -> list[EquationRecord]:
     j = judge((rhs(p37[0], S["dx1"]), rhs(p37[1], S["dx2"])), tuple(f), samp)
     out.append(record_from("37", tuple(f), [
         "A = [[0, 1], [0, -a]], B = [0, a]^T from eq. (1); u = -k1 x1 - k2 x2 (eq. 34)",
-        f"A - B K = {sp.sstr(Acl.tolist())}"], j, "Closed loop of the linear zone (no saturation)."))
+        f"A - B K = {sp.sstr(Acl.tolist())}"], j,
+        "Closed loop of the linear zone (no saturation)."))
     out.append(definition("38", "V - (a*k1*x1**2 + x2**2)", "Lyapunov candidate."))
     p39 = parsed("39")
     Vd = lyapunov_derivative()
@@ -185,7 +186,7 @@ def _rec_39_lasalle(Acl: sp.Matrix) -> EquationRecord:
 
 @lru_cache(maxsize=None)
 def records() -> tuple[EquationRecord, ...]:
-    """Records of eqs. (36)-(39) and the stability claim 39L.
+    """Build the records of eqs. (36)-(39) and the stability claim 39L.
 
     Returns
     -------
