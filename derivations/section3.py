@@ -272,10 +272,20 @@ def _rec_mintime() -> EquationRecord:
     B1, B2 = flow(wm, A1, A2, t2)
     samp = _state_sampler(+1)
     j_end = judge((B1, B2), (sp.Integer(0), sp.Integer(0)), samp, symbolic=False)
-    # the forms quoted in the issue brief (not in the paper), compared with the derived ones
-    t2_alt = sp.log(1 - q / wm) / a
-    t1_alt = (sp.log(1 - q / wm) + (a * x1 + x2) / wm) / a
-    j_alt = judge((t1_alt, t2_alt), (t1, t2), samp)
+    # the forms quoted in the issue brief (not in the paper), compared with the derived ones;
+    # parametrized by the switch velocity qs, with x1 eliminated through the q relation
+    e = extremal()
+    qs = e["q_symbol"]
+    x1_of_q = sp.solve(e["q_relation"].subs(q, qs), x1)[0]
+    t1_q = e["t1"].subs(x1, x1_of_q)
+    t1_alt = ((sp.log(1 - qs / wm) + (a * x1 + x2) / wm) / a).subs(x1, x1_of_q)
+    t2_alt = sp.log(1 - qs / wm) / a
+
+    def samp_q(rng, n):
+        w = rng.uniform(1.0, 1000.0, n)
+        return {a: rng.uniform(1.0, 500.0, n), wm: w, qs: -rng.uniform(0.01, 0.99, n) * w,
+                x2: rng.uniform(-0.99, 0.99, n) * w}
+    j_alt = judge((t1_alt, t2_alt), (t1_q, e["t2"]), samp_q)
     pos = judge(sp.Min(t1, t2, -q) > 0, sp.true, samp, symbolic=False)
     steps = ["arc 2: +omega_m from (p, q) reaches 0: t2 = " + sp.sstr(t2),
              "and p on l1 (eq. 9)",
