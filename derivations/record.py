@@ -217,7 +217,8 @@ def judge(printed: Any, derived: Any, sampler: Sampler, n: int = N_POINTS,
     printed, derived : sympy.Expr or tuple of sympy.Expr
         The two forms; compared componentwise.
     sampler : callable
-        ``sampler(rng, n) -> {symbol: array of n floats}``, admissible points.
+        ``sampler(rng, n) -> {symbol: array of n floats}``, admissible points (it may
+        return fewer than n when it filters out inadmissible draws).
     n : int
         Number of points (at least 200 are required for a verdict).
     seed : int
@@ -260,8 +261,9 @@ def judge(printed: Any, derived: Any, sampler: Sampler, n: int = N_POINTS,
     f_p = sp.lambdify(syms, list(p_t), modules="mpmath")
     f_d = sp.lambdify(syms, list(d_t), modules="mpmath")
     worst, worst_err, n_ok = None, -1.0, 0
+    n_drawn = min((len(v) for v in pts.values()), default=0)   # a sampler may filter points
     with mpmath.workdps(DPS):
-        for i in range(n):
+        for i in range(n_drawn):
             args = [mpmath.mpf(float(pts[s][i])) for s in syms]
             try:
                 vp = [_to_real(v) for v in f_p(*args)]

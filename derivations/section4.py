@@ -261,8 +261,9 @@ def _rec_13_17() -> list[EquationRecord]:
         f"printed line 1 against the -omega_m map instead: {j1m.verdict} (the sign of "
         "line 1 is that of u = -omega_m)",
         f"line 2 from line 1 with (x1, x2) on l1 (eq. 9): {j2.verdict}"], jj,
-        "Line 1 must follow from the map (15) it cites (u = +omega_m); it carries the sign "
-        "of u = -omega_m: a*omega_m*T enters with the wrong sign.",
+        "Line 1 must follow from the map (15) it cites (u = +omega_m)"
+        + ("; it is the -omega_m result instead: a*omega_m*T enters with the wrong sign."
+           if j1m.verdict == "verified" else "."),
         corrected=corrected, inherits=inherits))
     p17 = parsed("17")
     i1, i2 = one_step_inverse(+1)

@@ -113,6 +113,49 @@ def _rec_36() -> EquationRecord:
         "omega_m. With omega0 > omega_m the zone is empty.")
 
 
+def _rec_36_claim() -> EquationRecord:
+    """The claim that a sample from l1* (x1 > d) under -omega_m stays above l1."""
+    from derivations.section4 import _paper, intersection, l1_x1, one_step
+
+    x1_star = l1_x1(x2, w0)
+    n1, n2 = one_step(-1)
+    img = {x1: n1.subs(x1, x1_star), x2: n2.subs(x1, x1_star)}
+    resid = (a * x1 + x2 + wm * sp.log(1 - x2 / wm)).subs(img, simultaneous=True)
+    av, wv, Tv, dv = _paper()
+    f_x1 = sp.lambdify((x2, a, w0), x1_star, "numpy")
+
+    def sampler(om0):
+        def draw(rng, n):
+            v = -rng.uniform(0.001, 0.999, 10 * n) * wv
+            with np.errstate(all="ignore"):
+                keep = f_x1(v, av, om0) > dv          # the claim is for x1 > d only
+            v = v[keep][:n]
+            full = np.ones_like(v)
+            return {x2: v, a: av * full, wm: wv * full, T: Tv * full, w0: om0 * full}
+        return draw
+    pr = intersection(av, wv, Tv, dv, corrected=False)
+    co = intersection(av, wv, Tv, dv, corrected=True)
+    j_pr = judge(sp.sign(resid), sp.Integer(1), sampler(pr["omega0"]), symbolic=False)
+    j_co = judge(sp.sign(resid), sp.Integer(1), sampler(co["omega0"]), symbolic=False)
+    return record_from("36Z", f"sign of the l1 residual one -omega_m sample after l1*: "
+                       f"{sp.sstr(resid)}", [
+                           "state on l1* (level omega0) with x1 > d, |x2| < omega_m; one exact "
+                           "sample of u = -omega_m; l1 residual of the image must be > 0",
+                           f"printed chain (omega0 = {pr['omega0']:.6g} mm/s): {j_pr.verdict}"
+                           f" ({j_pr.n_points} states of l1* with x1 > d in the band)",
+                           f"corrected chain (omega0 = {co['omega0']:.6g} mm/s): "
+                           f"{j_co.verdict} ({j_co.n_points} states)"], j_pr,
+                       "Claim of rule (1) and of Section 5 ('l1* lies above l~1 when |x1| > d'"
+                       "): from l1*, one -omega_m sample does not stride over l1. Judged at "
+                       "the paper defaults for the omega0 of the printed chain. "
+                       + (f"With it, no state of l1* with x1 > d has |x2| < omega_m (l1* "
+                          f"reaches x1 = d at x2 = {pr['x20']:.6g} mm/s), so the claim has no "
+                          "admissible instance (and by 36 the zone is empty for omega0 > "
+                          "omega_m). " if j_pr.n_points == 0 else "")
+                       + f"With the corrected omega0 (19c, 22c): {j_co.verdict}.",
+                       printed_str="(claim in Sections 4-5)")
+
+
 def _rec_37_39() -> list[EquationRecord]:
     out = []
     Acl = closed_loop_matrix()
@@ -192,4 +235,4 @@ def records() -> tuple[EquationRecord, ...]:
     -------
     tuple of EquationRecord
     """
-    return tuple([_rec_36()] + _rec_37_39())
+    return tuple([_rec_36(), _rec_36_claim()] + _rec_37_39())
