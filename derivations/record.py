@@ -177,6 +177,10 @@ def _symbolic_zero(diff: sp.Expr) -> bool | None:
     if diff == 0:
         return True
     try:
+        # cheap steps first; log expansion is valid where log arguments are > 0 (admissible)
+        e = sp.expand(sp.expand_log(sp.expand(diff), force=True))
+        if e == 0 or sp.cancel(e) == 0:
+            return True
         s = sp.simplify(diff)
         if s == 0:
             return True

@@ -70,7 +70,8 @@ def trajectory_residual(level: sp.Expr) -> sp.Expr:
     """
     X1, X2 = flow(level)
     (t_of_x2,) = sp.solve(sp.Eq(X2, x2), t)
-    return sp.expand(sp.simplify(a * (x1 - X1.subs(t, t_of_x2))))
+    r = sp.expand(sp.simplify(a * (x1 - X1.subs(t, t_of_x2))))
+    return r.replace(sp.log, lambda z: sp.log(sp.together(z)))
 
 
 @lru_cache(maxsize=None)
@@ -133,8 +134,8 @@ def min_time_closed_form() -> dict[str, sp.Expr]:
     """
     e = extremal()
     q = e["q"]
-    t1 = sp.simplify(e["t1"].subs(e["q_symbol"], q))
-    t2 = sp.simplify(e["t2"].subs(e["q_symbol"], q))
+    t1 = e["t1"].subs(e["q_symbol"], q)
+    t2 = e["t2"].subs(e["q_symbol"], q)
     return {"q": q, "t1": t1, "t2": t2, "t_f": t1 + t2}
 
 

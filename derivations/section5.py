@@ -114,7 +114,7 @@ def _rec_36() -> EquationRecord:
 
 
 def _rec_36_claim() -> EquationRecord:
-    """The claim that a sample from l1* (x1 > d) under -omega_m stays above l1."""
+    """Judge the claim that one -omega_m sample from l1* (x1 > d) stays above l1."""
     from derivations.section4 import _paper, intersection, l1_x1, one_step
 
     x1_star = l1_x1(x2, w0)
