@@ -255,6 +255,14 @@ def _rec_13_17() -> list[EquationRecord]:
         "at the paper defaults in the note of 27)",
         "36, 35: the zone S~_P and the law use the omega0 of the corrected chain"]
     jj = combine([j1, j2])
+
+    def at_defaults(ce):
+        av, wv, Tv, _ = _paper()
+        num = {a: av, wm: wv, T: Tv, x2: -wv / 2}
+        num[x1] = float(l1_x1(x2).subs(num))
+        return {"at_paper_defaults": {
+            "point": {str(k_): float(v_) for k_, v_ in num.items()},
+            "printed": float(p16[1].subs(num)), "derived": float(lhs_plus.subs(num))}}
     out.append(record_from("16", (lhs_plus, p16[2]), [
         "a*tx1 + tx2 under the +omega_m map of (15): " + sp.sstr(lhs_plus),
         f"printed line 1 against the +omega_m map: {j1.verdict}",
@@ -264,7 +272,7 @@ def _rec_13_17() -> list[EquationRecord]:
         "Line 1 must follow from the map (15) it cites (u = +omega_m)"
         + ("; it is the -omega_m result instead: a*omega_m*T enters with the wrong sign."
            if j1m.verdict == "verified" else "."),
-        corrected=corrected, inherits=inherits))
+        corrected=corrected, inherits=inherits, extra=at_defaults))
     p17 = parsed("17")
     i1, i2 = one_step_inverse(+1)
     samp = _plant

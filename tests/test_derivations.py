@@ -125,6 +125,23 @@ def test_unchecked_path_synthetic():
         EquationRecord("X", "", "", [], "maybe", "")
 
 
+def test_unchecked_record_36z(records):
+    # the no-stride claim has no admissible instance with the printed omega0 (> omega_m)
+    r = records["36Z"]
+    assert r.verdict == "unchecked"
+    assert "0 states" in r.steps[1] and "verified" in r.steps[2]
+
+
+def test_erratum_16_at_paper_defaults(records):
+    ce = records["16"].counterexample["at_paper_defaults"]
+    p = ce["point"]
+    tx1, tx2 = np_flow(p["x1"], p["x2"], p["omega_m"], p["T"], p["a"])
+    assert_allclose(ce["derived"], p["a"] * tx1 + tx2, rtol=1e-12,
+                    err_msg="a x~1 + x~2 under +w_max at the paper defaults (a few ulps)")
+    assert_allclose(ce["derived"] - ce["printed"], 2 * p["a"] * p["omega_m"] * p["T"],
+                    rtol=1e-9, err_msg="(16) error is 2 a omega_m T at the paper defaults")
+
+
 def test_verdicts_follow_the_transcription():
     # with the sign of (16) corrected, the same comparison passes: verdicts are computed
     m1, m2 = section4.one_step(+1)
