@@ -1,0 +1,157 @@
+"""Shared pieces of the derivations: the plant's flow, samplers, record helpers.
+
+The flow under a constant input (eq. 7) is obtained once, here, by ``dsolve``
+of eq. (1); every later section uses it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from derivations.printed import SYMBOLS, printed, printed_text
+from derivations.record import EquationRecord, Judgement
+
+__all__ = ["S", "flow", "flow_T", "switch_curve_x1", "uniform", "record_from", "rhs",
+           "combine"]
+
+S = SYMBOLS
+
+
+@lru_cache(maxsize=None)
+def _flow_general() -> tuple[sp.Expr, sp.Expr]:
+    """Solve eq. (1) with constant input u and x(0) = (x10, x20) by dsolve."""
+    a, t, u, x10, x20 = (S[n] for n in ("a", "t", "u", "x10", "x20"))
+    X1, X2 = sp.Function("X1"), sp.Function("X2")
+    sol = sp.dsolve([sp.Eq(X1(t).diff(t), X2(t)), sp.Eq(X2(t).diff(t), -a * X2(t) + a * u)],
+                    [X1(t), X2(t)], ics={X1(0): x10, X2(0): x20})
+    by = {s.lhs.func: s.rhs for s in sol}
+    return sp.simplify(by[X1]), sp.simplify(by[X2])
+
+
+def flow(u: sp.Expr, x10: sp.Expr | None = None, x20: sp.Expr | None = None,
+         t: sp.Expr | None = None) -> tuple[sp.Expr, sp.Expr]:
+    """State after time t under constant input u, from eq. (1) by dsolve (eq. 7).
+
+    Parameters
+    ----------
+    u : sympy.Expr
+        Constant input [mm/s].
+    x10, x20 : sympy.Expr, optional
+        Initial state (default the symbols x10, x20).
+    t : sympy.Expr, optional
+        Elapsed time (default the symbol t).
+
+    Returns
+    -------
+    x1, x2 : sympy.Expr
+    """
+    x1, x2 = _flow_general()
+    sub = {S["u"]: u, S["x10"]: S["x10"] if x10 is None else x10,
+           S["x20"]: S["x20"] if x20 is None else x20, S["t"]: S["t"] if t is None else t}
+    return x1.xreplace(sub), x2.xreplace(sub)
+
+
+def flow_T(u: sp.Expr, x1: sp.Expr, x2: sp.Expr) -> tuple[sp.Expr, sp.Expr]:
+    """One sample (duration T) of the exact flow from (x1, x2) under input u.
+
+    Parameters
+    ----------
+    u, x1, x2 : sympy.Expr
+        Held input and state at the sample.
+
+    Returns
+    -------
+    x1, x2 : sympy.Expr
+        State one sample later.
+    """
+    return flow(u, x1, x2, S["T"])
+
+
+def switch_curve_x1(x2: np.ndarray, a: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Position on the level-w curve l1-o-l2 through the origin at velocity x2 (floats).
+
+    Only used to draw admissible sample points on a chosen side of a curve.
+    """
+    r = np.abs(x2) / w
+    return -np.sign(x2) * w * (r - np.log1p(r)) / a
+
+
+def uniform(rng: np.random.Generator, n: int, **ranges: tuple[float, float]
+            ) -> dict[sp.Symbol, np.ndarray]:
+    """Independent uniform draws, one array per named symbol."""
+    return {S[k]: rng.uniform(lo, hi, n) for k, (lo, hi) in ranges.items()}
+
+
+def rhs(residual: sp.Expr, lhs: sp.Symbol) -> sp.Expr:
+    """Right-hand side of a printed ``lhs - rhs`` residual."""
+    return sp.expand(lhs - residual)
+
+
+def combine(judgements: Sequence[Judgement]) -> Judgement:
+    """Combine several judgements: erratum wins, then unchecked, else verified."""
+    for v in ("erratum", "unchecked"):
+        for j in judgements:
+            if j.verdict == v:
+                return j
+    n = sum(j.n_points for j in judgements)
+    err = max(j.max_rel_err for j in judgements)
+    sym = all(j.symbolic for j in judgements) or None
+    reasons = "; ".join(j.reason for j in judgements)
+    return Judgement("verified", sym, n, err, None, reasons)
+
+
+def record_from(id_: str, derived: Any, steps: list[str], j: Judgement, note: str,
+                corrected: str | None = None, inherits: list[str] | None = None,
+                printed_str: str | None = None,
+                extra: Callable[[dict[str, Any]], dict[str, Any]] | None = None
+                ) -> EquationRecord:
+    """Build a record whose verdict is the judgement's.
+
+    Parameters
+    ----------
+    id_ : str
+        Equation id.
+    derived : sympy expression(s) or str
+        The derived form.
+    steps : list of str
+        Derivation steps.
+    j : Judgement
+        The computed comparison; its verdict becomes the record's.
+    note : str
+        What was compared; the judgement's reason is appended.
+    corrected, inherits
+        Only kept when the verdict is ``erratum``.
+    printed_str : str, optional
+        Printed text (default: the transcription of ``id_``).
+    extra : callable, optional
+        Adds fields (e.g. the state) to the counterexample.
+
+    Returns
+    -------
+    EquationRecord
+    """
+    if isinstance(derived, str):
+        d = derived
+    elif isinstance(derived, (tuple, list)):
+        d = "; ".join(sp.sstr(e) for e in derived)
+    else:
+        d = sp.sstr(derived)
+    ce = j.counterexample
+    if ce is not None and extra is not None:
+        ce = dict(ce, **extra(ce))
+    err = j.verdict == "erratum"
+    return EquationRecord(
+        id=id_, printed=printed_text(id_) if printed_str is None else printed_str, derived=d,
+        steps=list(steps), verdict=j.verdict, note=f"{note} Check: {j.reason}.",
+        counterexample=ce, corrected=corrected if err else None,
+        inherits=list(inherits or []) if err else [])
+
+
+def parsed(id_: str) -> tuple[sp.Basic, ...]:
+    """Shorthand for :func:`derivations.printed.printed`."""
+    return printed(id_)
