@@ -282,6 +282,122 @@ def _discrete(cfg: Config) -> CheckResult:
     return res
 
 
+# ------------------------------------------------------------ derivation gate
+@gate("derivation-identities-vs-numerics")
+def _derivations(cfg: Config) -> CheckResult:
+    """SymPy results (flow by dsolve, min-time closed form) lambdified against the numerics."""
+    import sympy as sp
+
+    from derivations.common import S, flow
+    from derivations.section3 import min_time_closed_form
+    from ptoverify.mintime import min_time
+    from ptoverify.plant import flow as flow_num
+
+    p = cfg.plant
+    a, w, t, u, x10, x20 = (S[n] for n in ("a", "omega_m", "t", "u", "x10", "x20"))
+    fx1, fx2 = (sp.lambdify((x10, x20, u, t, a), e, "numpy") for e in flow(u))
+    rng = np.random.default_rng(31)
+    y1, y2 = _random_states(cfg, 500, 32, 1.5)
+    uu = rng.uniform(-p.w_max, p.w_max, 500)
+    tt = rng.uniform(0, 5 * p.T, 500)
+    n1, n2 = flow_num(y1, y2, uu, tt, p.a)
+    e_flow = max(np.max(np.abs(fx1(y1, y2, uu, tt, p.a) - n1) / (1 + np.abs(n1))),
+                 np.max(np.abs(fx2(y1, y2, uu, tt, p.a) - n2) / (1 + np.abs(n2))))
+    # the SymPy closed form is evaluated in 50-digit arithmetic: as printed by SymPy it
+    # subtracts nearly equal numbers near x2 = -omega_m, which the numerics avoid
+    import mpmath
+
+    mt_sym = min_time_closed_form()
+    f_tf = sp.lambdify((S["x1"], S["x2"], a, w), mt_sym["t_f"], "mpmath")
+    mt = min_time(y1, y2, p)
+    r1, r2 = mt.side * y1, mt.side * y2               # the SymPy form is for sigma >= 0
+    e_tf = 0.0
+    with mpmath.workdps(50):
+        for i in np.flatnonzero(r2 > -p.w_max)[:200]:  # its logarithms need x2 > -omega_m
+            ref = f_tf(mpmath.mpf(r1[i]), mpmath.mpf(r2[i]), mpmath.mpf(p.a),
+                       mpmath.mpf(p.w_max))
+            e_tf = max(e_tf, abs(float(mpmath.re(ref)) - mt.t_f[i]) / mt.t_f[i])
+    worst = max(e_flow, e_tf)
+    return _at_most("derivation-identities-vs-numerics", worst, 1e-12,
+                    f"max relative difference of the lambdified SymPy flow of eq. (1) "
+                    f"({e_flow:.1e}, 500 states) and of the SymPy minimum time evaluated in 50 "
+                    f"digits ({e_tf:.1e}, 200 states) from the float64 numerics; limit 1e-12: "
+                    "round-off of the numerics")
+
+
+# ------------------------------------------------------------ PTO / zone / pole gates
+@gate("zone-corrected-valid")
+def _zone_valid(cfg: Config) -> CheckResult:
+    """The corrected switching zone exists, is not degenerate, and holds on the grid."""
+    from ptoverify.zones import corrected_zone
+
+    z = corrected_zone(cfg)
+    if not z.valid:
+        return CheckResult("zone-corrected-valid", FAIL, z.omega0, cfg.plant.w_max,
+                           f"no valid corrected zone: {z.reason}")
+    return CheckResult("zone-corrected-valid", PASS if z.grid_violations == 0 else FAIL,
+                       float(z.grid_violations), 0.0,
+                       f"omega0 = {z.omega0:.6g} mm/s; principle violations on the 2-D grid "
+                       f"of {z.grid_points} source states outside l1*/l2* (limit 0)")
+
+
+@functools.lru_cache(maxsize=4)
+def _pto_properties(cfg: Config):
+    from ptoverify.laws import make_law
+    from ptoverify.properties import law_properties
+
+    return law_properties(make_law("pto", cfg), cfg)
+
+
+@gate("no-stride-over")
+def _no_stride(cfg: Config) -> CheckResult:
+    """Corrected PTO: no sampled state strides over the switching zone."""
+    pr = _pto_properties(cfg)
+    return _at_most("no-stride-over", float(pr.stride_overs), 0.0,
+                    f"stride-overs of the corrected PTO over {pr.states} initial states x "
+                    f"{pr.steps} samples (a sample outside the zone and linear zone whose next "
+                    "sample is strictly across l1/l2 and outside the linear zone)")
+
+
+@gate("no-limit-cycle")
+def _no_limit_cycle(cfg: Config) -> CheckResult:
+    """Corrected PTO: no sustained oscillation at the end of the horizon."""
+    pr = _pto_properties(cfg)
+    return _at_most("no-limit-cycle", float(pr.limit_cycles + pr.not_settled), 0.0,
+                    f"states of {pr.states} with sustained oscillation ({pr.limit_cycles}) or "
+                    f"not settled within {pr.band:g} mm ({pr.not_settled}) after {pr.steps} "
+                    "samples, corrected PTO")
+
+
+def _loop_gate(name: str, which: str, cfg: Config) -> CheckResult:
+    from ptoverify.poles import all_loop_poles
+
+    lp = all_loop_poles(cfg)[which]
+    radius = max(lp.sampled_moduli)
+    if lp.pole_mismatch > 1e-9:
+        return CheckResult(name, UNVERIFIED, radius, 1.0,
+                           f"python-control and numpy disagree on the sampled poles by "
+                           f"{lp.pole_mismatch:.2e}")
+    status = PASS if radius < 1.0 else FAIL
+    return CheckResult(name, status, radius, 1.0,
+                       f"largest |z| of the ZOH-sampled {which} loop, gains {lp.gains}, "
+                       f"T = {cfg.plant.T:g} s (python-control, cross-checked with numpy "
+                       f"eigenvalues to {lp.pole_mismatch:.1e}); must be < 1; gain margin "
+                       f"{lp.gain_margin:.3g}")
+
+
+@gate("pd-sampled-stable")
+def _pd_stable(cfg: Config) -> CheckResult:
+    """The PD loop sampled with ZOH at T is stable."""
+    return _loop_gate("pd-sampled-stable", "pd", cfg)
+
+
+@gate("linear-zone-sampled-stable")
+def _linear_stable(cfg: Config) -> CheckResult:
+    """The PTO linear-zone loop (eq. 37) sampled with ZOH at T is stable."""
+    return _loop_gate("linear-zone-sampled-stable", "linear", cfg)
+
+
 def run_checks(cfg: Config, names: list[str] | None = None,
                max_iter: int | None = None) -> list[CheckResult]:
     """Run the gates (all, or the named ones) in registration order.

@@ -37,3 +37,24 @@ def test_exception_in_gate_fails_closed(paper_cfg):
 def test_unknown_gate_is_bad_input(capsys):
     assert main(["check", "--gate", "no-such-gate"]) == 2
     assert capsys.readouterr().err.startswith("ptoverify: error:")
+
+
+def test_unstable_sampled_loop_fails_its_gate(paper_cfg):
+    """Gains that meet Section 5's Lyapunov conditions but are unstable when sampled fail."""
+    from dataclasses import replace
+
+    cfg = replace(paper_cfg, pd=replace(paper_cfg.pd, kp=5000.0),
+                  pto=replace(paper_cfg.pto, k1=5000.0))
+    results = {r.name: r for r in run_checks(cfg, ["pd-sampled-stable",
+                                                   "linear-zone-sampled-stable"])}
+    assert results["pd-sampled-stable"].status == FAIL
+    assert results["linear-zone-sampled-stable"].status == FAIL
+    assert results["pd-sampled-stable"].measured > 1.0
+
+
+def test_zone_that_cannot_be_built_fails(paper_cfg):
+    from dataclasses import replace
+
+    cfg = replace(paper_cfg, pto=replace(paper_cfg.pto, d=0.0))
+    r = run_checks(cfg, ["zone-corrected-valid"])[0]
+    assert r.status != PASS, r
