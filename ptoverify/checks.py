@@ -328,7 +328,7 @@ def _derivations(cfg: Config) -> CheckResult:
 # ------------------------------------------------------------ PTO / zone / pole gates
 @gate("zone-corrected-valid")
 def _zone_valid(cfg: Config) -> CheckResult:
-    """The corrected switching zone exists, is not degenerate, and holds on the grid."""
+    """Check that the corrected zone exists, acts, and holds on the grid."""
     from ptoverify.zones import corrected_zone
 
     z = corrected_zone(cfg)
@@ -388,13 +388,13 @@ def _loop_gate(name: str, which: str, cfg: Config) -> CheckResult:
 
 @gate("pd-sampled-stable")
 def _pd_stable(cfg: Config) -> CheckResult:
-    """The PD loop sampled with ZOH at T is stable."""
+    """Check that the PD loop sampled with ZOH at T is stable."""
     return _loop_gate("pd-sampled-stable", "pd", cfg)
 
 
 @gate("linear-zone-sampled-stable")
 def _linear_stable(cfg: Config) -> CheckResult:
-    """The PTO linear-zone loop (eq. 37) sampled with ZOH at T is stable."""
+    """Check that the linear-zone loop (eq. 37) sampled with ZOH at T is stable."""
     return _loop_gate("linear-zone-sampled-stable", "linear", cfg)
 
 
