@@ -363,7 +363,7 @@ def _rec_18_19() -> list[EquationRecord]:
         "of l1, derived as the l1 residual of the -omega_m one-step image (record 19c)"],
         combine([j_plus, j_minus]),
         "Claim: the one-step images of l1 form l~1. "
-        + ("False for either input sign; " if j_minus.verdict == "erratum" else "")
+        + ("False for either input sign. " if j_minus.verdict == "erratum" else "")
         + "On l~1 the "
         "l1 residual equals -2 a omega_m T < 0, i.e. l~1 lies left of l1 (in S_P), on the "
         "opposite side from the switching zone.",
