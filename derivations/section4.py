@@ -362,7 +362,9 @@ def _rec_18_19() -> list[EquationRecord]:
         "rule (1) needs the states whose next sample under -omega_m lands on l1: the preimage "
         "of l1, derived as the l1 residual of the -omega_m one-step image (record 19c)"],
         combine([j_plus, j_minus]),
-        "Claim: the one-step images of l1 form l~1. False for either input sign; on l~1 the "
+        "Claim: the one-step images of l1 form l~1. "
+        + ("False for either input sign. " if j_minus.verdict == "erratum" else "")
+        + "On l~1 the "
         "l1 residual equals -2 a omega_m T < 0, i.e. l~1 lies left of l1 (in S_P), on the "
         "opposite side from the switching zone.",
         corrected=sp.sstr(pre), inherits=[
@@ -451,8 +453,9 @@ def _rec_20_27() -> list[EquationRecord]:
     co = intersection(*_paper(), corrected=True)
     av, wv, _, dv = _paper()
     nums = (f" At the paper defaults (a = {av:.6g} rad/s, omega_m = {wv:.6g} mm/s, T, d) the "
-            f"printed chain gives x~20 = {pr['x20']:.6g} mm/s (|x~20| > omega_m: outside the "
-            f"saturation band) and omega0 = {pr['omega0']:.6g} mm/s "
+            f"printed chain gives x~20 = {pr['x20']:.6g} mm/s "
+            + ("(|x~20| > omega_m: outside the saturation band) " if abs(pr["x20"]) > wv else "")
+            + f"and omega0 = {pr['omega0']:.6g} mm/s "
             f"({'>' if pr['omega0'] > wv else '<='} omega_m); the corrected chain (19c, 22c) "
             f"gives x~20 = {co['x20']:.6g} mm/s and omega0 = {co['omega0']:.6g} mm/s.")
     out.append(record_from("27", d27, ["solve z = -x~20/omega0 for omega0"],
