@@ -1,0 +1,325 @@
+"""Benchmark suite of issue 7: speed of the laws, closed forms, solvers and CLI.
+
+Run from the repository root::
+
+    python benchmarks/run.py            # table
+    python benchmarks/run.py --json     # one JSON object (the issue's keys + machine)
+    python benchmarks/run.py --json --small   # CI smoke test: small sizes, no speed meaning
+
+Every figure is the median over ``--repeat`` measurements (solver figures: the
+median over their states).  Ratios are measured side by side in the same run.
+With ``--small`` the sizes are cut so the whole run takes seconds; ``check_s``
+then times ``ptoverify check --gate roots-closed-form-vs-bisection`` (one cheap gate) and ``report_s``
+``ptoverify report --help``, so the figures only show that the harness works.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+# `python benchmarks/run.py` puts benchmarks/, not the repository root, first on sys.path;
+# an editable install elsewhere (another worktree) would then be measured instead of this
+# tree.  Only this script does this; the package never edits sys.path.
+if sys.path[0] != str(ROOT):
+    sys.path.insert(0, str(ROOT))
+
+from ptoverify.config import paper_config  # noqa: E402
+from ptoverify.curves import omega_c  # noqa: E402
+from ptoverify.laws import make_law  # noqa: E402
+from ptoverify.mintime import discrete_min_steps, min_time  # noqa: E402
+from ptoverify.simulate import simulate_batch  # noqa: E402
+
+TARGETS = {  # key: (target, ">=" or "<=")
+    "law_vector_evals_per_s": (2e6, ">="),
+    "law_scalar_us": (20.0, "<="),
+    "omega_c_bisection_vs_closed_form": (10.0, ">="),
+    "mintime_vector_evals_per_s": (5e6, ">="),
+    "sim_state_steps_per_s": (2e6, ">="),
+    "two_phase_ms": (20.0, "<="),
+    "collocation_ms": (150.0, "<="),
+    "collocation_vs_two_phase_error_ratio": (None, ""),
+    "discrete_ms": (50.0, "<="),
+    "check_s": (60.0, "<="),
+    "report_s": (120.0, "<="),
+}
+
+FULL = {"law": 10**6, "scalar": 20000, "omega": 10**5, "mintime": 10**6, "sim_states": 10000,
+        "sim_steps": 250, "two_phase": 50, "collocation": 20, "repeat": 5, "cli_repeat": 3}
+SMALL = {"law": 2000, "scalar": 200, "omega": 2000, "mintime": 2000, "sim_states": 100,
+         "sim_steps": 20, "two_phase": 3, "collocation": 2, "repeat": 2, "cli_repeat": 1}
+
+
+def envelope_states(cfg, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Uniform random states in |x1| <= position_range, |x2| <= w_max."""
+    rng = np.random.default_rng(seed)
+    p = cfg.plant
+    return (rng.uniform(-1.0, 1.0, n) * p.position_range,
+            rng.uniform(-1.0, 1.0, n) * p.w_max)
+
+
+def median_time(fn, repeat: int) -> float:
+    """Median wall time [s] of ``fn()`` over ``repeat`` calls, after one warm-up call."""
+    fn()
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+# ---------------------------------------------------------------- laws
+def bench_law_vector(cfg, size: dict) -> float:
+    law = make_law("pto", cfg)
+    x1, x2 = envelope_states(cfg, size["law"], 1)
+    return size["law"] / median_time(lambda: law.vector(x1, x2), size["repeat"])
+
+
+def bench_law_scalar(cfg, size: dict) -> float:
+    """Mean time of one ``law.scalar`` call over random envelope states [us], median of runs."""
+    law = make_law("pto", cfg)
+    x1, x2 = envelope_states(cfg, size["scalar"], 2)
+    pairs = list(zip(x1.tolist(), x2.tolist(), strict=True))
+    f = law.scalar
+
+    def run():
+        for a, b in pairs:
+            f(a, b)
+
+    return 1e6 * median_time(run, size["repeat"]) / len(pairs)
+
+
+# ---------------------------------------------------------------- omega_c
+def omega_c_bisection(x1: np.ndarray, x2: np.ndarray, a: float, tol: float = 1e-12,
+                      max_iter: int = 200) -> np.ndarray:
+    """omega_c by the paper's method: bisection on f(z) = ln(1 + z) - k z, eq. (31).
+
+    k = 1 + a x1 / x2 (eq. 30), 0 < k < 1; the non-trivial root z* > 0 lies in
+    (0, 1/k^2 + 1]: f > 0 on (0, z*), f < 0 beyond.  The bracket is halved,
+    vectorized over all states, until hi - lo <= tol * hi (relative tolerance
+    1e-12) or ``max_iter`` halvings; then omega_c = |x2| / z* (eq. 32).
+    """
+    k = 1.0 + a * x1 / x2
+    lo = np.full_like(k, 1e-300)
+    hi = 1.0 / (k * k) + 1.0
+    for _ in range(max_iter):
+        mid = 0.5 * (lo + hi)
+        pos = np.log1p(mid) - k * mid > 0
+        lo = np.where(pos, mid, lo)
+        hi = np.where(pos, hi, mid)
+        if np.all(hi - lo <= tol * hi):
+            break
+    return np.abs(x2) / (0.5 * (lo + hi))
+
+
+def omega_states(cfg, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """States in the fourth quadrant with 0 < m = -a x1/x2 < 1 (omega_c finite)."""
+    rng = np.random.default_rng(seed)
+    p = cfg.plant
+    x2 = -rng.uniform(1e-3, 1.0, n) * p.w_max
+    m = rng.uniform(1e-6, 1.0 - 1e-6, n)
+    return -m * x2 / p.a, x2
+
+
+def bench_omega(cfg, size: dict) -> dict:
+    a = cfg.plant.a
+    x1, x2 = omega_states(cfg, size["omega"], 3)
+    t_closed = median_time(lambda: omega_c(x1, x2, a), size["repeat"])
+    t_bisect = median_time(lambda: omega_c_bisection(x1, x2, a), size["repeat"])
+    rel = np.abs(omega_c_bisection(x1, x2, a) / omega_c(x1, x2, a) - 1.0)
+    return {"ratio": t_bisect / t_closed, "closed_ms": 1e3 * t_closed,
+            "bisection_ms": 1e3 * t_bisect, "max_rel_diff": float(np.max(rel))}
+
+
+# ---------------------------------------------------------------- min time, simulation
+def bench_mintime(cfg, size: dict) -> float:
+    x1, x2 = envelope_states(cfg, size["mintime"], 4)
+    return size["mintime"] / median_time(lambda: min_time(x1, x2, cfg.plant), size["repeat"])
+
+
+def bench_sim(cfg, size: dict) -> float:
+    law = make_law("pto", cfg)
+    x1, x2 = envelope_states(cfg, size["sim_states"], 5)
+    n = size["sim_steps"]
+    t = median_time(lambda: simulate_batch(law, cfg.plant, x1, x2, n), max(1, size["repeat"] - 2))
+    return size["sim_states"] * n / t
+
+
+# ---------------------------------------------------------------- solvers
+def bench_ocp(cfg, size: dict) -> dict:
+    """Two-phase and collocation (N = 100, warm start) on the same states, wall time."""
+    from ptoverify.ocp import CollocationOCP, TwoPhaseOCP
+
+    plant = cfg.plant
+    rng = np.random.default_rng(21)
+    n2 = size["two_phase"]
+    S = np.column_stack([rng.uniform(-1, 1, n2) * plant.position_range,
+                         rng.uniform(-1, 1, n2) * plant.w_max * (1 - 1e-9)])
+    tp = TwoPhaseOCP(plant)
+    tp.solve(10.0, 0.0)                                  # build + warm-up
+    t_tp, res_tp = [], []
+    for x1, x2 in S:
+        t0 = time.perf_counter()
+        res_tp.append(tp.solve(float(x1), float(x2)))
+        t_tp.append(time.perf_counter() - t0)
+    Sc = S[: size["collocation"]]
+    co = CollocationOCP(plant, 100, warm_start=True)
+    co.solve(10.0, 0.0)
+    t_co, res_co = [], []
+    for x1, x2 in Sc:
+        t0 = time.perf_counter()
+        res_co.append(co.solve(float(x1), float(x2)))
+        t_co.append(time.perf_counter() - t0)
+    tf = min_time(Sc[:, 0], Sc[:, 1], plant).t_f
+    err_co = np.abs(np.array([r.t_f for r in res_co]) - tf) / tf
+    err_tp = np.abs(np.array([r.t_f for r in res_tp[: len(Sc)]]) - tf) / tf
+    med_tp = float(np.median(err_tp))
+    return {"two_phase_ms": 1e3 * statistics.median(t_tp),
+            "collocation_ms": 1e3 * statistics.median(t_co),
+            "collocation_err": float(np.median(err_co)), "two_phase_err": med_tp,
+            "ratio": float(np.median(err_co)) / max(med_tp, 2.2e-16),
+            "failures": sum(not r.success for r in res_tp + res_co)}
+
+
+def bench_discrete(cfg, size: dict) -> float:
+    d = discrete_min_steps(50.0, 0.0, cfg.plant)
+    assert d.success, d.status
+    return 1e3 * median_time(lambda: discrete_min_steps(50.0, 0.0, cfg.plant),
+                             max(5, size["repeat"]))
+
+
+# ---------------------------------------------------------------- whole process
+def run_cli(args: list[str], repeat: int) -> tuple[float | None, str]:
+    """Median wall time [s] of ``python -m ptoverify ARGS`` (cwd repo root)."""
+    times, note = [], ""
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        p = subprocess.run([sys.executable, "-m", "ptoverify", *args], cwd=ROOT,
+                           capture_output=True, text=True)
+        times.append(time.perf_counter() - t0)
+        if p.returncode == 2 and "invalid choice" in p.stderr:
+            return None, f"'ptoverify {args[0]}' does not exist in this tree"
+        if p.returncode not in (0, 1):
+            return None, f"'ptoverify {' '.join(args)}' exited {p.returncode}"
+        if p.returncode == 1:
+            note = f"'ptoverify {' '.join(args)}' exited 1 (a gate did not pass)"
+    return statistics.median(times), note
+
+
+# ---------------------------------------------------------------- machine
+def machine() -> dict:
+    cpu = "unknown"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    blas = "unknown"
+    try:
+        from threadpoolctl import threadpool_info
+
+        libs = [i for i in threadpool_info() if i.get("user_api") == "blas"]
+        if libs:
+            i = libs[0]
+            blas = (f"{i.get('internal_api')} {i.get('version')} "
+                    f"({i.get('architecture')}, {i.get('num_threads')} threads)")
+    except ImportError:
+        try:
+            cfg = np.show_config(mode="dicts")
+            b = cfg["Build Dependencies"]["blas"]
+            blas = f"{b.get('name')} {b.get('version')}"
+        except Exception:  # noqa: BLE001 - older numpy: no dict mode
+            pass
+    return {"cpu": cpu, "cores": os.cpu_count(), "numpy": np.__version__, "blas": blas,
+            "openblas_coretype": os.environ.get("OPENBLAS_CORETYPE"),
+            "load_average": [round(x, 2) for x in os.getloadavg()],
+            "ptoverify": str(Path(sys.modules["ptoverify"].__file__).parent)}
+
+
+# ---------------------------------------------------------------- main
+def run(small: bool) -> tuple[dict, dict]:
+    size = SMALL if small else FULL
+    cfg = paper_config()
+    out, extra = {}, {}
+    out["law_vector_evals_per_s"] = bench_law_vector(cfg, size)
+    out["law_scalar_us"] = bench_law_scalar(cfg, size)
+    om = bench_omega(cfg, size)
+    out["omega_c_bisection_vs_closed_form"] = om["ratio"]
+    extra["omega_c"] = om
+    out["mintime_vector_evals_per_s"] = bench_mintime(cfg, size)
+    out["sim_state_steps_per_s"] = bench_sim(cfg, size)
+    oc = bench_ocp(cfg, size)
+    out["two_phase_ms"] = oc["two_phase_ms"]
+    out["collocation_ms"] = oc["collocation_ms"]
+    out["collocation_vs_two_phase_error_ratio"] = oc["ratio"]
+    extra["ocp"] = oc
+    out["discrete_ms"] = bench_discrete(cfg, size)
+    check = ["check", "--gate", "roots-closed-form-vs-bisection"] if small else ["check"]
+    out["check_s"], extra["check_note"] = run_cli(check, size["cli_repeat"])
+    report = ["report", "--help"] if small else ["report"]
+    out["report_s"], extra["report_note"] = run_cli(report, size["cli_repeat"])
+    extra["vector_vs_scalar"] = out["law_vector_evals_per_s"] * out["law_scalar_us"] * 1e-6
+    return out, extra
+
+
+def table(out: dict, extra: dict) -> str:
+    rows = [f"{'key':<38} {'measured':>12} {'target':>10}  met"]
+    for key, (target, op) in TARGETS.items():
+        v = out[key]
+        if target is None:
+            met, tgt = "-", "-"
+        elif v is None:
+            met, tgt = "n/a", f"{op} {target:g}"
+        else:
+            met = "yes" if (v >= target if op == ">=" else v <= target) else "NO"
+            tgt = f"{op} {target:g}"
+        vs = "null" if v is None else f"{v:.4g}"
+        rows.append(f"{key:<38} {vs:>12} {tgt:>10}  {met}")
+    om, oc = extra["omega_c"], extra["ocp"]
+    rows += ["",
+             f"omega_c: bisection {om['bisection_ms']:.1f} ms vs closed form "
+             f"{om['closed_ms']:.2f} ms, max rel diff {om['max_rel_diff']:.2g}",
+             f"t_f rel error median: collocation {oc['collocation_err']:.3g}, two-phase "
+             f"{oc['two_phase_err']:.3g}; solver failures {oc['failures']}",
+             f"vector law vs scalar law (per-state speed-up): {extra['vector_vs_scalar']:.3g}"]
+    for k in ("check_note", "report_note"):
+        if extra[k]:
+            rows.append(f"{k}: {extra[k]}")
+    return "\n".join(rows)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--json", action="store_true", help="print one JSON object")
+    ap.add_argument("--small", action="store_true", help="small sizes (CI smoke test)")
+    args = ap.parse_args(argv)
+    out, extra = run(args.small)
+    if args.json:
+        obj = dict(out)
+        obj["machine"] = machine()
+        notes = {k: v for k, v in (("check_s", extra["check_note"]),
+                                   ("report_s", extra["report_note"])) if v}
+        if notes:                 # reasons for a null (or a failing gate) ride with machine
+            obj["machine"]["notes"] = notes
+        print(json.dumps(obj, indent=1))
+    else:
+        print(table(out, extra))
+        print("machine:", json.dumps(machine()))
+    return 0 if all(v is None or math.isfinite(v) for v in out.values()) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
