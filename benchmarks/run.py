@@ -9,8 +9,9 @@ Run from the repository root::
 Every figure is the median over ``--repeat`` measurements (solver figures: the
 median over their states).  Ratios are measured side by side in the same run.
 With ``--small`` the sizes are cut so the whole run takes seconds; ``check_s``
-then times ``ptoverify check --gate roots-closed-form-vs-bisection`` (one cheap gate) and ``report_s``
-``ptoverify report --help``, so the figures only show that the harness works.
+then times ``ptoverify check --gate roots-closed-form-vs-bisection`` (one cheap
+gate) and ``report_s`` ``ptoverify report --help``, so the figures only show
+that the harness works.
 """
 
 from __future__ import annotations

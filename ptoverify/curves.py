@@ -37,7 +37,7 @@ from scipy.special import lambertw
 
 __all__ = [
     "h", "level_residual", "switching_function", "level_curve_x1",
-    "root_22", "root_k", "omega_c", "bisect", "root_22_bisect", "root_k_bisect",
+    "root_22", "root_k", "omega_c", "bisect", "root_22_bisect", "root_k_bisect", "blockwise",
 ]
 
 Array = NDArray[np.float64]
@@ -48,11 +48,55 @@ _H_SERIES = np.array([(-1.0) ** n / n for n in range(2, 26)])
 _E2_SERIES = np.array([1.0 / np.prod(np.arange(1, n + 1, dtype=float)) for n in range(2, 22)])
 
 
+BLOCK = 8192   # states per block: 64 kB per float array, heap-allocated and cache-resident
+
+
+def blockwise(fn, *arrays: ArrayLike, block: int = BLOCK):
+    """Apply an elementwise array function block by block over broadcast arrays.
+
+    Large temporaries (> 128 kB) are fresh ``mmap`` pages for every numpy
+    operation, and first-touch page faults then cost more than the arithmetic;
+    blocks of ``block`` elements stay in the heap and the cache.  Every output
+    element depends only on the inputs at its index, so the result is bit-for-bit
+    that of ``fn`` on the whole arrays.
+
+    Parameters
+    ----------
+    fn : callable
+        ``fn(*arrays) -> ndarray or tuple of ndarray``, elementwise.
+    *arrays : array_like
+        Inputs, broadcast together.
+    block : int
+        Elements per block.
+
+    Returns
+    -------
+    ndarray or tuple of ndarray
+        As ``fn``, of the broadcast shape.
+    """
+    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in arrays))
+    shape, n = arrays[0].shape, arrays[0].size
+    if n <= 2 * block:
+        return fn(*arrays)
+    flat = [a.ravel() for a in arrays]
+    outs, single = None, False
+    for i in range(0, n, block):
+        res = fn(*(a[i:i + block] for a in flat))
+        if outs is None:
+            single = not isinstance(res, tuple)
+            outs = [np.empty(n, dtype=r.dtype) for r in ((res,) if single else res)]
+        for o, r in zip(outs, (res,) if single else res, strict=True):
+            o[i:i + block] = r
+    outs = tuple(o.reshape(shape) for o in outs)
+    return outs[0] if single else outs
+
+
 def _series(x: Array, coef: Array, lowest: int) -> Array:
     """Evaluate sum_j coef[j] x^(lowest + j) by Horner's rule."""
     acc = np.zeros_like(x)
-    for c in coef[::-1]:
-        acc = acc * x + c
+    for c in coef[::-1]:                     # in place: the same roundings as acc * x + c
+        acc *= x
+        acc += c
     return acc * x**lowest
 
 
@@ -75,18 +119,27 @@ def h(r: ArrayLike) -> Array:
     5e-21
     """
     r = np.asarray(r, dtype=float)
-    small = np.abs(r) < 0.2
     with np.errstate(invalid="ignore", divide="ignore"):
-        direct = r - np.log1p(r)
-    return np.where(small, _series(np.where(small, r, 0.0), _H_SERIES, 2), direct)
+        out = r - np.log1p(r)
+    if out.ndim == 0:
+        return np.asarray(out if abs(r) >= 0.2 else _series(r, _H_SERIES, 2))
+    small = np.abs(r) < 0.2                      # the series only where it is used
+    if small.any():
+        out[small] = _series(r[small], _H_SERIES, 2)
+    return out
 
 
 def _e2(u: Array) -> Array:
     """Return e^u - 1 - u, exact to round-off near u = 0."""
-    small = np.abs(u) < 0.5
-    with np.errstate(over="ignore"):
-        direct = np.expm1(u) - u
-    return np.where(small, _series(np.where(small, u, 0.0), _E2_SERIES, 2), direct)
+    u = np.asarray(u, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = np.expm1(u) - u
+    if out.ndim == 0:
+        return np.asarray(out if abs(u) >= 0.5 else _series(u, _E2_SERIES, 2))
+    small = np.abs(u) < 0.5                      # the series only where it is used
+    if small.any():
+        out[small] = _series(u[small], _E2_SERIES, 2)
+    return out
 
 
 def level_residual(x1: ArrayLike, x2: ArrayLike, a: float, omega: ArrayLike) -> Array:
@@ -277,22 +330,46 @@ def _u_of_m_positive(m: Array) -> Array:
     """
     k = 1.0 - m
     with np.errstate(all="ignore"):
-        bound = 2.0 * m / k
-        for _ in range(3):
-            bound = np.log1p(bound / k)
-        u = np.where(m < 0.25, m * (2.0 + m * (2.0 / 3.0 + m * 4.0 / 9.0)), bound)
-        iterate = m > 1e-4               # below, the series start is exact to ~m^3 already
+        u = m * (2.0 + m * (2.0 / 3.0 + m * 4.0 / 9.0))
+        big = np.flatnonzero(m >= 0.25)  # the bound start, only where it is used
+        if big.size:
+            kb = k[big]
+            bound = 2.0 * m[big] / kb
+            for _ in range(3):
+                bound = np.log1p(bound / kb)
+            u[big] = bound
+        keep = np.flatnonzero(m <= 1e-4)  # the series start is exact to ~m^3 already there
+        u_keep = u[keep]
+        # two Halley steps u -= 2 f f' / (2 f'^2 - f f'') over all states (those in `keep`
+        # are restored after), in place with the same roundings as f = u - k em1,
+        # f' = m - k em1, f'' = -k (em1 + 1) written out
+        em1, f, df, num, den = (np.empty_like(u) for _ in range(5))
         for _ in range(2):
-            em1 = np.expm1(u)
-            f = u - k * em1
-            df = m - k * em1
-            d2f = -k * (em1 + 1.0)
-            u = np.where(iterate, u - 2.0 * f * df / (2.0 * df * df - f * d2f), u)
-        em1 = np.expm1(u)
-        f = u - k * em1
+            np.expm1(u, out=em1)
+            np.multiply(k, em1, out=f)
+            np.subtract(m, f, out=df)                # f'
+            np.subtract(u, f, out=f)                 # f
+            em1 += 1.0
+            em1 *= k
+            np.negative(em1, out=em1)                # f''
+            np.multiply(2.0, f, out=num)
+            num *= df
+            np.multiply(2.0, df, out=den)
+            den *= df
+            em1 *= f
+            den -= em1
+            num /= den
+            u -= num
+        u[keep] = u_keep
+        np.expm1(u, out=em1)                         # Newton: u - f / (m - k em1)
+        np.multiply(k, em1, out=f)
+        np.subtract(m, f, out=den)
+        np.subtract(u, f, out=f)
         small = np.flatnonzero(m < 0.5)
-        f[small] = m[small] * em1[small] - _e2(u[small])
-        return u - f / (m - k * em1)
+        if small.size:
+            f[small] = m[small] * em1[small] - _e2(u[small])
+        f /= den
+        return np.subtract(u, f, out=f)
 
 
 def _u_of_m_negative(m: Array) -> Array:
@@ -338,9 +415,15 @@ def omega_c(x1: ArrayLike, x2: ArrayLike, a: float) -> Array:
     >>> abs(188.5 * 0.1 - 100.0 + wc * np.log1p(100.0 / wc)) < 1e-10
     True
     """
-    x1, x2 = np.broadcast_arrays(np.asarray(x1, dtype=float), np.asarray(x2, dtype=float))
+    return blockwise(lambda b1, b2: _omega_c(b1, b2, a), x1, x2)
+
+
+def _omega_c(x1: Array, x2: Array, a: float) -> Array:
+    """:func:`omega_c` on broadcast float arrays (one block)."""
     with np.errstate(all="ignore"):
         m = -a * x1 / x2
+        if m.ndim and m.size and ((m > 0) & (m < 1)).all():     # every state has a curve
+            return np.abs(x2) / np.expm1(_u_of_m_positive(m))
         w = root_k(np.where((m > 0) & (m < 1), m, 0.5))
         wc = np.abs(x2) / w
     wc = np.where((m > 0) & (m < 1), wc, np.where(m >= 1, 0.0, np.inf))

@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Config
-from ptoverify.curves import level_residual, omega_c, switching_function
+from ptoverify.curves import blockwise, level_residual, omega_c, switching_function
 from ptoverify.errors import InputError
 
 __all__ = ["Region", "Law", "to_law", "pd_law", "pto_law", "pto_corrected_law",
@@ -279,26 +279,41 @@ def pto_law(cfg: Config, omega0: float | None, name: str = "pto", note: str = ""
     zone = omega0 is not None and 0.0 < omega0 < w
     om = float(omega0) if zone else w
 
-    def vector(x1, x2):
-        sig = switching_function(x1, x2, a, w)
-        u, region = _bang(sig, x2, w)
-        if zone:
-            r0 = level_residual(x1, x2, a, om)
-            zp = (x2 < 0) & (sig > 0) & (r0 <= 0)
-            zn = (x2 > 0) & (sig < 0) & (r0 >= 0)
-            inz = zp | zn
-            u = np.array(u, dtype=float)
-            if np.any(inz):                         # closed form only where it is used
-                wc = np.clip(omega_c(x1[inz], x2[inz], a), om, w)
-                u[inz] = np.where(zp[inz], wc, -wc)
-            region = np.where(zp, Region.ZONE_P, np.where(zn, Region.ZONE_N, region))
+    def block(x1, x2):
+        # each branch on the states it acts on (the linear zone first, as it takes
+        # precedence); the same elementwise arithmetic as evaluating every branch
+        # everywhere and selecting, so the result is unchanged
+        u = np.empty(x1.shape)
+        region = np.empty(x1.shape, dtype=np.int8)
         lin = np.abs(x1) < d
-        ul, rl = saturate_linear(-k1 * x1 - k2 * x2, w)
-        u = np.where(lin, ul, u)
-        region = np.where(lin, rl, region)
+        if lin.any():
+            u[lin], region[lin] = saturate_linear(-k1 * x1[lin] - k2 * x2[lin], w)
+        out = ~lin
+        if out.any():
+            y1, y2 = x1[out], x2[out]
+            sig = switching_function(y1, y2, a, w)
+            uo, ro = _bang(sig, y2, w)
+            if zone:
+                cand = np.flatnonzero(((y2 < 0) & (sig > 0)) | ((y2 > 0) & (sig < 0)))
+                if cand.size:
+                    c1, c2 = y1[cand], y2[cand]
+                    r0 = level_residual(c1, c2, a, om)
+                    zp = (c2 < 0) & (r0 <= 0)
+                    inz = zp | ((c2 > 0) & (r0 >= 0))
+                    if inz.any():                   # closed form only where it is used
+                        wc = np.clip(omega_c(c1[inz], c2[inz], a), om, w)
+                        zpi = zp[inz]
+                        idx = cand[inz]
+                        uo[idx] = np.where(zpi, wc, -wc)
+                        ro[idx] = np.where(zpi, Region.ZONE_P, Region.ZONE_N)
+            u[out], region[out] = uo, ro
         origin = (x1 == 0) & (x2 == 0)
-        return (np.where(origin, 0.0, u),
-                np.where(origin, Region.ORIGIN, region).astype(np.int8))
+        if origin.any():
+            u[origin], region[origin] = 0.0, Region.ORIGIN
+        return u, region
+
+    def vector(x1, x2):
+        return blockwise(block, x1, x2)
 
     def scalar(x1: float, x2: float) -> tuple[float, int]:
         if x1 == 0.0 and x2 == 0.0:

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Plant
-from ptoverify.curves import h, switching_function
+from ptoverify.curves import blockwise, h, switching_function
 from ptoverify.errors import InputError
 
 __all__ = ["MinTime", "min_time", "DiscreteMinTime", "ZOHReach", "discrete_min_steps",
@@ -81,8 +81,13 @@ def min_time(x1: ArrayLike, x2: ArrayLike, plant: Plant) -> MinTime:
     >>> 0.02 < float(mt.t_f) < 0.03, float(mt.t_switch) < float(mt.t_f)
     (True, True)
     """
-    a, w = plant.a, plant.w_max
-    x1, x2 = np.broadcast_arrays(np.asarray(x1, dtype=float), np.asarray(x2, dtype=float))
+    t_f, t_switch, side, q = blockwise(lambda b1, b2: _min_time(b1, b2, plant.a, plant.w_max),
+                                       x1, x2)
+    return MinTime(t_f=t_f, t_switch=t_switch, side=side, q=q)
+
+
+def _min_time(x1: NDArray, x2: NDArray, a: float, w: float) -> tuple[NDArray, ...]:
+    """:func:`min_time` on broadcast float arrays (one block): (t_f, t_switch, side, q)."""
     sigma = switching_function(x1, x2, a, w)
     side = np.where(sigma > 0, 1.0, np.where(sigma < 0, -1.0, np.where(x2 < 0, 1.0, -1.0)))
     y1, y2 = side * x1, side * x2
@@ -98,8 +103,8 @@ def min_time(x1: ArrayLike, x2: ArrayLike, plant: Plant) -> MinTime:
     t1 = np.maximum((lq + (a * y1 + y2) / w) / a, 0.0)
     origin = (x1 == 0) & (x2 == 0)
     zero = np.zeros_like(t1)
-    return MinTime(t_f=np.where(origin, zero, t1 + t2), t_switch=np.where(origin, zero, t1),
-                   side=np.where(origin, zero, side), q=np.where(origin, zero, side * q))
+    return (np.where(origin, zero, t1 + t2), np.where(origin, zero, t1),
+            np.where(origin, zero, side), np.where(origin, zero, side * q))
 
 
 # ---------------------------------------------------------------- discrete-time limit
