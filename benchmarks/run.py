@@ -36,7 +36,7 @@ if sys.path[0] != str(ROOT):
     sys.path.insert(0, str(ROOT))
 
 from ptoverify.config import paper_config  # noqa: E402
-from ptoverify.curves import omega_c  # noqa: E402
+from ptoverify.curves import blockwise, omega_c  # noqa: E402
 from ptoverify.laws import make_law  # noqa: E402
 from ptoverify.mintime import discrete_min_steps, min_time  # noqa: E402
 from ptoverify.simulate import simulate_batch  # noqa: E402
@@ -56,7 +56,7 @@ TARGETS = {  # key: (target, ">=" or "<=")
 }
 
 FULL = {"law": 10**6, "scalar": 20000, "omega": 10**5, "mintime": 10**6, "sim_states": 10000,
-        "sim_steps": 250, "two_phase": 50, "collocation": 20, "repeat": 5, "cli_repeat": 3}
+        "sim_steps": 250, "two_phase": 50, "collocation": 20, "repeat": 7, "cli_repeat": 3}
 SMALL = {"law": 2000, "scalar": 200, "omega": 2000, "mintime": 2000, "sim_states": 100,
          "sim_steps": 20, "two_phase": 3, "collocation": 2, "repeat": 2, "cli_repeat": 1}
 
@@ -80,6 +80,23 @@ def median_time(fn, repeat: int) -> float:
     return statistics.median(times)
 
 
+def median_times(fns: list, repeat: int) -> list[float]:
+    """Median wall times [s] of several functions timed in turn, for a ratio.
+
+    Each round times every function once, so a change of machine load during
+    the run falls on all of them alike.
+    """
+    for fn in fns:
+        fn()
+    times = [[] for _ in fns]
+    for _ in range(repeat):
+        for t, fn in zip(times, fns, strict=True):
+            t0 = time.perf_counter()
+            fn()
+            t.append(time.perf_counter() - t0)
+    return [statistics.median(t) for t in times]
+
+
 # ---------------------------------------------------------------- laws
 def bench_law_vector(cfg, size: dict) -> float:
     law = make_law("pto", cfg)
@@ -87,10 +104,17 @@ def bench_law_vector(cfg, size: dict) -> float:
     return size["law"] / median_time(lambda: law.vector(x1, x2), size["repeat"])
 
 
-def bench_law_scalar(cfg, size: dict) -> float:
-    """Mean time of one ``law.scalar`` call over random envelope states [us], median of runs."""
+def bench_law_scalar(cfg, size: dict, zone_only: bool = False) -> float:
+    """Mean time of one ``law.scalar`` call over random envelope states [us], median of runs.
+
+    ``zone_only``: only states where the law uses omega_c (the costliest branch).
+    """
     law = make_law("pto", cfg)
-    x1, x2 = envelope_states(cfg, size["scalar"], 2)
+    x1, x2 = envelope_states(cfg, 50 * size["scalar"] if zone_only else size["scalar"], 2)
+    if zone_only:
+        _, region = law.vector(x1, x2)
+        sel = np.flatnonzero((region == 3) | (region == 4))[: size["scalar"]]
+        x1, x2 = x1[sel], x2[sel]
     pairs = list(zip(x1.tolist(), x2.tolist(), strict=True))
     f = law.scalar
 
@@ -136,11 +160,16 @@ def omega_states(cfg, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
 def bench_omega(cfg, size: dict) -> dict:
     a = cfg.plant.a
     x1, x2 = omega_states(cfg, size["omega"], 3)
-    t_closed = median_time(lambda: omega_c(x1, x2, a), size["repeat"])
-    t_bisect = median_time(lambda: omega_c_bisection(x1, x2, a), size["repeat"])
+    t_closed, t_bisect = median_times([lambda: omega_c(x1, x2, a),
+                                       lambda: omega_c_bisection(x1, x2, a)], size["repeat"])
+    # the same bisection given the closed form's blockwise evaluation (not the key: a
+    # check that the ratio measures the method, not the memory traffic)
+    t_blocked = median_time(lambda: blockwise(lambda b1, b2: omega_c_bisection(b1, b2, a),
+                                              x1, x2), size["repeat"])
     rel = np.abs(omega_c_bisection(x1, x2, a) / omega_c(x1, x2, a) - 1.0)
     return {"ratio": t_bisect / t_closed, "closed_ms": 1e3 * t_closed,
-            "bisection_ms": 1e3 * t_bisect, "max_rel_diff": float(np.max(rel))}
+            "bisection_ms": 1e3 * t_bisect, "blocked_bisection_ms": 1e3 * t_blocked,
+            "max_rel_diff": float(np.max(rel))}
 
 
 # ---------------------------------------------------------------- min time, simulation
@@ -257,6 +286,7 @@ def run(small: bool) -> tuple[dict, dict]:
     out, extra = {}, {}
     out["law_vector_evals_per_s"] = bench_law_vector(cfg, size)
     out["law_scalar_us"] = bench_law_scalar(cfg, size)
+    extra["law_scalar_zone_us"] = bench_law_scalar(cfg, size, zone_only=True)
     om = bench_omega(cfg, size)
     out["omega_c_bisection_vs_closed_form"] = om["ratio"]
     extra["omega_c"] = om
@@ -292,10 +322,14 @@ def table(out: dict, extra: dict) -> str:
     om, oc = extra["omega_c"], extra["ocp"]
     rows += ["",
              f"omega_c: bisection {om['bisection_ms']:.1f} ms vs closed form "
-             f"{om['closed_ms']:.2f} ms, max rel diff {om['max_rel_diff']:.2g}",
+             f"{om['closed_ms']:.2f} ms, max rel diff {om['max_rel_diff']:.2g}; blockwise "
+             f"bisection {om['blocked_bisection_ms']:.1f} ms "
+             f"(ratio {om['blocked_bisection_ms'] / om['closed_ms']:.3g})",
              f"t_f rel error median: collocation {oc['collocation_err']:.3g}, two-phase "
              f"{oc['two_phase_err']:.3g}; solver failures {oc['failures']}",
-             f"vector law vs scalar law (per-state speed-up): {extra['vector_vs_scalar']:.3g}"]
+             f"vector law vs scalar law (per-state speed-up): {extra['vector_vs_scalar']:.3g}",
+             f"scalar law on switching-zone states only (omega_c by Newton): "
+             f"{extra['law_scalar_zone_us']:.3g} us"]
     for k in ("check_note", "report_note"):
         if extra[k]:
             rows.append(f"{k}: {extra[k]}")
