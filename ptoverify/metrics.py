@@ -142,7 +142,7 @@ def oscillation_amplitude(e: ArrayLike) -> float:
 
 
 def sign_reversals(e: ArrayLike, band: float) -> int:
-    """Number of sign reversals of a signal, with hysteresis.
+    """Count the sign reversals of a signal, with hysteresis.
 
     Samples with |e| <= band are ignored, so noise-sized wiggles around zero
     do not count: a reversal is a sample above +band following one below
@@ -368,7 +368,7 @@ def time_to_linear_zone(t: ArrayLike, region: ArrayLike,
 
 
 def input_switches(u: ArrayLike, *, tol: float = 0.0) -> int:
-    """Number of input switches: sign reversals of u between samples.
+    """Count the input switches: sign reversals of u between samples.
 
     Samples with |u| <= tol are skipped (u = 0 at the origin is no switch).
 
