@@ -22,6 +22,7 @@ cancellation.  Both hold for any |x2|, including |x2| >= w_max.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,7 +31,8 @@ from numpy.typing import ArrayLike, NDArray
 from ptoverify.config import Plant
 from ptoverify.curves import h, switching_function
 
-__all__ = ["MinTime", "min_time"]
+__all__ = ["MinTime", "min_time", "DiscreteMinTime", "ZOHReach", "discrete_min_steps",
+           "discrete_min_steps_batch"]
 
 
 @dataclass(frozen=True)
@@ -97,3 +99,260 @@ def min_time(x1: ArrayLike, x2: ArrayLike, plant: Plant) -> MinTime:
     zero = np.zeros_like(t1)
     return MinTime(t_f=np.where(origin, zero, t1 + t2), t_switch=np.where(origin, zero, t1),
                    side=np.where(origin, zero, side), q=np.where(origin, zero, side * q))
+
+
+# ---------------------------------------------------------------- discrete-time limit
+@dataclass(frozen=True)
+class DiscreteMinTime:
+    """Fewest ZOH samples to the origin and an input sequence that does it.
+
+    Attributes
+    ----------
+    steps : int
+        N*, the fewest samples after which the sampled plant is exactly at the
+        origin with |u_k| <= w_max (0 at the origin; -1 when not found).
+    time_s : float
+        N* T [s] (NaN when not found).
+    u : ndarray, shape (N*,)
+        An input sequence [mm/s] that reaches the origin in N* samples.
+    status : str
+        ``"optimal"`` (N* found, N* - 1 infeasible, sequence verified by exact
+        simulation), ``"origin"``, or a failure: ``"not_found"`` (no N <=
+        n_max), ``"lp_failed: ..."``, ``"unverified: ..."``,
+        ``"below_continuous_bound"`` (N* T < t_f*, which theory excludes).
+    end : tuple of float
+        State [mm], [mm/s] reached by simulating ``u`` on the exact plant.
+    t_f_continuous : float
+        The closed-form continuous minimum time t_f* [s] the search started from.
+    lp_solves : int
+        Number of linear programs solved.
+    """
+
+    steps: int
+    time_s: float
+    u: NDArray[np.float64]
+    status: str
+    end: tuple[float, float]
+    t_f_continuous: float
+    lp_solves: int
+
+    @property
+    def success(self) -> bool:
+        """True when N* is established (``"optimal"`` or ``"origin"``)."""
+        return self.status in ("optimal", "origin")
+
+
+_END_TOL_X1 = 1e-9      # mm: required end position error of the verified sequence
+_END_TOL_X2 = 1e-6      # mm/s: required end velocity error
+_U_TOL = 1e-9           # relative overshoot of |u| <= w_max tolerated after polishing
+
+
+class ZOHReach:
+    """Reachability generators Ad^m Bd of the ZOH plant, reused across states.
+
+    x_N = Ad^N x0 + sum_k Ad^(N-1-k) Bd u_k, with (eq. 15 sampled, a = bandwidth)
+    Ad^m = [[1, (1 - e^{-a T m}) / a], [0, e^{-a T m}]], written in the
+    dimensionless rows (a x1 / w_max, x2 / w_max) and inputs v = u / w_max so
+    that every linear program has two equality rows and unit bounds.
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant (a [rad/s], w_max [mm/s], sample_time T [s]).
+    """
+
+    def __init__(self, plant: Plant):
+        from ptoverify.plant import zoh_matrices
+
+        self.plant = plant
+        _, bd = zoh_matrices(plant.a, plant.sample_time)
+        self._bd = bd.ravel()
+        self._gen = np.zeros((2, 0))
+
+    def _powers(self, m: NDArray) -> tuple[NDArray, NDArray]:
+        """Return (1 - e^{-a T m}) / a and e^{-a T m} for integer m >= 0."""
+        at = self.plant.a * self.plant.sample_time
+        return -np.expm1(-at * m) / self.plant.a, np.exp(-at * m)
+
+    def generators(self, n: int) -> NDArray[np.float64]:
+        """Dimensionless columns for u_0..u_{n-1}, shape (2, n)."""
+        if self._gen.shape[1] < n:
+            m = np.arange(max(n, 2 * self._gen.shape[1]), dtype=float)
+            p12, p22 = self._powers(m)
+            b1, b2 = self._bd
+            a, w = self.plant.a, self.plant.w_max
+            self._gen = np.vstack([a * (b1 + p12 * b2), p22 * b2])   # times w / (w, w/a)
+        return self._gen[:, n - 1::-1] if n > 0 else np.zeros((2, 0))
+
+    def free(self, x1: float, x2: float, n: int) -> NDArray[np.float64]:
+        """Dimensionless Ad^n x0."""
+        p12, p22 = self._powers(np.float64(n))
+        a, w = self.plant.a, self.plant.w_max
+        return np.array([a / w * (x1 + p12 * x2), p22 * x2 / w])
+
+    def feasible(self, x1: float, x2: float, n: int) -> tuple[bool, NDArray | None, str]:
+        """Whether n samples reach the origin with |u| <= w_max, by an LP (HiGHS).
+
+        Parameters
+        ----------
+        x1, x2 : float
+            Initial state [mm], [mm/s].
+        n : int
+            Number of samples, n >= 1.
+
+        Returns
+        -------
+        feasible : bool
+        u : ndarray or None
+            A polished input sequence [mm/s] (exact to round-off) when feasible.
+        status : str
+            ``"feasible"``, ``"infeasible"``, ``"boundary"`` (the LP is feasible
+            only within its tolerance: treated as infeasible) or ``"lp_failed: ..."``.
+        """
+        from scipy.optimize import linprog
+
+        A = self.generators(n)
+        b = -self.free(x1, x2, n)
+        res = linprog(np.zeros(n), A_eq=A, b_eq=b, bounds=(-1.0, 1.0), method="highs-ds")
+        if res.status == 2:
+            return False, None, "infeasible"
+        if res.status != 0:
+            return False, None, f"lp_failed: {res.message}"
+        v = _polish(A, b, np.asarray(res.x, dtype=float))
+        if np.max(np.abs(v)) > 1.0 + _U_TOL:
+            return False, None, "boundary"
+        return True, np.clip(v, -1.0, 1.0) * self.plant.w_max, "feasible"
+
+
+def _polish(A: NDArray, b: NDArray, v: NDArray) -> NDArray[np.float64]:
+    """Solve A v = b to round-off, moving only the inputs not at their bounds."""
+    v = v.copy()
+    slack = 1.0 - np.abs(v)
+    free = np.nonzero(slack > 1e-9)[0]
+    if free.size < 2:                        # pad with the inputs closest to interior
+        free = np.argsort(-slack)[:2]
+    v[np.setdiff1d(np.arange(v.size), free)] = np.sign(v[np.setdiff1d(np.arange(v.size), free)])
+    for _ in range(3):
+        r = b - A @ v
+        v[free] += np.linalg.lstsq(A[:, free], r, rcond=None)[0]
+    return v
+
+
+def _simulate_zoh(x1: float, x2: float, u: NDArray, plant: Plant) -> tuple[float, float]:
+    from ptoverify.plant import flow
+
+    for uk in u:
+        x1, x2 = flow(x1, x2, uk, plant.sample_time, plant.a)
+    return float(x1), float(x2)
+
+
+def discrete_min_steps(x1: float, x2: float, plant: Plant, n_max: int = 20000,
+                       reach: ZOHReach | None = None, confirm: bool = True) -> DiscreteMinTime:
+    """Fewest ZOH samples N* to reach the origin exactly, |u_k| <= w_max.
+
+    Linear-programming feasibility (scipy HiGHS, two equality rows from the
+    reachability matrix) with exponential search and bisection over N.  No
+    sampled input beats the continuous optimum, N* T >= t_f*, so the search
+    starts at ceil(t_f* / T); feasibility is monotone in N (u = 0 holds the
+    origin).  The returned sequence is polished to round-off and verified by
+    simulating the exact plant (eq. 7): |x1| <= 1e-9 mm, |x2| <= 1e-6 mm/s.
+
+    Parameters
+    ----------
+    x1, x2 : float
+        Initial position [mm] and velocity [mm/s]; any finite values.
+    plant : Plant
+        The plant (a [rad/s], w_max [mm/s], sample_time T [s]).
+    n_max : int
+        Largest N tried.
+    reach : ZOHReach, optional
+        Precomputed generators of this plant (reuse across states).
+    confirm : bool
+        Also solve the LP at N* - 1 and check that it is infeasible.
+
+    Returns
+    -------
+    DiscreteMinTime
+        N*, N* T [s], the sequence and the status.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> plant = paper_config().plant
+    >>> d = discrete_min_steps(5.0, 0.0, plant)
+    >>> d.status, d.time_s >= float(min_time(5.0, 0.0, plant).t_f)
+    ('optimal', True)
+    """
+    x1, x2 = float(x1), float(x2)
+    tf = float(min_time(x1, x2, plant).t_f)
+    if x1 == 0.0 and x2 == 0.0:
+        return DiscreteMinTime(0, 0.0, np.zeros(0), "origin", (0.0, 0.0), 0.0, 0)
+    reach = reach if reach is not None and reach.plant == plant else ZOHReach(plant)
+    n0 = max(1, math.ceil(tf / plant.sample_time - 1e-9))
+    solves = 0
+
+    def fail(status: str) -> DiscreteMinTime:
+        return DiscreteMinTime(-1, math.nan, np.zeros(0), status, (x1, x2), tf, solves)
+
+    if n0 > n_max:
+        return fail("not_found")
+    lo, hi, u_hi, step = n0 - 1, n0, None, 1
+    while True:                               # exponential search for a feasible N
+        ok, u, st = reach.feasible(x1, x2, hi)
+        solves += 1
+        if st.startswith("lp_failed"):
+            return fail(st)
+        if ok:
+            u_hi = u
+            break
+        lo, hi, step = hi, hi + step, 2 * step
+        if hi > n_max:
+            return fail("not_found")
+    while hi - lo > 1:                        # bisection: lo infeasible, hi feasible
+        mid = (lo + hi) // 2
+        ok, u, st = reach.feasible(x1, x2, mid)
+        solves += 1
+        if st.startswith("lp_failed"):
+            return fail(st)
+        if ok:
+            hi, u_hi = mid, u
+        else:
+            lo = mid
+    status = "optimal"
+    if confirm and hi == n0 and hi > 1:       # N* - 1 was assumed, not solved: check it
+        ok, _, st = reach.feasible(x1, x2, hi - 1)
+        solves += 1
+        if ok:
+            status = "below_continuous_bound"
+        elif st.startswith("lp_failed"):
+            status = st
+    end = _simulate_zoh(x1, x2, u_hi, plant)
+    if abs(end[0]) > _END_TOL_X1 or abs(end[1]) > _END_TOL_X2:
+        status = f"unverified: end state ({end[0]:.3g} mm, {end[1]:.3g} mm/s)"
+    return DiscreteMinTime(hi, hi * plant.sample_time, u_hi, status, end, tf, solves)
+
+
+def discrete_min_steps_batch(x1: ArrayLike, x2: ArrayLike, plant: Plant, n_max: int = 20000,
+                             confirm: bool = True) -> list[DiscreteMinTime]:
+    """:func:`discrete_min_steps` for many states, sharing the generators.
+
+    Parameters
+    ----------
+    x1, x2 : array_like
+        Initial positions [mm] and velocities [mm/s]; broadcast, flattened.
+    plant : Plant
+        The plant (a [rad/s], w_max [mm/s], sample_time T [s]).
+    n_max : int
+        Largest N tried.
+    confirm : bool
+        Check N* - 1 by LP where it was not solved during the search.
+
+    Returns
+    -------
+    list of DiscreteMinTime
+        One per state, in flattened order.
+    """
+    x1, x2 = np.broadcast_arrays(np.asarray(x1, dtype=float), np.asarray(x2, dtype=float))
+    reach = ZOHReach(plant)
+    return [discrete_min_steps(a, b, plant, n_max=n_max, reach=reach, confirm=confirm)
+            for a, b in zip(x1.ravel(), x2.ravel(), strict=True)]
