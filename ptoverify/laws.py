@@ -19,10 +19,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Config
-from ptoverify.curves import switching_function
+from ptoverify.curves import level_residual, omega_c, switching_function
 from ptoverify.errors import InputError
 
-__all__ = ["Region", "Law", "to_law", "pd_law", "make_law", "LAW_NAMES", "h_scalar"]
+__all__ = ["Region", "Law", "to_law", "pd_law", "pto_law", "pto_corrected_law",
+           "pto_printed_law", "omega_c_scalar", "make_law", "LAW_NAMES", "h_scalar"]
 
 
 class Region(IntEnum):
@@ -190,7 +191,195 @@ def pd_law(cfg: Config) -> Law:
     return Law("pd", vector, scalar, w, f"PD u = sat(-{kp:g} x1 - {kd:g} x2)")
 
 
-_FACTORIES: dict[str, Callable[[Config], Law]] = {"to": to_law, "pd": pd_law}
+def omega_c_scalar(x1: float, x2: float, a: float) -> float:
+    """Level omega_c of the curve through (x1, x2), eqs. (28)-(32), for Python floats.
+
+    Solves eq. (31) in u = ln(1 + w), where it reads m = 1 - u / (e^u - 1) with
+    m = -a x1 / x2 (eq. 30, m = 1 - k).  m(u) is increasing and concave for
+    u > 0 and m(u) < u / 2, so Newton from u = 2 m climbs monotonically to the
+    root; then omega_c = |x2| / (e^u - 1) (eq. 32).
+
+    Parameters
+    ----------
+    x1, x2 : float
+        State [mm], [mm/s] with x1 x2 < 0.
+    a : float
+        Bandwidth [rad/s].
+
+    Returns
+    -------
+    float
+        omega_c [mm/s]; 0.0 when m >= 1, inf when m <= 0.
+
+    Examples
+    --------
+    >>> wc = omega_c_scalar(0.1, -100.0, 188.5)
+    >>> abs(188.5 * 0.1 - 100.0 + wc * math.log1p(100.0 / wc)) < 1e-10
+    True
+    """
+    m = -a * x1 / x2
+    if m <= 0.0:
+        return math.inf
+    if m >= 1.0:
+        return 0.0
+    u = 2.0 * m
+    for _ in range(60):
+        if u < 1e-3:
+            g = u * (0.5 - u * (1.0 / 12.0 - u * u / 720.0)) - m
+            dg = 0.5 - u / 6.0
+        else:
+            e = math.expm1(u)
+            g = 1.0 - u / e - m
+            dg = ((u - 1.0) * e + u) / (e * e)
+        du = g / dg
+        u -= du
+        if abs(du) <= 4e-16 * u:
+            break
+    return abs(x2) / math.expm1(u)
+
+
+def pto_law(cfg: Config, omega0: float | None, name: str = "pto", note: str = "") -> Law:
+    """PTO law, eq. (35), with the saturated linear zone of eq. (34).
+
+    Regions, first match wins:
+
+    * origin: u = 0;
+    * S_L, |x1| < d: u = sat(-k1 x1 - k2 x2) (eq. 34, clipped at +-w_max);
+    * S~_P u l1*, x2 < 0, sigma > 0 and a x1 + x2 + omega0 ln(1 - x2/omega0) <= 0:
+      u = +omega_c (eqs. 28-32), clipped to [omega0, w_max];
+    * S~_N u l2*, the mirror image: u = -omega_c (eq. 33);
+    * S_P u l1: u = +w_max; S_N u l2: u = -w_max (eq. 12).
+
+    The linear zone takes precedence over the others (the paper's "when the
+    position x1 is smaller than a certain threshold ... linear control").
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (a [rad/s], w_max [mm/s], d [mm], k1 [1/s], k2 [-]).
+    omega0 : float or None
+        Level of l1*, l2* [mm/s], 0 < omega0 < w_max; None: no switching zone.
+    name, note : str
+        Law name and one-line description.
+
+    Returns
+    -------
+    Law
+        The PTO law, |u| <= w_max, odd in the state.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> law = pto_law(paper_config(), 100.0)
+    >>> law.scalar(0.1, 0.0)
+    (-32.300000000000004, 5)
+    """
+    a, w = cfg.plant.a, cfg.plant.w_max
+    d, k1, k2 = cfg.pto.d, cfg.pto.k1, cfg.pto.k2
+    zone = omega0 is not None and 0.0 < omega0 < w
+    om = float(omega0) if zone else w
+
+    def vector(x1, x2):
+        sig = switching_function(x1, x2, a, w)
+        u, region = _bang(sig, x2, w)
+        if zone:
+            r0 = level_residual(x1, x2, a, om)
+            zp = (x2 < 0) & (sig > 0) & (r0 <= 0)
+            zn = (x2 > 0) & (sig < 0) & (r0 >= 0)
+            inz = zp | zn
+            with np.errstate(all="ignore"):
+                wc = np.clip(omega_c(np.where(inz, x1, 1.0), np.where(inz, x2, -1.0), a), om, w)
+            u = np.where(zp, wc, np.where(zn, -wc, u))
+            region = np.where(zp, Region.ZONE_P, np.where(zn, Region.ZONE_N, region))
+        lin = np.abs(x1) < d
+        ul, rl = saturate_linear(-k1 * x1 - k2 * x2, w)
+        u = np.where(lin, ul, u)
+        region = np.where(lin, rl, region)
+        origin = (x1 == 0) & (x2 == 0)
+        return (np.where(origin, 0.0, u),
+                np.where(origin, Region.ORIGIN, region).astype(np.int8))
+
+    def scalar(x1: float, x2: float) -> tuple[float, int]:
+        if x1 == 0.0 and x2 == 0.0:
+            return 0.0, int(Region.ORIGIN)
+        if -d < x1 < d:
+            v = -k1 * x1 - k2 * x2
+            if v > w:
+                return w, int(Region.SATURATED)
+            if v < -w:
+                return -w, int(Region.SATURATED)
+            return v, int(Region.LINEAR)
+        s = sigma_scalar(x1, x2, a, w)
+        if zone:
+            if x2 < 0 and s > 0 and sigma_scalar(x1, x2, a, om) <= 0:
+                return min(max(omega_c_scalar(x1, x2, a), om), w), int(Region.ZONE_P)
+            if x2 > 0 and s < 0 and sigma_scalar(x1, x2, a, om) >= 0:
+                return -min(max(omega_c_scalar(x1, x2, a), om), w), int(Region.ZONE_N)
+        if s < 0 or (s == 0 and x2 < 0):
+            return w, int(Region.BANG_P)
+        return -w, int(Region.BANG_N)
+
+    return Law(name, vector, scalar, w, note or f"PTO eq. (35), omega0 = {om:g} mm/s")
+
+
+def pto_corrected_law(cfg: Config) -> Law:
+    """PTO law with the corrected omega0 (``zones.corrected_zone``, strict reading).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    Law
+        ``pto``; without a usable corrected zone, the law has no switching zone
+        and its note says so.
+    """
+    from ptoverify.zones import zone_for_law
+
+    z = zone_for_law(cfg, "corrected")
+    if z.usable and not z.degenerate:
+        note = (f"PTO eq. (35), corrected omega0 = {z.omega0:.6g} mm/s "
+                f"({'valid' if z.valid else 'NOT valid'})")
+        return pto_law(cfg, z.omega0, "pto", note)
+    return pto_law(cfg, None, "pto", "PTO eq. (35) without switching zone: no corrected omega0 "
+                   f"acts ({z.reason})")
+
+
+def pto_printed_law(cfg: Config) -> Law:
+    """PTO law with omega0 from eqs. (19)-(27) as printed (``zones.printed_zone``).
+
+    When the printed omega0 is not in (0, w_max) the interval [omega0, w_max] of
+    eq. (28) is empty, so the text implies no switching zone: the law is the
+    time-optimal law outside the linear zone, and its note says so.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    Law
+        ``pto-printed``.
+    """
+    from ptoverify.zones import zone_for_law
+
+    z = zone_for_law(cfg, "printed")
+    if z.usable:
+        return pto_law(cfg, z.omega0, "pto-printed",
+                       f"PTO eq. (35), printed omega0 = {z.omega0:.6g} mm/s "
+                       f"({'valid' if z.valid else 'NOT valid'})")
+    return pto_law(cfg, None, "pto-printed",
+                   f"printed omega0 = {z.omega0:.6g} mm/s is not below w_max = {cfg.plant.w_max:g}"
+                   " mm/s: [omega0, w_max] is empty, so no switching zone; time-optimal outside"
+                   " the linear zone, saturated eq. (34) inside")
+
+
+_FACTORIES: dict[str, Callable[[Config], Law]] = {"to": to_law, "pd": pd_law,
+                                                  "pto": pto_corrected_law,
+                                                  "pto-printed": pto_printed_law}
 LAW_NAMES: tuple[str, ...] = ("to", "pd", "pto", "pto-printed")
 
 

@@ -52,6 +52,7 @@ right); the scan over (0, w_max] does not rely on it.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -358,12 +359,12 @@ def printed_zone(cfg: Config) -> PTOZone:
     details = {"usable": usable, "margin_lenient_mm_s": margin_l, **img}
     return PTOZone("printed", om, x20, num["b0"], num["y_star"], num["k"], num["z_star"],
                    valid, degenerate, "; ".join(reasons), (), "strict", margin, -1, 0,
-                   _NAN, details)
+                   smallest_d(cfg, "strict"), details)
 
 
 # ------------------------------------------------------------------ corrected
 def _degenerate(cfg: Config, omega0: float) -> bool:
-    """True when l1* stays inside |x1| < d over the envelope, so the zone never acts."""
+    """Return True when l1* stays inside |x1| < d over the envelope (zone never acts)."""
     a, w, d = cfg.plant.a, cfg.plant.w_max, cfg.pto.d
     if not 0 < omega0 < w:
         return True
@@ -509,13 +510,14 @@ def corrected_zone(cfg: Config, *, reading: str = "strict", scan: int = 200,
                    tuple(intervals), reading, margin, viol, pts, dmin, details)
 
 
+@functools.lru_cache(maxsize=32)
 def zone_for_law(cfg: Config, variant: str) -> PTOZone:
     """Zone the ``pto`` (``corrected``) or ``pto-printed`` (``printed``) law uses."""
     return corrected_zone(cfg, verify=False) if variant == "corrected" else printed_zone(cfg)
 
 
 def zone_summary(cfg: Config, *, verify: bool = True) -> dict:
-    """The ``ptoverify zone --json`` object (shared/DESIGN.md keys plus extras).
+    """Return the ``ptoverify zone --json`` object (DESIGN.md keys plus extras).
 
     Parameters
     ----------
