@@ -293,11 +293,13 @@ def plot_fig6(cfg: Config, law: str = "pto", ax=None, *, x0: tuple[float, float]
     line, = ax.plot(b.x1[:, 0], b.x2[:, 0], color="0.4", lw=0.8, label=f"{law} trajectory")
     drawn[line.get_label()] = line
     reg = b.region[:, 0]
+    lo, hi = ax.get_xlim()
+    ax.set_xlim(min(lo, 1.15 * min(x0[0], 0)), max(hi, 1.15 * max(x0[0], 0)))
     for code, (col, lab) in REGION_STYLE.items():
         k = np.flatnonzero(reg == code)
         if k.size:
-            drawn[lab] = ax.scatter(b.x1[k, 0], b.x2[k, 0], s=14, color=col, zorder=3,
-                                    label=f"sample in {lab}")
+            key = f"sample in {lab}"
+            drawn[key] = ax.scatter(b.x1[k, 0], b.x2[k, 0], s=14, color=col, zorder=3, label=key)
     ax.set_title(f"Fig. 6: {law} from ({x0[0]:g} mm, {x0[1]:g} mm/s), region of each sample",
                  fontsize=9)
     ax.legend(fontsize=6, loc="lower left")
@@ -309,6 +311,9 @@ def _sims(cfg: Config, signal: str, feedforward: bool) -> dict[str, SimResult]:
             for name in LAW_NAMES}
 
 
+_FIGNUM = {("step", "position"): 7, ("step", "error"): 8, ("ramp", "position"): 9,
+           ("ramp", "velocity"): 10, ("ramp", "error"): 11, ("sine", "position"): 12,
+           ("sine", "velocity"): 13}
 _QUANT = {"position": ("x1", "position x1 [mm]"), "velocity": ("x2", "velocity x2 [mm/s]"),
           "error": ("e", "error r - x1 [mm]")}
 
@@ -359,7 +364,9 @@ def plot_response(cfg: Config, signal: str, quantity: str = "position", ax=None,
         drawn[ld.get_label()], drawn[lb.get_label()] = ld, lb
         ax.set_ylim(-3 * d, 3 * d) if signal != "sine" else None
     ff = "feed-forward" if feedforward else "no feed-forward"
-    _finish(ax, f"{signal} response: {quantity} ({ff}, a = {cfg.plant.a:.4g} rad/s)", drawn,
+    fig = _FIGNUM.get((signal, quantity))
+    num = f"Fig. {fig}: " if fig else ""
+    _finish(ax, f"{num}{signal} response: {quantity} ({ff}, a = {cfg.plant.a:.4g} rad/s)", drawn,
             xlab="time t [s]", ylab=ylab)
     return drawn
 
