@@ -110,9 +110,21 @@ def _add_mintime(sub) -> None:
     p.set_defaults(handler=_cmd_mintime)
 
 
-def mintime_result(cfg: Config, x1: float, x2: float, intervals: int) -> dict[str, Any]:
-    """Compute the ``mintime`` JSON object (DESIGN.md keys)."""
-    from ptoverify.mintime import min_time
+def mintime_result(cfg: Config, x1: float, x2: float, intervals: int,
+                   max_iter: int | None = None) -> dict[str, Any]:
+    """Compute the ``mintime`` JSON object (DESIGN.md keys plus status keys).
+
+    A reference whose solver did not converge (or an N* search that failed) is
+    reported as null with its status in ``<name>_status``: unverified, never truth.
+    ``max_iter`` caps IPOPT's iterations (default: the solvers' own caps).
+
+    States beyond 1000 x the envelope (|x1| > 1000 position_range or
+    |x2| > 1000 w_max) are rejected (InputError, exit 2).  Inside that, every
+    number is computed; N* is searched up to 20000 samples and is null with
+    ``discrete_status`` "not_found: ..." beyond.
+    """
+    from ptoverify.mintime import discrete_min_steps, min_time
+    from ptoverify.ocp import CollocationOCP, TwoPhaseOCP
 
     plant = cfg.plant
     limit = 1e3 * plant.position_range
@@ -120,7 +132,32 @@ def mintime_result(cfg: Config, x1: float, x2: float, intervals: int) -> dict[st
         raise InputError(f"state ({x1:g}, {x2:g}) is far outside the envelope "
                          f"(|x1| <= {limit:g} mm, |x2| <= {1e3 * plant.w_max:g} mm/s accepted)")
     mt = min_time(x1, x2, plant)
-    return {"x0": [x1, x2], "analytic_s": float(mt.t_f), "switch_time_s": float(mt.t_switch)}
+    caps = {} if max_iter is None else {"max_iter": max_iter}
+    tp = TwoPhaseOCP(plant, **caps).solve(x1, x2)
+    co = CollocationOCP(plant, intervals=intervals, **caps).solve(x1, x2)
+    dm = discrete_min_steps(x1, x2, plant)
+
+    def verified(value: float, ok: bool) -> float | None:
+        return float(value) if ok else None
+
+    return {
+        "x0": [x1, x2],
+        "analytic_s": float(mt.t_f),
+        "switch_time_s": float(mt.t_switch),
+        "two_phase_s": verified(tp.t_f, tp.success),
+        "collocation_s": verified(co.t_f, co.success),
+        "collocation_intervals": intervals,
+        "discrete_steps": dm.steps if dm.success else None,
+        "discrete_s": verified(dm.time_s, dm.success),
+        "two_phase_switch_time_s": verified(tp.t_switch, tp.success),
+        "two_phase_status": tp.status,
+        "two_phase_iterations": tp.iterations,
+        "collocation_status": co.status,
+        "collocation_iterations": co.iterations,
+        "collocation_resim_error_mm": verified(co.resim_error, co.success),
+        "discrete_status": dm.status,
+        "sample_time_s": plant.sample_time,
+    }
 
 
 def _cmd_mintime(args: argparse.Namespace) -> int:

@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Plant
 from ptoverify.curves import h, switching_function
+from ptoverify.errors import InputError
 
 __all__ = ["MinTime", "min_time", "DiscreteMinTime", "ZOHReach", "discrete_min_steps",
            "discrete_min_steps_batch"]
@@ -180,8 +181,8 @@ class ZOHReach:
             m = np.arange(max(n, 2 * self._gen.shape[1]), dtype=float)
             p12, p22 = self._powers(m)
             b1, b2 = self._bd
-            a, w = self.plant.a, self.plant.w_max
-            self._gen = np.vstack([a * (b1 + p12 * b2), p22 * b2])   # times w / (w, w/a)
+            a = self.plant.a
+            self._gen = np.vstack([a * (b1 + p12 * b2), p22 * b2])  # diag(a/w, 1/w) Ad^m Bd w
         return self._gen[:, n - 1::-1] if n > 0 else np.zeros((2, 0))
 
     def free(self, x1: float, x2: float, n: int) -> NDArray[np.float64]:
@@ -284,6 +285,8 @@ def discrete_min_steps(x1: float, x2: float, plant: Plant, n_max: int = 20000,
     ('optimal', True)
     """
     x1, x2 = float(x1), float(x2)
+    if not (math.isfinite(x1) and math.isfinite(x2)):
+        raise InputError(f"state ({x1}, {x2}) is not finite")
     tf = float(min_time(x1, x2, plant).t_f)
     if x1 == 0.0 and x2 == 0.0:
         return DiscreteMinTime(0, 0.0, np.zeros(0), "origin", (0.0, 0.0), 0.0, 0)
@@ -295,7 +298,7 @@ def discrete_min_steps(x1: float, x2: float, plant: Plant, n_max: int = 20000,
         return DiscreteMinTime(-1, math.nan, np.zeros(0), status, (x1, x2), tf, solves)
 
     if n0 > n_max:
-        return fail("not_found")
+        return fail(f"not_found: N* > n_max = {n_max}")
     lo, hi, u_hi, step = n0 - 1, n0, None, 1
     while True:                               # exponential search for a feasible N
         ok, u, st = reach.feasible(x1, x2, hi)
@@ -307,7 +310,7 @@ def discrete_min_steps(x1: float, x2: float, plant: Plant, n_max: int = 20000,
             break
         lo, hi, step = hi, hi + step, 2 * step
         if hi > n_max:
-            return fail("not_found")
+            return fail(f"not_found: N* > n_max = {n_max}")
     while hi - lo > 1:                        # bisection: lo infeasible, hi feasible
         mid = (lo + hi) // 2
         ok, u, st = reach.feasible(x1, x2, mid)
