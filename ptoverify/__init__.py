@@ -9,8 +9,13 @@ plant       flow (eq. 7), step (one-sample map, eq. 15), zoh_matrices
 curves      switching_function, level_residual (eqs. 9, 11, 13, 14, 28, 33), Lambert-W roots
             root_22 (eq. 22), root_k (eqs. 26, 31), omega_c (eq. 32), bisection references
 mintime     min_time: closed-form minimum time and switch time from any state
-laws        Law, Region; to_law (eq. 12), pd_law; make_law(name, cfg)
+zones       PTOZone; printed_zone (eqs. 19-27 as printed, judged), corrected_zone (largest
+            omega0 meeting the no-stride-over principle, verified on a grid), zone_summary
+laws        Law, Region; to_law (eq. 12), pd_law, pto_law (eq. 35: pto, pto-printed); make_law
 simulate    simulate (sampled closed loop on step/ramp/sine), simulate_batch
+properties  closed-loop properties over a grid: stride-overs, limit cycles, chattering, overshoot
+poles       PD and linear-zone (eq. 37) loops: poles, damping, margins (python-control), Lyapunov
+plots_zone  figure of the zone geometry with sampled trajectories (matplotlib, Agg)
 cli         the ``ptoverify`` command line
 errors      InputError (exit 2), ConfigError, SolverError
 """

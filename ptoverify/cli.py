@@ -366,6 +366,8 @@ def _add_zone(sub) -> None:
         epilog="example:\n  ptoverify zone --json\n  ptoverify zone --config fast.toml")
     p.add_argument("--no-verify", action="store_true",
                    help="skip the 2-D grid verification of the corrected zone")
+    p.add_argument("--no-outcome", action="store_true",
+                   help="skip the closed-loop outcome (simulation of both PTO variants)")
     p.set_defaults(handler=_cmd_zone)
 
 
@@ -374,6 +376,10 @@ def _cmd_zone(args: argparse.Namespace) -> int:
 
     cfg = _config(args)
     result = zone_summary(cfg, verify=not args.no_verify)
+    if not args.no_outcome:
+        from ptoverify.properties import zone_outcome
+
+        result["outcome"] = zone_outcome(cfg)
     if args.json:
         print_json(result)
         return 0
@@ -385,6 +391,12 @@ def _cmd_zone(args: argparse.Namespace) -> int:
               f"mm/s, valid = {z['valid']}, degenerate = {z['degenerate']}")
         for part in z["reason"].split("; "):
             print(f"  - {part}")
+    for name, o in result.get("outcome", {}).items():
+        print(f"\n[outcome {name}] enters zone before crossing l1/l2: "
+              f"{o['enters_zone_before_crossing']}; settles without overshoot: "
+              f"{o['settles_without_overshoot']} (stride-overs {o['stride_overs']}, crossings "
+              f"into the linear zone {o['crossings_into_linear']}, overshoots {o['overshoots']}, "
+              f"max {o['max_overshoot_mm']:.3g} mm, limit cycles {o['limit_cycles']})")
     return 0
 
 

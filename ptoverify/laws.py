@@ -287,9 +287,10 @@ def pto_law(cfg: Config, omega0: float | None, name: str = "pto", note: str = ""
             zp = (x2 < 0) & (sig > 0) & (r0 <= 0)
             zn = (x2 > 0) & (sig < 0) & (r0 >= 0)
             inz = zp | zn
-            with np.errstate(all="ignore"):
-                wc = np.clip(omega_c(np.where(inz, x1, 1.0), np.where(inz, x2, -1.0), a), om, w)
-            u = np.where(zp, wc, np.where(zn, -wc, u))
+            u = np.array(u, dtype=float)
+            if np.any(inz):                         # closed form only where it is used
+                wc = np.clip(omega_c(x1[inz], x2[inz], a), om, w)
+                u[inz] = np.where(zp[inz], wc, -wc)
             region = np.where(zp, Region.ZONE_P, np.where(zn, Region.ZONE_N, region))
         lin = np.abs(x1) < d
         ul, rl = saturate_linear(-k1 * x1 - k2 * x2, w)

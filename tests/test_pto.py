@@ -1,0 +1,144 @@
+"""PTO law, eq. (35): both variants, omega_c closed form, ZOH riding, properties."""
+
+import math
+import time
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_allclose
+from scipy.linalg import expm
+
+from ptoverify import cli
+from ptoverify.config import paper_config
+from ptoverify.curves import bisect, h, level_residual, omega_c
+from ptoverify.laws import LAW_NAMES, Region, make_law, omega_c_scalar, pto_law
+from ptoverify.zones import corrected_zone, printed_zone
+
+PAPER = paper_config()
+A, W, T = PAPER.plant.a, PAPER.plant.w_max, PAPER.plant.sample_time
+LAWS = {name: make_law(name, PAPER) for name in ("pto", "pto-printed")}
+OMEGA0 = corrected_zone(PAPER, verify=False).omega0
+
+finite_x1 = st.floats(-60.0, 60.0, allow_nan=False)
+finite_x2 = st.floats(-320.0, 320.0, allow_nan=False)
+
+
+@pytest.mark.parametrize("name", ["pto", "pto-printed"])
+def test_registered(name):
+    assert name in LAW_NAMES
+    law = make_law(name, PAPER)
+    assert law.name == name and law.note
+
+
+def test_printed_variant_falls_back_and_says_so():
+    z = printed_zone(PAPER)
+    assert not z.usable
+    law = LAWS["pto-printed"]
+    assert "no switching zone" in law.note and "empty" in law.note
+    # outside the linear zone it is the time-optimal law
+    to = make_law("to", PAPER)
+    x1, x2 = np.linspace(0.6, 50, 300), np.linspace(-300, 300, 300)
+    assert_allclose(law(x1, x2)[0], to(x1, x2)[0], rtol=0, atol=0,
+                    err_msg="pto-printed equals TO outside the linear zone")
+
+
+@settings(max_examples=300, deadline=None)
+@given(finite_x1, finite_x2)
+def test_properties_finite_bounded_odd(x1, x2):
+    for law in LAWS.values():
+        u, r = law.scalar(x1, x2)
+        assert math.isfinite(u) and abs(u) <= W
+        um, _ = law.scalar(-x1, -x2)
+        assert um == -u, (law.name, x1, x2)
+        uv, rv = law(np.array([x1]), np.array([x2]))
+        assert_allclose(uv[0], u, rtol=1e-12, atol=1e-12, err_msg="vector vs scalar u")
+        assert rv[0] == r
+
+
+def test_vector_odd_and_bounded_dense():
+    x1, x2 = np.meshgrid(np.linspace(-50, 50, 301), np.linspace(-300, 300, 301))
+    for law in LAWS.values():
+        u, r = law(x1, x2)
+        um, rm = law(-x1, -x2)
+        assert np.all(np.isfinite(u)) and np.abs(u).max() <= W
+        assert_allclose(um, -u, rtol=0, atol=0, err_msg=f"{law.name} odd symmetry")
+
+
+def test_regions_zone_and_linear():
+    law = LAWS["pto"]
+    d = PAPER.pto.d
+    # a state between l1 and l1* right of the linear zone
+    s = 250.0
+    x1_l1 = W * float(h(s / W)) / A
+    x1_l1s = OMEGA0 * float(h(s / OMEGA0)) / A
+    x1 = 0.5 * (max(x1_l1, d) + x1_l1s)
+    u, r = law.scalar(x1, -s)
+    assert r == Region.ZONE_P and OMEGA0 <= u <= W
+    u, r = law.scalar(-x1, s)
+    assert r == Region.ZONE_N
+    assert law.scalar(0.1, 0.0) == (-PAPER.pto.k1 * 0.1, int(Region.LINEAR))
+    assert law.scalar(0.4, 300.0)[1] == Region.SATURATED
+    assert law.scalar(0.0, 0.0) == (0.0, int(Region.ORIGIN))
+    assert law.scalar(20.0, 0.0) == (-W, int(Region.BANG_N))
+
+
+def test_omega_c_scalar_against_bisection():
+    rng = np.random.default_rng(3)
+    om = rng.uniform(5.0, 300.0, 400)
+    s = rng.uniform(1.0, 300.0, 400)
+    x1 = om * h(s / om) / A                  # on the level-om curve
+    ref = bisect(lambda w: level_residual(x1, -s, A, w), np.full(400, 1e-3),
+                 np.full(400, 1e6))
+    got = np.array([omega_c_scalar(a, -b, A) for a, b in zip(x1, s)])
+    assert_allclose(got, om, rtol=1e-10, err_msg="omega_c scalar recovers the level")
+    assert_allclose(got, ref, rtol=1e-10, err_msg="omega_c scalar vs bisection")
+    assert_allclose(got, omega_c(x1, -s, A), rtol=1e-12, err_msg="scalar vs closed form")
+
+
+def test_zone_state_rides_its_curve_under_zoh():
+    """u = omega_c keeps a sampled state on its curve (one-sample map by expm)."""
+    M = np.zeros((3, 3))
+    M[0, 1], M[1, 1], M[1, 2] = 1.0, -A, A
+    E = expm(M * T)
+    law = LAWS["pto"]
+    for s in (120.0, 200.0, 299.0):
+        x1 = 0.5 * (OMEGA0 * float(h(s / OMEGA0)) + W * float(h(s / W))) / A
+        if x1 < PAPER.pto.d:
+            continue
+        u, r = law.scalar(x1, -s)
+        assert r == Region.ZONE_P
+        y = E @ np.array([x1, -s, u])
+        assert_allclose(level_residual(y[0], y[1], A, u), 0.0, atol=1e-9,
+                        err_msg="residual of the omega_c curve after one sample")
+
+
+def test_scalar_speed():
+    law = LAWS["pto"]
+    pts = [(0.5 * (OMEGA0 * float(h(s / OMEGA0)) + W * float(h(s / W))) / A, -s)
+           for s in np.linspace(150, 300, 200)]
+    pts += [(float(a), float(b)) for a, b in zip(np.linspace(-50, 50, 200),
+                                                 np.linspace(300, -300, 200))]
+    best = math.inf
+    for _ in range(5):
+        t0 = time.perf_counter()
+        for a, b in pts:
+            law.scalar(a, b)
+        best = min(best, (time.perf_counter() - t0) / len(pts))
+    assert best < 20e-6, f"{best * 1e6:.1f} us per call"
+
+
+def test_no_zone_when_omega0_none():
+    law = pto_law(PAPER, None)
+    _, r = law(np.linspace(0.6, 2, 50), np.full(50, -250.0))
+    assert not np.any((r == Region.ZONE_P) | (r == Region.ZONE_N))
+
+
+@pytest.mark.parametrize("name", ["pto", "pto-printed"])
+def test_cli_simulate(name, capsys):
+    import json
+
+    assert cli.main(["simulate", "--law", name, "--signal", "step", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["law"] == name and abs(out["final_error_mm"]) < 1e-3

@@ -1,0 +1,234 @@
+"""Switching zone: printed construction, principle, corrected zone (Section 4)."""
+
+import dataclasses
+import functools
+import json
+import math
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+from scipy.linalg import expm
+
+from ptoverify import cli
+from ptoverify.config import paper_config
+from ptoverify.curves import level_curve_x1, level_residual, root_22_bisect, root_k_bisect
+from ptoverify.plant import flow
+from ptoverify.zones import (
+    corrected_zone,
+    principle_margin,
+    principle_violations,
+    printed_zone,
+    smallest_d,
+)
+
+
+def with_d(cfg, d):
+    return dataclasses.replace(cfg, pto=dataclasses.replace(cfg.pto, d=d))
+
+
+PAPER = paper_config()
+CONFIGS = {
+    "paper": PAPER,
+    "a30": PAPER.with_plant(a=30.0),
+    "T1ms": PAPER.with_plant(sample_time=0.001),
+    "d1": with_d(PAPER, 1.0),
+}
+
+
+@functools.lru_cache(maxsize=None)
+def cz(name, reading="strict"):
+    """Corrected zone of a named configuration, computed once per test session."""
+    return corrected_zone(CONFIGS[name], reading=reading, verify=False)
+
+
+def expm_step(x1, x2, u, a, T):
+    """One ZOH sample by expm of the augmented matrix [[A, B], [0, 0]] (reference)."""
+    M = np.zeros((3, 3))
+    M[0, 1], M[1, 1], M[1, 2] = 1.0, -a, a
+    E = expm(M * T)
+    X = np.stack(np.broadcast_arrays(np.asarray(x1, float), np.asarray(x2, float),
+                                     np.asarray(u, float)))
+    Y = np.tensordot(E, X, axes=1)
+    return Y[0], Y[1]
+
+
+def test_flow_matches_expm():
+    rng = np.random.default_rng(1)
+    x1, x2 = rng.uniform(-50, 50, 500), rng.uniform(-300, 300, 500)
+    u = rng.choice([-300.0, 300.0, 37.0], 500)
+    for a, T in ((PAPER.plant.a, 0.002), (30.0, 0.002), (PAPER.plant.a, 0.001)):
+        ref = expm_step(x1, x2, u, a, T)
+        got = flow(x1, x2, u, T, a)
+        # expm is accurate to a few ulps of the state magnitude (50 mm, 300 mm/s)
+        assert_allclose(got[0], ref[0], atol=1e-11, rtol=0, err_msg="x1 one-sample map")
+        assert_allclose(got[1], ref[1], atol=1e-10, rtol=0, err_msg="x2 one-sample map")
+
+
+def test_printed_numbers_paper():
+    cfg = PAPER
+    a, w, T, d = cfg.plant.a, cfg.plant.w_max, cfg.plant.sample_time, cfg.pto.d
+    z = printed_zone(cfg)
+    b0 = a * d / w + 2 * a * T
+    assert_allclose(z.b0, b0, rtol=1e-15, err_msg="b0, eq. (21)")
+    y_ref = float(root_22_bisect(b0))
+    assert_allclose(z.y_star, y_ref, rtol=1e-13, err_msg="y*, eq. (22) vs bisection")
+    assert_allclose(z.x20_tilde, -y_ref * w, rtol=1e-13, err_msg="x~20, eq. (23)")
+    m = -a * d / z.x20_tilde
+    assert_allclose(z.k, 1 - m, rtol=1e-15, err_msg="k, eq. (25)")
+    z_ref = float(root_k_bisect(m))
+    assert_allclose(z.z_star, z_ref, rtol=1e-12, err_msg="z*, eq. (26) vs bisection")
+    assert_allclose(z.omega0, -z.x20_tilde / z_ref, rtol=1e-12, err_msg="omega0, eq. (27)")
+    # the verdict: beyond the envelope, omega0 above w_max, so invalid
+    assert z.x20_tilde < -w
+    assert z.omega0 > w
+    assert not z.valid and not z.usable
+    assert "empty" in z.reason and "eq. (16)" in z.reason
+
+
+@pytest.mark.parametrize("name", ["paper", "a30", "T1ms", "d1"])
+def test_printed_invalid_everywhere(name):
+    z = printed_zone(CONFIGS[name])
+    assert not z.valid
+    assert z.omega0 > CONFIGS[name].plant.w_max, "printed omega0 above w_max"
+
+
+def test_eq16_sign_error():
+    """Under the +w_max flow of (15) the image of l1 stays on l1 (eq. 9), not on (19)."""
+    a, w, T = PAPER.plant.a, PAPER.plant.w_max, PAPER.plant.sample_time
+    x2 = -np.linspace(1.0, w, 50)
+    x1 = level_curve_x1(x2, a, w)
+    f1, f2 = expm_step(x1, x2, w, a, T)
+    res = a * f1 + f2 + w * np.log1p(-f2 / w)
+    assert_allclose(res, 0.0, atol=1e-9, err_msg="image of l1 under +w_max is on l1")
+    assert np.all(np.abs(res + 2 * a * w * T) > 100), "not on the printed curve (19)"
+    # a x1 + x2 grows by a w T under +w_max (eq. 16 prints a decrease)
+    assert_allclose(a * f1 + f2 - (a * x1 + x2), a * w * T, rtol=1e-9,
+                    err_msg="a x1 + x2 after one sample of +w_max")
+
+
+def brute_margin(cfg, omega0, x2, reading, n=2001):
+    """Worst landing sigma at each velocity over a dense x1 grid, landing by expm."""
+    a, w, T, d = cfg.plant.a, cfg.plant.w_max, cfg.plant.sample_time, cfg.pto.d
+    R = cfg.plant.position_range
+    out = []
+    for v in x2:
+        x1 = np.linspace(-R, R, n)
+        sig = level_residual(x1, v, a, w)
+        zone = (v < 0) & (sig >= 0) & (level_residual(x1, v, a, omega0) < 0)
+        src = (np.abs(x1) >= d) & ((sig > 0) | ((sig == 0) & (v > 0))) & ~zone
+        f1, f2 = expm_step(x1[src], v, -w, a, T)
+        r = level_residual(f1, f2, a, w)
+        if reading == "lenient":
+            r = np.where(np.abs(f1) >= d, r, np.inf)
+        out.append(r.min() if r.size else np.inf)
+    return np.array(out)
+
+
+@pytest.mark.parametrize("reading", ["strict", "lenient"])
+@pytest.mark.parametrize("name", ["paper", "a30"])
+def test_margin_matches_brute_force(name, reading):
+    cfg = CONFIGS[name]
+    w = cfg.plant.w_max
+    x2 = np.linspace(-w, w, 25)
+    for omega0 in (0.05 * w, 0.3 * w, w):
+        exact = principle_margin(cfg, omega0, x2, reading=reading)
+        brute = brute_margin(cfg, omega0, x2, reading)
+        # the exact margin is the infimum; the grid can only find larger values, within
+        # one x1 step (2 R / 2000) times a [mm/s]
+        step = cfg.plant.a * 2 * cfg.plant.position_range / 2000
+        fin = np.isfinite(exact)
+        assert np.array_equal(fin, np.isfinite(brute)), "same velocities have sources"
+        assert np.all(brute[fin] >= exact[fin] - 1e-9), "exact margin is a lower bound"
+        assert_allclose(brute[fin], exact[fin], atol=step * 1.01, rtol=0,
+                        err_msg=f"principle margin, omega0 = {omega0}")
+
+
+@pytest.mark.parametrize("name", ["paper", "a30", "T1ms", "d1"])
+def test_corrected_zone_valid_and_largest(name):
+    cfg = CONFIGS[name]
+    w, a, T = cfg.plant.w_max, cfg.plant.a, cfg.plant.sample_time
+    z = cz(name)
+    assert z.valid and not z.degenerate, z.reason
+    assert 0 < z.omega0 < w
+    assert z.feasible_intervals and z.feasible_intervals[-1][0] == 0.0
+    assert z.feasible_intervals[-1][1] >= z.omega0
+    # just above the edge, some state on l1* strides over l1 (landing by expm)
+    om = z.feasible_intervals[-1][1] * 1.01
+    s = np.linspace(1e-3, 1.0, 20001) * w
+    x1 = level_curve_x1(-s, a, om)
+    x1 = np.maximum(x1, cfg.pto.d)
+    f1, f2 = expm_step(x1, -s, -w, a, T)
+    assert level_residual(f1, f2, a, w).min() < 0, "omega0 1% above the edge fails"
+    # and at the chosen omega0 none does
+    x1 = np.maximum(level_curve_x1(-s, a, z.omega0), cfg.pto.d)
+    f1, f2 = expm_step(x1, -s, -w, a, T)
+    assert level_residual(f1, f2, a, w).min() > -1e-6, "chosen omega0 holds on l1*"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["paper", "a30", "T1ms", "d1"])
+def test_corrected_zone_grid_verified(name):
+    z = cz(name)
+    bad, pts = principle_violations(CONFIGS[name], z.omega0)
+    assert bad == 0 and pts > 100_000
+
+
+def test_mirror_rule():
+    """Rule 2: sources in S_P outside l2* under +w_max land on or below l2."""
+    cfg = PAPER
+    a, w, T, d = cfg.plant.a, cfg.plant.w_max, cfg.plant.sample_time, cfg.pto.d
+    om = cz("paper").omega0
+    x1, x2 = np.meshgrid(np.linspace(-50, 50, 801), np.linspace(-w, w, 301))
+    x1, x2 = x1.ravel(), x2.ravel()
+    sig = level_residual(x1, x2, a, w)
+    zone_n = (x2 > 0) & (sig <= 0) & (level_residual(x1, x2, a, om) > 0)
+    src = (np.abs(x1) >= d) & ((sig < 0) | ((sig == 0) & (x2 < 0))) & ~zone_n
+    f1, f2 = expm_step(x1[src], x2[src], w, a, T)
+    assert level_residual(f1, f2, a, w).max() <= 1e-6
+
+
+def test_lenient_reading_needs_no_zone_at_paper():
+    z = cz("paper", "lenient")
+    assert z.degenerate and not z.valid
+    assert z.feasible_intervals[-1][1] == PAPER.plant.w_max
+
+
+def test_smallest_d_and_infeasible():
+    cfg = PAPER
+    dmin = smallest_d(cfg)
+    assert 0 < dmin < cfg.pto.d
+    lo = corrected_zone(with_d(cfg, 0.9 * dmin), verify=False)
+    assert not lo.valid and not lo.feasible_intervals and "smallest d" in lo.reason
+    assert_allclose(lo.d_min, dmin, rtol=1e-12, err_msg="d_min reported")
+    hi = corrected_zone(with_d(cfg, 1.1 * dmin), verify=False)
+    assert hi.feasible_intervals
+
+
+def test_degenerate_large_d():
+    z = corrected_zone(with_d(PAPER, 2.0), verify=False)
+    assert z.degenerate and not z.valid
+    assert "degenerate" in z.reason
+
+
+def test_violations_counted_above_edge():
+    cfg = PAPER
+    z = cz("paper")
+    bad, pts = principle_violations(cfg, 2 * z.omega0, n1=201, n2=201, band=51)
+    assert bad > 0 and pts > 0
+
+
+def test_cli_zone_json(capsys):
+    assert cli.main(["zone", "--json", "--no-verify"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("printed", "corrected", "d", "w_max"):
+        assert key in out
+    for key in ("omega0", "x20_tilde", "valid", "reason"):
+        assert key in out["printed"] and key in out["corrected"]
+    assert out["printed"]["valid"] is False and out["corrected"]["valid"] is True
+    assert math.isclose(out["d"], PAPER.pto.d)
+
+
+def test_cli_zone_bad_config(tmp_path, capsys):
+    assert cli.main(["zone", "--config", str(tmp_path / "missing.toml")]) == 2
+    assert capsys.readouterr().err.startswith("ptoverify: error:")
