@@ -302,6 +302,9 @@ def _publish(tmp: Path, target: Path) -> None:
             old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old.", dir=target.parent))
             os.replace(target, old / "prev")
         os.replace(tmp, target)
+        umask = os.umask(0)
+        os.umask(umask)
+        target.chmod(0o777 & ~umask)               # mkdtemp made it 0700
     except OSError as exc:
         shutil.rmtree(tmp, ignore_errors=True)
         raise InputError(f"cannot write '{target}': {exc.strerror or exc}") from None
@@ -345,9 +348,13 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
               f"{'median t/N*T':>13} {'worst t/N*T':>12}  worst state (x1 mm, x2 mm/s)")
         for name, r in result["laws"].items():
             ws = r["worst_state_tf"]
-            print(f"{name:<12} {r['fraction_settled']:>8.1%} {r['median_ratio_tf']:>13.3f} "
-                  f"{r['worst_ratio_tf']:>12.3f} {r['median_ratio_nt']:>13.3f} "
-                  f"{r['worst_ratio_nt']:>12.3f}  ({ws[0]:.2f}, {ws[1]:.1f})")
+            num = {k: "n/a" if not math.isfinite(r[k]) else f"{r[k]:.3f}" for k in
+                   ("median_ratio_tf", "worst_ratio_tf", "median_ratio_nt", "worst_ratio_nt")}
+            where = "(never settles)" if not math.isfinite(ws[0]) else \
+                f"({ws[0]:.2f}, {ws[1]:.1f})"
+            print(f"{name:<12} {r['fraction_settled']:>8.1%} {num['median_ratio_tf']:>13} "
+                  f"{num['worst_ratio_tf']:>12} {num['median_ratio_nt']:>13} "
+                  f"{num['worst_ratio_nt']:>12}  {where}")
         for name, why in result["skipped"].items():
             print(f"{name:<12} skipped: {why}")
         for f in result.get("files", []):

@@ -407,7 +407,7 @@ def plot_state_trajectories(cfg: Config, signal: str = "sine", ax=None, *,
     return drawn
 
 
-def plot_sweep(res, law: str, which: str = "tf", ax=None) -> dict:
+def plot_sweep(res, law: str, which: str = "tf", ax=None, *, vmax: float | None = None) -> dict:
     """Heat map of a law's settling time over t_f* (``tf``) or N* T (``nt``).
 
     Parameters
@@ -420,6 +420,8 @@ def plot_sweep(res, law: str, which: str = "tf", ax=None) -> dict:
         Denominator: continuous t_f* or discrete N* T.
     ax : matplotlib Axes, optional
         Where to draw.
+    vmax : float, optional
+        Top of the colour scale [-] (default: the 99th percentile, at least 2).
 
     Returns
     -------
@@ -433,7 +435,8 @@ def plot_sweep(res, law: str, which: str = "tf", ax=None) -> dict:
     den = "t_f*" if which == "tf" else "N* T"
     drawn: dict = {}
     finite = ratio[np.isfinite(ratio)]
-    vmax = max(2.0, float(np.nanpercentile(finite, 99))) if finite.size else 2.0
+    if vmax is None:
+        vmax = max(2.0, float(np.nanpercentile(finite, 99))) if finite.size else 2.0
     drawn["mesh"] = ax.pcolormesh(res.x1, res.x2, np.ma.masked_invalid(ratio), shading="nearest",
                                   cmap="viridis", vmin=min(1.0, finite.min()) if finite.size
                                   else 0.9, vmax=vmax)
@@ -462,7 +465,10 @@ def _save(fig, path: Path, out: list[Path]) -> None:
 
 
 def save_sweep(res, outdir: str | Path) -> list[Path]:
-    """Write the sweep's heat maps (one PNG per denominator, a panel per law)."""
+    """Write the sweep's heat maps (one PNG per denominator, a panel per law).
+
+    The panels of one PNG share their colour scale, so the laws compare by eye.
+    """
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     files: list[Path] = []
@@ -470,9 +476,12 @@ def save_sweep(res, outdir: str | Path) -> list[Path]:
     cols = 2 if len(laws) > 1 else 1
     rows = math.ceil(len(laws) / cols)
     for which in ("tf", "nt"):
+        ratios = [r.ratio_tf if which == "tf" else r.ratio_nt for r in res.laws.values()]
+        finite = np.concatenate([r[np.isfinite(r)] for r in ratios])
+        vmax = max(2.0, float(np.percentile(finite, 99))) if finite.size else 2.0
         fig, axes = plt.subplots(rows, cols, figsize=(5.6 * cols, 4.2 * rows), squeeze=False)
         for ax, law in zip(axes.flat, laws, strict=False):
-            plot_sweep(res, law, which, ax)
+            plot_sweep(res, law, which, ax, vmax=vmax)
         for ax in list(axes.flat)[len(laws):]:
             ax.set_visible(False)
         _save(fig, outdir / f"sweep_ratio_{which}.png", files)
