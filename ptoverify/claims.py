@@ -13,14 +13,21 @@ that can touch it, and each reading gets its own verdict:
 * ``a``: "velocity loop bandwidth is 30Hz" read as a = 2 pi 30 rad/s (the
   suite's default) or as a = 30 rad/s.  Only when the configuration gives the
   bandwidth in Hz; a configuration that gives ``a`` has one reading.
-* ``feedforward``: tracking with or without reference-velocity feed-forward
-  (ramp and sine claims only; the step's reference velocity is 0).
+* ``tracking`` (ramp and sine claims only; the step's reference velocity is 0):
+  how the laws, written for regulation to the origin, track a moving reference.
+  ``feed-forward``: the law sees the error state (x1 - r, x2 - r') and r' is
+  added to its input (``simulate(feedforward=True)``); ``none``: the law sees
+  (x1 - r, x2), nothing is added (``simulate(feedforward=False)``); ``error``:
+  the law sees the error state (x1 - r, x2 - r') and nothing is added, i.e. a
+  PD on the error e and its derivative, the textbook PD.  The third reading is
+  simulated here by :func:`_simulate_error_tracking` (same exact ZOH update as
+  ``simulate``), until ``simulate`` offers it.
 * ``pto``: PTO with the corrected zone (``pto``) or as printed (``pto-printed``),
   for the claims that involve PTO.
 * ``band``: the settling band of "adjustment time", 2 % or 5 % of the step
   (claims that compare settling times).
 
-The primary reading is the first of each: a = 2 pi f, feed-forward on, PTO
+The primary reading is the first of each: a = 2 pi f, feed-forward, PTO
 corrected, 2 % band.  A claim's overall verdict is the common verdict of its
 readings, and ``ambiguous`` when they disagree.
 
@@ -59,7 +66,7 @@ from functools import lru_cache
 import numpy as np
 
 from ptoverify import metrics as mt
-from ptoverify.config import Config
+from ptoverify.config import Config, Plant
 from ptoverify.laws import Law, make_law
 from ptoverify.simulate import SIGNALS, SimResult, simulate
 
@@ -81,8 +88,8 @@ class Reading:
     ----------
     a : str
         ``2pi*f`` (a = 2 pi f rad/s), ``f`` (a = f rad/s) or ``given``.
-    feedforward : bool or None
-        Reference-velocity feed-forward (None: does not apply).
+    tracking : str or None
+        ``feed-forward``, ``none`` or ``error`` (None: does not apply).
     pto : str or None
         ``corrected`` or ``printed`` (None: does not apply).
     band : float or None
@@ -90,7 +97,7 @@ class Reading:
     """
 
     a: str = "given"
-    feedforward: bool | None = None
+    tracking: str | None = None
     pto: str | None = None
     band: float | None = None
 
@@ -98,8 +105,9 @@ class Reading:
         """Describe the reading in words, with the value of a."""
         parts = [f"a = {_a_value(cfg, self.a):.4g} rad/s"
                  + {"2pi*f": " (2 pi f)", "f": " (f in rad/s)"}.get(self.a, "")]
-        if self.feedforward is not None:
-            parts.append("feed-forward" if self.feedforward else "no feed-forward")
+        if self.tracking is not None:
+            parts.append({"feed-forward": "feed-forward", "none": "no feed-forward",
+                          "error": "law on the error, no feed-forward"}[self.tracking])
         if self.pto is not None:
             parts.append(f"PTO {self.pto}")
         if self.band is not None:
@@ -108,7 +116,7 @@ class Reading:
 
     def to_json(self) -> dict:
         """Return the reading as a dict."""
-        return {"a": self.a, "feedforward": self.feedforward, "pto": self.pto,
+        return {"a": self.a, "tracking": self.tracking, "pto": self.pto,
                 "band": self.band}
 
 
@@ -213,8 +221,35 @@ def _law(name: str, cfg: Config) -> Law:
 
 
 @lru_cache(maxsize=256)
-def _sim(cfg: Config, law: str, signal: str, feedforward: bool) -> SimResult:
-    return simulate(_law(law, cfg), cfg.plant, signal, feedforward=feedforward)
+def _sim(cfg: Config, law: str, signal: str, tracking: str) -> SimResult:
+    if tracking == "error":
+        return _simulate_error_tracking(_law(law, cfg), cfg.plant, signal)
+    return simulate(_law(law, cfg), cfg.plant, signal, feedforward=tracking == "feed-forward")
+
+
+def _simulate_error_tracking(law: Law, plant: Plant, signal: str) -> SimResult:
+    """Simulate u_k = sat(law(x1_k - r_k, x2_k - r'_k)), no velocity added.
+
+    Local to the claims (the ``error`` tracking reading) until
+    :func:`~ptoverify.simulate.simulate` offers it; the state update is the same
+    exact ZOH flow (eq. 7 held for T).
+    """
+    ref = SIGNALS[signal]
+    n = int(round(ref.duration / plant.sample_time))
+    t = np.arange(n + 1) * plant.sample_time
+    r, r_dot = ref.r(t), ref.r_dot(t)
+    x1, x2, u = np.zeros(n + 1), np.zeros(n + 1), np.zeros(n + 1)
+    region = np.zeros(n + 1, dtype=np.int8)
+    w, a, T = plant.w_max, plant.a, plant.sample_time
+    g = -math.expm1(-a * T)
+    for k in range(n + 1):
+        v, region[k] = law.scalar(float(x1[k] - r[k]), float(x2[k] - r_dot[k]))
+        u[k] = min(max(v, -w), w)
+        if k < n:
+            dv = x2[k] - u[k]
+            x1[k + 1] = x1[k] + u[k] * T + dv * g / a
+            x2[k + 1] = x2[k] - dv * g
+    return SimResult(law.name, signal, False, t, r, r_dot, x1, x2, r - x1, u, region)
 
 
 class _Ctx:
@@ -223,13 +258,14 @@ class _Ctx:
     def __init__(self, cfg: Config, reading: Reading):
         self.cfg = _cfg_for(cfg, reading)
         self.reading = reading
-        self.ff = True if reading.feedforward is None else reading.feedforward
+        self.tracking = reading.tracking or "feed-forward"
         self.pto = "pto-printed" if reading.pto == "printed" else "pto"
         self.vband = self.cfg.plant.a * mt.TIGHT_BAND
 
     def sim(self, law: str, signal: str) -> SimResult:
         name = self.pto if law == "pto" else law
-        return _sim(self.cfg, name, signal, self.ff if signal != "step" else True)
+        return _sim(self.cfg, name, signal,
+                    self.tracking if signal != "step" else "feed-forward")
 
     def tail(self, law: str, signal: str, what: str = "e") -> np.ndarray:
         r = self.sim(law, signal)
@@ -459,7 +495,8 @@ CLAIMS: tuple[_Claim, ...] = (
 
 def _readings(cfg: Config, dims: tuple[str, ...]) -> list[Reading]:
     a_opts = ["2pi*f", "f"] if cfg.bandwidth_hz is not None else ["given"]
-    opts = {"a": a_opts, "ff": [True, False], "pto": ["corrected", "printed"],
+    opts = {"a": a_opts, "ff": ["feed-forward", "none", "error"],
+            "pto": ["corrected", "printed"],
             "band": [mt.STEP_FRACTION, 0.05]}
     axes = [opts[d] if d in dims else [None] for d in ("a", "ff", "pto", "band")]
     return [Reading(a, ff, pto, band) for a, ff, pto, band in itertools.product(*axes)]

@@ -52,11 +52,13 @@ def test_readings_cover_the_ambiguities(results):
     by = {r.id: r for r in results}
     for r in results:
         assert {x.reading.a for x in r.readings} == {"2pi*f", "f"}, r.id
-    assert {x.reading.feedforward for x in by["sine-pd-delay"].readings} == {True, False}
+    assert {x.reading.tracking for x in by["sine-pd-delay"].readings} == {
+        "feed-forward", "none", "error"}
     assert {x.reading.pto for x in by["sine-pto-delay"].readings} == {"corrected", "printed"}
-    assert {x.reading.feedforward for x in by["step-to-oscillation"].readings} == {None}
+    assert {x.reading.tracking for x in by["step-to-oscillation"].readings} == {None}
     first = by["sine-pto-delay"].readings[0].reading
-    assert (first.a, first.feedforward, first.pto) == ("2pi*f", True, "corrected"), "primary"
+    assert (first.a, first.tracking, first.pto) == ("2pi*f", "feed-forward", "corrected"), \
+        "primary reading"
     one = cl.evaluate_claims(paper_config().with_plant(a=100.0))
     assert all({x.reading.a for x in r.readings} == {"given"} for r in one), \
         "a config giving a in rad/s has a single a-reading"
@@ -95,3 +97,14 @@ def test_cached_and_cheap():
     t2 = time.perf_counter()
     assert t1 - t0 < 10.0, f"evaluate_claims took {t1 - t0:.1f} s"
     assert t2 - t1 < 0.05 and all(a is b for a, b in zip(first, again, strict=True)), "cache"
+
+
+def test_error_tracking_reading_matches_simulate_for_a_step(paper_cfg):
+    """With r' = 0 the local 'error' loop is the feed-forward loop of simulate (same flow)."""
+    from ptoverify.claims import _simulate_error_tracking
+
+    for name in ("pd", "pto"):
+        law = make_law(name, paper_cfg)
+        ref = simulate(law, paper_cfg.plant, "step")
+        loc = _simulate_error_tracking(law, paper_cfg.plant, "step")
+        assert (loc.x1 == ref.x1).all() and (loc.u == ref.u).all(), name
