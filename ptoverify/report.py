@@ -279,7 +279,9 @@ th,td{border:1px solid #ccc;padding:.3em .5em;vertical-align:top;text-align:left
 th{background:#f0f0f0}.pass,.verified,.reproduced{background:#e6f4e6}
 .fail,.erratum,.not-reproduced{background:#fbe3e3}.unverified,.ambiguous,.unchecked{background:#fff4d6}
 img{max-width:100%;border:1px solid #ddd}figure{margin:1em 0}nav a{margin-right:1em}
-math{font-size:1.05em}code{font-size:.85em}"""
+math{font-size:1.05em}code{font-size:.85em}
+table.derivations{table-layout:fixed;width:100%}table.derivations td{overflow-x:auto;
+overflow-wrap:anywhere}table.derivations td:nth-child(-n+2){width:6em}"""
 
 _STATUS_WORDS = {"pass", "fail", "unverified", "verified", "erratum", "unchecked", "definition",
                  "reproduced", "not reproduced", "ambiguous"}
