@@ -15,6 +15,13 @@ laws        Law, Region; to_law (eq. 12), pd_law, pto_law (eq. 35: pto, pto-prin
 simulate    simulate (sampled closed loop on step/ramp/sine), simulate_batch
 properties  closed-loop properties over a grid: stride-overs, limit cycles, chattering, overshoot
 poles       PD and linear-zone (eq. 37) loops: poles, damping, margins (python-control), Lyapunov
+metrics     settling_time (2 % and 0.01 mm bands), overshoot, oscillation_amplitude,
+            sign_reversals, ramp_lag, sine_fit/phase_delay (whole periods), rise_time,
+            time_to_linear_zone, input_switches, summarize
+claims      Section 6 and conclusion claims, each measured under every reading
+            (a = 2 pi f or f, feed-forward, PTO printed/corrected, band); evaluate_claims
+sweep       run_sweep: settling time / t_f* and / N* T over a 50 x 50 grid of initial states
+plots       Figs. 2-14 for TO, PD, PTO (both) and the sweep heat maps; save_all, save_sweep
 plots_zone  figure of the zone geometry with sampled trajectories (matplotlib, Agg)
 cli         the ``ptoverify`` command line
 errors      InputError (exit 2), ConfigError, SolverError

@@ -280,10 +280,125 @@ def _cmd_check(args: argparse.Namespace) -> int:
         for r in results:
             measured = "-" if r.measured is None else f"{r.measured:.3g}"
             limit = "-" if r.limit is None else f"{r.limit:.3g}"
-            print(f"{r.status.upper():<10} {r.name:<40} {measured:>10} <= {limit:<10} {r.detail}")
+            print(f"{r.status.upper():<10} {r.name:<36} measured {measured:>9}  limit {limit:<9} "
+                  f"{r.detail}")
         print(f"{summary['pass']}/{summary['total']} passed, {summary['fail']} failed, "
               f"{summary['unverified']} unverified")
     return 0 if summary["ok"] else 1
+
+
+# ---------------------------------------------------------------- sweep
+def _add_sweep(sub) -> None:
+    p = sub.add_parser(
+        "sweep", help="suboptimality of each law over a grid of initial states",
+        description="Settling time of each law (to 0.01 mm and a * 0.01 mm/s, held 0.05 s) from "
+                    "a grid of initial states over the envelope, divided by the continuous "
+                    "minimum time t_f* and by the discrete limit N* T.",
+        epilog="example:\n  ptoverify sweep --json\n  ptoverify sweep --out sweep-paper")
+    p.add_argument("--out", metavar="DIR", default=None,
+                   help="write heat maps and sweep.json into DIR (atomically)")
+    p.add_argument("--grid", type=positive_int, default=50,
+                   help="grid points per axis (default 50: 2,500 states)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
+    p.set_defaults(handler=_cmd_sweep)
+
+
+def _progress_bar(enabled: bool):
+    """Return a progress callback drawing on stderr, or None."""
+    if not enabled:
+        return None
+
+    def show(stage: str, frac: float) -> None:
+        n = int(round(30 * frac))
+        sys.stderr.write(f"\r[{'#' * n}{'.' * (30 - n)}] {stage:<24}")
+        if frac >= 1.0:
+            sys.stderr.write("\n")
+        sys.stderr.flush()
+
+    return show
+
+
+def _prepare_out(out: str) -> tuple[Path, Path]:
+    """Create a temporary folder beside ``out``; fail early when it cannot be written."""
+    target = Path(out)
+    if target.exists() and not target.is_dir():
+        raise InputError(f"--out '{target}' exists and is not a directory")
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
+    except OSError as exc:
+        raise InputError(f"cannot write '{target}': {exc.strerror or exc}") from None
+    return target, tmp
+
+
+def _publish(tmp: Path, target: Path) -> None:
+    """Move a finished temporary folder to ``target``, replacing an older one."""
+    import shutil
+
+    old = None
+    try:
+        if target.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old.", dir=target.parent))
+            os.replace(target, old / "prev")
+        os.replace(tmp, target)
+        umask = os.umask(0)
+        os.umask(umask)
+        target.chmod(0o777 & ~umask)               # mkdtemp made it 0700
+    except OSError as exc:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise InputError(f"cannot write '{target}': {exc.strerror or exc}") from None
+    finally:
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+
+
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    import shutil
+
+    from ptoverify.sweep import SweepSettings, run_sweep
+
+    cfg = _config(args)
+    if args.grid < 2 or args.grid > 400:
+        raise InputError(f"--grid must be in [2, 400], got {args.grid}")
+    target = tmp = None
+    if args.out is not None:
+        target, tmp = _prepare_out(args.out)
+    try:
+        bar = _progress_bar(sys.stderr.isatty() and not args.quiet)
+        res = run_sweep(cfg, SweepSettings(n1=args.grid, n2=args.grid), progress=bar)
+        result = res.to_json()
+        if tmp is not None:
+            from ptoverify.plots import save_sweep
+
+            files = save_sweep(res, tmp)
+            (tmp / "sweep.json").write_text(json.dumps(to_jsonable(result), indent=2) + "\n")
+            result["files"] = [str(target / f.name) for f in files] + [str(target / "sweep.json")]
+            _publish(tmp, target)
+            tmp = None
+    finally:
+        if tmp is not None:
+            shutil.rmtree(tmp, ignore_errors=True)
+    if args.json:
+        print_json(result)
+    else:
+        print(f"sweep over {result['grid']['states']} states, band {result['band_mm']} mm, "
+              f"horizon {result['horizon_s']:.3f} s")
+        print(f"{'law':<12} {'settled':>8} {'median t/tf*':>13} {'worst t/tf*':>12} "
+              f"{'median t/N*T':>13} {'worst t/N*T':>12}  worst state (x1 mm, x2 mm/s)")
+        for name, r in result["laws"].items():
+            ws = r["worst_state_tf"]
+            num = {k: "n/a" if not math.isfinite(r[k]) else f"{r[k]:.3f}" for k in
+                   ("median_ratio_tf", "worst_ratio_tf", "median_ratio_nt", "worst_ratio_nt")}
+            where = "(never settles)" if not math.isfinite(ws[0]) else \
+                f"({ws[0]:.2f}, {ws[1]:.1f})"
+            print(f"{name:<12} {r['fraction_settled']:>8.1%} {num['median_ratio_tf']:>13} "
+                  f"{num['worst_ratio_tf']:>12} {num['median_ratio_nt']:>13} "
+                  f"{num['worst_ratio_nt']:>12}  {where}")
+        for name, why in result["skipped"].items():
+            print(f"{name:<12} skipped: {why}")
+        for f in result.get("files", []):
+            print(f"wrote {f}")
+    return 0
 
 
 # ---------------------------------------------------------------- zone
@@ -331,11 +446,45 @@ def _cmd_zone(args: argparse.Namespace) -> int:
     return 0
 
 
+# ---------------------------------------------------------------- report
+def _add_report(sub) -> None:
+    p = sub.add_parser(
+        "report", help="write the verification report (HTML, Markdown, JSON, figures)",
+        description="Run every verification and write a report folder: index.html (opens "
+                    "offline; MathML equations), report.md, results.json and figures/*.png. "
+                    "Written atomically: a failed run leaves nothing half-written.",
+        epilog="example:\n  ptoverify report\n  ptoverify report --config axis.toml --out "
+               "reports/axis")
+    p.add_argument("--out", metavar="DIR", default=None,
+                   help="report folder (default reports/<config name>)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
+    p.set_defaults(handler=_cmd_report)
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    from ptoverify.report import stderr_progress, write_report
+
+    cfg = _config(args)
+    if args.out is not None and Path(args.out).exists() and not Path(args.out).is_dir():
+        raise InputError(f"--out '{args.out}' exists and is not a directory")
+    out = write_report(cfg, args.out, stderr_progress(args.quiet))
+    res = json.loads((out / "results.json").read_text())
+    if args.json:
+        print_json({"out": str(out), "summary": res["summary"]})
+    else:
+        g = res["summary"]["gates"]
+        print(f"wrote {out}/index.html, report.md, results.json, "
+              f"{len(res['meta']['figures'])} figures; gates {g['pass']}/{g['total']} pass")
+    return 0
+
+
 COMMANDS: list[tuple[str, Callable[[Any], None]]] = [
+    ("report", _add_report),
     ("check", _add_check),
     ("mintime", _add_mintime),
     ("simulate", _add_simulate),
     ("derive", _add_derive),
+    ("sweep", _add_sweep),
     ("zone", _add_zone),
 ]
 

@@ -1,0 +1,447 @@
+"""Response metrics of Section 6: settling, overshoot, oscillation, lag, phase.
+
+Every metric is a pure numpy function of sampled arrays (or of a
+:class:`~ptoverify.simulate.SimResult` through :func:`summarize`).  Samples
+are the controller's samples t_k = k T; the plant is exact between them, but
+the metrics look at the samples only (the paper's figures are sampled too).
+
+The paper's wording each metric stands for:
+
+* :func:`settling_time` -- "adjustment time" (Sec. 6.1, Sec. 7): the time after
+  which |e| stays within a band until the end of the record.  Two bands are
+  used: 2 % of the step height (the classical band), and a tight band of
+  0.01 mm (:data:`TIGHT_BAND`, 2 % of the linear zone d = 0.5 mm).
+* :func:`overshoot` -- "with the same overshoot" (Sec. 6.1), "avoids ...
+  overshoots" (Sec. 7).
+* :func:`oscillation_amplitude` and :func:`sign_reversals` -- "persistent
+  oscillations in the steady-state phase" (Sec. 6.1), "series position and
+  velocity oscillations" (Sec. 6.2), "reaches zero without any oscillation".
+* :func:`ramp_lag` -- "the PD controller delays a large value about the command
+  signal" (Sec. 6.2).
+* :func:`sine_fit` / :func:`phase_delay` -- "the phase delay is about 4.5 deg"
+  (Sec. 6.3); the fundamental is fitted by least squares over whole periods.
+* :func:`rise_time` -- "a quicker dynamic response" (Sec. 7).
+* :func:`time_to_linear_zone` -- "when the position x1 is smaller than a certain
+  threshold, the system enters the linear zone" (Sec. 4).
+* :func:`input_switches` -- the bang-bang "switching" of the input (Sec. 1, 4).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ptoverify.simulate import SimResult
+
+__all__ = ["TIGHT_BAND", "STEP_FRACTION", "settling_time", "overshoot", "oscillation_amplitude",
+           "sign_reversals", "ramp_lag", "SineFit", "sine_fit", "phase_delay", "rise_time",
+           "time_to_linear_zone", "input_switches", "summarize"]
+
+TIGHT_BAND = 0.01
+"""Tight settling band [mm]: 2 % of the paper's linear zone d = 0.5 mm."""
+
+STEP_FRACTION = 0.02
+"""Classical settling band as a fraction of the step height [-] (2 %)."""
+
+
+def _arr(x: ArrayLike) -> NDArray[np.float64]:
+    return np.asarray(x, dtype=float)
+
+
+def settling_time(t: ArrayLike, e: ArrayLike, band: float, *, hold: float = 0.0) -> float:
+    """Time after which |e| stays within a band: the "adjustment time".
+
+    t_s = t_k for the first sample k such that |e_j| <= band for every j >= k
+    up to the end of the record.  A record that ends outside the band, or whose
+    settled tail is shorter than ``hold``, has not settled: NaN.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,)
+        Sample times [s].
+    e : array_like, shape (n,)
+        Error [mm] (or any signal that should settle to 0).
+    band : float
+        Half-width of the band [same unit as e], > 0.
+    hold : float
+        Shortest settled tail that counts as settled [s] (default 0).
+
+    Returns
+    -------
+    float
+        Settling time [s] measured from t[0]; NaN if it never settles.
+
+    Examples
+    --------
+    >>> t = np.linspace(0, 1, 1001)
+    >>> round(settling_time(t, np.exp(-10 * t), 0.1), 3)
+    0.231
+    """
+    t, e = _arr(t), _arr(e)
+    outside = np.flatnonzero(np.abs(e) > band)
+    k = 0 if outside.size == 0 else outside[-1] + 1
+    if k >= t.size or t[-1] - t[k] < hold:
+        return math.nan
+    return float(t[k] - t[0])
+
+
+def overshoot(x: ArrayLike, target: float, start: float = 0.0) -> float:
+    """Overshoot: largest excursion past the target, in the direction of travel.
+
+    Parameters
+    ----------
+    x : array_like
+        Position [mm].
+    target : float
+        Final value of the reference [mm].
+    start : float
+        Initial value [mm]; the direction of travel is sign(target - start).
+
+    Returns
+    -------
+    float
+        max(0, max_k s (x_k - target)) [mm], s = sign(target - start).
+
+    Examples
+    --------
+    >>> overshoot([0.0, 4.0, 5.3, 4.9, 5.0], 5.0)
+    0.2999999999999998
+    """
+    s = 1.0 if target >= start else -1.0
+    return float(max(0.0, np.max(s * (_arr(x) - target))))
+
+
+def oscillation_amplitude(e: ArrayLike) -> float:
+    """Amplitude of an oscillation: half the peak-to-peak of the samples.
+
+    Apply it to the steady part of a record (e.g. its last half) to measure
+    the "persistent oscillations in the steady-state phase".
+
+    Parameters
+    ----------
+    e : array_like
+        Signal over the steady part [mm] or [mm/s].
+
+    Returns
+    -------
+    float
+        (max e - min e) / 2.
+
+    Examples
+    --------
+    >>> oscillation_amplitude([0.1, -0.3, 0.5, -0.1])
+    0.4
+    """
+    e = _arr(e)
+    return float(0.5 * np.ptp(e)) if e.size else math.nan
+
+
+def sign_reversals(e: ArrayLike, band: float) -> int:
+    """Count the sign reversals of a signal, with hysteresis.
+
+    Samples with |e| <= band are ignored, so noise-sized wiggles around zero
+    do not count: a reversal is a sample above +band following one below
+    -band, or the reverse.  "Without any oscillation" is zero reversals.
+
+    Parameters
+    ----------
+    e : array_like
+        Signal [mm] or [mm/s].
+    band : float
+        Hysteresis half-width, same unit, >= 0.
+
+    Returns
+    -------
+    int
+        The count.
+
+    Examples
+    --------
+    >>> sign_reversals([1.0, 0.5, -0.001, 0.2, -1.0, 1.0], 0.01)
+    2
+    """
+    e = _arr(e)
+    s = np.sign(e[np.abs(e) > band])
+    return int(np.count_nonzero(s[1:] != s[:-1]))
+
+
+def ramp_lag(t: ArrayLike, e: ArrayLike, r_dot: ArrayLike, *, skip: float = 0.5) -> float:
+    """Tracking lag of a ramp: mean error while the ramp is moving.
+
+    The mean of e = r - x1 over the samples where r' > 0, after the first
+    ``skip`` fraction of that interval (the start-up transient).  A positive
+    lag means the position trails the command; lag / slope is the delay in s.
+
+    Parameters
+    ----------
+    t : array_like
+        Sample times [s].
+    e : array_like
+        Error r - x1 [mm].
+    r_dot : array_like
+        Reference velocity [mm/s].
+    skip : float
+        Fraction of the moving interval left out at its start [-], in [0, 1).
+
+    Returns
+    -------
+    float
+        Lag [mm]; NaN if the ramp never moves.
+
+    Examples
+    --------
+    >>> t = np.arange(0, 0.2, 0.001)
+    >>> rd = np.where(t < 0.15, 200.0, 0.0)
+    >>> round(ramp_lag(t, np.where(t < 0.15, 1.2, 0.0), rd), 6)
+    1.2
+    """
+    t, e, r_dot = _arr(t), _arr(e), _arr(r_dot)
+    moving = np.flatnonzero(r_dot > 0)
+    if moving.size == 0:
+        return math.nan
+    t0, t1 = t[moving[0]], t[moving[-1]]
+    sel = moving[t[moving] >= t0 + skip * (t1 - t0)]
+    return float(np.mean(e[sel]))
+
+
+@dataclass(frozen=True)
+class SineFit:
+    """Least-squares fit y = A sin(wt) + B cos(wt) + C of the fundamental.
+
+    Attributes
+    ----------
+    amplitude : float
+        sqrt(A^2 + B^2) [unit of y].
+    phase_deg : float
+        phi in y = amplitude sin(w t + phi) + C [deg].
+    offset : float
+        C [unit of y].
+    residual_rms : float
+        RMS of y minus the fit over the fitted samples [unit of y]: what the
+        fundamental does not explain (harmonics, chattering).
+    periods : int
+        Number of whole periods fitted.
+    """
+
+    amplitude: float
+    phase_deg: float
+    offset: float
+    residual_rms: float
+    periods: int
+
+
+def sine_fit(t: ArrayLike, y: ArrayLike, freq: float, *, t_from: float = 0.0) -> SineFit:
+    """Fit the fundamental over whole periods of the steady part.
+
+    The fit uses the largest integer number of periods 1/freq that ends at the
+    last sample and starts at or after ``t_from``, so an integer number of
+    periods is fitted and the harmonics are orthogonal to the fundamental.
+
+    Parameters
+    ----------
+    t : array_like
+        Sample times [s] (uniform).
+    y : array_like
+        Signal [mm].
+    freq : float
+        Frequency of the fundamental [Hz].
+    t_from : float
+        Start of the steady part [s].
+
+    Returns
+    -------
+    SineFit
+        The fit.
+
+    Examples
+    --------
+    >>> t = np.arange(0, 1.0 + 1e-9, 0.002)
+    >>> f = sine_fit(t, 2 * np.sin(2 * np.pi * 5 * t - 0.1), 5.0)
+    >>> round(f.amplitude, 9), round(f.phase_deg, 6)
+    (2.0, -5.729578)
+    """
+    t, y = _arr(t), _arr(y)
+    dt = t[1] - t[0]
+    per = int(round(1.0 / (freq * dt)))                 # samples per period
+    if abs(per * freq * dt - 1.0) > 1e-9:
+        raise ValueError("the period must be a whole number of samples")
+    periods = int((t[-1] - max(t_from, t[0]) + 1e-9 * dt) // (per * dt))
+    if periods < 1:
+        raise ValueError("the steady part holds less than one period")
+    n = periods * per                                   # samples [-n:], whole periods
+    tt, yy = t[-n:], y[-n:]
+    w = 2.0 * math.pi * freq
+    M = np.column_stack([np.sin(w * tt), np.cos(w * tt), np.ones_like(tt)])
+    (A, B, C), *_ = np.linalg.lstsq(M, yy, rcond=None)
+    res = yy - M @ np.array([A, B, C])
+    return SineFit(float(math.hypot(A, B)), float(math.degrees(math.atan2(B, A))), float(C),
+                   float(np.sqrt(np.mean(res * res))), periods)
+
+
+def phase_delay(ref: SineFit, out: SineFit) -> float:
+    """Phase delay of the output behind the reference [deg], wrapped to (-180, 180].
+
+    Positive when the output lags.
+
+    Parameters
+    ----------
+    ref, out : SineFit
+        Fits of the reference and of the output.
+
+    Returns
+    -------
+    float
+        phase(ref) - phase(out) [deg].
+    """
+    d = (ref.phase_deg - out.phase_deg + 180.0) % 360.0 - 180.0
+    return 180.0 if d == -180.0 else d
+
+
+def rise_time(t: ArrayLike, x: ArrayLike, target: float, *, low: float = 0.1,
+              high: float = 0.9) -> float:
+    """Rise time from ``low`` to ``high`` of a step from 0 to ``target``.
+
+    Parameters
+    ----------
+    t : array_like
+        Sample times [s].
+    x : array_like
+        Position [mm], starting at 0.
+    target : float
+        Step height [mm], nonzero.
+    low, high : float
+        Fractions of the step [-].
+
+    Returns
+    -------
+    float
+        First time x/target >= high minus first time >= low [s]; NaN if not reached.
+
+    Examples
+    --------
+    >>> t = np.linspace(0, 1, 1001)
+    >>> round(rise_time(t, 1 - np.exp(-10 * t), 1.0), 3)
+    0.22
+    """
+    t, y = _arr(t), _arr(x) / target
+    k_lo, k_hi = np.flatnonzero(y >= low), np.flatnonzero(y >= high)
+    if k_lo.size == 0 or k_hi.size == 0:
+        return math.nan
+    return float(t[k_hi[0]] - t[k_lo[0]])
+
+
+def time_to_linear_zone(t: ArrayLike, region: ArrayLike,
+                        codes: tuple[int, ...] | None = None) -> float:
+    """First time the linear scheme acts: "the system enters the linear zone".
+
+    Parameters
+    ----------
+    t : array_like
+        Sample times [s].
+    region : array_like of int
+        :class:`~ptoverify.laws.Region` code of each sample.
+    codes : tuple of int, optional
+        Codes that count as the linear zone; default LINEAR and SATURATED
+        (eq. 34 or PD, clipped or not).
+
+    Returns
+    -------
+    float
+        Time of the first such sample [s], measured from t[0]; NaN if never.
+
+    Examples
+    --------
+    >>> time_to_linear_zone([0.0, 0.1, 0.2], [2, 3, 5])
+    0.2
+    """
+    from ptoverify.laws import Region
+
+    codes = (Region.LINEAR, Region.SATURATED) if codes is None else codes
+    t, region = _arr(t), np.asarray(region)
+    k = np.flatnonzero(np.isin(region, np.asarray(codes, dtype=int)))
+    return float(t[k[0]] - t[0]) if k.size else math.nan
+
+
+def input_switches(u: ArrayLike, *, tol: float = 0.0) -> int:
+    """Count the input switches: sign reversals of u between samples.
+
+    Samples with |u| <= tol are skipped (u = 0 at the origin is no switch).
+
+    Parameters
+    ----------
+    u : array_like
+        Input [mm/s].
+    tol : float
+        Dead band [mm/s].
+
+    Returns
+    -------
+    int
+        The count.
+
+    Examples
+    --------
+    >>> input_switches([300.0, -300.0, -300.0, 0.0, 300.0])
+    2
+    """
+    return sign_reversals(u, tol)
+
+
+def summarize(res: SimResult, *, band: float = TIGHT_BAND,
+              step_fraction: float = STEP_FRACTION) -> dict[str, float]:
+    """All metrics of one simulated response, by name (units in the names).
+
+    The steady part is the last half of the record.  For the sine, the fit
+    starts after the first period.
+
+    Parameters
+    ----------
+    res : SimResult
+        A Section 6 response.
+    band : float
+        Tight band [mm].
+    step_fraction : float
+        Classical band as a fraction of the reference's final value [-].
+
+    Returns
+    -------
+    dict
+        Metric name -> value (NaN where undefined for this signal).
+    """
+    t, e = res.t, res.e
+    half = t.size // 2
+    final = float(res.r[-1])
+    out = {
+        "settling_tight_s": settling_time(t, e, band),
+        "steady_amplitude_mm": oscillation_amplitude(e[half:]),
+        "steady_velocity_amplitude_mm_s": oscillation_amplitude((res.x2 - res.r_dot)[half:]),
+        "error_reversals": float(sign_reversals(e, band)),
+        "input_switches": float(input_switches(res.u)),
+        "linear_zone_s": time_to_linear_zone(t, res.region),
+    }
+    if res.signal in ("step", "ramp"):
+        out["settling_2pct_s"] = settling_time(t, e, step_fraction * abs(final))
+        out["overshoot_mm"] = overshoot(res.x1, final)
+    if res.signal == "step":
+        out["rise_time_s"] = rise_time(t, res.x1, final)
+    if res.signal == "ramp":
+        out["ramp_lag_mm"] = ramp_lag(t, e, res.r_dot)
+    if res.signal == "sine":
+        freq = _sine_freq(res)
+        ref = sine_fit(t, res.r, freq, t_from=1.0 / freq)
+        pos = sine_fit(t, res.x1, freq, t_from=1.0 / freq)
+        out["phase_delay_deg"] = phase_delay(ref, pos)
+        out["amplitude_ratio"] = pos.amplitude / ref.amplitude
+        out["fit_residual_rms_mm"] = pos.residual_rms
+    return out
+
+
+def _sine_freq(res: SimResult) -> float:
+    from ptoverify.simulate import SIGNALS
+
+    return SIGNALS["sine"].rate

@@ -1,0 +1,321 @@
+"""Suboptimality sweep: each law's settling time over a grid of initial states.
+
+For every initial state of a grid over the envelope |x1| <= position_range,
+|x2| <= w_max, each law regulates the sampled plant to the origin (batch
+simulation, exact ZOH flow, all states at once).  Its settling time is
+divided by two lower bounds:
+
+* t_f*, the continuous minimum time (closed form, :func:`~ptoverify.mintime.min_time`);
+* N* T, the discrete-time limit: the fewest ZOH samples from which the origin
+  can be reached exactly with |u_k| <= w_max
+  (:func:`~ptoverify.mintime.discrete_min_steps`, an LP per N).
+
+Decisions (the issue is silent on them):
+
+* Grid: 50 x 50 = 2,500 states, evenly spaced and including the envelope's
+  corners.  An even count per axis keeps the origin (t_f* = 0) off the grid.
+* Settled: |x1| <= ``band`` (0.01 mm, :data:`~ptoverify.metrics.TIGHT_BAND`)
+  and |x2| <= ``velocity_band`` (default a * band: a state coasting with
+  u = 0 from the velocity band moves at most x2 / a = band further), from a
+  sample on until the end of the horizon.  The settling time is that sample's
+  time (not the exact crossing between samples, so a ratio can fall slightly
+  below 1: settling to a band is easier than reaching the origin exactly).
+* A state counts as settled only if it stays settled for at least ``hold``
+  (default 0.05 s = 25 samples at T = 2 ms) before the horizon ends; the
+  horizon is 4 max t_f* + hold over the grid, rounded up to whole samples.
+* N* is computed only for states that some law settles from (the ratio is
+  undefined elsewhere), once per (plant, grid), and cached in memory.
+* Statistics per law: the fraction of states that settle, the median of the
+  ratio over the settled states, the worst (largest) ratio with its state, and
+  the 95th percentile (the worst states lie next to the origin, where t_f* is
+  a few samples and a fixed settling tail weighs most).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ptoverify.config import Config, Plant
+from ptoverify.errors import InputError
+from ptoverify.laws import LAW_NAMES, make_law
+from ptoverify.metrics import TIGHT_BAND
+from ptoverify.mintime import discrete_min_steps_batch, min_time
+from ptoverify.simulate import simulate_batch
+
+__all__ = ["SweepSettings", "LawSweep", "SweepResult", "run_sweep", "settle_steps",
+           "grid_states", "discrete_limit"]
+
+Progress = Callable[[str, float], None]
+
+
+@dataclass(frozen=True)
+class SweepSettings:
+    """Settings of the sweep (defaults: module docstring).
+
+    Attributes
+    ----------
+    n1, n2 : int
+        Grid points along x1 and x2 [-].
+    band : float
+        Position band [mm].
+    velocity_band : float or None
+        Velocity band [mm/s]; None gives a * band.
+    hold : float
+        Shortest settled tail that counts [s].
+    horizon_factor : float
+        Horizon in units of the largest t_f* on the grid [-] (plus ``hold``).
+    laws : tuple of str
+        Laws to sweep.
+    """
+
+    n1: int = 50
+    n2: int = 50
+    band: float = TIGHT_BAND
+    velocity_band: float | None = None
+    hold: float = 0.05
+    horizon_factor: float = 4.0
+    laws: tuple[str, ...] = LAW_NAMES
+
+
+@dataclass(frozen=True)
+class LawSweep:
+    """One law's sweep result; arrays have the grid's shape (n2, n1).
+
+    Attributes
+    ----------
+    law : str
+        Law name.
+    settle_time : ndarray
+        Settling time [s]; NaN where the law does not settle.
+    ratio_tf : ndarray
+        settle_time / t_f* [-].
+    ratio_nt : ndarray
+        settle_time / (N* T) [-].
+    fraction_settled : float
+        Share of grid states that settle [-].
+    median_ratio_tf, median_ratio_nt : float
+        Medians over the settled states [-].
+    worst_ratio_tf, worst_ratio_nt : float
+        Largest ratios over the settled states [-].
+    worst_state_tf, worst_state_nt : tuple of float
+        (x1 [mm], x2 [mm/s]) of the largest ratios.
+    p95_ratio_tf : float
+        95th percentile of settle_time / t_f* over the settled states [-]; the
+        worst ratio sits next to the origin, where t_f* is a few samples.
+    seconds : float
+        Wall time of this law's simulation [s].
+    """
+
+    law: str
+    settle_time: NDArray[np.float64]
+    ratio_tf: NDArray[np.float64]
+    ratio_nt: NDArray[np.float64]
+    fraction_settled: float
+    median_ratio_tf: float
+    median_ratio_nt: float
+    worst_ratio_tf: float
+    worst_ratio_nt: float
+    worst_state_tf: tuple[float, float]
+    worst_state_nt: tuple[float, float]
+    seconds: float
+    p95_ratio_tf: float = math.nan
+
+    def to_json(self) -> dict:
+        """Return the statistics (not the arrays) as a JSON-able dict."""
+        return {"law": self.law, "fraction_settled": self.fraction_settled,
+                "median_ratio_tf": self.median_ratio_tf, "median_ratio_nt": self.median_ratio_nt,
+                "worst_ratio_tf": self.worst_ratio_tf, "worst_state_tf": list(self.worst_state_tf),
+                "worst_ratio_nt": self.worst_ratio_nt, "worst_state_nt": list(self.worst_state_nt),
+                "p95_ratio_tf": self.p95_ratio_tf, "seconds": self.seconds}
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """The whole sweep.
+
+    Attributes
+    ----------
+    x1, x2 : ndarray, shape (n2, n1)
+        Initial states [mm], [mm/s] (meshgrid, x1 along columns).
+    t_f : ndarray
+        Continuous minimum time t_f* [s].
+    n_star : ndarray of int
+        Discrete limit N* [samples]; -1 where not computed or not found.
+    laws : dict of str to LawSweep
+        Per law.
+    settings : SweepSettings
+        The settings used.
+    velocity_band : float
+        The velocity band used [mm/s].
+    steps : int
+        Horizon [samples].
+    sample_time : float
+        T [s].
+    timings : dict
+        Wall times [s] of the stages.
+    skipped : dict
+        Laws that could not be built, with the reason.
+    """
+
+    x1: NDArray[np.float64]
+    x2: NDArray[np.float64]
+    t_f: NDArray[np.float64]
+    n_star: NDArray[np.int64]
+    laws: dict[str, LawSweep]
+    settings: SweepSettings
+    velocity_band: float
+    steps: int
+    sample_time: float
+    timings: dict = field(default_factory=dict)
+    skipped: dict = field(default_factory=dict)
+
+    def to_json(self) -> dict:
+        """Return the ``sweep --json`` object."""
+        s = self.settings
+        return {"grid": {"n1": s.n1, "n2": s.n2, "states": int(self.x1.size),
+                         "x1_range_mm": [float(self.x1.min()), float(self.x1.max())],
+                         "x2_range_mm_s": [float(self.x2.min()), float(self.x2.max())]},
+                "band_mm": s.band, "velocity_band_mm_s": self.velocity_band, "hold_s": s.hold,
+                "horizon_s": self.steps * self.sample_time, "horizon_steps": self.steps,
+                "n_star_computed": int(np.count_nonzero(self.n_star >= 0)),
+                "laws": {name: r.to_json() for name, r in self.laws.items()},
+                "skipped": self.skipped, "timings_s": self.timings}
+
+
+def grid_states(plant: Plant, n1: int, n2: int) -> tuple[NDArray, NDArray]:
+    """Even grid over the envelope, shape (n2, n1) each: (x1 [mm], x2 [mm/s])."""
+    x1 = np.linspace(-plant.position_range, plant.position_range, n1)
+    x2 = np.linspace(-plant.w_max, plant.w_max, n2)
+    return np.meshgrid(x1, x2)
+
+
+def settle_steps(x1: NDArray, x2: NDArray, band: float, velocity_band: float,
+                 hold_steps: int) -> NDArray[np.int64]:
+    """First sample from which every later state lies in the band.
+
+    Parameters
+    ----------
+    x1, x2 : ndarray, shape (steps + 1, n)
+        Trajectories [mm], [mm/s].
+    band, velocity_band : float
+        Half-widths [mm], [mm/s].
+    hold_steps : int
+        Shortest settled tail [samples].
+
+    Returns
+    -------
+    ndarray of int, shape (n,)
+        Settling sample; -1 where the tail settled for fewer than ``hold_steps``.
+    """
+    out = (np.abs(x1) > band) | (np.abs(x2) > velocity_band)
+    last = out.shape[0] - 1
+    rev = out[::-1]
+    k = np.where(rev.any(axis=0), last - rev.argmax(axis=0) + 1, 0)
+    return np.where(last - k >= hold_steps, k, -1)
+
+
+@lru_cache(maxsize=8)
+def _n_star_cached(plant: Plant, x1: tuple[float, ...], x2: tuple[float, ...]) -> tuple[int, ...]:
+    res = discrete_min_steps_batch(np.array(x1), np.array(x2), plant, confirm=False)
+    return tuple(r.steps if r.success else -1 for r in res)
+
+
+def discrete_limit(plant: Plant, x1: NDArray, x2: NDArray) -> NDArray[np.int64]:
+    """N* for each state (-1 where the LP search failed), cached per plant and states."""
+    x1, x2 = np.ravel(x1), np.ravel(x2)
+    return np.array(_n_star_cached(plant, tuple(x1.tolist()), tuple(x2.tolist())), dtype=np.int64)
+
+
+def _stats(ratio: NDArray, x1: NDArray, x2: NDArray) -> tuple[float, float, tuple[float, float]]:
+    ok = np.isfinite(ratio)
+    if not ok.any():
+        return math.nan, math.nan, (math.nan, math.nan)
+    k = int(np.nanargmax(np.where(ok, ratio, -np.inf)))
+    return float(np.median(ratio[ok])), float(ratio.flat[k]), (float(x1.flat[k]),
+                                                                float(x2.flat[k]))
+
+
+def run_sweep(cfg: Config, settings: SweepSettings | None = None, *,
+              progress: Progress | None = None) -> SweepResult:
+    """Run the suboptimality sweep.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (plant and law settings).
+    settings : SweepSettings, optional
+        Grid, bands, horizon and laws; default :class:`SweepSettings`.
+    progress : callable, optional
+        ``progress(stage, fraction)`` called as the sweep advances.
+
+    Returns
+    -------
+    SweepResult
+        Per-law settling times, ratios and statistics.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> res = run_sweep(paper_config(), SweepSettings(n1=4, n2=4, laws=("pd",)))
+    >>> res.laws["pd"].fraction_settled
+    1.0
+    """
+    s = settings or SweepSettings()
+    if s.n1 < 2 or s.n2 < 2:
+        raise InputError("the sweep grid needs at least 2 points per axis")
+    plant, T = cfg.plant, cfg.plant.sample_time
+    vband = plant.a * s.band if s.velocity_band is None else s.velocity_band
+    report = progress or (lambda stage, frac: None)
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    X1, X2 = grid_states(plant, s.n1, s.n2)
+    t_f = min_time(X1, X2, plant).t_f
+    hold_steps = math.ceil(s.hold / T - 1e-9)
+    steps = math.ceil(s.horizon_factor * float(t_f.max()) / T) + hold_steps
+    timings["min_time"] = time.perf_counter() - t0
+    settle: dict[str, NDArray] = {}
+    secs: dict[str, float] = {}
+    skipped: dict[str, str] = {}
+    for i, name in enumerate(s.laws):
+        report(f"simulate {name}", i / (len(s.laws) + 1))
+        try:
+            law = make_law(name, cfg)
+        except InputError as exc:
+            skipped[name] = str(exc)
+            continue
+        t1 = time.perf_counter()
+        b = simulate_batch(law, plant, X1.ravel(), X2.ravel(), steps)
+        k = settle_steps(b.x1, b.x2, s.band, vband, hold_steps)
+        settle[name] = np.where(k >= 0, k * T, np.nan).reshape(X1.shape)
+        secs[name] = time.perf_counter() - t1
+        timings[f"simulate_{name}"] = secs[name]
+    report("discrete limit N*", len(s.laws) / (len(s.laws) + 1))
+    t1 = time.perf_counter()
+    need = np.zeros(X1.shape, dtype=bool)
+    for st in settle.values():
+        need |= np.isfinite(st)
+    n_star = np.full(X1.shape, -1, dtype=np.int64)
+    if need.any():
+        n_star[need] = discrete_limit(plant, X1[need], X2[need])
+    timings["discrete_limit"] = time.perf_counter() - t1
+    nt = np.where(n_star > 0, n_star * T, np.nan)
+    laws = {}
+    for name, st in settle.items():
+        with np.errstate(invalid="ignore", divide="ignore"):
+            r_tf, r_nt = st / t_f, st / nt
+        med_tf, worst_tf, at_tf = _stats(r_tf, X1, X2)
+        med_nt, worst_nt, at_nt = _stats(r_nt, X1, X2)
+        laws[name] = LawSweep(name, st, r_tf, r_nt, float(np.mean(np.isfinite(st))), med_tf,
+                              med_nt, worst_tf, worst_nt, at_tf, at_nt, secs[name],
+                              float(np.percentile(r_tf[np.isfinite(r_tf)], 95))
+                              if np.isfinite(r_tf).any() else math.nan)
+    timings["total"] = time.perf_counter() - t0
+    report("done", 1.0)
+    return SweepResult(X1, X2, t_f, n_star, laws, s, vband, steps, T, timings, skipped)
