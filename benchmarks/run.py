@@ -11,7 +11,8 @@ median over their states).  Ratios are measured side by side in the same run.
 With ``--small`` the sizes are cut so the whole run takes seconds; ``check_s``
 then times ``ptoverify check --gate roots-closed-form-vs-bisection`` (one cheap
 gate) and ``report_s`` ``ptoverify report --help``, so the figures only show
-that the harness works.
+that the harness works.  At full size ``report_s`` times ``ptoverify report
+--quiet --out TMPDIR`` (a temporary folder, so the tracked reports/ is untouched).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import os
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -300,8 +302,9 @@ def run(small: bool) -> tuple[dict, dict]:
     out["discrete_ms"] = bench_discrete(cfg, size)
     check = ["check", "--gate", "roots-closed-form-vs-bisection"] if small else ["check"]
     out["check_s"], extra["check_note"] = run_cli(check, size["cli_repeat"])
-    report = ["report", "--help"] if small else ["report"]
-    out["report_s"], extra["report_note"] = run_cli(report, size["cli_repeat"])
+    with tempfile.TemporaryDirectory() as tmp:      # never the tracked reports/ folder
+        report = ["report", "--help"] if small else ["report", "--quiet", "--out", tmp]
+        out["report_s"], extra["report_note"] = run_cli(report, size["cli_repeat"])
     extra["vector_vs_scalar"] = out["law_vector_evals_per_s"] * out["law_scalar_us"] * 1e-6
     return out, extra
 
