@@ -63,7 +63,8 @@ def blockwise(fn, *arrays: ArrayLike, block: int = BLOCK):
     Parameters
     ----------
     fn : callable
-        ``fn(*arrays) -> ndarray or tuple of ndarray``, elementwise.
+        ``fn(*arrays) -> ndarray or tuple of ndarray``, elementwise; it is
+        given 1-D arrays (of at most ``2 * block`` elements).
     *arrays : array_like
         Inputs, broadcast together.
     block : int
@@ -76,9 +77,12 @@ def blockwise(fn, *arrays: ArrayLike, block: int = BLOCK):
     """
     arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in arrays))
     shape, n = arrays[0].shape, arrays[0].size
-    if n <= 2 * block:
-        return fn(*arrays)
     flat = [a.ravel() for a in arrays]
+    if n <= 2 * block:                            # one block; fn sees 1-D arrays always
+        res = fn(*flat)
+        if isinstance(res, tuple):
+            return tuple(r.reshape(shape) for r in res)
+        return res.reshape(shape)
     outs, single = None, False
     for i in range(0, n, block):
         res = fn(*(a[i:i + block] for a in flat))
@@ -422,7 +426,7 @@ def _omega_c(x1: Array, x2: Array, a: float) -> Array:
     """:func:`omega_c` on broadcast float arrays (one block)."""
     with np.errstate(all="ignore"):
         m = -a * x1 / x2
-        if m.ndim and m.size and ((m > 0) & (m < 1)).all():     # every state has a curve
+        if m.size and ((m > 0) & (m < 1)).all():     # every state has a curve
             return np.abs(x2) / np.expm1(_u_of_m_positive(m))
         w = root_k(np.where((m > 0) & (m < 1), m, 0.5))
         wc = np.abs(x2) / w

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Plant
-from ptoverify.curves import blockwise, h, switching_function
+from ptoverify.curves import blockwise, h
 from ptoverify.errors import InputError
 
 __all__ = ["MinTime", "min_time", "DiscreteMinTime", "ZOHReach", "discrete_min_steps",
@@ -88,23 +88,35 @@ def min_time(x1: ArrayLike, x2: ArrayLike, plant: Plant) -> MinTime:
 
 def _min_time(x1: NDArray, x2: NDArray, a: float, w: float) -> tuple[NDArray, ...]:
     """:func:`min_time` on broadcast float arrays (one block): (t_f, t_switch, side, q)."""
-    sigma = switching_function(x1, x2, a, w)
-    side = np.where(sigma > 0, 1.0, np.where(sigma < 0, -1.0, np.where(x2 < 0, 1.0, -1.0)))
+    hr = h(np.abs(x2) / w)
+    sigma = a * x1 + np.sign(x2) * w * hr               # switching_function, eqs. (9), (11)
+    pos = sigma > 0
+    pos |= ~(pos | (sigma < 0)) & (x2 < 0)              # on the curve: the side of x2
+    side = np.where(pos, 1.0, -1.0)
     y1, y2 = side * x1, side * x2
     rho = y2 / w
     fast = rho <= -1.0
     with np.errstate(all="ignore"):
-        g = a * y1 / w + h(np.where(fast, 0.0, rho))
-        q2_slow = -(w * w) * np.expm1(-g)
-        q2_fast = w * w - w * (w + y2) * np.exp(-(a * y1 + y2) / w)
-    q = -np.sqrt(np.maximum(np.where(fast, q2_fast, q2_slow), 0.0))
+        # h(rho) is h(|x2| / w), computed above, where y2 > 0 (rho = |x2| / w bit for bit)
+        redo = np.flatnonzero(~(y2 > 0) | fast)
+        if redo.size:
+            hr[redo] = h(np.where(fast[redo], 0.0, rho[redo]))
+        g = a * y1 / w + hr
+        q2 = -(w * w) * np.expm1(-g)
+        fi = np.flatnonzero(fast)                       # y2 <= -w: the form without cancellation
+        if fi.size:
+            y1f, y2f = y1[fi], y2[fi]
+            q2[fi] = w * w - w * (w + y2f) * np.exp(-(a * y1f + y2f) / w)
+    q = -np.sqrt(np.maximum(q2, 0.0))
     lq = np.log1p(-q / w)
     t2 = lq / a
     t1 = np.maximum((lq + (a * y1 + y2) / w) / a, 0.0)
-    origin = (x1 == 0) & (x2 == 0)
-    zero = np.zeros_like(t1)
-    return (np.where(origin, zero, t1 + t2), np.where(origin, zero, t1),
-            np.where(origin, zero, side), np.where(origin, zero, side * q))
+    t_f, q = t1 + t2, side * q
+    origin = np.flatnonzero((x1 == 0) & (x2 == 0))
+    if origin.size:
+        for v in (t_f, t1, side, q):
+            v[origin] = 0.0
+    return t_f, t1, side, q
 
 
 # ---------------------------------------------------------------- discrete-time limit

@@ -24,7 +24,6 @@ from numpy.typing import ArrayLike, NDArray
 from ptoverify.config import Plant
 from ptoverify.errors import InputError
 from ptoverify.laws import Law
-from ptoverify.plant import flow
 
 __all__ = ["Reference", "reference", "SIGNALS", "SimResult", "simulate", "BatchResult",
            "simulate_batch"]
@@ -225,7 +224,17 @@ def simulate_batch(law: Law, plant: Plant, x1: ArrayLike, x2: ArrayLike,
     X1, X2 = np.empty((steps + 1, n)), np.empty((steps + 1, n))
     U, R = np.empty((steps, n)), np.empty((steps, n), dtype=np.int8)
     X1[0], X2[0] = x1, x2
+    T, a = plant.sample_time, plant.a
+    g = -np.expm1(-a * np.float64(T))        # 1 - e^{-aT}, as plant.flow computes it
+    dv = np.empty(n)
     for k in range(steps):
         U[k], R[k] = law(X1[k], X2[k])
-        X1[k + 1], X2[k + 1] = flow(X1[k], X2[k], U[k], plant.sample_time, plant.a)
+        # plant.flow in place, the same roundings: x1 + u T + (x2 - u) g / a, x2 - (x2 - u) g
+        np.subtract(X2[k], U[k], out=dv)
+        dv *= g
+        np.subtract(X2[k], dv, out=X2[k + 1])
+        np.multiply(U[k], T, out=X1[k + 1])
+        X1[k + 1] += X1[k]
+        dv /= a
+        X1[k + 1] += dv
     return BatchResult(X1, X2, U, R)
