@@ -398,6 +398,27 @@ def _linear_stable(cfg: Config) -> CheckResult:
     return _loop_gate("linear-zone-sampled-stable", "linear", cfg)
 
 
+# ------------------------------------------------------------ Section 6 gate
+@gate("claims-computed")
+def _claims_computed(cfg: Config) -> CheckResult:
+    """Every Section 6 claim has a verdict computed from simulation under every reading.
+
+    The verdicts themselves (reproduced or not) are findings of the report, not
+    gate failures; this gate fails when a claim could not be measured.
+    """
+    from ptoverify.claims import evaluate_claims
+
+    allowed = {"reproduced", "not reproduced", "ambiguous"}
+    results = evaluate_claims(cfg)
+    missing = [c.id for c in results
+               if c.verdict not in allowed or not c.readings
+               or any(not r.values or r.verdict not in allowed for r in c.readings)]
+    readings = sum(len(c.readings) for c in results)
+    return _at_most("claims-computed", float(len(missing)), 0.0,
+                    f"{len(results)} claims, {readings} claim-readings simulated; claims "
+                    f"without computed values: {', '.join(missing) or 'none'}")
+
+
 def run_checks(cfg: Config, names: list[str] | None = None,
                max_iter: int | None = None) -> list[CheckResult]:
     """Run the gates (all, or the named ones) in registration order.

@@ -92,6 +92,8 @@ def ground_truth(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
         Block("p", text=f"Collocation convergence over N = {conv['intervals']}: observed "
                         f"order {_fmt(conv['order'], 3)} (per state "
                         f"{_fmt(conv['order_per_state'], 3)})."),
+        *_img(figures, "fig02_trajectories", "Fig. 2: trajectories under +-w_max, l1 and l2"),
+        *_img(figures, "fig03_saturation", "Fig. 3: trajectories with velocity saturation"),
         *_img(figures, "convergence", "Collocation t_f error against N"),
         *_img(figures, "collocation_switch", "Collocation input near the switch"),
     ]
@@ -112,11 +114,9 @@ def zone(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
         blocks.append(Block("p", text=f"Closed-loop outcome of {name}: " + ", ".join(
             f"{k} = {_fmt(v)}" for k, v in o.items())))
     blocks += _img(figures, "zone_geometry", "Zone geometry, sampled trajectories by region")
-    for key, cap in (("fig04_zones_corrected", "Fig. 4: zones, corrected"),
-                     ("fig04_zones_printed", "Fig. 4: zones, as printed"),
-                     ("fig05_l1_image_printed", "Fig. 5: l1, l1*, and the image curve (19)"),
-                     ("fig06_trajectory_pto", "Fig. 6: trajectory, corrected PTO")):
-        blocks += _img(figures, key, cap)
+    for key in sorted(figures):
+        if key.startswith(("fig04", "fig05", "fig06")):
+            blocks += _img(figures, key, key.replace("_", " "))
     return blocks
 
 
