@@ -69,3 +69,42 @@ def test_simulate_json(capsys):
     code, out, _ = run(capsys, "simulate", "--law", "to", "--signal", "sine", "--json")
     data = json.loads(out)
     assert code == 0 and data["law"] == "to" and len(data["series"]["t"]) == 501
+
+
+BAD_CONFIGS = {
+    "not_toml": "this is [not toml",
+    "unknown_key": '[plant]\na = 1.0\nw_max = 1.0\nsample_time = 0.1\nposition_range = 1.0\n'
+                   'colour = 2.0\n[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n',
+    "nan": '[plant]\na = nan\nw_max = 1.0\nsample_time = 0.1\nposition_range = 1.0\n'
+           '[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n',
+    "non_numeric": '[plant]\na = "fast"\nw_max = 1.0\nsample_time = 0.1\nposition_range = 1.0\n'
+                   '[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n',
+    "out_of_range": '[plant]\na = 1.0\nw_max = 1.0\nsample_time = -0.1\nposition_range = 1.0\n'
+                    '[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n',
+}
+
+
+@pytest.mark.parametrize("kind", sorted(BAD_CONFIGS))
+@pytest.mark.parametrize("command", [["report", "--quiet"], ["check"], ["sweep", "--quiet"],
+                                     ["zone"], ["derive"], ["simulate"], ["mintime", "1", "0"]])
+def test_bad_config_every_command_exit_2_writes_nothing(capsys, tmp_path, monkeypatch, kind,
+                                                        command):
+    monkeypatch.chdir(tmp_path)
+    cfg = tmp_path / "bad.toml"
+    cfg.write_text(BAD_CONFIGS[kind])
+    extra = ["--out", str(tmp_path / "out")] if command[0] in ("report", "sweep") else []
+    code = main([*command, "--config", str(cfg), *extra])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and err.startswith("ptoverify: error:")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"], "something was written"
+
+
+def test_every_command_help_has_an_example(capsys):
+    from ptoverify.cli import COMMANDS
+
+    for name, _ in COMMANDS:
+        with pytest.raises(SystemExit) as exc:
+            main([name, "--help"])
+        assert exc.value.code == 0
+        assert "example:" in capsys.readouterr().out, name
