@@ -15,8 +15,8 @@ import math
 import os
 import re
 import sys
-import warnings
 import tempfile
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any

@@ -189,8 +189,8 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
 def sweep(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     """Section 8: settling time over t_f* and over N* T, per law."""
     sw = res["sweep"]
-    rows = [[law, f"{100 * v['fraction_settled']:.1f} %", v["median_ratio_tf"], v.get("p95_ratio_tf"),
-             v["worst_ratio_tf"], v["worst_state_tf"], v["median_ratio_nt"],
+    rows = [[law, f"{100 * v['fraction_settled']:.1f} %", v["median_ratio_tf"],
+             v.get("p95_ratio_tf"), v["worst_ratio_tf"], v["worst_state_tf"], v["median_ratio_nt"],
              v["worst_ratio_nt"], v["worst_state_nt"]] for law, v in sw["laws"].items()]
     blocks = [Block("p", text=f"Grid {sw['grid']} of initial states, horizon {sw['steps']} "
                               "samples; settling to the tight band and staying there."),
