@@ -8,7 +8,9 @@ config      Plant, PDGains, PTOSettings, Config; TOML loading and validation; pa
 plant       flow (eq. 7), step (one-sample map, eq. 15), zoh_matrices
 curves      switching_function, level_residual (eqs. 9, 11, 13, 14, 28, 33), Lambert-W roots
             root_22 (eq. 22), root_k (eqs. 26, 31), omega_c (eq. 32), bisection references
-mintime     min_time: closed-form minimum time and switch time from any state
+mintime     min_time: closed-form minimum time and switch time from any state;
+            discrete_min_steps (N*, the discrete-time limit, by LPs), ZOHReach
+ocp         TwoPhaseOCP, CollocationOCP (CasADi + IPOPT), convergence_study
 zones       PTOZone; printed_zone (eqs. 19-27 as printed, judged), corrected_zone (largest
             omega0 meeting the no-stride-over principle, verified on a grid), zone_summary
 laws        Law, Region; to_law (eq. 12), pd_law, pto_law (eq. 35: pto, pto-printed); make_law
@@ -21,8 +23,11 @@ metrics     settling_time (2 % and 0.01 mm bands), overshoot, oscillation_amplit
 claims      Section 6 and conclusion claims, each measured under every reading
             (a = 2 pi f or f, feed-forward, PTO printed/corrected, band); evaluate_claims
 sweep       run_sweep: settling time / t_f* and / N* T over a 50 x 50 grid of initial states
-plots       Figs. 2-14 for TO, PD, PTO (both) and the sweep heat maps; save_all, save_sweep
-plots_zone  figure of the zone geometry with sampled trajectories (matplotlib, Agg)
+plots       Figs. 2-14 for TO, PD, PTO (both), sweep heat maps, zone geometry, collocation
+            convergence (the only module importing matplotlib)
+checks      the gates of ``ptoverify check``: CheckResult, GATES, run_checks
+report      collect, render_html / render_markdown, write_report (atomic);
+            report_sections builds the nine sections
 cli         the ``ptoverify`` command line
 errors      InputError (exit 2), ConfigError, SolverError
 """

@@ -43,6 +43,8 @@ class CheckResult:
         The measured figure (None when it could not be computed).
     limit : float or None
         The limit it is compared with.
+    comparison : str
+        How ``measured`` must relate to ``limit`` to pass: ``<=``, ``>=`` or ``<``.
     detail : str
         What was measured, against what, and why the limit.
     """
@@ -52,6 +54,7 @@ class CheckResult:
     measured: float | None
     limit: float | None
     detail: str
+    comparison: str = "<="
 
     def to_json(self) -> dict[str, Any]:
         """Return a JSON-able dict."""
@@ -263,22 +266,28 @@ def _discrete(cfg: Config) -> CheckResult:
         dm = discrete_min_steps(float(x1[i]), float(x2[i]), cfg.plant)
         if not dm.success:
             return CheckResult("discrete-limit-consistency", UNVERIFIED, None, 0.0,
-                               f"N* search failed at ({x1[i]:.4g}, {x2[i]:.4g}): {dm.status}")
+                               f"N* search failed at ({x1[i]:.4g}, {x2[i]:.4g}): {dm.status}",
+                               ">=")
         t_f = float(min_time(x1[i], x2[i], cfg.plant).t_f)
-        ok_prev, _, _ = reach.feasible(float(x1[i]), float(x2[i]), dm.steps - 1)
+        ok_prev, _, why = reach.feasible(float(x1[i]), float(x2[i]), dm.steps - 1)
         if ok_prev:
             return CheckResult("discrete-limit-consistency", FAIL, None, 0.0,
                                f"N* - 1 = {dm.steps - 1} steps feasible at "
-                               f"({x1[i]:.4g}, {x2[i]:.4g})")
+                               f"({x1[i]:.4g}, {x2[i]:.4g})", ">=")
+        if why != "infeasible":
+            return CheckResult("discrete-limit-consistency", UNVERIFIED, None, 0.0,
+                               f"N* - 1 = {dm.steps - 1} steps at ({x1[i]:.4g}, {x2[i]:.4g}): "
+                               f"the LP was inconclusive ({why})", ">=")
         if abs(dm.end[0]) > 1e-9 or abs(dm.end[1]) > 1e-6:
             return CheckResult("discrete-limit-consistency", FAIL, None, 0.0,
-                               f"N* sequence ends at {dm.end} from ({x1[i]:.4g}, {x2[i]:.4g})")
+                               f"N* sequence ends at {dm.end} from ({x1[i]:.4g}, {x2[i]:.4g})",
+                               ">=")
         worst_gap = min(worst_gap, (dm.time_s - t_f) / cfg.plant.T)
     res = CheckResult("discrete-limit-consistency", PASS if worst_gap >= 0 else FAIL,
                       worst_gap, 0.0,
                       "min over 25 states of (N* T - t_f*) / T, which theory keeps >= 0; every "
                       "N* sequence ends within 1e-9 mm, 1e-6 mm/s of the origin and N* - 1 "
-                      "samples are infeasible")
+                      "samples are infeasible (LP status 'infeasible', not inconclusive)", ">=")
     return res
 
 
@@ -333,7 +342,8 @@ def _zone_valid(cfg: Config) -> CheckResult:
 
     z = corrected_zone(cfg)
     if not z.valid:
-        return CheckResult("zone-corrected-valid", FAIL, z.omega0, cfg.plant.w_max,
+        measured = float(z.grid_violations) if z.grid_violations > 0 else None
+        return CheckResult("zone-corrected-valid", FAIL, measured, 0.0,
                            f"no valid corrected zone: {z.reason}")
     return CheckResult("zone-corrected-valid", PASS if z.grid_violations == 0 else FAIL,
                        float(z.grid_violations), 0.0,
@@ -379,7 +389,7 @@ def _loop_gate(name: str, which: str, cfg: Config) -> CheckResult:
                            f"python-control and numpy disagree on the sampled poles by "
                            f"{lp.pole_mismatch:.2e}")
     status = PASS if radius < 1.0 else FAIL
-    return CheckResult(name, status, radius, 1.0,
+    return CheckResult(name, status, radius, 1.0, comparison="<", detail=
                        f"largest |z| of the ZOH-sampled {which} loop, gains {lp.gains}, "
                        f"T = {cfg.plant.T:g} s (python-control, cross-checked with numpy "
                        f"eigenvalues to {lp.pole_mismatch:.1e}); must be < 1; gain margin "
@@ -396,6 +406,31 @@ def _pd_stable(cfg: Config) -> CheckResult:
 def _linear_stable(cfg: Config) -> CheckResult:
     """Check that the linear-zone loop (eq. 37) sampled with ZOH at T is stable."""
     return _loop_gate("linear-zone-sampled-stable", "linear", cfg)
+
+
+# ------------------------------------------------------------ Section 6 gate
+@gate("claims-computed")
+def _claims_computed(cfg: Config) -> CheckResult:
+    """Every Section 6 claim has a verdict computed from simulation under every reading.
+
+    The verdicts themselves (reproduced or not) are findings of the report, not
+    gate failures; this gate fails when a claim could not be measured.
+    """
+    from ptoverify.claims import evaluate_claims
+
+    allowed = {"reproduced", "not reproduced", "ambiguous"}
+    results = evaluate_claims(cfg)
+    def measured(values: dict) -> bool:
+        return any(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                   for v in values.values())
+
+    missing = [c.id for c in results
+               if c.verdict not in allowed or not c.readings
+               or any(not measured(r.values) or r.verdict not in allowed for r in c.readings)]
+    readings = sum(len(c.readings) for c in results)
+    return _at_most("claims-computed", float(len(missing)), 0.0,
+                    f"{len(results)} claims, {readings} claim-readings simulated; claims "
+                    f"without computed values: {', '.join(missing) or 'none'}")
 
 
 def run_checks(cfg: Config, names: list[str] | None = None,

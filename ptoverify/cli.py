@@ -13,20 +13,32 @@ import io
 import json
 import math
 import os
+import re
 import sys
 import tempfile
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from ptoverify.config import Config, load_config
-from ptoverify.errors import InputError, PtoverifyError
+from ptoverify.errors import InputError, PtoverifyError, SolverError
+from ptoverify.outdir import check_target, discard, make_temp, publish
 
 __all__ = ["main", "build_parser"]
 
 
 class _Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors become one-line :class:`InputError`."""
+    """ArgumentParser whose errors become one-line :class:`InputError`.
+
+    Any float literal with a leading minus (``-5``, ``-1e2``, ``-.5``, ``-5.``) is a
+    negative number, not an option, so states can be given as positionals.
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(
+            r"^-(\d+\.?\d*([eE][-+]?\d+)?|\.\d+([eE][-+]?\d+)?|inf|nan)$", re.I)
 
     def error(self, message: str):  # noqa: D102
         raise InputError(f"{self.prog}: {message}")
@@ -106,7 +118,7 @@ def _add_mintime(sub) -> None:
     p.add_argument("x1", type=finite_float, metavar="X1", help="initial position [mm]")
     p.add_argument("x2", type=finite_float, metavar="X2", help="initial velocity [mm/s]")
     p.add_argument("--intervals", type=positive_int, default=100,
-                   help="collocation intervals N (default 100)")
+                   help="collocation intervals N (default 100, at most 2000)")
     p.set_defaults(handler=_cmd_mintime)
 
 
@@ -162,6 +174,8 @@ def mintime_result(cfg: Config, x1: float, x2: float, intervals: int,
 
 def _cmd_mintime(args: argparse.Namespace) -> int:
     cfg = _config(args)
+    if args.intervals > 2000:
+        raise InputError(f"--intervals must be at most 2000, got {args.intervals}")
     result = mintime_result(cfg, args.x1, args.x2, args.intervals)
     if args.json:
         print_json(result)
@@ -198,13 +212,18 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     cfg = _config(args)
     if args.duration is not None and not 0 < args.duration <= 100:
         raise InputError(f"--duration must be in (0, 100] s, got {args.duration:g}")
-    if args.csv and args.json:
+    if args.csv is not None and args.json:
         raise InputError("--csv and --json are exclusive")
+    if args.csv is not None and (args.csv.strip() == "" or Path(args.csv).is_dir()):
+        raise InputError(f"--csv must name a file, got {args.csv!r}")
+    if args.duration is not None and args.duration < cfg.plant.sample_time:
+        raise InputError(f"--duration {args.duration:g} s is shorter than one sample "
+                         f"(T = {cfg.plant.sample_time:g} s)")
     law = make_law(args.law, cfg)
     res = simulate(law, cfg.plant, args.signal, duration=args.duration,
                    feedforward=not args.no_feedforward)
     cols = res.columns()
-    if args.csv:
+    if args.csv is not None:
         buf = io.StringIO()
         writer = csv.writer(buf, lineterminator="\n")
         writer.writerow(list(cols))
@@ -280,8 +299,8 @@ def _cmd_check(args: argparse.Namespace) -> int:
         for r in results:
             measured = "-" if r.measured is None else f"{r.measured:.3g}"
             limit = "-" if r.limit is None else f"{r.limit:.3g}"
-            print(f"{r.status.upper():<10} {r.name:<36} measured {measured:>9}  limit {limit:<9} "
-                  f"{r.detail}")
+            print(f"{r.status.upper():<10} {r.name:<36} {measured:>9} {r.comparison:<2} "
+                  f"{limit:<9} {r.detail}")
         print(f"{summary['pass']}/{summary['total']} passed, {summary['fail']} failed, "
               f"{summary['unverified']} unverified")
     return 0 if summary["ok"] else 1
@@ -318,43 +337,7 @@ def _progress_bar(enabled: bool):
     return show
 
 
-def _prepare_out(out: str) -> tuple[Path, Path]:
-    """Create a temporary folder beside ``out``; fail early when it cannot be written."""
-    target = Path(out)
-    if target.exists() and not target.is_dir():
-        raise InputError(f"--out '{target}' exists and is not a directory")
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
-    except OSError as exc:
-        raise InputError(f"cannot write '{target}': {exc.strerror or exc}") from None
-    return target, tmp
-
-
-def _publish(tmp: Path, target: Path) -> None:
-    """Move a finished temporary folder to ``target``, replacing an older one."""
-    import shutil
-
-    old = None
-    try:
-        if target.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old.", dir=target.parent))
-            os.replace(target, old / "prev")
-        os.replace(tmp, target)
-        umask = os.umask(0)
-        os.umask(umask)
-        target.chmod(0o777 & ~umask)               # mkdtemp made it 0700
-    except OSError as exc:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise InputError(f"cannot write '{target}': {exc.strerror or exc}") from None
-    finally:
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-
-
 def _cmd_sweep(args: argparse.Namespace) -> int:
-    import shutil
-
     from ptoverify.sweep import SweepSettings, run_sweep
 
     cfg = _config(args)
@@ -362,22 +345,22 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         raise InputError(f"--grid must be in [2, 400], got {args.grid}")
     target = tmp = None
     if args.out is not None:
-        target, tmp = _prepare_out(args.out)
+        target = check_target(args.out)
     try:
         bar = _progress_bar(sys.stderr.isatty() and not args.quiet)
         res = run_sweep(cfg, SweepSettings(n1=args.grid, n2=args.grid), progress=bar)
         result = res.to_json()
-        if tmp is not None:
+        if args.out is not None:
+            tmp = make_temp(target)
             from ptoverify.plots import save_sweep
 
             files = save_sweep(res, tmp)
             (tmp / "sweep.json").write_text(json.dumps(to_jsonable(result), indent=2) + "\n")
             result["files"] = [str(target / f.name) for f in files] + [str(target / "sweep.json")]
-            _publish(tmp, target)
+            publish(tmp, target)
             tmp = None
     finally:
-        if tmp is not None:
-            shutil.rmtree(tmp, ignore_errors=True)
+        discard(tmp)
     if args.json:
         print_json(result)
     else:
@@ -517,8 +500,14 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     try:
-        args = build_parser().parse_args(argv)
-        return int(args.handler(args))
+        with warnings.catch_warnings():
+            # numeric caveats belong in the results, not on stderr (one line on error)
+            warnings.simplefilter("ignore")
+            args = build_parser().parse_args(argv)
+            return int(args.handler(args))
+    except SolverError as exc:
+        print(f"ptoverify: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 1
     except PtoverifyError as exc:
         message = " ".join(str(exc).split())
         print(f"ptoverify: error: {message}", file=sys.stderr)
@@ -526,6 +515,14 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("ptoverify: error: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:                          # e.g. `ptoverify ... | head`
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except (MemoryError, OverflowError, ValueError, ZeroDivisionError) as exc:
+        # a configuration inside the validated ranges that still breaks a numeric step
+        print(f"ptoverify: error: the computation failed for this input "
+              f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

@@ -197,6 +197,36 @@ def _section(data: dict[str, Any], name: str) -> dict[str, float]:
     return {key: _number(name, key, value) for key, value in raw.items()}
 
 
+#: Ranges beyond which the suite's computations are not meaningful (or would not fit in memory):
+#: they are rejected as out of range, each naming the key.
+LIMITS = {"a": 1e6, "w_max": 1e6, "position_range": 1e6, "sample_time": (1e-7, 1.0),
+          "aT": (1e-6, 20.0), "samples_across_range": 1e6}
+
+
+def _check_scales(a: float, plant: dict[str, float], a_key: str) -> None:
+    """Reject plants outside the ranges of :data:`LIMITS` (the key is named)."""
+    if a > LIMITS["a"]:
+        raise ConfigError(f"config key '{a_key}' gives a = {a:g} rad/s, above {LIMITS['a']:g}")
+    for key in ("w_max", "position_range"):
+        if plant[key] > LIMITS[key]:
+            raise ConfigError(f"config key 'plant.{key}' must be <= {LIMITS[key]:g}, "
+                              f"got {plant[key]!r}")
+    lo, hi = LIMITS["sample_time"]
+    T = plant["sample_time"]  # noqa: N806
+    if not lo <= T <= hi:
+        raise ConfigError(f"config key 'plant.sample_time' must be in [{lo:g}, {hi:g}] s, "
+                          f"got {T!r}")
+    lo, hi = LIMITS["aT"]
+    if not lo <= a * T <= hi:
+        raise ConfigError(f"config key 'plant.sample_time' gives a T = {a * T:g}, outside "
+                          f"[{lo:g}, {hi:g}] (the sampling is too fast or too slow for the "
+                          f"bandwidth)")
+    n = plant["position_range"] / (plant["w_max"] * T)
+    if n > LIMITS["samples_across_range"]:
+        raise ConfigError(f"config key 'plant.position_range' needs {n:.3g} samples to cross "
+                          f"at w_max, above {LIMITS['samples_across_range']:g}")
+
+
 def config_from_mapping(data: dict[str, Any]) -> Config:
     """Validate a parsed TOML mapping and build a :class:`Config`.
 
@@ -220,8 +250,8 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
         if key not in {"name", *_SECTIONS}:
             raise ConfigError(f"unknown config key '{key}'")
     name = data.get("name", "custom")
-    if not isinstance(name, str) or not name or not all(c.isalnum() or c in "-_." for c in name) \
-            or name.startswith("."):
+    if not isinstance(name, str) or not name or not name.isascii() \
+            or not all(c.isalnum() or c in "-_." for c in name) or name.startswith("."):
         raise ConfigError(f"config key 'name' must be a non-empty word of letters, digits, "
                           f"'-', '_' or '.', got {name!r}")
     plant = _section(data, "plant")
@@ -240,6 +270,7 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
         a = plant["a"]
     for key in ("w_max", "sample_time", "position_range"):
         _positive("plant", key, plant[key])
+    _check_scales(a, plant, "plant.bandwidth_hz" if has_hz else "plant.a")
     if pto["d"] < 0:
         raise ConfigError(f"config key 'pto.d' must be >= 0, got {pto['d']!r}")
     if pto["d"] > plant["position_range"]:
@@ -275,8 +306,14 @@ def load_config(path: str | Path | None) -> Config:
     """
     if path is None:
         return paper_config()
+    if str(path).strip() == "":
+        raise ConfigError("config file name is empty")
     path = Path(path)
+    if path.exists() and not path.is_file():
+        raise ConfigError(f"config file '{path}' is not a regular file")
     try:
+        if path.stat().st_size > 1 << 20:
+            raise ConfigError(f"config file '{path}' is larger than 1 MiB")
         text = path.read_bytes().decode("utf-8")
     except FileNotFoundError:
         raise ConfigError(f"config file '{path}' does not exist") from None

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import matplotlib
 
@@ -35,9 +36,15 @@ from ptoverify.laws import LAW_NAMES, Region, make_law  # noqa: E402
 from ptoverify.metrics import TIGHT_BAND  # noqa: E402
 from ptoverify.plant import flow  # noqa: E402
 from ptoverify.simulate import SimResult, simulate, simulate_batch  # noqa: E402
+from ptoverify.zones import corrected_zone, printed_zone  # noqa: E402
+
+if TYPE_CHECKING:
+    from ptoverify.ocp import ConvergenceStudy
 
 __all__ = ["plot_fig2", "plot_fig3", "plot_zones", "plot_fig5", "plot_fig6", "plot_response",
-           "plot_state_trajectories", "plot_sweep", "save_all", "save_sweep"]
+           "plot_state_trajectories", "plot_sweep", "save_all", "save_sweep",
+           "plot_zone_geometry", "plot_convergence", "plot_switch_profiles", "save_ground_truth",
+           "save_zone_geometry"]
 
 DPI = 110
 STYLE = {"to": dict(color="tab:red", lw=1.0, label="TO"),
@@ -540,8 +547,6 @@ def save_all(cfg: Config, outdir: str | Path) -> list[Path]:
 
 def save_ground_truth(study, outdir: str | Path) -> list[Path]:
     """Write the collocation convergence and switch-profile figures; return the paths."""
-    from ptoverify.plots_ocp import plot_convergence, plot_switch_profiles
-
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     files: list[Path] = []
@@ -556,8 +561,6 @@ def save_ground_truth(study, outdir: str | Path) -> list[Path]:
 
 def save_zone_geometry(cfg: Config, outdir: str | Path) -> list[Path]:
     """Write the zone-geometry figure with sampled trajectories; return the path."""
-    from ptoverify.plots_zone import plot_zone_geometry
-
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     files: list[Path] = []
@@ -565,3 +568,153 @@ def save_zone_geometry(cfg: Config, outdir: str | Path) -> list[Path]:
     plot_zone_geometry(cfg, ax)
     _save(fig, outdir / "zone_geometry.png", files)
     return files
+
+
+# ------------------------------------------------------------ zone geometry
+_ZONE_MARKERS = {Region.BANG_P: ("^", "tab:red"), Region.BANG_N: ("v", "tab:blue"),
+            Region.ZONE_P: ("s", "tab:orange"), Region.ZONE_N: ("s", "tab:cyan"),
+            Region.LINEAR: ("o", "tab:green"), Region.SATURATED: ("D", "tab:olive"),
+            Region.ORIGIN: ("x", "k")}
+
+
+def plot_zone_geometry(cfg: Config, ax=None, starts: tuple[tuple[float, float], ...] | None = None,
+                       steps: int = 60, x1_max: float | None = None) -> dict:
+    """Draw the zone geometry and sampled PTO trajectories.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (a [rad/s], w_max [mm/s], T [s], d [mm]).
+    ax : matplotlib Axes, optional
+        Axes to draw on; a new figure when None.
+    starts : tuple of (x1, x2), optional
+        Initial states [mm], [mm/s] of the trajectories; default a few states
+        right of l1* and their mirror images.
+    steps : int
+        Samples per trajectory.
+    x1_max : float, optional
+        Half-width of the x1 axis [mm]; default 4 d or l1* at -w_max, whichever is larger.
+
+    Returns
+    -------
+    dict
+        ``figure``, ``ax``, ``lines`` (name -> Line2D), ``zone`` and ``printed``
+        (:class:`~ptoverify.zones.PTOZone`).
+    """
+    a, w, T, d = cfg.plant.a, cfg.plant.w_max, cfg.plant.sample_time, cfg.pto.d
+    zc, zp = corrected_zone(cfg, verify=False), printed_zone(cfg)
+    om = zc.omega0 if zc.usable else w
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(8, 6))
+    fig = ax.figure
+    s = np.linspace(0.0, w, 400)
+    l1 = level_curve_x1(-s, a, w)
+    l1s = level_curve_x1(-s, a, om)
+    xmax = x1_max or max(4 * d, 1.3 * float(l1s[-1]))
+    lines = {}
+    lines["l1"], = ax.plot(l1, -s, "k-", lw=1.5, label="l1, l2 (eqs. 9, 11)")
+    ax.plot(-l1, s, "k-", lw=1.5)
+    lines["l1*"], = ax.plot(l1s, -s, "--", color="tab:orange",
+                            label=f"l1*, l2* corrected, omega0 = {om:.4g} mm/s")
+    ax.plot(-l1s, s, "--", color="tab:orange")
+    ax.fill_betweenx(-s, l1, l1s, color="tab:orange", alpha=0.15, label="zones S~_P, S~_N")
+    ax.fill_betweenx(s, -l1s, -l1, color="tab:orange", alpha=0.15)
+    # printed curve (19): a x1 + x2 + w ln(1 - x2/w) = -2 a w T
+    s19 = np.linspace(0.0, max(w, -zp.x20_tilde if np.isfinite(zp.x20_tilde) else w), 400)
+    x19 = (-2 * a * w * T + s19 - w * np.log1p(s19 / w)) / a
+    lines["eq19"], = ax.plot(x19, -s19, ":", color="tab:purple", label="printed curve (19)")
+    ax.axvspan(-d, d, color="tab:green", alpha=0.08, label=f"linear zone |x1| < {d:g} mm")
+    if starts is None:
+        x0 = np.linspace(1.2, 0.9 * xmax / max(d, 1e-9), 4) * d
+        starts = tuple((float(v), 0.0) for v in x0) + ((float(xmax * 0.9), -w),)
+        starts = starts + tuple((-x, -v) for x, v in starts)
+    res = simulate_batch(make_law("pto", cfg), cfg.plant, [p[0] for p in starts],
+                         [p[1] for p in starts], steps)
+    for j in range(len(starts)):
+        ax.plot(res.x1[:, j], res.x2[:, j], "-", color="0.6", lw=0.7)
+    for reg, (mk, col) in _ZONE_MARKERS.items():
+        sel = res.region == reg
+        if sel.any():
+            ax.plot(res.x1[:-1][sel], res.x2[:-1][sel], mk, color=col, ms=3, ls="none",
+                    label=f"sample: {reg.name}")
+    ax.set_xlim(-xmax, xmax)
+    ax.set_ylim(-1.1 * w, 1.1 * w)
+    ax.set_xlabel("position x1 [mm]")
+    ax.set_ylabel("velocity x2 [mm/s]")
+    ax.set_title(f"{cfg.name}: switching zone, T = {T * 1e3:g} ms, a = {a:.4g} rad/s")
+    ax.legend(fontsize=7, loc="upper right")
+    ax.grid(True, alpha=0.3)
+    return {"figure": fig, "ax": ax, "lines": lines, "zone": zc, "printed": zp}
+
+
+# ------------------------------------------------------------ collocation study
+def plot_convergence(study: ConvergenceStudy, ax=None):
+    """Plot the relative t_f error against N, one line per state.
+
+    Parameters
+    ----------
+    study : ConvergenceStudy
+        Output of :func:`ptoverify.ocp.convergence_study`.
+    ax : matplotlib Axes, optional
+        Axes to draw on (a new figure when None).
+
+    Returns
+    -------
+    ax : matplotlib Axes
+        The axes drawn on.
+    """
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6, 4))
+    n = study.intervals.astype(float)
+    for (x1, x2), err in zip(study.states, study.rel_error, strict=True):
+        ax.loglog(n, err, "o-", ms=3, label=f"x0 = ({x1:g} mm, {x2:g} mm/s)")
+    ref = np.nanmax(study.rel_error[:, 0]) * (n / n[0]) ** -2.0
+    ax.loglog(n, ref, "k--", lw=0.8, label="slope -2")
+    ax.set_xlabel("collocation intervals N [-]")
+    ax.set_ylabel("|t_f - t_f*| / t_f* [-]")
+    ax.set_title(f"Radau collocation, observed order {study.order:.2f}")
+    ax.grid(True, which="both", lw=0.3)
+    ax.legend(fontsize=7)
+    return ax
+
+
+def plot_switch_profiles(study: ConvergenceStudy, state: int = 0, ax=None,
+                         window: float = 0.15):
+    """Plot the collocation input near the switch for each N (smearing, chattering).
+
+    Parameters
+    ----------
+    study : ConvergenceStudy
+        Output of :func:`ptoverify.ocp.convergence_study`.
+    state : int
+        Row of ``study.states`` to draw.
+    ax : matplotlib Axes, optional
+        Axes to draw on (a new figure when None).
+    window : float
+        Half-width of the time window around the exact switch, as a fraction
+        of t_f* [-].
+
+    Returns
+    -------
+    ax : matplotlib Axes
+        The axes drawn on.
+    """
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6, 4))
+    tf = float(study.t_f_exact[state])
+    ts = float(study.t_switch_exact[state])
+    x1, x2 = study.states[state]
+    for n in study.intervals:
+        t, u = study.profiles[(state, int(n))]
+        if t is None or u is None or len(u) == 0:
+            continue
+        ax.step(t, np.append(u, u[-1]), where="post", lw=0.9, label=f"N = {n}")
+    ax.axvline(ts, color="k", lw=0.6, ls="--", label="switch (closed form)")
+    ax.axvline(tf, color="k", lw=0.6, ls=":", label="t_f* (closed form)")
+    ax.set_xlim(max(0.0, ts - window * tf), min(ts + window * tf, 1.02 * tf))
+    ax.set_xlabel("time t [s]")
+    ax.set_ylabel("input u [mm/s]")
+    ax.set_title(f"collocation input near the switch, x0 = ({x1:g} mm, {x2:g} mm/s)")
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize=7)
+    return ax

@@ -20,12 +20,9 @@ import datetime as _dt
 import html
 import json
 import math
-import os
 import platform
-import shutil
 import subprocess
 import sys
-import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,7 +31,6 @@ from typing import Any
 import numpy as np
 
 from ptoverify.config import Config
-from ptoverify.errors import InputError
 
 __all__ = ["collect", "build_sections", "render_html", "render_markdown", "write_report",
            "GROUND_TRUTH_STATES"]
@@ -116,27 +112,44 @@ def _environment(cfg: Config) -> dict[str, Any]:
     import scipy
     import sympy
 
+    here = Path(__file__).resolve().parent
     try:
         commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
-                                cwd=Path(__file__).resolve().parent, timeout=5,
-                                check=False).stdout.strip() or None
+                                cwd=here, timeout=5, check=False).stdout.strip() or None
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, cwd=here, timeout=5,
+                               check=False).stdout.strip()
+        if commit and dirty:
+            commit += " (working tree modified)"
     except (OSError, subprocess.SubprocessError):
         commit = None
-    try:
-        ipopt = casadi.nlpsol("probe", "ipopt", {"x": casadi.SX.sym("x"),
-                              "f": casadi.SX.sym("x") ** 2}, {"ipopt.print_level": 0,
-                                                               "print_time": False})
-        ipopt_version = str(ipopt.plugin_name())
-    except Exception:  # noqa: BLE001 - environment probe only
-        ipopt_version = "unavailable"
+    ipopt_version = _ipopt_version(casadi)
     from ptoverify import __version__
 
     return {"python": platform.python_version(), "ptoverify": __version__,
-            "casadi": casadi.__version__, "ipopt": f"bundled with casadi ({ipopt_version})",
+            "casadi": casadi.__version__, "ipopt": ipopt_version,
             "sympy": sympy.__version__, "control": control.__version__,
             "numpy": np.__version__, "scipy": scipy.__version__,
             "platform": platform.platform(), "git_commit": commit,
             "config": cfg.to_mapping()}
+
+
+def _ipopt_version(casadi) -> str:
+    """IPOPT's version, read from the banner of a one-variable solve (bundled with CasADi)."""
+    import io
+    import re
+    from contextlib import redirect_stdout
+
+    x = casadi.SX.sym("x")
+    buf = io.StringIO()
+    try:
+        with redirect_stdout(buf):
+            casadi.nlpsol("probe", "ipopt", {"x": x, "f": (x - 1) ** 2},
+                          {"ipopt.print_level": 5, "print_time": False})(x0=0)
+    except Exception:  # noqa: BLE001 - environment probe only
+        return "unknown"
+    m = re.search(r"Ipopt version (\S+)", buf.getvalue())
+    return m.group(1).rstrip(",") if m else "bundled with casadi"
 
 
 def collect(cfg: Config, progress: Progress | None = None) -> dict[str, Any]:
@@ -206,10 +219,12 @@ def _summary(out: dict[str, Any], gates: dict[str, Any]) -> dict[str, Any]:
     return {"gates": gates, "derivation_verdicts": verdicts, "claim_verdicts": claims,
             "errata": [r["id"] for r in out["derivations"] if r["verdict"] == "erratum"],
             "claims_not_reproduced": [c["id"] for c in out["claims"]
-                                      if c["verdict"] != "reproduced"],
+                                      if c["verdict"] == "not reproduced"],
+            "claims_ambiguous": [c["id"] for c in out["claims"] if c["verdict"] == "ambiguous"],
             "printed_zone_valid": bool(out["zone"]["printed"]["valid"]),
             "corrected_zone_valid": bool(out["zone"]["corrected"]["valid"]),
-            "corrected_omega0": out["zone"]["corrected"]["omega0"]}
+            "corrected_omega0": out["zone"]["corrected"]["omega0"],
+            "corrected_zone_margin_mm_s": out["zone"]["corrected"].get("margin_mm_s")}
 
 
 # ------------------------------------------------------------------ sections
@@ -379,15 +394,12 @@ def write_report(cfg: Config, out: str | Path | None = None,
     InputError
         When the folder cannot be written.
     """
-    out = Path(out) if out is not None else Path("reports") / cfg.name
-    parent = out.resolve().parent
+    from ptoverify.outdir import check_target, discard, make_temp, publish
+
+    out = check_target(out if out is not None else Path("reports") / cfg.name)
+    res = collect(cfg, progress)                      # nothing is written before this ends
+    tmp = make_temp(out)
     try:
-        parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=parent))
-    except OSError as exc:
-        raise InputError(f"cannot write report to '{out}': {exc.strerror or exc}") from None
-    try:
-        res = collect(cfg, progress)
         if progress:
             progress("figures")
         figures = _figures(res, cfg, tmp / "figures")
@@ -403,20 +415,10 @@ def write_report(cfg: Config, out: str | Path | None = None,
                                                      allow_nan=False) + "\n")
         (tmp / "index.html").write_text(render_html(sections, title))
         (tmp / "report.md").write_text(render_markdown(sections, title))
-        os.chmod(tmp, 0o755)
-        backup = None
-        if out.exists():
-            backup = parent / f".{out.name}.old-{os.getpid()}"
-            os.rename(out, backup)
-        os.rename(tmp, out)
-        if backup is not None:
-            shutil.rmtree(backup, ignore_errors=True)
-    except OSError as exc:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise InputError(f"cannot write report to '{out}': {exc.strerror or exc}") from None
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+        publish(tmp, out)
+        tmp = None
+    finally:
+        discard(tmp)
     return out
 
 

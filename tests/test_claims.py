@@ -2,7 +2,6 @@
 
 import json
 import math
-import time
 
 import pytest
 
@@ -88,15 +87,12 @@ def test_numeric_rule():
     assert not cl.numeric_verdict(math.nan, 4.5, 1.0)
 
 
-def test_cached_and_cheap():
+def test_cached():
+    """Speed is measured in benchmarks/; here only that a second call reuses the results."""
     cfg = paper_config().with_plant(w_max=280.0)
-    t0 = time.perf_counter()
     first = cl.evaluate_claims(cfg)
-    t1 = time.perf_counter()
     again = cl.evaluate_claims(cfg)
-    t2 = time.perf_counter()
-    assert t1 - t0 < 10.0, f"evaluate_claims took {t1 - t0:.1f} s"
-    assert t2 - t1 < 0.05 and all(a is b for a, b in zip(first, again, strict=True)), "cache"
+    assert all(a is b for a, b in zip(first, again, strict=True)), "cache"
 
 
 def test_error_tracking_reading_matches_simulate_for_a_step(paper_cfg):

@@ -69,3 +69,109 @@ def test_simulate_json(capsys):
     code, out, _ = run(capsys, "simulate", "--law", "to", "--signal", "sine", "--json")
     data = json.loads(out)
     assert code == 0 and data["law"] == "to" and len(data["series"]["t"]) == 501
+
+
+BAD_CONFIGS = {
+    "not_toml": "this is [not toml",
+    "unknown_key": '[plant]\na = 1.0\nw_max = 1.0\nsample_time = 0.1\nposition_range = 1.0\n'
+                   'colour = 2.0\n[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n',
+    "nan": '[plant]\na = nan\nw_max = 1.0\nsample_time = 0.1\nposition_range = 1.0\n'
+           '[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n',
+    "non_numeric": '[plant]\na = "fast"\nw_max = 1.0\nsample_time = 0.1\nposition_range = 1.0\n'
+                   '[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n',
+    "out_of_range": '[plant]\na = 1.0\nw_max = 1.0\nsample_time = -0.1\nposition_range = 1.0\n'
+                    '[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n',
+}
+
+
+@pytest.mark.parametrize("kind", sorted(BAD_CONFIGS))
+@pytest.mark.parametrize("command", [["report", "--quiet"], ["check"], ["sweep", "--quiet"],
+                                     ["zone"], ["derive"], ["simulate"], ["mintime", "1", "0"]])
+def test_bad_config_every_command_exit_2_writes_nothing(capsys, tmp_path, monkeypatch, kind,
+                                                        command):
+    monkeypatch.chdir(tmp_path)
+    cfg = tmp_path / "bad.toml"
+    cfg.write_text(BAD_CONFIGS[kind])
+    extra = ["--out", str(tmp_path / "out")] if command[0] in ("report", "sweep") else []
+    code = main([*command, "--config", str(cfg), *extra])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and err.startswith("ptoverify: error:")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"], "something was written"
+
+
+def test_every_command_help_has_an_example(capsys):
+    from ptoverify.cli import COMMANDS
+
+    for name, _ in COMMANDS:
+        with pytest.raises(SystemExit) as exc:
+            main([name, "--help"])
+        assert exc.value.code == 0
+        assert "example:" in capsys.readouterr().out, name
+
+
+MORE_BAD = {
+    "inf": ("w_max = 300.0", "w_max = inf"),
+    "both_a_and_hz": ("bandwidth_hz = 30.0", "bandwidth_hz = 30.0\na = 3.0"),
+    "d_negative": ("d = 0.5", "d = -0.5"),
+    "d_beyond_range": ("d = 0.5", "d = 60.0"),
+    "huge_w_max": ("w_max = 300.0", "w_max = 1e300"),
+    "tiny_T": ("sample_time = 0.002", "sample_time = 1e-300"),
+    "huge_T": ("sample_time = 0.002", "sample_time = 1e300"),
+    "missing_section": ("[pd]\nkp = 356.0\nkd = 1.15\n", ""),
+}
+GOOD_TEXT = ('name = "x"\n[plant]\nbandwidth_hz = 30.0\nw_max = 300.0\nsample_time = 0.002\n'
+             'position_range = 50.0\n[pd]\nkp = 356.0\nkd = 1.15\n[pto]\nd = 0.5\nk1 = 323.0\n'
+             'k2 = 3.6\n')
+
+
+@pytest.mark.parametrize("kind", sorted(MORE_BAD))
+def test_more_bad_configs_in_a_subprocess_no_traceback(tmp_path, kind):
+    """A real process: one line on stderr, exit 2, no traceback, for each class."""
+    import subprocess
+    import sys
+
+    old, new = MORE_BAD[kind]
+    assert old in GOOD_TEXT
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(GOOD_TEXT.replace(old, new))
+    proc = subprocess.run([sys.executable, "-m", "ptoverify", "simulate", "--law", "pd",
+                           "--config", str(cfg)], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("path", ["/dev/zero", ".", ""])
+def test_config_that_is_not_a_file(capsys, path):
+    assert main(["mintime", "1", "0", "--config", path]) == 2
+    assert capsys.readouterr().err.startswith("ptoverify: error: config file")
+
+
+@pytest.mark.parametrize("x1", ["-1e2", "-5.", "-.5", "-5"])
+def test_negative_float_positionals(capsys, x1):
+    assert main(["mintime", x1, "0", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["x0"][0] == float(x1)
+
+
+def test_out_refuses_to_replace_a_foreign_folder(capsys, tmp_path):
+    victim = tmp_path / "thesis"
+    victim.mkdir()
+    (victim / "thesis.tex").write_text("precious")
+    code = main(["sweep", "--grid", "2", "--quiet", "--out", str(victim)])
+    assert code == 2 and "not a ptoverify output" in capsys.readouterr().err
+    assert (victim / "thesis.tex").read_text() == "precious"
+
+
+def test_out_replaces_its_own_previous_output(capsys, tmp_path):
+    out = tmp_path / "a" / "b" / "sweep"
+    assert main(["sweep", "--grid", "2", "--quiet", "--out", str(out)]) == 0
+    first = sorted(p.name for p in out.iterdir())
+    assert ".ptoverify" in first and "sweep.json" in first
+    assert main(["sweep", "--grid", "3", "--quiet", "--out", str(out)]) == 0
+    assert json.loads((out / "sweep.json").read_text())["grid"]["states"] == 9
+    assert sorted(p.name for p in out.parent.iterdir()) == ["sweep"], "leftovers"
+
+
+def test_empty_csv_and_short_duration_rejected(capsys):
+    assert main(["simulate", "--law", "pd", "--csv", ""]) == 2
+    assert main(["simulate", "--law", "pd", "--duration", "1e-9"]) == 2

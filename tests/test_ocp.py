@@ -195,7 +195,7 @@ def test_convergence_study_order():
 
 
 def test_convergence_figures(tmp_path):
-    from ptoverify.plots_ocp import plot_convergence, plot_switch_profiles
+    from ptoverify.plots import plot_convergence, plot_switch_profiles
 
     study = convergence_study(PLANTS["paper"], [(5.0, 0.0)], intervals=(10, 20))
     ax = plot_convergence(study)

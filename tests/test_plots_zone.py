@@ -9,7 +9,7 @@ from numpy.testing import assert_allclose  # noqa: E402
 
 from ptoverify.config import paper_config  # noqa: E402
 from ptoverify.curves import level_residual  # noqa: E402
-from ptoverify.plots_zone import plot_zone_geometry  # noqa: E402
+from ptoverify.plots import plot_zone_geometry  # noqa: E402
 
 
 def test_plot_zone_geometry(tmp_path):

@@ -1,7 +1,6 @@
 """PTO law, eq. (35): both variants, omega_c closed form, ZOH riding, properties."""
 
 import math
-import time
 
 import numpy as np
 import pytest
@@ -114,19 +113,20 @@ def test_zone_state_rides_its_curve_under_zoh():
                         err_msg="residual of the omega_c curve after one sample")
 
 
-def test_scalar_speed():
+def test_scalar_path_agrees_on_zone_states():
     law = LAWS["pto"]
     pts = [(0.5 * (OMEGA0 * float(h(s / OMEGA0)) + W * float(h(s / W))) / A, -s)
            for s in np.linspace(150, 300, 200)]
     pts += [(float(a), float(b)) for a, b in zip(np.linspace(-50, 50, 200),
                                                  np.linspace(300, -300, 200))]
-    best = math.inf
-    for _ in range(5):
-        t0 = time.perf_counter()
-        for a, b in pts:
-            law.scalar(a, b)
-        best = min(best, (time.perf_counter() - t0) / len(pts))
-    assert best < 20e-6, f"{best * 1e6:.1f} us per call"
+    # speed is measured in benchmarks/ (law_scalar_us); here: the scalar path agrees with the
+    # vector path on these states
+    x1 = np.array([p[0] for p in pts])
+    x2 = np.array([p[1] for p in pts])
+    u_vec, r_vec = law(x1, x2)
+    for k, (a, b) in enumerate(pts):
+        u, r = law.scalar(a, b)
+        assert u == pytest.approx(u_vec[k], rel=1e-12, abs=1e-9) and r == r_vec[k]
 
 
 def test_no_zone_when_omega0_none():
