@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
+LOAD_AT_START = [round(x, 2) for x in os.getloadavg()]   # 1, 5, 15 min, before any work
 # `python benchmarks/run.py` puts benchmarks/, not the repository root, first on sys.path;
 # an editable install elsewhere (another worktree) would then be measured instead of this
 # tree.  Only this script does this; the package never edits sys.path.
@@ -277,7 +278,8 @@ def machine() -> dict:
             pass
     return {"cpu": cpu, "cores": os.cpu_count(), "numpy": np.__version__, "blas": blas,
             "openblas_coretype": os.environ.get("OPENBLAS_CORETYPE"),
-            "load_average": [round(x, 2) for x in os.getloadavg()],
+            "load_average_start": LOAD_AT_START,
+            "load_average_end": [round(x, 2) for x in os.getloadavg()],
             "ptoverify": str(Path(sys.modules["ptoverify"].__file__).parent)}
 
 
