@@ -1,0 +1,963 @@
+"""Conformance of a third-party PTO implementation to the reference law, eq. (35).
+
+``ptoverify conform`` judges a user's law ``u = f(x1, x2, cfg)`` (a Python
+callable) or a table of its values (CSV, columns x1, x2, u) against the
+reference ``make_law("pto", cfg)`` (corrected omega0) and, for a callable, by
+the closed-loop properties that ``ptoverify check`` gates.
+
+Decisions (also in ``ptoverify conform --help``):
+
+Loading
+    ``MODULE:FUNCTION`` imports exactly the named module with
+    :func:`importlib.import_module` (it must be importable from ``sys.path`` as
+    it stands; nothing is added to the path).  ``path/to/file.py:FUNCTION``
+    (the part before the last ``:`` ends in ``.py``) loads exactly that file
+    with :func:`importlib.util.spec_from_file_location`.  No path is ever
+    searched for.  Loading runs the user's code.  FUNCTION may be dotted
+    (``Class.method``).
+Interface errors versus findings
+    Everything about the *interface* is bad input (exit 2): the module cannot be
+    imported, the attribute is missing or not callable, its signature does not
+    take (x1, x2, cfg), it returns something that is not a number (scalar mode)
+    or an array of the wrong shape.  Everything about the *values at states* is
+    a finding (exit 1, naming the state): the function raises at a state,
+    returns NaN or an infinity there, or is not a pure function of the state
+    (two calls at the same state differ, e.g. a law with memory or a delay).
+Vectorized or scalar
+    The law is called with arrays of 8 probe states; if that returns a float
+    array of the same shape that agrees with element-wise calls on Python floats
+    to 1e-12 w_max, the law is used vectorized, otherwise it is wrapped in a
+    scalar loop.  The output says which and why.
+Agreement
+    On the conformance grid (:func:`conformance_grid`, what ``--emit-grid``
+    writes) or the table's points: |u - u_ref| <= ``rtol`` w_max, default
+    rtol = 1e-6 (0.3 mm/s at the paper's w_max; float32 implementations round
+    at ~6e-8 relative, so they pass with headroom, while every seeded fault of
+    the mutation suite is orders of magnitude above).  Reported per reference
+    region: largest |du|, its state, count of points.  Points outside the
+    linear zone within ``TIE_BAND`` (1e-9 (w_max + a position_range) mm/s, the
+    tolerance of ``properties``) of a computed curve, l1/l2 or l1*/l2*, are
+    excluded and counted: there a float tie can flip the region and u jumps
+    by up to 2 w_max.  The linear-zone edge |x1| = d, x2 = 0 and the origin
+    are exact comparisons in floats, so no point near them is excluded.
+Closed loop (callable only)
+    The sweep of ``check`` (:func:`ptoverify.properties.initial_grid`, 101 x 101
+    + 200 rest states, vectorized; 21 x 21 + 40 in scalar mode, where every
+    state and sample is a Python call) with the same definitions as
+    :mod:`ptoverify.properties`: stride-overs (sources in a switching zone are
+    judged by the reference's zone geometry, since a user law has no region
+    codes), limit cycles and states not settled within 1e-3 mm, |u| <= w_max.
+    Odd symmetry u(-x) = -u(x) on the grid to the agreement tolerance (as
+    ``check``'s odd-symmetry gate for every law).
+Settling against N* T
+    On a settling sweep (11 x 11 + 20 rest states) N* is the discrete-time
+    limit (fewest ZOH samples to the origin).  The settling step s is the
+    first sample after which |x1| stays within 1e-3 mm.  The excess s - N* of
+    the reference is computed for the same states; a law passes when its
+    worst excess is at most E_ref + max(2, ceil(E_ref / 2)) samples, with
+    E_ref the reference's worst excess: the reference passes with that margin,
+    an implementation that agrees to tolerance moves its settling sample by at
+    most one where a trajectory grazes the band, and a law that loses more
+    than half again what the reference loses to the discrete optimum fails.
+    If N* cannot be established for a state, the property is ``unverified``
+    and the law does not conform (fail closed).
+Tables
+    Only the agreement and |u| <= w_max are judged where the table has points;
+    the closed-loop properties need a callable and are reported ``not_run``.
+"""
+
+from __future__ import annotations
+
+import csv
+import functools
+import importlib
+import importlib.util
+import inspect
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ptoverify.config import Config
+from ptoverify.curves import level_curve_x1, level_residual, switching_function
+from ptoverify.errors import InputError
+from ptoverify.laws import Law, Region, make_law
+
+__all__ = ["reference_law", "reference_law_scalar", "load_callable", "UserLaw", "wrap_callable",
+           "LawFault", "conformance_grid", "grid_csv", "read_table", "agreement",
+           "closed_loop", "ConformResult", "conform_callable", "conform_table", "format_result",
+           "DEFAULT_RTOL"]
+
+DEFAULT_RTOL = 1e-6            #: agreement tolerance relative to w_max
+_VEC_RTOL = 1e-12              #: vectorized-vs-scalar agreement relative to w_max
+_BAND_MM = 1e-3                #: settling / oscillation band [mm], as properties
+PASS, FAIL, NOT_RUN, UNVERIFIED = "pass", "fail", "not_run", "unverified"
+
+
+# ------------------------------------------------------------------ reference
+def reference_law(x1, x2, cfg: Config):
+    """Reference PTO law (corrected omega0) as a user-style callable, vectorized.
+
+    Parameters
+    ----------
+    x1, x2 : float or array_like
+        State [mm], [mm/s].
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    float or ndarray
+        u [mm/s]; a float for scalar inputs.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> reference_law(0.1, 0.0, paper_config())
+    -32.300000000000004
+    """
+    u, _ = make_law("pto", cfg)(x1, x2)
+    return float(u) if np.ndim(u) == 0 else u
+
+
+def reference_law_scalar(x1: float, x2: float, cfg: Config) -> float:
+    """Reference PTO law on Python floats only (exercises the scalar mode)."""
+    if not isinstance(x1, float) or not isinstance(x2, float):
+        raise TypeError("scalar law: x1 and x2 must be floats")
+    return make_law("pto", cfg).scalar(x1, x2)[0]
+
+
+def _tie_band(cfg: Config) -> float:
+    p = cfg.plant
+    return 1e-9 * (p.w_max + p.a * p.position_range)
+
+
+def _omega0(cfg: Config) -> float | None:
+    """omega0 [mm/s] the reference uses, None when it has no switching zone."""
+    from ptoverify.zones import zone_for_law
+
+    z = zone_for_law(cfg, "corrected")
+    ok = z.usable and not z.degenerate and 0.0 < z.omega0 < cfg.plant.w_max
+    return float(z.omega0) if ok else None
+
+
+# ------------------------------------------------------------------ loading
+def load_callable(spec: str) -> Callable:
+    """Import ``MODULE:FUNCTION`` or load ``path/file.py:FUNCTION`` (runs user code).
+
+    Parameters
+    ----------
+    spec : str
+        ``package.module:function`` (imported from ``sys.path`` as it stands) or
+        ``path/to/file.py:function`` (exactly that file).
+
+    Returns
+    -------
+    callable
+        The named object.
+
+    Raises
+    ------
+    InputError
+        Malformed spec, import failure, missing attribute, not callable.
+    """
+    mod_name, sep, attr = spec.rpartition(":")
+    if not sep or not mod_name or not attr:
+        raise InputError(f"--law '{spec}': expected MODULE:FUNCTION or path/file.py:FUNCTION")
+    try:
+        if mod_name.endswith(".py"):
+            path = Path(mod_name)
+            if not path.is_file():
+                raise InputError(f"--law '{spec}': no such file '{mod_name}'")
+            name = f"_ptoverify_user_{path.stem}"
+            mspec = importlib.util.spec_from_file_location(name, path)
+            if mspec is None or mspec.loader is None:
+                raise InputError(f"--law '{spec}': cannot load '{mod_name}'")
+            module = importlib.util.module_from_spec(mspec)
+            mspec.loader.exec_module(module)
+        else:
+            module = importlib.import_module(mod_name)
+    except InputError:
+        raise
+    except BaseException as exc:  # noqa: BLE001 - user code may raise anything, even SystemExit
+        raise InputError(f"--law '{spec}': importing '{mod_name}' failed: "
+                         f"{type(exc).__name__}: {exc}") from None
+    obj: Any = module
+    for part in attr.split("."):
+        if not hasattr(obj, part):
+            raise InputError(f"--law '{spec}': '{mod_name}' has no attribute '{attr}'")
+        obj = getattr(obj, part)
+    if not callable(obj):
+        raise InputError(f"--law '{spec}': '{attr}' is not callable ({type(obj).__name__})")
+    return obj
+
+
+# ------------------------------------------------------------------ wrapping
+class LawFault(Exception):
+    """The user law failed at a state (raised, or returned a non-finite u): a finding."""
+
+    def __init__(self, state: tuple[float, float], message: str):
+        super().__init__(message)
+        self.state = state
+        self.message = message
+
+
+def _as_number(value: Any, state: tuple[float, float]) -> float:
+    """Convert a scalar return value to float; wrong type is bad input (exit 2)."""
+    if isinstance(value, bool) or np.ndim(value) != 0:
+        raise InputError(f"the law returned {type(value).__name__} (shape {np.shape(value)}) at "
+                         f"state ({state[0]!r}, {state[1]!r}); expected one number u [mm/s]")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"the law returned {type(value).__name__} at state ({state[0]!r}, "
+                         f"{state[1]!r}); expected one number u [mm/s]") from None
+
+
+@dataclass
+class UserLaw:
+    """A user law u = f(x1, x2, cfg) with its evaluation mode.
+
+    Attributes
+    ----------
+    fn : callable
+        The user's function.
+    cfg : Config
+        Configuration passed to it.
+    mode : str
+        ``vectorized`` or ``scalar``.
+    reason : str
+        Why that mode was chosen.
+    calls : int
+        Number of calls made so far.
+    """
+
+    fn: Callable
+    cfg: Config
+    mode: str = "scalar"
+    reason: str = ""
+    calls: int = 0
+
+    def scalar(self, x1: float, x2: float) -> float:
+        """Evaluate at one state; LawFault on exception or non-finite u."""
+        self.calls += 1
+        try:
+            value = self.fn(x1, x2, self.cfg)
+        except Exception as exc:  # noqa: BLE001 - any user exception is a finding
+            raise LawFault((x1, x2), f"the law raised {type(exc).__name__}: {exc}") from None
+        u = _as_number(value, (x1, x2))
+        if not math.isfinite(u):
+            raise LawFault((x1, x2), f"the law returned u = {u!r}")
+        return u
+
+    def __call__(self, x1: NDArray, x2: NDArray) -> NDArray[np.float64]:
+        """Evaluate on 1-D arrays [mm], [mm/s]; returns u [mm/s]."""
+        x1 = np.asarray(x1, dtype=float).ravel()
+        x2 = np.asarray(x2, dtype=float).ravel()
+        if self.mode == "scalar":
+            return np.array([self.scalar(float(a), float(b)) for a, b in zip(x1, x2)],
+                            dtype=float)
+        self.calls += 1
+        try:
+            value = self.fn(x1, x2, self.cfg)
+        except Exception as exc:  # noqa: BLE001 - locate the failing state element-wise
+            for a, b in zip(x1, x2):
+                self.scalar(float(a), float(b))
+            raise LawFault((float(x1[0]), float(x2[0])),
+                           f"the law raised {type(exc).__name__} on arrays but no element "
+                           f"raised alone: {exc}") from None
+        try:
+            u = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(f"the law returned {type(value).__name__} for arrays; expected a "
+                             "float array") from None
+        if u.shape != x1.shape:
+            raise InputError(f"the law returned shape {u.shape} for {x1.size} states")
+        bad = np.flatnonzero(~np.isfinite(u))
+        if bad.size:
+            i = int(bad[0])
+            raise LawFault((float(x1[i]), float(x2[i])), f"the law returned u = {u[i]!r}")
+        return u
+
+
+def _probe_states(cfg: Config) -> tuple[NDArray, NDArray]:
+    """Eight states across the regions: rest, bang, linear, zone band, |x2| = w_max."""
+    R, w, d = cfg.plant.position_range, cfg.plant.w_max, cfg.pto.d
+    x1 = np.array([0.3 * R, -0.7 * R, 0.5 * d, -0.5 * d, 0.2 * R, -0.2 * R, 1.5 * d, -1.5 * d])
+    x2 = np.array([0.0, 0.5 * w, -0.25 * w, 0.1 * w, -w, w, -0.9 * w, 0.9 * w])
+    return x1, x2
+
+
+def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
+    """Check the signature, detect vectorized or scalar, test purity on probe states.
+
+    Parameters
+    ----------
+    fn : callable
+        The user law ``u = f(x1, x2, cfg)``.
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    law : UserLaw
+        The wrapped law with its mode.
+    failures : list of dict
+        Findings (``evaluation`` or ``pure-function``) at the probe states.
+    """
+    try:
+        inspect.signature(fn).bind(0.0, 0.0, cfg)
+    except TypeError as exc:
+        raise InputError(f"the law's signature does not accept (x1, x2, cfg): {exc}") from None
+    except ValueError:
+        pass                                    # no signature available (builtins): try it
+    law = UserLaw(fn, cfg)
+    p1, p2 = _probe_states(cfg)
+    try:
+        first = law(p1, p2)
+        second = law(p1, p2)
+    except LawFault as fault:
+        return law, [_failure("evaluation", fault.state, fault.message)]
+    failures = []
+    diff = np.abs(first - second)
+    if np.any(diff > 0):
+        i = int(np.argmax(diff > 0))
+        failures.append(_failure("pure-function", (p1[i], p2[i]),
+                                 f"two calls at the same state returned {first[i]!r} and "
+                                 f"{second[i]!r} mm/s: the law has memory (e.g. a delay)"))
+    law.mode, law.reason = "vectorized", ""
+    try:
+        vec = law(p1, p2)
+        close = np.abs(vec - first) <= _VEC_RTOL * cfg.plant.w_max
+        if not np.all(close):
+            i = int(np.argmin(close))
+            law.reason = (f"array call differs from element-wise calls at ({p1[i]:g}, "
+                          f"{p2[i]:g}): {vec[i]!r} vs {first[i]!r}")
+    except (LawFault, InputError) as exc:
+        law.reason = f"array call failed: {getattr(exc, 'message', exc)}"
+    if law.reason:
+        law.mode = "scalar"
+    else:
+        law.reason = f"array call of {p1.size} probe states equals element-wise calls"
+    return law, failures
+
+
+def _failure(prop: str, state, detail: str, **extra) -> dict:
+    return {"property": prop, "state": [float(state[0]), float(state[1])], "detail": detail,
+            **extra}
+
+
+# ------------------------------------------------------------------ grid and table
+def conformance_grid(cfg: Config, n: int = 61, n_curve: int = 121) -> tuple[NDArray, NDArray]:
+    """States dense near every curve, boundary, the origin and |x2| = w_max.
+
+    An ``n`` x ``n`` background over |x1| <= position_range, |x2| <= w_max, plus,
+    for ``n_curve`` speeds |x2| (geometric from 1e-6 w_max, and linear):
+
+    * l1, l2 (level w_max) and l1*, l2* (level omega0, the zone boundary): the
+      curve point and points at residual offsets of +-10^k TIE_BAND, k = 1..7,
+      with TIE_BAND = 1e-9 (w_max + a position_range) [mm/s];
+    * the switching-zone band between l1 and l1*: 11 points across it;
+    * the linear-zone edges x1 = +-d exactly, one ulp either side, and
+      +-d (1 +- 10^-k), k = 1..9;
+    * |x2| = w_max exactly and w_max (1 - 10^-k), k = 1..9, over n positions;
+    * the origin and 16 directions at radii 10^-k (d, w_max), k = 0..9.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+    n, n_curve : int
+        Background resolution and number of speeds along each curve.
+
+    Returns
+    -------
+    x1, x2 : ndarray
+        States [mm], [mm/s], inside the envelope, duplicates removed, symmetric
+        under x -> -x.
+    """
+    p = cfg.plant
+    a, w, R, d = p.a, p.w_max, p.position_range, cfg.pto.d
+    band = _tie_band(cfg)
+    g1, g2 = np.meshgrid(np.linspace(-R, R, n), np.linspace(-w, w, n))
+    xs, vs = [g1.ravel()], [g2.ravel()]
+    s = np.unique(np.concatenate([np.geomspace(1e-6 * w, w, n_curve // 2),
+                                  np.linspace(w / n_curve, w, n_curve - n_curve // 2)]))
+    rho = band * 10.0 ** np.arange(1, 8)
+    offsets = np.concatenate([-rho[::-1], [0.0], rho]) / a
+    om = _omega0(cfg)
+    for x2 in (-s, s):
+        for level in (w,) if om is None else (w, om):
+            c = level_curve_x1(x2, a, level)
+            xs.append((c[:, None] + offsets[None, :]).ravel())
+            vs.append(np.repeat(x2, offsets.size))
+        if om is not None:
+            c1, c2 = level_curve_x1(x2, a, w), level_curve_x1(x2, a, om)
+            f = np.linspace(0.0, 1.0, 11)
+            xs.append((c1[:, None] + f[None, :] * (c2 - c1)[:, None]).ravel())
+            vs.append(np.repeat(x2, f.size))
+    k = 10.0 ** -np.arange(1, 10)
+    edge = np.concatenate([[d, np.nextafter(d, 0.0), np.nextafter(d, np.inf)],
+                           d * (1 - k), d * (1 + k)])
+    v = np.linspace(-w, w, n_curve)
+    for sign in (1.0, -1.0):
+        e1, e2 = np.meshgrid(sign * edge, v)
+        xs.append(e1.ravel())
+        vs.append(e2.ravel())
+        top = sign * np.concatenate([[w], w * (1 - k)])
+        t1, t2 = np.meshgrid(np.linspace(-R, R, n), top)
+        xs.append(t1.ravel())
+        vs.append(t2.ravel())
+    r = 10.0 ** -np.arange(0, 10)
+    ang = np.linspace(0.0, 2.0 * math.pi, 16, endpoint=False)
+    xs.append(np.concatenate([[0.0], (r[:, None] * d * np.cos(ang)).ravel()]))
+    vs.append(np.concatenate([[0.0], (r[:, None] * w * np.sin(ang)).ravel()]))
+    x1, x2 = np.concatenate(xs), np.concatenate(vs)
+    keep = (np.abs(x1) <= R) & (np.abs(x2) <= w)
+    x1, x2 = np.concatenate([x1[keep], -x1[keep]]), np.concatenate([x2[keep], -x2[keep]])
+    pts = np.unique(np.stack([x1, x2], axis=1), axis=0)
+    return pts[:, 0].copy(), pts[:, 1].copy()
+
+
+def grid_csv(cfg: Config) -> str:
+    """Return the conformance grid as CSV text, columns x1, x2 (exact float repr)."""
+    x1, x2 = conformance_grid(cfg)
+    lines = ["x1,x2"] + [f"{a!r},{b!r}" for a, b in zip(x1.tolist(), x2.tolist())]
+    return "\n".join(lines) + "\n"
+
+
+def read_table(path: str | Path) -> tuple[NDArray, NDArray, NDArray]:
+    """Read a CSV with a header naming columns x1, x2, u (others ignored).
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV file.
+
+    Returns
+    -------
+    x1, x2, u : ndarray
+        States [mm], [mm/s] and the implementation's input [mm/s].
+
+    Raises
+    ------
+    InputError
+        Unreadable file, missing column, empty table, a field that is not a
+        finite number (line and column named).
+    """
+    try:
+        with open(path, newline="") as fh:
+            rows = list(csv.reader(fh))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read table '{path}': {getattr(exc, 'strerror', None) or exc}"
+                         ) from None
+    except csv.Error as exc:
+        raise InputError(f"table '{path}': malformed CSV: {exc}") from None
+    if not rows:
+        raise InputError(f"table '{path}' is empty")
+    header = [h.strip() for h in rows[0]]
+    cols = {}
+    for name in ("x1", "x2", "u"):
+        if name not in header:
+            raise InputError(f"table '{path}': no column '{name}' in header {','.join(header)} "
+                             "(need x1, x2, u)")
+        cols[name] = header.index(name)
+    data = []
+    for line, row in enumerate(rows[1:], start=2):
+        if not any(f.strip() for f in row):
+            continue
+        vals = []
+        for name, j in cols.items():
+            text = row[j].strip() if j < len(row) else ""
+            try:
+                v = float(text)
+            except ValueError:
+                v = math.nan
+            if not math.isfinite(v):
+                raise InputError(f"table '{path}' line {line}: column {name} = {text!r} is not "
+                                 "a finite number")
+            vals.append(v)
+        data.append(vals)
+    if not data:
+        raise InputError(f"table '{path}' has a header but no rows")
+    arr = np.array(data, dtype=float)
+    return arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy()
+
+
+# ------------------------------------------------------------------ agreement
+def _ties(x1: NDArray, x2: NDArray, cfg: Config) -> NDArray[np.bool_]:
+    """Points outside |x1| < d within TIE_BAND of l1/l2 or l1*/l2* (region may flip)."""
+    a, w = cfg.plant.a, cfg.plant.w_max
+    band = _tie_band(cfg)
+    near = np.abs(switching_function(x1, x2, a, w)) <= band
+    om = _omega0(cfg)
+    if om is not None:
+        near |= np.abs(level_residual(x1, x2, a, om)) <= band
+    return near & (np.abs(x1) >= cfg.pto.d)
+
+
+def agreement(x1: NDArray, x2: NDArray, u: NDArray, cfg: Config,
+              rtol: float = DEFAULT_RTOL) -> tuple[dict, list[dict]]:
+    """Compare u with the reference PTO law, region by region.
+
+    Parameters
+    ----------
+    x1, x2 : ndarray
+        States [mm], [mm/s].
+    u : ndarray
+        The implementation's input [mm/s] at those states.
+    cfg : Config
+        Configuration.
+    rtol : float
+        Tolerance relative to w_max.
+
+    Returns
+    -------
+    summary : dict
+        ``points``, ``excluded``, ``tolerance_mm_s``, ``max_abs_du``, ``worst``,
+        ``regions`` (per reference region: points, excluded, max_abs_du, state,
+        u, u_ref, violations).
+    failures : list of dict
+        One ``agreement`` failure (first state in order, worst named) or none.
+    """
+    w = cfg.plant.w_max
+    tol = rtol * w
+    u_ref, reg = make_law("pto", cfg)(x1, x2)
+    du = np.abs(u - u_ref)
+    tie = _ties(x1, x2, cfg)
+    judged = ~tie
+    bad = judged & (du > tol)
+    regions = {}
+    for code in Region:
+        m = reg == code
+        if not m.any():
+            continue
+        mj = m & judged
+        entry = {"code": int(code), "points": int(m.sum()), "excluded": int((m & tie).sum()),
+                 "violations": int((m & bad).sum()), "max_abs_du": 0.0, "state": None}
+        if mj.any():
+            i = int(np.flatnonzero(mj)[np.argmax(du[mj])])
+            entry.update(max_abs_du=float(du[i]), state=[float(x1[i]), float(x2[i])],
+                         u=float(u[i]), u_ref=float(u_ref[i]))
+        entry["pass"] = entry["violations"] == 0
+        regions[code.name] = entry
+    worst = int(np.argmax(np.where(judged, du, -1.0)))
+    summary = {"points": int(x1.size), "excluded": int(tie.sum()), "rtol": rtol,
+               "tolerance_mm_s": tol, "tie_band_mm_s": _tie_band(cfg),
+               "max_abs_du": float(du[worst]) if judged.any() else 0.0,
+               "worst": {"state": [float(x1[worst]), float(x2[worst])], "u": float(u[worst]),
+                         "u_ref": float(u_ref[worst]), "region": Region(reg[worst]).name},
+               "violations": int(bad.sum()), "pass": not bad.any(), "regions": regions}
+    failures = []
+    if bad.any():
+        i = int(np.argmax(bad))
+        failures.append(_failure(
+            "agreement", (x1[i], x2[i]),
+            f"|u - u_ref| = {du[i]:.6g} mm/s > {tol:.3g} mm/s ({rtol:g} w_max) in region "
+            f"{Region(reg[i]).name} (u = {u[i]:.10g}, u_ref = {u_ref[i]:.10g}); "
+            f"{int(bad.sum())} of {int(judged.sum())} judged points disagree, worst "
+            f"{du[worst]:.6g} mm/s at ({x1[worst]:.10g}, {x2[worst]:.10g}) in "
+            f"{Region(reg[worst]).name}"))
+    return summary, failures
+
+
+def _input_bound(x1: NDArray, x2: NDArray, u: NDArray, cfg: Config, where: str):
+    w = cfg.plant.w_max
+    over = np.abs(u) > w
+    prop = {"status": FAIL if over.any() else PASS, "measured": float(np.abs(u).max()),
+            "limit": w, "detail": f"max |u| [mm/s] {where}; limit w_max"}
+    fails = []
+    if over.any():
+        i = int(np.argmax(over))
+        fails.append(_failure("input-bound", (x1[i], x2[i]),
+                              f"|u| = {abs(u[i]):.10g} mm/s > w_max = {w:g} mm/s {where}"))
+    return prop, fails
+
+
+# ------------------------------------------------------------------ closed loop
+def _as_law(user: UserLaw, cfg: Config) -> Law:
+    """Wrap a user law as a :class:`Law` whose regions are the reference's (geometry)."""
+    ref = make_law("pto", cfg)
+
+    def vector(x1, x2):
+        u = user(x1, x2).reshape(np.shape(x1))
+        return u, ref.vector(x1, x2)[1]
+
+    def scalar(x1, x2):
+        return user.scalar(x1, x2), ref.scalar(x1, x2)[1]
+
+    return Law("user", vector, scalar, cfg.plant.w_max, "third-party law under conform")
+
+
+def _first(mask: NDArray[np.bool_]) -> tuple[int, int] | None:
+    """(sample, trajectory) of the first trajectory (grid order) where mask holds."""
+    cols = mask.any(axis=0)
+    if not cols.any():
+        return None
+    j = int(np.argmax(cols))
+    return int(np.argmax(mask[:, j])), j
+
+
+def _sweep_analysis(res, x1: NDArray, cfg: Config, band: float, window: int) -> dict:
+    """Masks of :func:`ptoverify.properties.law_properties` (same definitions)."""
+    from ptoverify.properties import _oscillating
+
+    p = cfg.plant
+    a, w, d = p.a, p.w_max, cfg.pto.d
+    X1, X2, R = res.x1, res.x2, res.region
+    tol = 1e-9 * (w + a * p.position_range)
+    sig = switching_function(X1, X2, a, w)
+    out = np.abs(X1) >= d
+    zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
+    s0, s1 = sig[:-1], sig[1:]
+    n_side = (s0 > 0) | ((s0 == 0) & (X2[:-1] > 0))
+    p_side = (s0 < 0) | ((s0 == 0) & (X2[:-1] < 0))
+    cross = (n_side & (s1 < -tol)) | (p_side & (s1 > tol))
+    stride = out[:-1] & ~zone & cross & out[1:]
+    osc = _oscillating(X1[-window:], band)
+    unsettled = np.abs(X1[-1]) > band
+    return {"stride": stride, "osc": osc, "unsettled": unsettled,
+            "over": np.abs(res.u) > w, "max_u": float(np.abs(res.u).max())}
+
+
+def _settle_steps(X1: NDArray, band: float) -> NDArray[np.float64]:
+    """First sample after which |x1| <= band for good (inf if not at the end)."""
+    bad = np.abs(X1) > band
+    n = X1.shape[0]
+    last_bad = np.where(bad.any(axis=0), n - np.argmax(bad[::-1], axis=0), 0)
+    return np.where(bad[-1], np.inf, last_bad.astype(float))
+
+
+@functools.lru_cache(maxsize=8)
+def _settling_reference(cfg: Config) -> dict:
+    """Settling sweep states, their N*, and the reference's settling steps (cached)."""
+    from ptoverify.mintime import discrete_min_steps_batch
+    from ptoverify.properties import default_steps, initial_grid
+    from ptoverify.simulate import simulate_batch
+
+    x1, x2, _ = initial_grid(cfg, 11, 11, 20)
+    dm = discrete_min_steps_batch(x1, x2, cfg.plant)
+    n_star = np.array([m.steps if m.success else -1 for m in dm], dtype=float)
+    steps = default_steps(cfg)
+    res = simulate_batch(make_law("pto", cfg), cfg.plant, x1, x2, steps)
+    s_ref = _settle_steps(res.x1, _BAND_MM)
+    ok = n_star >= 0
+    e_ref = float(np.max(s_ref[ok] - n_star[ok])) if ok.any() else math.inf
+    failed = [(float(x1[i]), float(x2[i]), dm[i].status) for i in np.flatnonzero(~ok)]
+    return {"x1": x1, "x2": x2, "n_star": n_star, "steps": steps, "s_ref": s_ref,
+            "e_ref": e_ref, "failed": failed}
+
+
+def _settling(law: Law, cfg: Config) -> tuple[dict, list[dict]]:
+    from ptoverify.simulate import simulate_batch
+
+    ref = _settling_reference(cfg)
+    T = cfg.plant.sample_time
+    if ref["failed"] or not math.isfinite(ref["e_ref"]):
+        s = ref["failed"][0] if ref["failed"] else (math.nan, math.nan, "reference unsettled")
+        prop = {"status": UNVERIFIED, "measured": None, "limit": None,
+                "detail": f"N* could not be established at ({s[0]:g}, {s[1]:g}): {s[2]}"}
+        return prop, [_failure("settling-vs-discrete-limit", s[:2], prop["detail"])]
+    res = simulate_batch(law, cfg.plant, ref["x1"], ref["x2"], ref["steps"])
+    s = _settle_steps(res.x1, _BAND_MM)
+    excess = s - ref["n_star"]
+    e_ref = ref["e_ref"]
+    limit = e_ref + max(2.0, math.ceil(e_ref / 2.0))
+    worst = float(np.max(excess))
+    ratio = float(np.max(s / np.maximum(ref["n_star"], 1.0)))
+    prop = {"status": PASS if worst <= limit else FAIL, "measured": worst, "limit": limit,
+            "detail": f"worst (settling samples - N*) over {s.size} states (settling: |x1| <= "
+                      f"{_BAND_MM:g} mm for good); reference worst {e_ref:g} samples; "
+                      f"limit E_ref + max(2, ceil(E_ref/2)); worst ratio t_s / (N* T) = "
+                      f"{ratio:.3g}", "sample_time_s": T, "worst_ratio_to_nstar": ratio}
+    fails = []
+    if worst > limit:
+        i = int(np.argmax(excess > limit))
+        fails.append(_failure(
+            "settling-vs-discrete-limit", (ref["x1"][i], ref["x2"][i]),
+            f"settles in {s[i]:g} samples, N* = {ref['n_star'][i]:g} (reference "
+            f"{ref['s_ref'][i]:g}); excess {excess[i]:g} > {limit:g} samples"))
+    return prop, fails
+
+
+def _grid_sizes(mode: str, sweep: tuple[int, int, int] | None) -> tuple[int, int, int]:
+    if sweep is not None:
+        return sweep
+    return (101, 101, 200) if mode == "vectorized" else (21, 21, 40)
+
+
+def closed_loop(user: UserLaw, cfg: Config, *,
+                sweep: tuple[int, int, int] | None = None) -> tuple[dict, list[dict]]:
+    """Closed-loop properties of a user law, as ``check`` gates them.
+
+    Parameters
+    ----------
+    user : UserLaw
+        The wrapped law.
+    cfg : Config
+        Configuration.
+    sweep : (n1, n2, rest), optional
+        Sweep grid (:func:`ptoverify.properties.initial_grid`); default
+        101 x 101 + 200 vectorized, 21 x 21 + 40 scalar.
+
+    Returns
+    -------
+    properties : dict
+        ``no-stride-over``, ``no-limit-cycle``, ``input-bound`` (closed loop),
+        ``settling-vs-discrete-limit``: each status, measured, limit, detail.
+    failures : list of dict
+        Failing properties with the first initial state that shows each.
+    """
+    from ptoverify.properties import default_steps, initial_grid
+    from ptoverify.simulate import simulate_batch
+
+    law = _as_law(user, cfg)
+    n1, n2, rest = _grid_sizes(user.mode, sweep)
+    x1, x2, _ = initial_grid(cfg, n1, n2, rest)
+    steps = default_steps(cfg)
+    window = max(20, steps // 4)
+    try:
+        res = simulate_batch(law, cfg.plant, x1, x2, steps)
+    except LawFault as fault:
+        detail = f"closed-loop simulation stopped: {fault.message}"
+        return ({"evaluation": {"status": FAIL, "measured": None, "limit": None,
+                                "detail": detail}},
+                [_failure("evaluation", fault.state, detail)])
+    m = _sweep_analysis(res, x1, cfg, _BAND_MM, window)
+    where = f"over {x1.size} initial states x {steps} samples"
+    props, fails = {}, []
+
+    def add(name: str, count: int, mask, detail: str, what: str):
+        props[name] = {"status": PASS if count == 0 else FAIL, "measured": count, "limit": 0,
+                       "detail": f"{detail} {where}"}
+        hit = _first(mask)
+        if hit is not None:
+            k, j = hit
+            fails.append(_failure(name, (x1[j], x2[j]),
+                                  f"{what} (first from initial state ({x1[j]:.6g}, "
+                                  f"{x2[j]:.6g}), sample {k}: ({res.x1[k, j]:.6g}, "
+                                  f"{res.x2[k, j]:.6g})); {count} in all",
+                                  sample=k, at=[float(res.x1[k, j]), float(res.x2[k, j])]))
+
+    add("no-stride-over", int(m["stride"].sum()), m["stride"],
+        "stride-overs (sample outside zone and linear zone whose next sample is strictly "
+        "across l1/l2 and outside the linear zone)", "stride-over")
+    cyc = m["osc"] | m["unsettled"]
+    at_end = np.zeros((steps + 1, x1.size), dtype=bool)
+    at_end[-1] = cyc
+    add("no-limit-cycle", int(cyc.sum()), at_end,
+        f"states with sustained oscillation ({int(m['osc'].sum())}) or not settled within "
+        f"{_BAND_MM:g} mm ({int(m['unsettled'].sum())})", "sustained oscillation or not settled")
+    add("input-bound", int(m["over"].sum()), m["over"],
+        f"samples with |u| > w_max = {cfg.plant.w_max:g} mm/s (max {m['max_u']:.10g})",
+        "|u| > w_max")
+    try:
+        props["settling-vs-discrete-limit"], f = _settling(law, cfg)
+    except LawFault as fault:
+        detail = f"settling simulation stopped: {fault.message}"
+        props["settling-vs-discrete-limit"] = {"status": FAIL, "measured": None,
+                                               "limit": None, "detail": detail}
+        f = [_failure("evaluation", fault.state, detail)]
+    fails += f
+    return props, fails
+
+
+def _odd_symmetry(user: UserLaw, x1: NDArray, x2: NDArray, u: NDArray, cfg: Config,
+                  rtol: float) -> tuple[dict, list[dict]]:
+    """u(-x) = -u(x) on the grid (tie points excluded), to the agreement tolerance."""
+    tol = rtol * cfg.plant.w_max
+    um = user(-x1, -x2)
+    err = np.where(_ties(x1, x2, cfg), 0.0, np.abs(u + um))
+    bad = err > tol
+    prop = {"status": FAIL if bad.any() else PASS, "measured": float(err.max()), "limit": tol,
+            "detail": f"max |u(x) + u(-x)| [mm/s] over {x1.size} grid states (curve ties "
+                      "excluded); the plant is odd, so the law must be"}
+    fails = []
+    if bad.any():
+        i = int(np.argmax(bad))
+        fails.append(_failure("odd-symmetry", (x1[i], x2[i]),
+                              f"u(x) = {u[i]:.10g}, u(-x) = {um[i]:.10g} mm/s"))
+    return prop, fails
+
+
+@dataclass
+class ConformResult:
+    """Outcome of ``ptoverify conform`` (the JSON object, see :meth:`to_json`).
+
+    Attributes
+    ----------
+    conforms : bool
+        True when every judged property passes.
+    mode : str
+        ``vectorized``, ``scalar`` or ``table``.
+    target : str
+        The ``--law`` spec or ``--table`` path.
+    mode_reason : str
+        Why the mode was chosen.
+    agreement : dict
+        Per-region agreement with the reference (:func:`agreement`).
+    properties : dict
+        Name -> status, measured, limit, detail.
+    failures : list of dict
+        Each with ``property``, ``state`` [x1, x2] (the first that shows it), ``detail``.
+    timings_s : dict
+        Wall time per phase [s].
+    """
+
+    conforms: bool
+    mode: str
+    target: str
+    mode_reason: str
+    agreement: dict
+    properties: dict
+    failures: list[dict]
+    timings_s: dict = field(default_factory=dict)
+    config: str = ""
+
+    def to_json(self) -> dict:
+        """Return the JSON object printed by ``--json``."""
+        return {"conforms": self.conforms, "mode": self.mode, "target": self.target,
+                "mode_reason": self.mode_reason, "config": self.config,
+                "agreement": self.agreement, "properties": self.properties,
+                "failures": self.failures, "timings_s": self.timings_s}
+
+    def failed_properties(self) -> list[str]:
+        """Names of the failing properties, in order, without repeats."""
+        return list(dict.fromkeys(f["property"] for f in self.failures))
+
+
+def conform_callable(fn: Callable, cfg: Config, *, target: str = "", rtol: float = DEFAULT_RTOL,
+                     sweep: tuple[int, int, int] | None = None,
+                     grid: tuple[NDArray, NDArray] | None = None) -> ConformResult:
+    """Judge a user law ``u = f(x1, x2, cfg)`` against the reference PTO law.
+
+    Parameters
+    ----------
+    fn : callable
+        The law.
+    cfg : Config
+        Configuration.
+    target : str
+        Name shown in the output.
+    rtol : float
+        Agreement tolerance relative to w_max.
+    sweep : (n1, n2, rest), optional
+        Closed-loop sweep grid (see :func:`closed_loop`).
+    grid : (x1, x2), optional
+        Agreement states; default :func:`conformance_grid`.
+
+    Returns
+    -------
+    ConformResult
+        The verdict; InputError for interface errors.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> r = conform_callable(reference_law, paper_config(), sweep=(5, 5, 4))
+    >>> r.conforms, r.mode
+    (True, 'vectorized')
+    """
+    t0 = time.perf_counter()
+    timings = {}
+    user, failures = wrap_callable(fn, cfg)
+    timings["detect"] = time.perf_counter() - t0
+    x1, x2 = conformance_grid(cfg) if grid is None else grid
+    props: dict[str, dict] = {}
+    agree: dict = {"pass": False, "detail": "not run: the law failed at a probe state"}
+    if not any(f["property"] == "evaluation" for f in failures):
+        t = time.perf_counter()
+        try:
+            u = user(x1, x2)
+        except LawFault as fault:
+            failures.append(_failure("evaluation", fault.state, fault.message))
+            agree = {"pass": False, "detail": f"not run: {fault.message}"}
+        else:
+            agree, f = agreement(x1, x2, u, cfg, rtol)
+            failures += f
+            props["input-bound-grid"], f = _input_bound(x1, x2, u, cfg, "on the grid")
+            failures += f
+            try:
+                props["odd-symmetry"], f = _odd_symmetry(user, x1, x2, u, cfg, rtol)
+            except LawFault as fault:
+                props["odd-symmetry"] = {"status": FAIL, "detail": fault.message}
+                f = [_failure("evaluation", fault.state, fault.message)]
+            failures += f
+        timings["agreement"] = time.perf_counter() - t
+        t = time.perf_counter()
+        cl, f = closed_loop(user, cfg, sweep=sweep)
+        props.update(cl)
+        failures += f
+        timings["closed_loop"] = time.perf_counter() - t
+    props.setdefault("pure-function", {"status": PASS, "detail": "two calls at 8 probe states "
+                                       "returned the same u"})
+    if any(f["property"] == "pure-function" for f in failures):
+        props["pure-function"] = {"status": FAIL, "detail": "two calls at the same state "
+                                  "returned different u"}
+    timings["total"] = time.perf_counter() - t0
+    ok = not failures and agree.get("pass", False)
+    return ConformResult(ok, user.mode, target, user.reason, agree, props, failures,
+                         {k: round(v, 4) for k, v in timings.items()}, cfg.name)
+
+
+def conform_table(path: str | Path, cfg: Config, *, rtol: float = DEFAULT_RTOL) -> ConformResult:
+    """Judge a table x1, x2, u (CSV) against the reference where it has points.
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV with columns x1, x2, u.
+    cfg : Config
+        Configuration.
+    rtol : float
+        Agreement tolerance relative to w_max.
+
+    Returns
+    -------
+    ConformResult
+        Agreement and |u| <= w_max; closed-loop properties ``not_run``.
+    """
+    t0 = time.perf_counter()
+    x1, x2, u = read_table(path)
+    agree, failures = agreement(x1, x2, u, cfg, rtol)
+    props = {}
+    props["input-bound-grid"], f = _input_bound(x1, x2, u, cfg, "at the table's points")
+    failures += f
+    for name in ("odd-symmetry", "no-stride-over", "no-limit-cycle", "input-bound",
+                 "settling-vs-discrete-limit"):
+        props[name] = {"status": NOT_RUN, "detail": "needs a callable law (--law)"}
+    ok = not failures and agree["pass"]
+    return ConformResult(ok, "table", str(path), f"table of {x1.size} points", agree, props,
+                         failures, {"total": round(time.perf_counter() - t0, 4)}, cfg.name)
+
+
+def format_result(r: ConformResult) -> str:
+    """Human-readable report: verdict, agreement per region, properties, failures."""
+    lines = [f"{'CONFORMS' if r.conforms else 'DOES NOT CONFORM'}: {r.target} "
+             f"(mode {r.mode}: {r.mode_reason})"]
+    a = r.agreement
+    if "regions" in a:
+        lines.append(f"agreement with reference PTO: {a['points']} points, {a['excluded']} "
+                     f"excluded (within {a['tie_band_mm_s']:.3g} mm/s of l1/l2/l1*/l2*), "
+                     f"tolerance {a['tolerance_mm_s']:.3g} mm/s ({a['rtol']:g} w_max), "
+                     f"max |du| = {a['max_abs_du']:.3g} mm/s")
+        for name, e in a["regions"].items():
+            where = "" if e["state"] is None else f" at ({e['state'][0]:.10g}, " \
+                                                  f"{e['state'][1]:.10g})"
+            lines.append(f"  {'ok  ' if e['pass'] else 'FAIL'} {name:<10} {e['points']:>6} "
+                         f"points ({e['excluded']} excluded) max |du| = "
+                         f"{e['max_abs_du']:.3g} mm/s{where}")
+    else:
+        lines.append(f"agreement: {a.get('detail', '')}")
+    for name, pr in r.properties.items():
+        lines.append(f"  {pr['status'].upper():<10} {name:<28} {pr.get('detail', '')}")
+    for f in r.failures:
+        lines.append(f"FAILED {f['property']} at state ({f['state'][0]:.10g}, "
+                     f"{f['state'][1]:.10g}): {f['detail']}")
+    lines.append(f"time {r.timings_s.get('total', 0.0):.2f} s")
+    return "\n".join(lines)
