@@ -330,19 +330,24 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
         failures.append(_failure("pure-function", (p1[i], p2[i]),
                                  f"two calls at the same state returned {first[i]!r} and "
                                  f"{second[i]!r} mm/s: the law has memory (e.g. a delay)"))
-    law.mode, law.reason = "vectorized", ""
+    law.reason = ""
     try:
-        vec = law(p1, p2)
-        close = np.abs(vec - first) <= _VEC_RTOL * cfg.plant.w_max
-        if not np.all(close):
-            i = int(np.argmin(close))
-            law.reason = (f"array call differs from element-wise calls at ({p1[i]:g}, "
-                          f"{p2[i]:g}): {vec[i]!r} vs {first[i]!r}")
-    except (LawFault, InputError) as exc:
-        law.reason = f"array call failed: {getattr(exc, 'message', exc)}"
-    if law.reason:
-        law.mode = "scalar"
+        vec = np.asarray(fn(p1, p2, cfg), dtype=float)
+    except Exception as exc:  # noqa: BLE001 - any failure on arrays means: scalar loop
+        law.reason = f"array call raised {type(exc).__name__}: {' '.join(str(exc).split())}"
     else:
+        if vec.shape != p1.shape:
+            law.reason = f"array call returned shape {vec.shape} for {p1.size} states"
+        else:
+            close = np.abs(vec - first) <= _VEC_RTOL * cfg.plant.w_max
+            if not np.all(close):
+                i = int(np.argmin(close))
+                law.reason = (f"array call differs from element-wise calls at ({p1[i]:g}, "
+                              f"{p2[i]:g}): {vec[i]!r} vs {first[i]!r}")
+    if law.reason:
+        law.reason += "; wrapped in a scalar loop"
+    else:
+        law.mode = "vectorized"
         law.reason = f"array call of {p1.size} probe states equals element-wise calls"
     return law, failures
 
