@@ -84,7 +84,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ptoverify.config import Config
-from ptoverify.curves import level_curve_x1, level_residual, switching_function
+from ptoverify.curves import level_curve_x1, level_residual, root_22, switching_function
 from ptoverify.errors import InputError
 from ptoverify.laws import Law, Region, make_law
 
@@ -121,15 +121,21 @@ def reference_law(x1, x2, cfg: Config):
     >>> reference_law(0.1, 0.0, paper_config())
     -32.300000000000004
     """
-    u, _ = make_law("pto", cfg)(x1, x2)
+    u, _ = _reference(cfg)(x1, x2)
     return float(u) if np.ndim(u) == 0 else u
+
+
+@functools.lru_cache(maxsize=8)
+def _reference(cfg: Config) -> Law:
+    """The reference law ``make_law("pto", cfg)``, built once per configuration."""
+    return make_law("pto", cfg)
 
 
 def reference_law_scalar(x1: float, x2: float, cfg: Config) -> float:
     """Reference PTO law on Python floats only (exercises the scalar mode)."""
     if not isinstance(x1, float) or not isinstance(x2, float):
         raise TypeError("scalar law: x1 and x2 must be floats")
-    return make_law("pto", cfg).scalar(x1, x2)[0]
+    return _reference(cfg).scalar(x1, x2)[0]
 
 
 def _tie_band(cfg: Config) -> float:
@@ -364,7 +370,8 @@ def conformance_grid(cfg: Config, n: int = 61, n_curve: int = 121) -> tuple[NDAr
     An ``n`` x ``n`` background over |x1| <= position_range, |x2| <= w_max, plus,
     for ``n_curve`` speeds |x2| (geometric from 1e-6 w_max, and linear):
 
-    * l1, l2 (level w_max) and l1*, l2* (level omega0, the zone boundary): the
+    * l1, l2 (level w_max) and l1*, l2* (level omega0, the zone boundary), also
+      at ``n_curve`` speeds from where each curve leaves |x1| < d up to w_max: the
       curve point and points at residual offsets of +-10^k TIE_BAND, k = 1..7,
       with TIE_BAND = 1e-9 (w_max + a position_range) [mm/s];
     * the switching-zone band between l1 and l1*: 11 points across it;
@@ -396,8 +403,14 @@ def conformance_grid(cfg: Config, n: int = 61, n_curve: int = 121) -> tuple[NDAr
     rho = band * 10.0 ** np.arange(1, 8)
     offsets = np.concatenate([-rho[::-1], [0.0], rho]) / a
     om = _omega0(cfg)
+    levels = (w,) if om is None else (w, om)
+    for level in levels:                     # speeds where the curve lies outside |x1| < d
+        s_d = level * float(root_22(a * d / level))
+        if s_d < w:
+            s = np.concatenate([s, np.linspace(s_d, w, n_curve)])
+    s = np.unique(s)
     for x2 in (-s, s):
-        for level in (w,) if om is None else (w, om):
+        for level in levels:
             c = level_curve_x1(x2, a, level)
             xs.append((c[:, None] + offsets[None, :]).ravel())
             vs.append(np.repeat(x2, offsets.size))
@@ -532,7 +545,7 @@ def agreement(x1: NDArray, x2: NDArray, u: NDArray, cfg: Config,
     """
     w = cfg.plant.w_max
     tol = rtol * w
-    u_ref, reg = make_law("pto", cfg)(x1, x2)
+    u_ref, reg = _reference(cfg)(x1, x2)
     du = np.abs(u - u_ref)
     tie = _ties(x1, x2, cfg)
     judged = ~tie
@@ -587,7 +600,7 @@ def _input_bound(x1: NDArray, x2: NDArray, u: NDArray, cfg: Config, where: str):
 # ------------------------------------------------------------------ closed loop
 def _as_law(user: UserLaw, cfg: Config) -> Law:
     """Wrap a user law as a :class:`Law` whose regions are the reference's (geometry)."""
-    ref = make_law("pto", cfg)
+    ref = _reference(cfg)
 
     def vector(x1, x2):
         u = user(x1, x2).reshape(np.shape(x1))
@@ -755,7 +768,7 @@ def closed_loop(user: UserLaw, cfg: Config, *,
     cyc = m["osc"] | m["unsettled"]
     at_end = np.zeros((steps + 1, x1.size), dtype=bool)
     at_end[-1] = cyc
-    add("no-limit-cycle", int(cyc.sum()), at_end,
+    add("no-limit-cycle", int(m["osc"].sum() + m["unsettled"].sum()), at_end,
         f"states with sustained oscillation ({int(m['osc'].sum())}) or not settled within "
         f"{_BAND_MM:g} mm ({int(m['unsettled'].sum())})", "sustained oscillation or not settled")
     add("input-bound", int(m["over"].sum()), m["over"],
