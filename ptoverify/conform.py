@@ -23,6 +23,8 @@ Interface errors versus findings
     a finding (exit 1, naming the state): the function raises at a state,
     returns NaN or an infinity there, or is not a pure function of the state
     (two calls at the same state differ, e.g. a law with memory or a delay).
+    A law with memory has no u(x) to compare or to simulate state by state in a
+    batch, so after that finding the other properties are ``not_run``.
 Vectorized or scalar
     The law is called with arrays of 8 probe states; if that returns a float
     array of the same shape that agrees with element-wise calls on Python floats
@@ -127,12 +129,12 @@ def reference_law(x1, x2, cfg: Config):
 
 @functools.lru_cache(maxsize=8)
 def _reference(cfg: Config) -> Law:
-    """The reference law ``make_law("pto", cfg)``, built once per configuration."""
+    """Return ``make_law("pto", cfg)``, built once per configuration."""
     return make_law("pto", cfg)
 
 
 def reference_law_scalar(x1: float, x2: float, cfg: Config) -> float:
-    """Reference PTO law on Python floats only (exercises the scalar mode)."""
+    """Evaluate the reference PTO law on Python floats only (exercises scalar mode)."""
     if not isinstance(x1, float) or not isinstance(x2, float):
         raise TypeError("scalar law: x1 and x2 must be floats")
     return _reference(cfg).scalar(x1, x2)[0]
@@ -888,7 +890,14 @@ def conform_callable(fn: Callable, cfg: Config, *, target: str = "", rtol: float
     x1, x2 = conformance_grid(cfg) if grid is None else grid
     props: dict[str, dict] = {}
     agree: dict = {"pass": False, "detail": "not run: the law failed at a probe state"}
-    if not any(f["property"] == "evaluation" for f in failures):
+    memory = any(f["property"] == "pure-function" for f in failures)
+    if memory:
+        agree = {"pass": False, "detail": "not run: the law has memory, so u is not a "
+                 "function of the state and there is nothing to compare state by state"}
+        for name in ("input-bound-grid", "odd-symmetry", "no-stride-over", "no-limit-cycle",
+                     "input-bound", "settling-vs-discrete-limit"):
+            props[name] = {"status": NOT_RUN, "detail": "the law has memory (pure-function)"}
+    elif not any(f["property"] == "evaluation" for f in failures):
         t = time.perf_counter()
         try:
             u = user(x1, x2)

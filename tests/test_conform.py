@@ -132,7 +132,7 @@ def test_grid_dense_near_every_boundary(paper_cfg):
             near = quadrant & (np.abs(r) > band) & (np.abs(r) <= 100 * band)
             assert near.sum() >= 100, f"points just off the level-{level:g} curve"
             # at the paper's values l1, l2 stay inside |x1| < d for |x2| <= w_max (x1 =
-            # 0.488 mm at x2 = -w_max); l1*, l2* bound the zone outside it
+            # x1 < d at x2 = -w_max, computed); l1*, l2* bound the zone outside it
             if level == om:
                 assert (near & (np.abs(x1) >= d)).sum() >= 100, "zone boundary off |x1| < d"
     assert np.sum(np.abs(x1) == d) >= 100, "points exactly on |x1| = d"
@@ -182,8 +182,8 @@ def test_law_raising_at_a_state_is_a_finding(capsys, tmp_path):
         def f(x1, x2, cfg):
             if x1 > 40.0:
                 raise RuntimeError("table lookup out of range")
-            from ptoverify.conform import reference_law
-            return reference_law(x1, x2, cfg)
+            from ptoverify.conform import reference_law_scalar
+            return reference_law_scalar(x1, x2, cfg)
         """)
     code, out, err = run(capsys, "conform", "--law", f"{path}:f", "--json")
     assert code == 1, err
