@@ -103,7 +103,7 @@ PASS, FAIL, NOT_RUN, UNVERIFIED = "pass", "fail", "not_run", "unverified"
 
 # ------------------------------------------------------------------ reference
 def reference_law(x1, x2, cfg: Config):
-    """Reference PTO law (corrected omega0) as a user-style callable, vectorized.
+    """Evaluate the reference PTO law (corrected omega0) as a user-style callable.
 
     Parameters
     ----------
