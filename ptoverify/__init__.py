@@ -16,6 +16,7 @@ simulate    simulate (sampled closed loop on step/ramp/sine), simulate_batch
 properties  closed-loop properties over a grid: stride-overs, limit cycles, chattering, overshoot
 poles       PD and linear-zone (eq. 37) loops: poles, damping, margins (python-control), Lyapunov
 plots_zone  figure of the zone geometry with sampled trajectories (matplotlib, Agg)
+conform     conform: gate a third-party PTO law (callable or table) against the reference
 cli         the ``ptoverify`` command line
 errors      InputError (exit 2), ConfigError, SolverError
 """
