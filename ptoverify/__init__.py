@@ -17,6 +17,7 @@ properties  closed-loop properties over a grid: stride-overs, limit cycles, chat
 poles       PD and linear-zone (eq. 37) loops: poles, damping, margins (python-control), Lyapunov
 plots_zone  figure of the zone geometry with sampled trajectories (matplotlib, Agg)
 conform     conform: gate a third-party PTO law (callable or table) against the reference
+agreement   conformance grid (--emit-grid), CSV tables, per-region agreement with the reference
 cli         the ``ptoverify`` command line
 errors      InputError (exit 2), ConfigError, SolverError
 """

@@ -30,14 +30,14 @@ Vectorized or scalar
     array of the same shape that agrees with element-wise calls on Python floats
     to 1e-12 w_max, the law is used vectorized, otherwise it is wrapped in a
     scalar loop.  The output says which and why.
-Agreement
+Agreement (:mod:`ptoverify.agreement`)
     On the conformance grid (:func:`conformance_grid`, what ``--emit-grid``
     writes) or the table's points: |u - u_ref| <= ``rtol`` w_max, default
-    rtol = 1e-6 (0.3 mm/s at the paper's w_max; float32 implementations round
-    at ~6e-8 relative, so they pass with headroom, while every seeded fault of
-    the mutation suite is orders of magnitude above).  Reported per reference
+    rtol = 1e-6 (float32 implementations round at ~6e-8 relative, so they pass
+    with headroom, while every seeded fault of the mutation suite is at least
+    two orders of magnitude above).  Reported per reference
     region: largest |du|, its state, count of points.  Points outside the
-    linear zone within ``TIE_BAND`` (1e-9 (w_max + a position_range) mm/s, the
+    linear zone within ``tie_band`` (1e-9 (w_max + a position_range) mm/s, the
     tolerance of ``properties``) of a computed curve, l1/l2 or l1*/l2*, are
     excluded and counted: there a float tie can flip the region and u jumps
     by up to 2 w_max.  The linear-zone edge |x1| = d, x2 = 0 and the origin
@@ -70,7 +70,6 @@ Tables
 
 from __future__ import annotations
 
-import csv
 import functools
 import importlib
 import importlib.util
@@ -85,20 +84,33 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ptoverify.agreement import (
+    DEFAULT_RTOL,
+    FAIL,
+    NOT_RUN,
+    PASS,
+    UNVERIFIED,
+    agreement,
+    conformance_grid,
+    failure,
+    grid_csv,
+    input_bound,
+    read_table,
+    reference,
+    ties,
+)
 from ptoverify.config import Config
-from ptoverify.curves import level_curve_x1, level_residual, root_22, switching_function
+from ptoverify.curves import switching_function
 from ptoverify.errors import InputError
-from ptoverify.laws import Law, Region, make_law
+from ptoverify.laws import Law, Region
 
 __all__ = ["reference_law", "reference_law_scalar", "load_callable", "UserLaw", "wrap_callable",
            "LawFault", "conformance_grid", "grid_csv", "read_table", "agreement",
            "closed_loop", "ConformResult", "conform_callable", "conform_table", "format_result",
            "DEFAULT_RTOL"]
 
-DEFAULT_RTOL = 1e-6            #: agreement tolerance relative to w_max
 _VEC_RTOL = 1e-12              #: vectorized-vs-scalar agreement relative to w_max
 _BAND_MM = 1e-3                #: settling / oscillation band [mm], as properties
-PASS, FAIL, NOT_RUN, UNVERIFIED = "pass", "fail", "not_run", "unverified"
 
 
 # ------------------------------------------------------------------ reference
@@ -123,35 +135,15 @@ def reference_law(x1, x2, cfg: Config):
     >>> reference_law(0.1, 0.0, paper_config())
     -32.300000000000004
     """
-    u, _ = _reference(cfg)(x1, x2)
+    u, _ = reference(cfg)(x1, x2)
     return float(u) if np.ndim(u) == 0 else u
-
-
-@functools.lru_cache(maxsize=8)
-def _reference(cfg: Config) -> Law:
-    """Return ``make_law("pto", cfg)``, built once per configuration."""
-    return make_law("pto", cfg)
 
 
 def reference_law_scalar(x1: float, x2: float, cfg: Config) -> float:
     """Evaluate the reference PTO law on Python floats only (exercises scalar mode)."""
     if not isinstance(x1, float) or not isinstance(x2, float):
         raise TypeError("scalar law: x1 and x2 must be floats")
-    return _reference(cfg).scalar(x1, x2)[0]
-
-
-def _tie_band(cfg: Config) -> float:
-    p = cfg.plant
-    return 1e-9 * (p.w_max + p.a * p.position_range)
-
-
-def _omega0(cfg: Config) -> float | None:
-    """omega0 [mm/s] the reference uses, None when it has no switching zone."""
-    from ptoverify.zones import zone_for_law
-
-    z = zone_for_law(cfg, "corrected")
-    ok = z.usable and not z.degenerate and 0.0 < z.omega0 < cfg.plant.w_max
-    return float(z.omega0) if ok else None
+    return reference(cfg).scalar(x1, x2)[0]
 
 
 # ------------------------------------------------------------------ loading
@@ -330,12 +322,12 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
         first = law(p1, p2)
         second = law(p1, p2)
     except LawFault as fault:
-        return law, [_failure("evaluation", fault.state, fault.message)]
+        return law, [failure("evaluation", fault.state, fault.message)]
     failures = []
     diff = np.abs(first - second)
     if np.any(diff > 0):
         i = int(np.argmax(diff > 0))
-        failures.append(_failure("pure-function", (p1[i], p2[i]),
+        failures.append(failure("pure-function", (p1[i], p2[i]),
                                  f"two calls at the same state returned {first[i]!r} and "
                                  f"{second[i]!r} mm/s: the law has memory (e.g. a delay)"))
     law.reason = ""
@@ -360,249 +352,10 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
     return law, failures
 
 
-def _failure(prop: str, state, detail: str, **extra) -> dict:
-    return {"property": prop, "state": [float(state[0]), float(state[1])], "detail": detail,
-            **extra}
-
-
-# ------------------------------------------------------------------ grid and table
-def conformance_grid(cfg: Config, n: int = 61, n_curve: int = 121) -> tuple[NDArray, NDArray]:
-    """States dense near every curve, boundary, the origin and |x2| = w_max.
-
-    An ``n`` x ``n`` background over |x1| <= position_range, |x2| <= w_max, plus,
-    for ``n_curve`` speeds |x2| (geometric from 1e-6 w_max, and linear):
-
-    * l1, l2 (level w_max) and l1*, l2* (level omega0, the zone boundary), also
-      at ``n_curve`` speeds from where each curve leaves |x1| < d up to w_max: the
-      curve point and points at residual offsets of +-10^k TIE_BAND, k = 1..7,
-      with TIE_BAND = 1e-9 (w_max + a position_range) [mm/s];
-    * the switching-zone band between l1 and l1*: 11 points across it;
-    * the linear-zone edges x1 = +-d exactly, one ulp either side, and
-      +-d (1 +- 10^-k), k = 1..9;
-    * |x2| = w_max exactly and w_max (1 - 10^-k), k = 1..9, over n positions;
-    * the origin and 16 directions at radii 10^-k (d, w_max), k = 0..9.
-
-    Parameters
-    ----------
-    cfg : Config
-        Configuration.
-    n, n_curve : int
-        Background resolution and number of speeds along each curve.
-
-    Returns
-    -------
-    x1, x2 : ndarray
-        States [mm], [mm/s], inside the envelope, duplicates removed, symmetric
-        under x -> -x.
-    """
-    p = cfg.plant
-    a, w, R, d = p.a, p.w_max, p.position_range, cfg.pto.d
-    band = _tie_band(cfg)
-    g1, g2 = np.meshgrid(np.linspace(-R, R, n), np.linspace(-w, w, n))
-    xs, vs = [g1.ravel()], [g2.ravel()]
-    s = np.unique(np.concatenate([np.geomspace(1e-6 * w, w, n_curve // 2),
-                                  np.linspace(w / n_curve, w, n_curve - n_curve // 2)]))
-    rho = band * 10.0 ** np.arange(1, 8)
-    offsets = np.concatenate([-rho[::-1], [0.0], rho]) / a
-    om = _omega0(cfg)
-    levels = (w,) if om is None else (w, om)
-    for level in levels:                     # speeds where the curve lies outside |x1| < d
-        s_d = level * float(root_22(a * d / level))
-        if s_d < w:
-            s = np.concatenate([s, np.linspace(s_d, w, n_curve)])
-    s = np.unique(s)
-    for x2 in (-s, s):
-        for level in levels:
-            c = level_curve_x1(x2, a, level)
-            xs.append((c[:, None] + offsets[None, :]).ravel())
-            vs.append(np.repeat(x2, offsets.size))
-        if om is not None:
-            c1, c2 = level_curve_x1(x2, a, w), level_curve_x1(x2, a, om)
-            f = np.linspace(0.0, 1.0, 11)
-            xs.append((c1[:, None] + f[None, :] * (c2 - c1)[:, None]).ravel())
-            vs.append(np.repeat(x2, f.size))
-    k = 10.0 ** -np.arange(1, 10)
-    edge = np.concatenate([[d, np.nextafter(d, 0.0), np.nextafter(d, np.inf)],
-                           d * (1 - k), d * (1 + k)])
-    v = np.linspace(-w, w, n_curve)
-    for sign in (1.0, -1.0):
-        e1, e2 = np.meshgrid(sign * edge, v)
-        xs.append(e1.ravel())
-        vs.append(e2.ravel())
-        top = sign * np.concatenate([[w], w * (1 - k)])
-        t1, t2 = np.meshgrid(np.linspace(-R, R, n), top)
-        xs.append(t1.ravel())
-        vs.append(t2.ravel())
-    r = 10.0 ** -np.arange(0, 10)
-    ang = np.linspace(0.0, 2.0 * math.pi, 16, endpoint=False)
-    xs.append(np.concatenate([[0.0], (r[:, None] * d * np.cos(ang)).ravel()]))
-    vs.append(np.concatenate([[0.0], (r[:, None] * w * np.sin(ang)).ravel()]))
-    x1, x2 = np.concatenate(xs), np.concatenate(vs)
-    keep = (np.abs(x1) <= R) & (np.abs(x2) <= w)
-    x1, x2 = np.concatenate([x1[keep], -x1[keep]]), np.concatenate([x2[keep], -x2[keep]])
-    pts = np.unique(np.stack([x1, x2], axis=1), axis=0)
-    return pts[:, 0].copy(), pts[:, 1].copy()
-
-
-def grid_csv(cfg: Config) -> str:
-    """Return the conformance grid as CSV text, columns x1, x2 (exact float repr)."""
-    x1, x2 = conformance_grid(cfg)
-    lines = ["x1,x2"] + [f"{a!r},{b!r}" for a, b in zip(x1.tolist(), x2.tolist())]
-    return "\n".join(lines) + "\n"
-
-
-def read_table(path: str | Path) -> tuple[NDArray, NDArray, NDArray]:
-    """Read a CSV with a header naming columns x1, x2, u (others ignored).
-
-    Parameters
-    ----------
-    path : str or Path
-        CSV file.
-
-    Returns
-    -------
-    x1, x2, u : ndarray
-        States [mm], [mm/s] and the implementation's input [mm/s].
-
-    Raises
-    ------
-    InputError
-        Unreadable file, missing column, empty table, a field that is not a
-        finite number (line and column named).
-    """
-    try:
-        with open(path, newline="") as fh:
-            rows = list(csv.reader(fh))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read table '{path}': {getattr(exc, 'strerror', None) or exc}"
-                         ) from None
-    except csv.Error as exc:
-        raise InputError(f"table '{path}': malformed CSV: {exc}") from None
-    if not rows:
-        raise InputError(f"table '{path}' is empty")
-    header = [h.strip() for h in rows[0]]
-    cols = {}
-    for name in ("x1", "x2", "u"):
-        if name not in header:
-            raise InputError(f"table '{path}': no column '{name}' in header {','.join(header)} "
-                             "(need x1, x2, u)")
-        cols[name] = header.index(name)
-    data = []
-    for line, row in enumerate(rows[1:], start=2):
-        if not any(f.strip() for f in row):
-            continue
-        vals = []
-        for name, j in cols.items():
-            text = row[j].strip() if j < len(row) else ""
-            try:
-                v = float(text)
-            except ValueError:
-                v = math.nan
-            if not math.isfinite(v):
-                raise InputError(f"table '{path}' line {line}: column {name} = {text!r} is not "
-                                 "a finite number")
-            vals.append(v)
-        data.append(vals)
-    if not data:
-        raise InputError(f"table '{path}' has a header but no rows")
-    arr = np.array(data, dtype=float)
-    return arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy()
-
-
-# ------------------------------------------------------------------ agreement
-def _ties(x1: NDArray, x2: NDArray, cfg: Config) -> NDArray[np.bool_]:
-    """Points outside |x1| < d within TIE_BAND of l1/l2 or l1*/l2* (region may flip)."""
-    a, w = cfg.plant.a, cfg.plant.w_max
-    band = _tie_band(cfg)
-    near = np.abs(switching_function(x1, x2, a, w)) <= band
-    om = _omega0(cfg)
-    if om is not None:
-        near |= np.abs(level_residual(x1, x2, a, om)) <= band
-    return near & (np.abs(x1) >= cfg.pto.d)
-
-
-def agreement(x1: NDArray, x2: NDArray, u: NDArray, cfg: Config,
-              rtol: float = DEFAULT_RTOL) -> tuple[dict, list[dict]]:
-    """Compare u with the reference PTO law, region by region.
-
-    Parameters
-    ----------
-    x1, x2 : ndarray
-        States [mm], [mm/s].
-    u : ndarray
-        The implementation's input [mm/s] at those states.
-    cfg : Config
-        Configuration.
-    rtol : float
-        Tolerance relative to w_max.
-
-    Returns
-    -------
-    summary : dict
-        ``points``, ``excluded``, ``tolerance_mm_s``, ``max_abs_du``, ``worst``,
-        ``regions`` (per reference region: points, excluded, max_abs_du, state,
-        u, u_ref, violations).
-    failures : list of dict
-        One ``agreement`` failure (first state in order, worst named) or none.
-    """
-    w = cfg.plant.w_max
-    tol = rtol * w
-    u_ref, reg = _reference(cfg)(x1, x2)
-    du = np.abs(u - u_ref)
-    tie = _ties(x1, x2, cfg)
-    judged = ~tie
-    bad = judged & (du > tol)
-    regions = {}
-    for code in Region:
-        m = reg == code
-        if not m.any():
-            continue
-        mj = m & judged
-        entry = {"code": int(code), "points": int(m.sum()), "excluded": int((m & tie).sum()),
-                 "violations": int((m & bad).sum()), "max_abs_du": 0.0, "state": None}
-        if mj.any():
-            i = int(np.flatnonzero(mj)[np.argmax(du[mj])])
-            entry.update(max_abs_du=float(du[i]), state=[float(x1[i]), float(x2[i])],
-                         u=float(u[i]), u_ref=float(u_ref[i]))
-        entry["pass"] = entry["violations"] == 0
-        regions[code.name] = entry
-    worst = int(np.argmax(np.where(judged, du, -1.0)))
-    summary = {"points": int(x1.size), "excluded": int(tie.sum()), "rtol": rtol,
-               "tolerance_mm_s": tol, "tie_band_mm_s": _tie_band(cfg),
-               "max_abs_du": float(du[worst]) if judged.any() else 0.0,
-               "worst": {"state": [float(x1[worst]), float(x2[worst])], "u": float(u[worst]),
-                         "u_ref": float(u_ref[worst]), "region": Region(reg[worst]).name},
-               "violations": int(bad.sum()), "pass": not bad.any(), "regions": regions}
-    failures = []
-    if bad.any():
-        i = int(np.argmax(bad))
-        failures.append(_failure(
-            "agreement", (x1[i], x2[i]),
-            f"|u - u_ref| = {du[i]:.6g} mm/s > {tol:.3g} mm/s ({rtol:g} w_max) in region "
-            f"{Region(reg[i]).name} (u = {u[i]:.10g}, u_ref = {u_ref[i]:.10g}); "
-            f"{int(bad.sum())} of {int(judged.sum())} judged points disagree, worst "
-            f"{du[worst]:.6g} mm/s at ({x1[worst]:.10g}, {x2[worst]:.10g}) in "
-            f"{Region(reg[worst]).name}"))
-    return summary, failures
-
-
-def _input_bound(x1: NDArray, x2: NDArray, u: NDArray, cfg: Config, where: str):
-    w = cfg.plant.w_max
-    over = np.abs(u) > w
-    prop = {"status": FAIL if over.any() else PASS, "measured": float(np.abs(u).max()),
-            "limit": w, "detail": f"max |u| [mm/s] {where}; limit w_max"}
-    fails = []
-    if over.any():
-        i = int(np.argmax(over))
-        fails.append(_failure("input-bound", (x1[i], x2[i]),
-                              f"|u| = {abs(u[i]):.10g} mm/s > w_max = {w:g} mm/s {where}"))
-    return prop, fails
-
-
 # ------------------------------------------------------------------ closed loop
 def _as_law(user: UserLaw, cfg: Config) -> Law:
     """Wrap a user law as a :class:`Law` whose regions are the reference's (geometry)."""
-    ref = _reference(cfg)
+    ref = reference(cfg)
 
     def vector(x1, x2):
         u = user(x1, x2).reshape(np.shape(x1))
@@ -664,7 +417,7 @@ def _settling_reference(cfg: Config) -> dict:
     dm = discrete_min_steps_batch(x1, x2, cfg.plant)
     n_star = np.array([m.steps if m.success else -1 for m in dm], dtype=float)
     steps = default_steps(cfg)
-    res = simulate_batch(make_law("pto", cfg), cfg.plant, x1, x2, steps)
+    res = simulate_batch(reference(cfg), cfg.plant, x1, x2, steps)
     s_ref = _settle_steps(res.x1, _BAND_MM)
     ok = n_star >= 0
     e_ref = float(np.max(s_ref[ok] - n_star[ok])) if ok.any() else math.inf
@@ -682,7 +435,7 @@ def _settling(law: Law, cfg: Config) -> tuple[dict, list[dict]]:
         s = ref["failed"][0] if ref["failed"] else (math.nan, math.nan, "reference unsettled")
         prop = {"status": UNVERIFIED, "measured": None, "limit": None,
                 "detail": f"N* could not be established at ({s[0]:g}, {s[1]:g}): {s[2]}"}
-        return prop, [_failure("settling-vs-discrete-limit", s[:2], prop["detail"])]
+        return prop, [failure("settling-vs-discrete-limit", s[:2], prop["detail"])]
     res = simulate_batch(law, cfg.plant, ref["x1"], ref["x2"], ref["steps"])
     s = _settle_steps(res.x1, _BAND_MM)
     excess = s - ref["n_star"]
@@ -698,7 +451,7 @@ def _settling(law: Law, cfg: Config) -> tuple[dict, list[dict]]:
     fails = []
     if worst > limit:
         i = int(np.argmax(excess > limit))
-        fails.append(_failure(
+        fails.append(failure(
             "settling-vs-discrete-limit", (ref["x1"][i], ref["x2"][i]),
             f"settles in {s[i]:g} samples, N* = {ref['n_star'][i]:g} (reference "
             f"{ref['s_ref'][i]:g}); excess {excess[i]:g} > {limit:g} samples"))
@@ -747,7 +500,7 @@ def closed_loop(user: UserLaw, cfg: Config, *,
         detail = f"closed-loop simulation stopped: {fault.message}"
         return ({"evaluation": {"status": FAIL, "measured": None, "limit": None,
                                 "detail": detail}},
-                [_failure("evaluation", fault.state, detail)])
+                [failure("evaluation", fault.state, detail)])
     m = _sweep_analysis(res, x1, cfg, _BAND_MM, window)
     where = f"over {x1.size} initial states x {steps} samples"
     props, fails = {}, []
@@ -758,7 +511,7 @@ def closed_loop(user: UserLaw, cfg: Config, *,
         hit = _first(mask)
         if hit is not None:
             k, j = hit
-            fails.append(_failure(name, (x1[j], x2[j]),
+            fails.append(failure(name, (x1[j], x2[j]),
                                   f"{what} (first from initial state ({x1[j]:.6g}, "
                                   f"{x2[j]:.6g}), sample {k}: ({res.x1[k, j]:.6g}, "
                                   f"{res.x2[k, j]:.6g})); {count} in all",
@@ -782,7 +535,7 @@ def closed_loop(user: UserLaw, cfg: Config, *,
         detail = f"settling simulation stopped: {fault.message}"
         props["settling-vs-discrete-limit"] = {"status": FAIL, "measured": None,
                                                "limit": None, "detail": detail}
-        f = [_failure("evaluation", fault.state, detail)]
+        f = [failure("evaluation", fault.state, detail)]
     fails += f
     return props, fails
 
@@ -792,7 +545,7 @@ def _odd_symmetry(user: UserLaw, x1: NDArray, x2: NDArray, u: NDArray, cfg: Conf
     """u(-x) = -u(x) on the grid (tie points excluded), to the agreement tolerance."""
     tol = rtol * cfg.plant.w_max
     um = user(-x1, -x2)
-    err = np.where(_ties(x1, x2, cfg), 0.0, np.abs(u + um))
+    err = np.where(ties(x1, x2, cfg), 0.0, np.abs(u + um))
     bad = err > tol
     prop = {"status": FAIL if bad.any() else PASS, "measured": float(err.max()), "limit": tol,
             "detail": f"max |u(x) + u(-x)| [mm/s] over {x1.size} grid states (curve ties "
@@ -800,7 +553,7 @@ def _odd_symmetry(user: UserLaw, x1: NDArray, x2: NDArray, u: NDArray, cfg: Conf
     fails = []
     if bad.any():
         i = int(np.argmax(bad))
-        fails.append(_failure("odd-symmetry", (x1[i], x2[i]),
+        fails.append(failure("odd-symmetry", (x1[i], x2[i]),
                               f"u(x) = {u[i]:.10g}, u(-x) = {um[i]:.10g} mm/s"))
     return prop, fails
 
@@ -902,18 +655,18 @@ def conform_callable(fn: Callable, cfg: Config, *, target: str = "", rtol: float
         try:
             u = user(x1, x2)
         except LawFault as fault:
-            failures.append(_failure("evaluation", fault.state, fault.message))
+            failures.append(failure("evaluation", fault.state, fault.message))
             agree = {"pass": False, "detail": f"not run: {fault.message}"}
         else:
             agree, f = agreement(x1, x2, u, cfg, rtol)
             failures += f
-            props["input-bound-grid"], f = _input_bound(x1, x2, u, cfg, "on the grid")
+            props["input-bound-grid"], f = input_bound(x1, x2, u, cfg, "on the grid")
             failures += f
             try:
                 props["odd-symmetry"], f = _odd_symmetry(user, x1, x2, u, cfg, rtol)
             except LawFault as fault:
                 props["odd-symmetry"] = {"status": FAIL, "detail": fault.message}
-                f = [_failure("evaluation", fault.state, fault.message)]
+                f = [failure("evaluation", fault.state, fault.message)]
             failures += f
         timings["agreement"] = time.perf_counter() - t
         t = time.perf_counter()
@@ -953,7 +706,7 @@ def conform_table(path: str | Path, cfg: Config, *, rtol: float = DEFAULT_RTOL) 
     x1, x2, u = read_table(path)
     agree, failures = agreement(x1, x2, u, cfg, rtol)
     props = {}
-    props["input-bound-grid"], f = _input_bound(x1, x2, u, cfg, "at the table's points")
+    props["input-bound-grid"], f = input_bound(x1, x2, u, cfg, "at the table's points")
     failures += f
     for name in ("odd-symmetry", "no-stride-over", "no-limit-cycle", "input-bound",
                  "settling-vs-discrete-limit"):

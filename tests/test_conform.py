@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from ptoverify.agreement import tie_band
 from ptoverify.cli import main
 from ptoverify.config import paper_config
 from ptoverify.conform import (
     LawFault,
     UserLaw,
     _as_law,
-    _tie_band,
     closed_loop,
     conform_callable,
     conformance_grid,
@@ -123,7 +123,7 @@ def test_grid_dense_near_every_boundary(paper_cfg):
     p = paper_cfg.plant
     a, w, R, d = p.a, p.w_max, p.position_range, paper_cfg.pto.d
     x1, x2 = conformance_grid(paper_cfg)
-    band = _tie_band(paper_cfg)
+    band = tie_band(paper_cfg)
     om = zone_for_law(paper_cfg, "corrected").omega0
     assert np.all(np.abs(x1) <= R) and np.all(np.abs(x2) <= w)
     for level in (w, om):
