@@ -18,6 +18,7 @@ poles       PD and linear-zone (eq. 37) loops: poles, damping, margins (python-c
 plots_zone  figure of the zone geometry with sampled trajectories (matplotlib, Agg)
 conform     conform: gate a third-party PTO law (callable or table) against the reference
 agreement   conformance grid (--emit-grid), CSV tables, per-region agreement with the reference
+userlaw     loading a user law (MODULE:FUNCTION or file.py:FUNCTION), vectorized/scalar detection
 cli         the ``ptoverify`` command line
 errors      InputError (exit 2), ConfigError, SolverError
 """
