@@ -140,7 +140,7 @@ class UserLaw:
         self.calls += 1
         try:
             value = self.fn(x1, x2, self.cfg)
-        except Exception as exc:  # noqa: BLE001 - any user exception is a finding
+        except (Exception, SystemExit) as exc:  # noqa: BLE001 - any user exception is a finding
             raise LawFault((x1, x2), f"the law raised {type(exc).__name__}: {exc}") from None
         u = _as_number(value, (x1, x2))
         if not math.isfinite(u):
@@ -157,7 +157,7 @@ class UserLaw:
         self.calls += 1
         try:
             value = self.fn(x1, x2, self.cfg)
-        except Exception as exc:  # noqa: BLE001 - locate the failing state element-wise
+        except (Exception, SystemExit) as exc:  # noqa: BLE001 - locate the failing state element-wise
             for a, b in zip(x1, x2):
                 self.scalar(float(a), float(b))
             raise LawFault((float(x1[0]), float(x2[0])),
@@ -225,7 +225,7 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
     law.reason = ""
     try:
         vec = np.asarray(fn(p1, p2, cfg), dtype=float)
-    except Exception as exc:  # noqa: BLE001 - any failure on arrays means: scalar loop
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - any failure on arrays means: scalar loop
         law.reason = f"array call raised {type(exc).__name__}: {' '.join(str(exc).split())}"
     else:
         if vec.shape != p1.shape:

@@ -192,6 +192,17 @@ def test_law_raising_at_a_state_is_a_finding(capsys, tmp_path):
     assert ev and ev[0]["state"][0] > 40.0 and "RuntimeError" in ev[0]["detail"]
 
 
+def test_sys_exit_in_law_is_a_finding(paper_cfg):
+    def f(x1, x2, cfg):
+        if x2 == 0.0:
+            raise SystemExit(3)                  # firmware shim that "exits" on a bad state
+        return reference_law(x1, x2, cfg)
+
+    r = conform_callable(f, paper_cfg, sweep=SMALL)
+    assert r.failed_properties()[0] == "evaluation"
+    assert r.failures[0]["state"][1] == 0.0 and "SystemExit" in r.failures[0]["detail"]
+
+
 def test_nan_at_a_state_is_a_finding(paper_cfg):
     def f(x1, x2, cfg):
         u = reference_law(x1, x2, cfg)
