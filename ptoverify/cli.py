@@ -349,7 +349,9 @@ of a computed curve outside |x1| < d are excluded and counted (a float tie may f
 region there); odd symmetry; |u| <= w_max; closed loop as `check` gates it: no stride-over,
 no limit cycle (and settled within 1e-3 mm), |u| <= w_max, and settling against the
 discrete-time limit N*T: worst (settling samples - N*) <= E_ref + max(2, ceil(E_ref/2)),
-E_ref the reference's worst. Table: agreement and |u| <= w_max at its points only.
+E_ref the reference's worst. Table: agreement and |u| <= w_max at its points only; the
+reference is evaluated at the table's x1, x2, so firmware that rounds the state (float32) must
+write back the state it actually evaluated.
 
 Exit codes: 0 conforms, 1 does not (each failing property named with the first state that
 shows it; a law that raises, returns NaN/inf, or has memory is a finding), 2 bad input

@@ -66,6 +66,10 @@ Settling against N* T
 Tables
     Only the agreement and |u| <= w_max are judged where the table has points;
     the closed-loop properties need a callable and are reported ``not_run``.
+    The reference is evaluated at the table's x1, x2 as written, so an
+    implementation that rounds the state (float32 firmware) must write back
+    the state it evaluated: near a curve, a rounded state can lie on the other
+    side, where u differs by up to 2 w_max.
 """
 
 from __future__ import annotations
