@@ -295,6 +295,6 @@ def input_bound(x1: NDArray, x2: NDArray, u: NDArray, cfg: Config, where: str):
     fails = []
     if over.any():
         i = int(np.argmax(over))
-        fails.append(failure("input-bound", (x1[i], x2[i]),
+        fails.append(failure("input-bound-grid", (x1[i], x2[i]),
                               f"|u| = {abs(u[i]):.10g} mm/s > w_max = {w:g} mm/s {where}"))
     return prop, fails

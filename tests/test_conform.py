@@ -249,7 +249,7 @@ def test_human_output_names_failures(capsys, tmp_path):
     code, out, _ = run(capsys, "conform", "--law", f"{path}:f")
     assert code == 1
     assert out.startswith("DOES NOT CONFORM")
-    assert "FAILED agreement at state (" in out and "FAILED input-bound at state (" in out
+    assert "FAILED agreement at state (" in out and "FAILED input-bound-grid at state (" in out
 
 
 def test_user_prints_do_not_break_json(capsys, tmp_path):
