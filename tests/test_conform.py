@@ -327,3 +327,32 @@ def test_reference_law_doc(paper_cfg):
     assert reference_law(x1, x2, paper_cfg) == make_law("pto", paper_cfg).scalar(x1, x2)[0] \
         or abs(reference_law(x1, x2, paper_cfg) - make_law("pto", paper_cfg).scalar(x1, x2)[0]) \
         <= 1e-12 * paper_config().plant.w_max
+
+
+def test_tolerance_option_is_used(capsys, tmp_path, paper_cfg):
+    """float32 output passes at 1e-6 w_max and fails at 1e-9 w_max (rounding ~6e-8 relative)."""
+    x1, x2 = conformance_grid(paper_cfg, n=11, n_curve=11)
+    u = reference_law(x1, x2, paper_cfg).astype(np.float32).astype(float)
+    table = tmp_path / "fw.csv"
+    table.write_text("x1,x2,u\n" + "".join(f"{a!r},{b!r},{c!r}\n" for a, b, c
+                                         in zip(x1.tolist(), x2.tolist(), u.tolist())))
+    code, out, _ = run(capsys, "conform", "--table", str(table), "--json")
+    assert code == 0 and json.loads(out)["agreement"]["rtol"] == 1e-6
+    code, out, _ = run(capsys, "conform", "--table", str(table), "--json", "--tolerance", "1e-9")
+    data = json.loads(out)
+    assert code == 1 and data["failures"][0]["property"] == "agreement"
+    assert data["agreement"]["tolerance_mm_s"] == 1e-9 * paper_cfg.plant.w_max
+
+
+def test_dotted_attribute_and_file_path(tmp_path, paper_cfg):
+    from ptoverify.userlaw import load_callable
+
+    path = write_law(tmp_path, """
+        class Drive:
+            @staticmethod
+            def law(x1, x2, cfg):
+                from ptoverify.conform import reference_law
+                return reference_law(x1, x2, cfg)
+        """)
+    fn = load_callable(f"{path}:Drive.law")
+    assert fn(0.1, 0.0, paper_cfg) == reference_law(0.1, 0.0, paper_cfg)
