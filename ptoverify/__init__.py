@@ -28,6 +28,9 @@ plots       Figs. 2-14 for TO, PD, PTO (both), sweep heat maps, zone geometry, c
 checks      the gates of ``ptoverify check``: CheckResult, GATES, run_checks
 report      collect, render_html / render_markdown, write_report (atomic);
             report_sections builds the nine sections
+conform     conform: gate a third-party PTO law (callable or table) against the reference
+agreement   conformance grid (--emit-grid), CSV tables, per-region agreement with the reference
+userlaw     loading a user law (MODULE:FUNCTION or file.py:FUNCTION), vectorized/scalar detection
 cli         the ``ptoverify`` command line
 errors      InputError (exit 2), ConfigError, SolverError
 """

@@ -8,6 +8,7 @@ line on stderr beginning ``ptoverify: error:``, no traceback, nothing written).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import io
 import json
@@ -461,6 +462,84 @@ def _cmd_report(args: argparse.Namespace) -> int:
     return 0
 
 
+# ---------------------------------------------------------------- conform
+_CONFORM_EPILOG = """\
+Loading a callable RUNS USER CODE: --law imports the named module (or executes the named
+.py file) in this process. Only the module or file you name is loaded; no path is searched
+(MODULE must be importable from sys.path as it stands; give path/to/file.py:FUNCTION for a
+file). The callable is u = f(x1, x2, cfg) with x1 [mm], x2 [mm/s], cfg the ptoverify Config;
+it must accept Python floats and may accept numpy arrays (vectorized use is detected: an
+array call of 8 probe states must equal element-wise calls to 1e-12 w_max; the output says
+which mode was used).
+
+Judged (callable): agreement with the reference PTO law (corrected omega0), region by
+region, |u - u_ref| <= TOL * w_max (default 1e-6) on a grid dense near l1, l2, l1*, l2*,
+the zone, |x1| = d, the origin and |x2| = w_max; points within 1e-9 (w_max + a range) mm/s
+of a computed curve outside |x1| < d are excluded and counted (a float tie may flip the
+region there); odd symmetry; |u| <= w_max; closed loop as `check` gates it: no stride-over,
+no limit cycle (and settled within 1e-3 mm), |u| <= w_max, and settling against the
+discrete-time limit N*T: worst (settling samples - N*) <= E_ref + max(2, ceil(E_ref/2)),
+E_ref the reference's worst. Table: agreement and |u| <= w_max at its points only; the
+reference is evaluated at the table's x1, x2, so firmware that rounds the state (float32) must
+write back the state it actually evaluated.
+
+Exit codes: 0 conforms, 1 does not (each failing property named with the first state that
+shows it; a law that raises, returns NaN/inf, or has memory is a finding), 2 bad input
+(import error, missing attribute, not callable, wrong signature, a non-number or wrong
+shape returned, unreadable table).
+
+examples:
+  ptoverify conform --law ptoverify.conform:reference_law
+  ptoverify conform --law examples/my_pto.py:pto --json
+  ptoverify conform --emit-grid grid.csv      # fill in column u, then:
+  ptoverify conform --table grid_with_u.csv"""
+
+
+def _add_conform(sub) -> None:
+    p = sub.add_parser(
+        "conform", help="gate a third-party PTO implementation (callable or table)",
+        description="Check that a third-party implementation of the PTO law agrees with the "
+                    "verified reference and keeps its closed-loop properties.",
+        epilog=_CONFORM_EPILOG)
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--law", metavar="MODULE:FUNCTION",
+                     help="callable u = f(x1, x2, cfg) to judge (runs its code)")
+    src.add_argument("--table", metavar="FILE.csv", help="CSV with columns x1, x2, u")
+    src.add_argument("--emit-grid", metavar="FILE.csv",
+                     help="write the conformance grid (columns x1, x2) and exit")
+    p.add_argument("--tolerance", type=finite_float, default=None, metavar="TOL",
+                   help="agreement tolerance relative to w_max (default 1e-6)")
+    p.set_defaults(handler=_cmd_conform)
+
+
+def _cmd_conform(args: argparse.Namespace) -> int:
+    from ptoverify import conform
+
+    cfg = _config(args)
+    rtol = conform.DEFAULT_RTOL if args.tolerance is None else args.tolerance
+    if not 0 < rtol < 1:
+        raise InputError(f"--tolerance must be in (0, 1), got {rtol:g}")
+    if args.emit_grid:
+        text = conform.grid_csv(cfg)
+        write_atomic(args.emit_grid, text)
+        if args.json:
+            print_json({"grid": str(args.emit_grid), "points": text.count("\n") - 1,
+                        "columns": ["x1", "x2"]})
+        return 0
+    if args.table:
+        result = conform.conform_table(args.table, cfg, rtol=rtol)
+    else:
+        # user code may print: keep stdout for the one JSON object / the report
+        with contextlib.redirect_stdout(sys.stderr):
+            fn = conform.load_callable(args.law)
+            result = conform.conform_callable(fn, cfg, target=args.law, rtol=rtol)
+    if args.json:
+        print_json(result.to_json())
+    else:
+        print(conform.format_result(result))
+    return 0 if result.conforms else 1
+
+
 COMMANDS: list[tuple[str, Callable[[Any], None]]] = [
     ("report", _add_report),
     ("check", _add_check),
@@ -469,6 +548,7 @@ COMMANDS: list[tuple[str, Callable[[Any], None]]] = [
     ("derive", _add_derive),
     ("sweep", _add_sweep),
     ("zone", _add_zone),
+    ("conform", _add_conform),
 ]
 
 
