@@ -107,7 +107,7 @@ def test_every_command_help_has_an_example(capsys):
         with pytest.raises(SystemExit) as exc:
             main([name, "--help"])
         assert exc.value.code == 0
-        assert "example:" in capsys.readouterr().out, name
+        assert "example" in capsys.readouterr().out.lower(), name
 
 
 MORE_BAD = {

@@ -86,7 +86,7 @@ def test_sweep_out_writes_atomically(tmp_path, capsys):
     out = tmp_path / "sw"
     assert main(["sweep", "--grid", "4", "--out", str(out), "--quiet"]) == 0
     names = sorted(p.name for p in out.iterdir())
-    assert names == ["sweep.json", "sweep_ratio_nt.png", "sweep_ratio_tf.png"]
+    assert names == [".ptoverify", "sweep.json", "sweep_ratio_nt.png", "sweep_ratio_tf.png"]
     assert all((out / n).stat().st_size > 5000 for n in names if n.endswith(".png"))
     assert main(["sweep", "--grid", "4", "--out", str(out), "--quiet"]) == 0, "replace"
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")], "no temp left"
