@@ -153,7 +153,7 @@ def simulate(law: Law, plant: Plant, signal: str | Reference = "step", *,
     >>> from ptoverify.laws import pd_law
     >>> cfg = paper_config()
     >>> res = simulate(pd_law(cfg), cfg.plant, "step")
-    >>> abs(res.e[-1]) < 1e-6
+    >>> bool(abs(res.e[-1]) < 1e-6)
     True
     """
     ref = reference(signal) if isinstance(signal, str) else signal
