@@ -136,6 +136,10 @@ def mintime_result(cfg: Config, x1: float, x2: float, intervals: int,
     number is computed; N* is searched up to 20000 samples and is null with
     ``discrete_status`` "not_found: ..." beyond.
     """
+    from dataclasses import replace
+
+    import numpy as np
+
     from ptoverify.mintime import discrete_min_steps, min_time
     from ptoverify.ocp import CollocationOCP, TwoPhaseOCP
 
@@ -149,6 +153,23 @@ def mintime_result(cfg: Config, x1: float, x2: float, intervals: int,
     tp = TwoPhaseOCP(plant, **caps).solve(x1, x2)
     co = CollocationOCP(plant, intervals=intervals, **caps).solve(x1, x2)
     dm = discrete_min_steps(x1, x2, plant)
+
+    from ptoverify.plant import flow
+
+    # a posteriori: IPOPT's "Solve_Succeeded" is not enough; the two-phase arcs, propagated by
+    # the exact flow, must end at the origin (relative to the state's scale), and the
+    # collocation input, re-simulated, must end near it
+    scale = abs(x1) + abs(x2) / plant.a
+    if tp.success and scale > 0:
+        y1, y2 = flow(x1, x2, -tp.side * plant.w_max, tp.t_switch, plant.a)
+        z1, z2 = flow(y1, y2, tp.side * plant.w_max, tp.t_f - tp.t_switch, plant.a)
+        miss = float(np.hypot(z1, z2 / plant.a))
+        if miss > 1e-6 * scale:
+            tp = replace(tp, success=False,
+                         status=f"inaccurate: arcs end {miss:.3g} mm from the origin")
+    if co.success and scale > 0 and co.resim_error > 1e-2 * scale:
+        co = replace(co, success=False, status=f"inaccurate: re-simulation ends "
+                                                f"{co.resim_error:.3g} mm from the origin")
 
     def verified(value: float, ok: bool) -> float | None:
         return float(value) if ok else None

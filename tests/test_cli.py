@@ -175,3 +175,12 @@ def test_out_replaces_its_own_previous_output(capsys, tmp_path):
 def test_empty_csv_and_short_duration_rejected(capsys):
     assert main(["simulate", "--law", "pd", "--csv", ""]) == 2
     assert main(["simulate", "--law", "pd", "--duration", "1e-9"]) == 2
+
+
+def test_mintime_converged_but_inaccurate_ocp_is_not_truth(capsys):
+    """At a state of 1e-300 mm IPOPT 'succeeds' at the scale of its tolerance; the a posteriori
+    propagation check reports null with an 'inaccurate' status, never a number."""
+    assert main(["mintime", "1e-300", "1e-300", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["analytic_s"] > 0
+    assert data["two_phase_s"] is None and data["two_phase_status"].startswith("inaccurate")
