@@ -209,49 +209,46 @@ def _gt_states(cfg: Config, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     return _random_states(cfg, n, seed, 0.95)
 
 
-@gate("mintime-closed-form-vs-two-phase")
-def _two_phase(cfg: Config) -> CheckResult:
-    """CasADi two-phase OCP (IPOPT) against the closed-form minimum time."""
+def _ocp_vs_closed_form(name: str, cfg: Config, ocp, n: int, seed: int, limit: float,
+                        detail: str) -> CheckResult:
+    """Worst relative t_f difference of an OCP solver from the closed form over n states."""
     from ptoverify.mintime import min_time
-    from ptoverify.ocp import TwoPhaseOCP
 
-    x1, x2 = _gt_states(cfg, 30, 21)
-    ocp = TwoPhaseOCP(cfg.plant, **_solver_caps())
+    x1, x2 = _gt_states(cfg, n, seed)
     mt = min_time(x1, x2, cfg.plant)
     worst = 0.0
-    for i in range(len(x1)):
+    for i in range(n):
         res = ocp.solve(float(x1[i]), float(x2[i]))
         if not res.success:
-            return CheckResult("mintime-closed-form-vs-two-phase", UNVERIFIED, None, 1e-9,
+            return CheckResult(name, UNVERIFIED, None, limit,
                                f"IPOPT did not converge at ({x1[i]:.4g}, {x2[i]:.4g}): "
                                f"{res.status}")
         worst = max(worst, abs(res.t_f - mt.t_f[i]) / mt.t_f[i])
-    return _at_most("mintime-closed-form-vs-two-phase", worst, 1e-9,
-                    "max relative t_f difference, two-phase OCP vs closed form, 30 random "
-                    "states in the envelope; limit 1e-9: IPOPT's tolerance on an exact flow")
+    return _at_most(name, worst, limit, detail)
+
+
+@gate("mintime-closed-form-vs-two-phase")
+def _two_phase(cfg: Config) -> CheckResult:
+    """CasADi two-phase OCP (IPOPT) against the closed-form minimum time."""
+    from ptoverify.ocp import TwoPhaseOCP
+
+    return _ocp_vs_closed_form(
+        "mintime-closed-form-vs-two-phase", cfg, TwoPhaseOCP(cfg.plant, **_solver_caps()), 30,
+        21, 1e-9, "max relative t_f difference, two-phase OCP vs closed form, 30 random states "
+        "in the envelope; limit 1e-9: IPOPT's tolerance on an exact flow")
 
 
 @gate("mintime-closed-form-vs-collocation")
 def _collocation(cfg: Config) -> CheckResult:
     """CasADi Radau collocation (N = 100) against the closed-form minimum time."""
-    from ptoverify.mintime import min_time
     from ptoverify.ocp import CollocationOCP
 
-    x1, x2 = _gt_states(cfg, 8, 22)
-    ocp = CollocationOCP(cfg.plant, intervals=100, **_solver_caps())
-    mt = min_time(x1, x2, cfg.plant)
-    worst = 0.0
-    for i in range(len(x1)):
-        res = ocp.solve(float(x1[i]), float(x2[i]))
-        if not res.success:
-            return CheckResult("mintime-closed-form-vs-collocation", UNVERIFIED, None, 5e-4,
-                               f"IPOPT did not converge at ({x1[i]:.4g}, {x2[i]:.4g}): "
-                               f"{res.status}")
-        worst = max(worst, abs(res.t_f - mt.t_f[i]) / mt.t_f[i])
-    return _at_most("mintime-closed-form-vs-collocation", worst, 5e-4,
-                    "max relative t_f difference, Radau-3 collocation with N = 100 vs closed "
-                    "form, 8 random states; limit 5e-4: the discretisation smears the switch "
-                    "over one interval (observed order ~2)")
+    return _ocp_vs_closed_form(
+        "mintime-closed-form-vs-collocation", cfg,
+        CollocationOCP(cfg.plant, intervals=100, **_solver_caps()), 8, 22, 5e-4,
+        "max relative t_f difference, Radau-3 collocation with N = 100 vs closed form, 8 "
+        "random states; limit 5e-4: the discretisation smears the switch over one interval "
+        "(observed order ~2)")
 
 
 @gate("discrete-limit-consistency")

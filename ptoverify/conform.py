@@ -100,8 +100,7 @@ from ptoverify.agreement import (
     ties,
 )
 from ptoverify.config import Config
-from ptoverify.curves import switching_function
-from ptoverify.laws import Law, Region
+from ptoverify.laws import Law
 from ptoverify.userlaw import LawFault, UserLaw, load_callable, wrap_callable
 
 __all__ = ["reference_law", "reference_law_scalar", "load_callable", "UserLaw", "wrap_callable",
@@ -171,20 +170,11 @@ def _first(mask: NDArray[np.bool_]) -> tuple[int, int] | None:
 
 def _sweep_analysis(res, x1: NDArray, cfg: Config, band: float, window: int) -> dict:
     """Masks of :func:`ptoverify.properties.law_properties` (same definitions)."""
-    from ptoverify.properties import _oscillating
+    from ptoverify.properties import _oscillating, crossing_masks
 
-    p = cfg.plant
-    a, w, d = p.a, p.w_max, cfg.pto.d
-    X1, X2, R = res.x1, res.x2, res.region
-    tol = 1e-9 * (w + a * p.position_range)
-    sig = switching_function(X1, X2, a, w)
-    out = np.abs(X1) >= d
-    zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
-    s0, s1 = sig[:-1], sig[1:]
-    n_side = (s0 > 0) | ((s0 == 0) & (X2[:-1] > 0))
-    p_side = (s0 < 0) | ((s0 == 0) & (X2[:-1] < 0))
-    cross = (n_side & (s1 < -tol)) | (p_side & (s1 > tol))
-    stride = out[:-1] & ~zone & cross & out[1:]
+    w = cfg.plant.w_max
+    X1 = res.x1
+    stride, _ = crossing_masks(res.x1, res.x2, res.region, cfg)
     osc = _oscillating(X1[-window:], band)
     unsettled = np.abs(X1[-1]) > band
     return {"stride": stride, "osc": osc, "unsettled": unsettled,

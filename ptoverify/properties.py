@@ -171,6 +171,42 @@ def _oscillating(x1: np.ndarray, band: float) -> np.ndarray:
     return (changes >= 4) & (second > band) & (second >= 0.5 * first)
 
 
+def crossing_masks(X1: np.ndarray, X2: np.ndarray, R: np.ndarray,  # noqa: N803
+                   cfg: Config) -> tuple[np.ndarray, np.ndarray]:
+    """Stride-overs and crossings into the linear zone, per sample transition.
+
+    A transition k -> k+1 crosses when sigma changes side strictly beyond a tolerance
+    1e-9 (w_max + a position_range) [mm/s]; it starts outside the zone and the linear zone.
+    A stride-over lands outside the linear zone; otherwise it is a crossing into it.
+
+    Parameters
+    ----------
+    X1, X2 : ndarray, shape (steps + 1, n)
+        States at the samples [mm], [mm/s].
+    R : ndarray, shape (steps, n) or (steps + 1, n)
+        Region codes of the samples (only the first ``steps`` rows are used).
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    stride, into_linear : ndarray of bool, shape (steps, n)
+    """
+    p = cfg.plant
+    a, w, d = p.a, p.w_max, cfg.pto.d
+    tol = 1e-9 * (w + a * p.position_range)
+    sig = switching_function(X1, X2, a, w)
+    out = np.abs(X1) >= d
+    R = R[: X1.shape[0] - 1]
+    zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
+    s0, s1 = sig[:-1], sig[1:]
+    n_side = (s0 > 0) | ((s0 == 0) & (X2[:-1] > 0))
+    p_side = (s0 < 0) | ((s0 == 0) & (X2[:-1] < 0))
+    cross = (n_side & (s1 < -tol)) | (p_side & (s1 > tol))
+    src = out[:-1] & ~zone
+    return src & cross & out[1:], src & cross & ~out[1:]
+
+
 def law_properties(law: Law, cfg: Config, *, n1: int = 101, n2: int = 101, rest: int = 200,
                    steps: int | None = None, band: float = 1e-3,
                    window: int | None = None) -> LawProperties:
@@ -197,24 +233,15 @@ def law_properties(law: Law, cfg: Config, *, n1: int = 101, n2: int = 101, rest:
         The measured properties.
     """
     p = cfg.plant
-    a, w, d, T = p.a, p.w_max, cfg.pto.d, p.sample_time
+    w, d, T = p.w_max, cfg.pto.d, p.sample_time
     steps = default_steps(cfg) if steps is None else steps
     window = max(20, steps // 4) if window is None else window
     x1, x2, is_rest = initial_grid(cfg, n1, n2, rest)
     res = simulate_batch(law, p, x1, x2, steps)
     X1, X2, R = res.x1, res.x2, res.region
-    tol = 1e-9 * (w + a * p.position_range)
-    sig = switching_function(X1, X2, a, w)
-    out = np.abs(X1) >= d
+    stride, into_lin = crossing_masks(X1, X2, R, cfg)
     zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
-    s0, s1 = sig[:-1], sig[1:]
-    n_side = (s0 > 0) | ((s0 == 0) & (X2[:-1] > 0))
-    p_side = (s0 < 0) | ((s0 == 0) & (X2[:-1] < 0))
-    cross = (n_side & (s1 < -tol)) | (p_side & (s1 > tol))
-    src = out[:-1] & ~zone
-    stride = src & cross & out[1:]
-    into_lin = src & cross & ~out[1:]
-    inside = ~out
+    inside = np.abs(X1) < d
     first_in = np.where(inside.any(axis=0), inside.argmax(axis=0), -1)
     never = first_in < 0
     t_lin = np.where(never, np.inf, first_in * T)
