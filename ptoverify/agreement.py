@@ -26,16 +26,17 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from ptoverify import verdict
 from ptoverify.config import Config
 from ptoverify.curves import level_curve_x1, level_residual, root_22, switching_function
 from ptoverify.errors import InputError
 from ptoverify.laws import Law, Region, make_law
+from ptoverify.verdict import FAIL, NOT_RUN, PASS, UNVERIFIED  # noqa: F401 - re-exported
 
 __all__ = ["DEFAULT_RTOL", "reference", "tie_band", "failure", "conformance_grid", "grid_csv",
            "read_table", "ties", "agreement", "input_bound"]
 
 DEFAULT_RTOL = 1e-6            #: agreement tolerance relative to w_max
-PASS, FAIL, NOT_RUN, UNVERIFIED = "pass", "fail", "not_run", "unverified"
 
 
 @functools.lru_cache(maxsize=8)
@@ -45,9 +46,9 @@ def reference(cfg: Config) -> Law:
 
 
 def tie_band(cfg: Config) -> float:
-    """Return the exclusion band 1e-9 (w_max + a position_range) [mm/s]."""
+    """Return the exclusion band of ``verdict.tie_band`` for ``cfg`` [mm/s]."""
     p = cfg.plant
-    return 1e-9 * (p.w_max + p.a * p.position_range)
+    return verdict.tie_band(p.w_max, p.a, p.position_range)
 
 
 def omega0_ref(cfg: Config) -> float | None:

@@ -16,59 +16,22 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
 
 from ptoverify.config import Config
 from ptoverify.errors import SolverError
+from ptoverify.verdict import FAIL, PASS, UNVERIFIED, Verdict, at_most
 
 __all__ = ["CheckResult", "GATES", "run_checks", "summarize"]
 
-PASS, FAIL, UNVERIFIED = "pass", "fail", "unverified"
-
-
-@dataclass(frozen=True)
-class CheckResult:
-    """Outcome of one gate.
-
-    Attributes
-    ----------
-    name : str
-        Gate name (stable; CI logs and other tools key on it).
-    status : str
-        ``pass``, ``fail`` or ``unverified``.
-    measured : float or None
-        The measured figure (None when it could not be computed).
-    limit : float or None
-        The limit it is compared with.
-    comparison : str
-        How ``measured`` must relate to ``limit`` to pass: ``<=``, ``>=`` or ``<``.
-    detail : str
-        What was measured, against what, and why the limit.
-    """
-
-    name: str
-    status: str
-    measured: float | None
-    limit: float | None
-    detail: str
-    comparison: str = "<="
-
-    def to_json(self) -> dict[str, Any]:
-        """Return a JSON-able dict."""
-        d = asdict(self)
-        for key in ("measured", "limit"):
-            v = d[key]
-            d[key] = None if v is None or not math.isfinite(v) else float(v)
-        return d
+#: A gate's outcome is the suite's one verdict type.
+CheckResult = Verdict
 
 
 def _at_most(name: str, measured: float, limit: float, detail: str) -> CheckResult:
-    if measured is None or not math.isfinite(measured):
-        return CheckResult(name, UNVERIFIED, None, limit, detail + " (not computable)")
-    return CheckResult(name, PASS if measured <= limit else FAIL, float(measured), limit, detail)
+    return at_most(name, measured, limit, detail)
 
 
 Gate = Callable[[Config], CheckResult]

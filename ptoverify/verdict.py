@@ -1,0 +1,141 @@
+"""One verdict vocabulary and one definition of each shared tolerance.
+
+Every gate of ``ptoverify check`` and every property of ``ptoverify conform``
+is a :class:`Verdict`: a name, a status (``pass``, ``fail``, ``unverified`` or
+``not_run``), the measured figure, its limit, how the two must compare, the
+unit of both, and a sentence saying why.  ``unverified`` and ``not_run`` fail
+closed: only ``pass`` passes.
+
+Tolerances used by more than one module live here, defined once.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+__all__ = [
+    "PASS",
+    "FAIL",
+    "UNVERIFIED",
+    "NOT_RUN",
+    "STATUSES",
+    "Verdict",
+    "at_most",
+    "tie_band",
+    "TIE_BAND_REL",
+]
+
+PASS, FAIL, UNVERIFIED, NOT_RUN = "pass", "fail", "unverified", "not_run"
+STATUSES = (PASS, FAIL, UNVERIFIED, NOT_RUN)
+
+#: Relative width of the band around a switching curve inside which a law's
+#: output is a tie (either side's input is right): 1e-9 of the largest
+#: velocity-like scale of the configuration, ``w_max + a position_range``.
+TIE_BAND_REL = 1e-9
+
+
+def tie_band(w_max: float, a: float, position_range: float) -> float:
+    """Return the curve tie band ``1e-9 (w_max + a position_range)``.
+
+    Parameters
+    ----------
+    w_max : float
+        Velocity saturation [mm/s].
+    a : float
+        Bandwidth of the velocity loop [rad/s].
+    position_range : float
+        Half-width of the position envelope [mm].
+
+    Returns
+    -------
+    float
+        Band [mm/s] in the switching function's units.
+
+    Examples
+    --------
+    >>> tie_band(300.0, 100.0, 50.0)
+    5.3e-06
+    """
+    return TIE_BAND_REL * (w_max + a * position_range)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Outcome of one gate or conformance property.
+
+    Attributes
+    ----------
+    name : str
+        Stable name (CI logs and other tools key on it).
+    status : str
+        ``pass``, ``fail``, ``unverified`` or ``not_run``.
+    measured : float or None
+        The measured figure (None when it could not be computed).
+    limit : float or None
+        The limit it is compared with.
+    detail : str
+        What was measured, against what, and why the limit.
+    comparison : str
+        How ``measured`` must relate to ``limit`` to pass: ``<=``, ``>=`` or ``<``.
+    unit : str
+        Unit of ``measured`` and ``limit`` (``"1"`` when dimensionless, ``""`` unknown).
+    """
+
+    name: str
+    status: str
+    measured: float | None
+    limit: float | None
+    detail: str
+    comparison: str = "<="
+    unit: str = ""
+
+    @property
+    def passed(self) -> bool:
+        """Whether the status is ``pass`` (everything else fails closed)."""
+        return self.status == PASS
+
+    def to_json(self) -> dict[str, Any]:
+        """Return a JSON-able dict; non-finite numbers become None."""
+        d = asdict(self)
+        for key in ("measured", "limit"):
+            v = d[key]
+            d[key] = None if v is None or not math.isfinite(v) else float(v)
+        return d
+
+
+def at_most(
+    name: str, measured: float | None, limit: float, detail: str, unit: str = ""
+) -> Verdict:
+    """Return ``pass`` when ``measured <= limit``, ``unverified`` when not computable.
+
+    Parameters
+    ----------
+    name : str
+        Gate or property name.
+    measured : float or None
+        Measured figure, in ``unit``.
+    limit : float
+        Limit, in ``unit``.
+    detail : str
+        What was measured and why the limit.
+    unit : str
+        Unit of both figures.
+
+    Returns
+    -------
+    Verdict
+        The verdict; NaN, infinity or None are ``unverified``.
+
+    Examples
+    --------
+    >>> at_most("x", 1.0, 2.0, "d").status
+    'pass'
+    >>> at_most("x", float("nan"), 2.0, "d").status
+    'unverified'
+    """
+    if measured is None or not math.isfinite(measured):
+        return Verdict(name, UNVERIFIED, None, limit, detail + " (not computable)", "<=", unit)
+    status = PASS if measured <= limit else FAIL
+    return Verdict(name, status, float(measured), limit, detail, "<=", unit)
