@@ -30,14 +30,20 @@ PLANTS = {
 
 def states(plant, n, seed):
     rng = np.random.default_rng(seed)
-    return np.column_stack([rng.uniform(-1, 1, n) * plant.position_range,
-                            rng.uniform(-1, 1, n) * plant.w_max * (1 - 1e-9)])
+    return np.column_stack(
+        [
+            rng.uniform(-1, 1, n) * plant.position_range,
+            rng.uniform(-1, 1, n) * plant.w_max * (1 - 1e-9),
+        ]
+    )
 
 
 def quantiles(x):
     x = np.asarray(x, dtype=float)
-    return {q: float(np.quantile(x, p)) for q, p in
-            (("min", 0), ("p05", .05), ("median", .5), ("p95", .95), ("max", 1))}
+    return {
+        q: float(np.quantile(x, p))
+        for q, p in (("min", 0), ("p05", 0.05), ("median", 0.5), ("p95", 0.95), ("max", 1))
+    }
 
 
 def main():
@@ -62,14 +68,17 @@ def main():
         out[key + "_ms"] = quantiles([1e3 * r.solve_time_s for r in res])
         out[key + "_iterations"] = quantiles([r.iterations for r in res])
 
-    discrete_min_steps(50.0, 0.0, plant)            # imports, generator table
+    discrete_min_steps(50.0, 0.0, plant)  # imports, generator table
     t = []
     for _ in range(20):
         t0 = time.perf_counter()
         d = discrete_min_steps(50.0, 0.0, plant)
         t.append(time.perf_counter() - t0)
-    out["discrete_50mm_step"] = {"steps": d.steps, "lp_solves": d.lp_solves,
-                                 "ms": quantiles(1e3 * np.array(t))}
+    out["discrete_50mm_step"] = {
+        "steps": d.steps,
+        "lp_solves": d.lp_solves,
+        "ms": quantiles(1e3 * np.array(t)),
+    }
 
     for name, pl in PLANTS.items():
         S = states(pl, args.states, 23)
@@ -97,8 +106,9 @@ def main():
             "collocation100_resim_error_mm": quantiles([r.resim_error for r in rc]),
             "discrete_status": sorted({x.status for x in dm}),
             "discrete_gap_in_T": quantiles(gap / pl.sample_time),
-            "discrete_gap_histogram_T": np.histogram(gap / pl.sample_time,
-                                                     bins=np.linspace(0, 1.5, 7))[0].tolist(),
+            "discrete_gap_histogram_T": np.histogram(
+                gap / pl.sample_time, bins=np.linspace(0, 1.5, 7)
+            )[0].tolist(),
             "discrete_ms_per_state": 1e3 * el / len(S),
         }
 
@@ -106,10 +116,14 @@ def main():
     for control in ("points", "interval"):
         st = convergence_study(plant, cs, control=control)
         out[f"convergence_{control}"] = {
-            "intervals": st.intervals.tolist(), "states": st.states.tolist(),
-            "rel_error": st.rel_error.tolist(), "resim_error_mm": st.resim_error.tolist(),
-            "order_per_state": st.order_per_state.tolist(), "order": st.order,
-            "all_converged": bool(st.success.all())}
+            "intervals": st.intervals.tolist(),
+            "states": st.states.tolist(),
+            "rel_error": st.rel_error.tolist(),
+            "resim_error_mm": st.resim_error.tolist(),
+            "order_per_state": st.order_per_state.tolist(),
+            "order": st.order,
+            "all_converged": bool(st.success.all()),
+        }
     print(json.dumps(out, indent=1))
 
 

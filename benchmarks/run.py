@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-LOAD_AT_START = [round(x, 2) for x in os.getloadavg()]   # 1, 5, 15 min, before any work
+LOAD_AT_START = [round(x, 2) for x in os.getloadavg()]  # 1, 5, 15 min, before any work
 # `python benchmarks/run.py` puts benchmarks/, not the repository root, first on sys.path;
 # an editable install elsewhere (another worktree) would then be measured instead of this
 # tree.  Only this script does this; the package never edits sys.path.
@@ -58,18 +58,37 @@ TARGETS = {  # key: (target, ">=" or "<=")
     "report_s": (120.0, "<="),
 }
 
-FULL = {"law": 10**6, "scalar": 20000, "omega": 10**5, "mintime": 10**6, "sim_states": 10000,
-        "sim_steps": 250, "two_phase": 50, "collocation": 20, "repeat": 7, "cli_repeat": 3}
-SMALL = {"law": 2000, "scalar": 200, "omega": 2000, "mintime": 2000, "sim_states": 100,
-         "sim_steps": 20, "two_phase": 3, "collocation": 2, "repeat": 2, "cli_repeat": 1}
+FULL = {
+    "law": 10**6,
+    "scalar": 20000,
+    "omega": 10**5,
+    "mintime": 10**6,
+    "sim_states": 10000,
+    "sim_steps": 250,
+    "two_phase": 50,
+    "collocation": 20,
+    "repeat": 7,
+    "cli_repeat": 3,
+}
+SMALL = {
+    "law": 2000,
+    "scalar": 200,
+    "omega": 2000,
+    "mintime": 2000,
+    "sim_states": 100,
+    "sim_steps": 20,
+    "two_phase": 3,
+    "collocation": 2,
+    "repeat": 2,
+    "cli_repeat": 1,
+}
 
 
 def envelope_states(cfg, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """Uniform random states in |x1| <= position_range, |x2| <= w_max."""
     rng = np.random.default_rng(seed)
     p = cfg.plant
-    return (rng.uniform(-1.0, 1.0, n) * p.position_range,
-            rng.uniform(-1.0, 1.0, n) * p.w_max)
+    return (rng.uniform(-1.0, 1.0, n) * p.position_range, rng.uniform(-1.0, 1.0, n) * p.w_max)
 
 
 def median_time(fn, repeat: int) -> float:
@@ -129,8 +148,9 @@ def bench_law_scalar(cfg, size: dict, zone_only: bool = False) -> float:
 
 
 # ---------------------------------------------------------------- omega_c
-def omega_c_bisection(x1: np.ndarray, x2: np.ndarray, a: float, tol: float = 1e-12,
-                      max_iter: int = 200) -> np.ndarray:
+def omega_c_bisection(
+    x1: np.ndarray, x2: np.ndarray, a: float, tol: float = 1e-12, max_iter: int = 200
+) -> np.ndarray:
     """omega_c by the paper's method: bisection on f(z) = ln(1 + z) - k z, eq. (31).
 
     k = 1 + a x1 / x2 (eq. 30), 0 < k < 1; the non-trivial root z* > 0 lies in
@@ -163,16 +183,22 @@ def omega_states(cfg, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
 def bench_omega(cfg, size: dict) -> dict:
     a = cfg.plant.a
     x1, x2 = omega_states(cfg, size["omega"], 3)
-    t_closed, t_bisect = median_times([lambda: omega_c(x1, x2, a),
-                                       lambda: omega_c_bisection(x1, x2, a)], size["repeat"])
+    t_closed, t_bisect = median_times(
+        [lambda: omega_c(x1, x2, a), lambda: omega_c_bisection(x1, x2, a)], size["repeat"]
+    )
     # the same bisection given the closed form's blockwise evaluation (not the key: a
     # check that the ratio measures the method, not the memory traffic)
-    t_blocked = median_time(lambda: blockwise(lambda b1, b2: omega_c_bisection(b1, b2, a),
-                                              x1, x2), size["repeat"])
+    t_blocked = median_time(
+        lambda: blockwise(lambda b1, b2: omega_c_bisection(b1, b2, a), x1, x2), size["repeat"]
+    )
     rel = np.abs(omega_c_bisection(x1, x2, a) / omega_c(x1, x2, a) - 1.0)
-    return {"ratio": t_bisect / t_closed, "closed_ms": 1e3 * t_closed,
-            "bisection_ms": 1e3 * t_bisect, "blocked_bisection_ms": 1e3 * t_blocked,
-            "max_rel_diff": float(np.max(rel))}
+    return {
+        "ratio": t_bisect / t_closed,
+        "closed_ms": 1e3 * t_closed,
+        "bisection_ms": 1e3 * t_bisect,
+        "blocked_bisection_ms": 1e3 * t_blocked,
+        "max_rel_diff": float(np.max(rel)),
+    }
 
 
 # ---------------------------------------------------------------- min time, simulation
@@ -197,10 +223,14 @@ def bench_ocp(cfg, size: dict) -> dict:
     plant = cfg.plant
     rng = np.random.default_rng(21)
     n2 = size["two_phase"]
-    S = np.column_stack([rng.uniform(-1, 1, n2) * plant.position_range,
-                         rng.uniform(-1, 1, n2) * plant.w_max * (1 - 1e-9)])
+    S = np.column_stack(
+        [
+            rng.uniform(-1, 1, n2) * plant.position_range,
+            rng.uniform(-1, 1, n2) * plant.w_max * (1 - 1e-9),
+        ]
+    )
     tp = TwoPhaseOCP(plant)
-    tp.solve(10.0, 0.0)                                  # build + warm-up
+    tp.solve(10.0, 0.0)  # build + warm-up
     t_tp, res_tp = [], []
     for x1, x2 in S:
         t0 = time.perf_counter()
@@ -218,18 +248,22 @@ def bench_ocp(cfg, size: dict) -> dict:
     err_co = np.abs(np.array([r.t_f for r in res_co]) - tf) / tf
     err_tp = np.abs(np.array([r.t_f for r in res_tp[: len(Sc)]]) - tf) / tf
     med_tp = float(np.median(err_tp))
-    return {"two_phase_ms": 1e3 * statistics.median(t_tp),
-            "collocation_ms": 1e3 * statistics.median(t_co),
-            "collocation_err": float(np.median(err_co)), "two_phase_err": med_tp,
-            "ratio": float(np.median(err_co)) / max(med_tp, 2.2e-16),
-            "failures": sum(not r.success for r in res_tp + res_co)}
+    return {
+        "two_phase_ms": 1e3 * statistics.median(t_tp),
+        "collocation_ms": 1e3 * statistics.median(t_co),
+        "collocation_err": float(np.median(err_co)),
+        "two_phase_err": med_tp,
+        "ratio": float(np.median(err_co)) / max(med_tp, 2.2e-16),
+        "failures": sum(not r.success for r in res_tp + res_co),
+    }
 
 
 def bench_discrete(cfg, size: dict) -> float:
     d = discrete_min_steps(50.0, 0.0, cfg.plant)
     assert d.success, d.status
-    return 1e3 * median_time(lambda: discrete_min_steps(50.0, 0.0, cfg.plant),
-                             max(5, size["repeat"]))
+    return 1e3 * median_time(
+        lambda: discrete_min_steps(50.0, 0.0, cfg.plant), max(5, size["repeat"])
+    )
 
 
 # ---------------------------------------------------------------- whole process
@@ -238,8 +272,9 @@ def run_cli(args: list[str], repeat: int) -> tuple[float | None, str]:
     times, note = [], ""
     for _ in range(repeat):
         t0 = time.perf_counter()
-        p = subprocess.run([sys.executable, "-m", "ptoverify", *args], cwd=ROOT,
-                           capture_output=True, text=True)
+        p = subprocess.run(
+            [sys.executable, "-m", "ptoverify", *args], cwd=ROOT, capture_output=True, text=True
+        )
         times.append(time.perf_counter() - t0)
         if p.returncode == 2 and "invalid choice" in p.stderr:
             return None, f"'ptoverify {args[0]}' does not exist in this tree"
@@ -267,8 +302,10 @@ def machine() -> dict:
         libs = [i for i in threadpool_info() if i.get("user_api") == "blas"]
         if libs:
             i = libs[0]
-            blas = (f"{i.get('internal_api')} {i.get('version')} "
-                    f"({i.get('architecture')}, {i.get('num_threads')} threads)")
+            blas = (
+                f"{i.get('internal_api')} {i.get('version')} "
+                f"({i.get('architecture')}, {i.get('num_threads')} threads)"
+            )
     except ImportError:
         try:
             cfg = np.show_config(mode="dicts")
@@ -276,11 +313,16 @@ def machine() -> dict:
             blas = f"{b.get('name')} {b.get('version')}"
         except Exception:  # noqa: BLE001 - older numpy: no dict mode
             pass
-    return {"cpu": cpu, "cores": os.cpu_count(), "numpy": np.__version__, "blas": blas,
-            "openblas_coretype": os.environ.get("OPENBLAS_CORETYPE"),
-            "load_average_start": LOAD_AT_START,
-            "load_average_end": [round(x, 2) for x in os.getloadavg()],
-            "ptoverify": str(Path(sys.modules["ptoverify"].__file__).parent)}
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "numpy": np.__version__,
+        "blas": blas,
+        "openblas_coretype": os.environ.get("OPENBLAS_CORETYPE"),
+        "load_average_start": LOAD_AT_START,
+        "load_average_end": [round(x, 2) for x in os.getloadavg()],
+        "ptoverify": str(Path(sys.modules["ptoverify"].__file__).parent),
+    }
 
 
 # ---------------------------------------------------------------- main
@@ -304,7 +346,7 @@ def run(small: bool) -> tuple[dict, dict]:
     out["discrete_ms"] = bench_discrete(cfg, size)
     check = ["check", "--gate", "roots-closed-form-vs-bisection"] if small else ["check"]
     out["check_s"], extra["check_note"] = run_cli(check, size["cli_repeat"])
-    with tempfile.TemporaryDirectory() as tmp:      # never the tracked reports/ folder
+    with tempfile.TemporaryDirectory() as tmp:  # never the tracked reports/ folder
         report = ["report", "--help"] if small else ["report", "--quiet", "--out", tmp]
         out["report_s"], extra["report_note"] = run_cli(report, size["cli_repeat"])
     extra["vector_vs_scalar"] = out["law_vector_evals_per_s"] * out["law_scalar_us"] * 1e-6
@@ -325,16 +367,18 @@ def table(out: dict, extra: dict) -> str:
         vs = "null" if v is None else f"{v:.4g}"
         rows.append(f"{key:<38} {vs:>12} {tgt:>10}  {met}")
     om, oc = extra["omega_c"], extra["ocp"]
-    rows += ["",
-             f"omega_c: bisection {om['bisection_ms']:.1f} ms vs closed form "
-             f"{om['closed_ms']:.2f} ms, max rel diff {om['max_rel_diff']:.2g}; blockwise "
-             f"bisection {om['blocked_bisection_ms']:.1f} ms "
-             f"(ratio {om['blocked_bisection_ms'] / om['closed_ms']:.3g})",
-             f"t_f rel error median: collocation {oc['collocation_err']:.3g}, two-phase "
-             f"{oc['two_phase_err']:.3g}; solver failures {oc['failures']}",
-             f"vector law vs scalar law (per-state speed-up): {extra['vector_vs_scalar']:.3g}",
-             f"scalar law on switching-zone states only (omega_c by Newton): "
-             f"{extra['law_scalar_zone_us']:.3g} us"]
+    rows += [
+        "",
+        f"omega_c: bisection {om['bisection_ms']:.1f} ms vs closed form "
+        f"{om['closed_ms']:.2f} ms, max rel diff {om['max_rel_diff']:.2g}; blockwise "
+        f"bisection {om['blocked_bisection_ms']:.1f} ms "
+        f"(ratio {om['blocked_bisection_ms'] / om['closed_ms']:.3g})",
+        f"t_f rel error median: collocation {oc['collocation_err']:.3g}, two-phase "
+        f"{oc['two_phase_err']:.3g}; solver failures {oc['failures']}",
+        f"vector law vs scalar law (per-state speed-up): {extra['vector_vs_scalar']:.3g}",
+        f"scalar law on switching-zone states only (omega_c by Newton): "
+        f"{extra['law_scalar_zone_us']:.3g} us",
+    ]
     for k in ("check_note", "report_note"):
         if extra[k]:
             rows.append(f"{k}: {extra[k]}")
@@ -350,9 +394,12 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         obj = dict(out)
         obj["machine"] = machine()
-        notes = {k: v for k, v in (("check_s", extra["check_note"]),
-                                   ("report_s", extra["report_note"])) if v}
-        if notes:                 # reasons for a null (or a failing gate) ride with machine
+        notes = {
+            k: v
+            for k, v in (("check_s", extra["check_note"]), ("report_s", extra["report_note"]))
+            if v
+        }
+        if notes:  # reasons for a null (or a failing gate) ride with machine
             obj["machine"]["notes"] = notes
         print(json.dumps(obj, indent=1))
     else:

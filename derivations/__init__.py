@@ -48,9 +48,15 @@ def _records() -> tuple[EquationRecord, ...]:
     from derivations import section3, section4, section5
     from derivations.printed import printed_text
 
-    recs = [definition("1", printed_text("1"), "The plant: x1' = x2, x2' = -a x2 + a u, "
-                       "|u| <= omega_m; every other equation is derived from it."),
-            definition("2", printed_text("2"), "The cost: minimum final time.")]
+    recs = [
+        definition(
+            "1",
+            printed_text("1"),
+            "The plant: x1' = x2, x2' = -a x2 + a u, "
+            "|u| <= omega_m; every other equation is derived from it.",
+        ),
+        definition("2", printed_text("2"), "The cost: minimum final time."),
+    ]
     recs += list(section3.records()) + list(section4.records()) + list(section5.records())
     return tuple(sorted(recs, key=_order))
 
@@ -89,14 +95,21 @@ def render_markdown(records: list[EquationRecord]) -> str:
     """
     lines = ["| id | verdict | printed | derived | note |", "|---|---|---|---|---|"]
     for r in records:
-        lines.append("| " + " | ".join(_md_cell(c) for c in (
-            r.id, r.verdict, f"`{r.printed}`", f"`{r.derived}`", r.note)) + " |")
+        lines.append(
+            "| "
+            + " | ".join(
+                _md_cell(c) for c in (r.id, r.verdict, f"`{r.printed}`", f"`{r.derived}`", r.note)
+            )
+            + " |"
+        )
     errata = [r for r in records if r.verdict == "erratum"]
     if errata:
         lines += ["", "Errata:", ""]
         for r in errata:
-            lines.append(f"- ({r.id}) corrected: `{r.corrected}`; counterexample: "
-                         f"{r.counterexample}; inherits: {'; '.join(r.inherits)}")
+            lines.append(
+                f"- ({r.id}) corrected: `{r.corrected}`; counterexample: "
+                f"{r.counterexample}; inherits: {'; '.join(r.inherits)}"
+            )
     return "\n".join(lines) + "\n"
 
 
@@ -121,20 +134,30 @@ def render_html(records: list[EquationRecord]) -> str:
     -------
     str
     """
-    rows = ["<table class=\"derivations\">",
-            "<thead><tr><th>id</th><th>verdict</th><th>printed</th><th>derived</th>"
-            "<th>note</th></tr></thead>", "<tbody>"]
+    rows = [
+        '<table class="derivations">',
+        "<thead><tr><th>id</th><th>verdict</th><th>printed</th><th>derived</th>"
+        "<th>note</th></tr></thead>",
+        "<tbody>",
+    ]
     for r in records:
         ml = r.to_mathml()
         note = html.escape(r.note)
         if r.verdict == "erratum":
-            note += ("<br/><b>corrected:</b> " + _math(ml.get("corrected", ""), r.corrected or "")
-                     + "<br/><b>counterexample:</b> " + html.escape(str(r.counterexample))
-                     + "<br/><b>inherits:</b><ul>"
-                     + "".join(f"<li>{html.escape(i)}</li>" for i in r.inherits) + "</ul>")
-        rows.append(f"<tr class=\"{html.escape(r.verdict)}\"><td>{html.escape(r.id)}</td>"
-                    f"<td>{html.escape(r.verdict)}</td>"
-                    f"<td>{_math(ml['printed'], r.printed)}</td>"
-                    f"<td>{_math(ml['derived'], r.derived)}</td><td>{note}</td></tr>")
+            note += (
+                "<br/><b>corrected:</b> "
+                + _math(ml.get("corrected", ""), r.corrected or "")
+                + "<br/><b>counterexample:</b> "
+                + html.escape(str(r.counterexample))
+                + "<br/><b>inherits:</b><ul>"
+                + "".join(f"<li>{html.escape(i)}</li>" for i in r.inherits)
+                + "</ul>"
+            )
+        rows.append(
+            f'<tr class="{html.escape(r.verdict)}"><td>{html.escape(r.id)}</td>'
+            f"<td>{html.escape(r.verdict)}</td>"
+            f"<td>{_math(ml['printed'], r.printed)}</td>"
+            f"<td>{_math(ml['derived'], r.derived)}</td><td>{note}</td></tr>"
+        )
     rows += ["</tbody>", "</table>"]
     return "\n".join(rows) + "\n"

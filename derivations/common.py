@@ -16,8 +16,7 @@ import sympy as sp
 from derivations.printed import SYMBOLS, printed, printed_text
 from derivations.record import EquationRecord, Judgement
 
-__all__ = ["S", "flow", "flow_T", "switch_curve_x1", "uniform", "record_from", "rhs",
-           "combine"]
+__all__ = ["S", "flow", "flow_T", "switch_curve_x1", "uniform", "record_from", "rhs", "combine"]
 
 S = SYMBOLS
 
@@ -27,14 +26,18 @@ def _flow_general() -> tuple[sp.Expr, sp.Expr]:
     """Solve eq. (1) with constant input u and x(0) = (x10, x20) by dsolve."""
     a, t, u, x10, x20 = (S[n] for n in ("a", "t", "u", "x10", "x20"))
     X1, X2 = sp.Function("X1"), sp.Function("X2")
-    sol = sp.dsolve([sp.Eq(X1(t).diff(t), X2(t)), sp.Eq(X2(t).diff(t), -a * X2(t) + a * u)],
-                    [X1(t), X2(t)], ics={X1(0): x10, X2(0): x20})
+    sol = sp.dsolve(
+        [sp.Eq(X1(t).diff(t), X2(t)), sp.Eq(X2(t).diff(t), -a * X2(t) + a * u)],
+        [X1(t), X2(t)],
+        ics={X1(0): x10, X2(0): x20},
+    )
     by = {s.lhs.func: s.rhs for s in sol}
     return sp.simplify(by[X1]), sp.simplify(by[X2])
 
 
-def flow(u: sp.Expr, x10: sp.Expr | None = None, x20: sp.Expr | None = None,
-         t: sp.Expr | None = None) -> tuple[sp.Expr, sp.Expr]:
+def flow(
+    u: sp.Expr, x10: sp.Expr | None = None, x20: sp.Expr | None = None, t: sp.Expr | None = None
+) -> tuple[sp.Expr, sp.Expr]:
     """State after time t under constant input u, from eq. (1) by dsolve (eq. 7).
 
     Parameters
@@ -51,8 +54,12 @@ def flow(u: sp.Expr, x10: sp.Expr | None = None, x20: sp.Expr | None = None,
     x1, x2 : sympy.Expr
     """
     x1, x2 = _flow_general()
-    sub = {S["u"]: u, S["x10"]: S["x10"] if x10 is None else x10,
-           S["x20"]: S["x20"] if x20 is None else x20, S["t"]: S["t"] if t is None else t}
+    sub = {
+        S["u"]: u,
+        S["x10"]: S["x10"] if x10 is None else x10,
+        S["x20"]: S["x20"] if x20 is None else x20,
+        S["t"]: S["t"] if t is None else t,
+    }
     return x1.xreplace(sub), x2.xreplace(sub)
 
 
@@ -81,8 +88,9 @@ def switch_curve_x1(x2: np.ndarray, a: np.ndarray, w: np.ndarray) -> np.ndarray:
     return -np.sign(x2) * w * (r - np.log1p(r)) / a
 
 
-def uniform(rng: np.random.Generator, n: int, **ranges: tuple[float, float]
-            ) -> dict[sp.Symbol, np.ndarray]:
+def uniform(
+    rng: np.random.Generator, n: int, **ranges: tuple[float, float]
+) -> dict[sp.Symbol, np.ndarray]:
     """Independent uniform draws, one array per named symbol."""
     return {S[k]: rng.uniform(lo, hi, n) for k, (lo, hi) in ranges.items()}
 
@@ -105,11 +113,17 @@ def combine(judgements: Sequence[Judgement]) -> Judgement:
     return Judgement("verified", sym, n, err, None, reasons)
 
 
-def record_from(id_: str, derived: Any, steps: list[str], j: Judgement, note: str,
-                corrected: str | None = None, inherits: list[str] | None = None,
-                printed_str: str | None = None,
-                extra: Callable[[dict[str, Any]], dict[str, Any]] | None = None
-                ) -> EquationRecord:
+def record_from(
+    id_: str,
+    derived: Any,
+    steps: list[str],
+    j: Judgement,
+    note: str,
+    corrected: str | None = None,
+    inherits: list[str] | None = None,
+    printed_str: str | None = None,
+    extra: Callable[[dict[str, Any]], dict[str, Any]] | None = None,
+) -> EquationRecord:
     """Build a record whose verdict is the judgement's.
 
     Parameters
@@ -146,10 +160,16 @@ def record_from(id_: str, derived: Any, steps: list[str], j: Judgement, note: st
         ce = dict(ce, **extra(ce))
     err = j.verdict == "erratum"
     return EquationRecord(
-        id=id_, printed=printed_text(id_) if printed_str is None else printed_str, derived=d,
-        steps=list(steps), verdict=j.verdict, note=f"{note} Check: {j.reason}.",
-        counterexample=ce, corrected=corrected if err else None,
-        inherits=list(inherits or []) if err else [])
+        id=id_,
+        printed=printed_text(id_) if printed_str is None else printed_str,
+        derived=d,
+        steps=list(steps),
+        verdict=j.verdict,
+        note=f"{note} Check: {j.reason}.",
+        counterexample=ce,
+        corrected=corrected if err else None,
+        inherits=list(inherits or []) if err else [],
+    )
 
 
 def parsed(id_: str) -> tuple[sp.Basic, ...]:

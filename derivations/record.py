@@ -27,8 +27,18 @@ import numpy as np
 import sympy as sp
 from sympy.printing.mathml import mathml
 
-__all__ = ["EquationRecord", "Judgement", "judge", "VERDICTS", "DPS", "RTOL", "N_POINTS",
-           "SEED", "definition", "as_tuple"]
+__all__ = [
+    "EquationRecord",
+    "Judgement",
+    "judge",
+    "VERDICTS",
+    "DPS",
+    "RTOL",
+    "N_POINTS",
+    "SEED",
+    "definition",
+    "as_tuple",
+]
 
 VERDICTS = ("verified", "erratum", "definition", "unchecked")
 DPS = 50
@@ -126,7 +136,7 @@ def _to_mathml(text: str) -> str:
             parts.append(mathml(parse(piece), printer="presentation"))
         except Exception:  # noqa: BLE001 - prose, not a formula: rendered as text
             return ""
-    sep = "<mo>;</mo><mspace width=\"1em\"/>"
+    sep = '<mo>;</mo><mspace width="1em"/>'
     return "<mrow>" + sep.join(parts) + "</mrow>"
 
 
@@ -206,8 +216,14 @@ def _to_real(v: Any) -> float | None:
     return f if mpmath.isfinite(f) else None
 
 
-def judge(printed: Any, derived: Any, sampler: Sampler, n: int = N_POINTS,
-          seed: int = SEED, symbolic: bool = True) -> Judgement:
+def judge(
+    printed: Any,
+    derived: Any,
+    sampler: Sampler,
+    n: int = N_POINTS,
+    seed: int = SEED,
+    symbolic: bool = True,
+) -> Judgement:
     """Compare a printed and a derived form; compute the verdict.
 
     Both arguments are SymPy expressions (or equal-length tuples of them) in the
@@ -265,7 +281,7 @@ def judge(printed: Any, derived: Any, sampler: Sampler, n: int = N_POINTS,
     f_p = sp.lambdify(syms, list(p_t), modules="mpmath")
     f_d = sp.lambdify(syms, list(d_t), modules="mpmath")
     worst, worst_err, n_ok = None, -1.0, 0
-    n_drawn = min((len(v) for v in pts.values()), default=0)   # a sampler may filter points
+    n_drawn = min((len(v) for v in pts.values()), default=0)  # a sampler may filter points
     with mpmath.workdps(DPS):
         for i in range(n_drawn):
             args = [mpmath.mpf(float(pts[s][i])) for s in syms]
@@ -280,25 +296,48 @@ def judge(printed: Any, derived: Any, sampler: Sampler, n: int = N_POINTS,
             err = max(float(abs(p - d) / (1 + abs(p) + abs(d))) for p, d in zip(vp, vd))
             if err > worst_err:
                 worst_err = err
-                worst = {"point": {str(s): float(pts[s][i]) for s in syms},
-                         "printed": [float(v) for v in vp], "derived": [float(v) for v in vd]}
+                worst = {
+                    "point": {str(s): float(pts[s][i]) for s in syms},
+                    "printed": [float(v) for v in vp],
+                    "derived": [float(v) for v in vd],
+                }
     if n_ok < N_POINTS:
-        return Judgement("unchecked", sym, n_ok, worst_err, None,
-                         f"only {n_ok} admissible points evaluated (need {N_POINTS})")
+        return Judgement(
+            "unchecked",
+            sym,
+            n_ok,
+            worst_err,
+            None,
+            f"only {n_ok} admissible points evaluated (need {N_POINTS})",
+        )
     ok = worst_err <= RTOL
     if ok:
         how = "proved symbolically and" if sym else "symbolic proof inconclusive;"
-        return Judgement("verified", sym, n_ok, worst_err, None,
-                         f"{how} agrees at {n_ok} random points (max rel. err {worst_err:.1e})")
+        return Judgement(
+            "verified",
+            sym,
+            n_ok,
+            worst_err,
+            None,
+            f"{how} agrees at {n_ok} random points (max rel. err {worst_err:.1e})",
+        )
     if not sym:
-        return Judgement("erratum", sym, n_ok, worst_err, worst,
-                         f"differs at random points (max rel. diff {worst_err:.3g})")
-    return Judgement("unchecked", sym, n_ok, worst_err, worst,
-                     "symbolic and numeric checks disagree")
+        return Judgement(
+            "erratum",
+            sym,
+            n_ok,
+            worst_err,
+            worst,
+            f"differs at random points (max rel. diff {worst_err:.3g})",
+        )
+    return Judgement(
+        "unchecked", sym, n_ok, worst_err, worst, "symbolic and numeric checks disagree"
+    )
 
 
-def definition(id_: str, printed: str, note: str, derived: str = "",
-               steps: Sequence[str] = ()) -> EquationRecord:
+def definition(
+    id_: str, printed: str, note: str, derived: str = "", steps: Sequence[str] = ()
+) -> EquationRecord:
     """Record for an equation that defines a symbol, set or law (nothing to prove).
 
     Parameters

@@ -28,17 +28,20 @@ u, u_star, l1, l2 = S["u"], S["u_star"], S["lambda1"], S["lambda2"]
 def _sampler(**ranges):
     def draw(rng, n):
         return {S[k]: rng.uniform(lo, hi, n) for k, (lo, hi) in ranges.items()}
+
     return draw
 
 
 def _state_sampler(side: int):
     """States with |x2| < omega_m strictly right (side=+1, S_N) or left (-1, S_P) of l1-o-l2."""
+
     def draw(rng, n):
         av = rng.uniform(1.0, 500.0, n)
         w = rng.uniform(1.0, 1000.0, n)
         v = rng.uniform(-0.95, 0.95, n) * w
-        gap = rng.uniform(0.02, 3.0, n) * w / av        # distance from the curve [mm]
+        gap = rng.uniform(0.02, 3.0, n) * w / av  # distance from the curve [mm]
         return {a: av, wm: w, x2: v, x1: switch_curve_x1(v, av, w) + side * gap}
+
     return draw
 
 
@@ -97,12 +100,13 @@ def extremal() -> dict[str, sp.Expr]:
     # arc 1: -omega_m from (x1, x2) to (p, q) in time t1
     B1, B2 = flow(-wm, x1, x2, t1s)
     (t1,) = sp.solve(sp.Eq(B2, q), t1s)
-    join = sp.expand(sp.simplify(a * (B1.subs(t1s, t1) - p_q)))       # = 0 at the switch
+    join = sp.expand(sp.simplify(a * (B1.subs(t1s, t1) - p_q)))  # = 0 at the switch
     # join/omega_m = ln((wm^2 - q^2) / (wm (wm + x2))) + (a x1 + x2)/wm: exponentiate
     rel = sp.expand(wm * (wm + x2) * sp.exp(-(a * x1 + x2) / wm) - (wm - q) * (wm + q))
     # exp(join/omega_m) omega_m (omega_m + x2) e^{-(a x1 + x2)/omega_m} = (omega_m - q)(omega_m + q)
-    check = sp.simplify(sp.exp(join / wm) * wm * (wm + x2) * sp.exp(-(a * x1 + x2) / wm)
-                        - (wm - q) * (wm + q))
+    check = sp.simplify(
+        sp.exp(join / wm) * wm * (wm + x2) * sp.exp(-(a * x1 + x2) / wm) - (wm - q) * (wm + q)
+    )
     if check != 0:
         raise ArithmeticError("switch relation did not reduce to the exponential form")
     roots = sp.solve(rel, q)
@@ -110,16 +114,32 @@ def extremal() -> dict[str, sp.Expr]:
     # costate: lambda1' = -dH/dx1, lambda2' = -dH/dx2, lambda2(t1) = 0, H(t1) = 0
     H = hamiltonian()
     L1, L2 = sp.Function("L1"), sp.Function("L2")
-    costate = sp.dsolve([sp.Eq(L1(s).diff(s), -H.diff(x1).subs({l1: L1(s), l2: L2(s)})),
-                         sp.Eq(L2(s).diff(s), -H.diff(x2).subs({l1: L1(s), l2: L2(s)}))],
-                        [L1(s), L2(s)], ics={L2(t1s): 0, L1(t1s): -1 / q})
+    costate = sp.dsolve(
+        [
+            sp.Eq(L1(s).diff(s), -H.diff(x1).subs({l1: L1(s), l2: L2(s)})),
+            sp.Eq(L2(s).diff(s), -H.diff(x2).subs({l1: L1(s), l2: L2(s)})),
+        ],
+        [L1(s), L2(s)],
+        ics={L2(t1s): 0, L1(t1s): -1 / q},
+    )
     lam = {e.lhs.func: e.rhs for e in costate}
     lam2 = lam[L2]
     lam2_tf = sp.simplify(lam2.subs(s, t1s + t2s).subs(t2s, t2))
     H_tf = sp.simplify(H.subs({l1: lam[L1], l2: lam2_tf, x2: 0, u: wm}))
-    return {"q": q_neg, "q_relation": rel, "t1": t1, "t2": t2, "p": p_q, "join": join,
-            "lambda1": -1 / q, "lambda2_0": sp.simplify(lam2.subs(s, 0)), "H_tf": H_tf,
-            "lambda2_tf": lam2_tf, "q_symbol": q, "t1_symbol": t1s}
+    return {
+        "q": q_neg,
+        "q_relation": rel,
+        "t1": t1,
+        "t2": t2,
+        "p": p_q,
+        "join": join,
+        "lambda1": -1 / q,
+        "lambda2_0": sp.simplify(lam2.subs(s, 0)),
+        "H_tf": H_tf,
+        "lambda2_tf": lam2_tf,
+        "q_symbol": q,
+        "t1_symbol": t1s,
+    }
 
 
 def min_time_closed_form() -> dict[str, sp.Expr]:
@@ -142,28 +162,54 @@ def min_time_closed_form() -> dict[str, sp.Expr]:
 def _rec_3_to_6() -> list[EquationRecord]:
     H = hamiltonian()
     out = []
-    samp = _sampler(a=(1, 500), x2=(-1000, 1000), u=(-1000, 1000), lambda1=(-5, 5),
-                    lambda2=(-5, 5))
+    samp = _sampler(a=(1, 500), x2=(-1000, 1000), u=(-1000, 1000), lambda1=(-5, 5), lambda2=(-5, 5))
     (p3,) = parsed("3")
     j = judge(rhs(p3, S["H"]), H, samp)
-    out.append(record_from("3", H, ["f(x, u) = (x2, -a x2 + a u) from eq. (1)",
-                                    "H = 1 + lambda^T f (cost integrand 1 for J = t_f, eq. 2)"],
-                           j, "Hamiltonian 1 + lambda^T f compared with the printed form."))
-    out.append(definition("4", "H_star - H_min", "Statement of the minimum principle: u* "
-                          "minimizes H over |u| <= omega_m (H_min denotes that minimum)."))
+    out.append(
+        record_from(
+            "3",
+            H,
+            [
+                "f(x, u) = (x2, -a x2 + a u) from eq. (1)",
+                "H = 1 + lambda^T f (cost integrand 1 for J = t_f, eq. 2)",
+            ],
+            j,
+            "Hamiltonian 1 + lambda^T f compared with the printed form.",
+        )
+    )
+    out.append(
+        definition(
+            "4",
+            "H_star - H_min",
+            "Statement of the minimum principle: u* "
+            "minimizes H over |u| <= omega_m (H_min denotes that minimum).",
+        )
+    )
     (p5,) = parsed("5")
     d5 = H.subs(u, u_star) - H
-    samp5 = _sampler(a=(1, 500), x2=(-1000, 1000), u=(-1000, 1000), u_star=(-1000, 1000),
-                     lambda1=(-5, 5), lambda2=(-5, 5))
+    samp5 = _sampler(
+        a=(1, 500),
+        x2=(-1000, 1000),
+        u=(-1000, 1000),
+        u_star=(-1000, 1000),
+        lambda1=(-5, 5),
+        lambda2=(-5, 5),
+    )
     j = judge(p5.lhs - p5.rhs, d5, samp5)
-    out.append(record_from("5", sp.Le(H.subs(u, u_star), H), [
-        "H(u*) <= H(u) for all admissible u is eq. (4) written out with H of eq. (3)"], j,
-        "Both sides of the printed inequality compared with H(x*, u*, lambda) and "
-        "H(x*, u, lambda) from the derived eq. (3)."))
+    out.append(
+        record_from(
+            "5",
+            sp.Le(H.subs(u, u_star), H),
+            ["H(u*) <= H(u) for all admissible u is eq. (4) written out with H of eq. (3)"],
+            j,
+            "Both sides of the printed inequality compared with H(x*, u*, lambda) and "
+            "H(x*, u, lambda) from the derived eq. (3).",
+        )
+    )
     (p6,) = parsed("6")
     dHdu = sp.diff(H, u)
     assert not dHdu.has(u)
-    d6 = -wm * sp.sign(dHdu)          # minimum of an affine function of u on [-wm, wm]
+    d6 = -wm * sp.sign(dHdu)  # minimum of an affine function of u on [-wm, wm]
     samp6 = _sampler(a=(1, 500), omega_m=(1, 1000), lambda2=(-5, 5))
     j6 = judge(rhs(p6, u_star), d6, samp6)
     # brute force: H(u*) is the minimum of H over a grid of admissible u
@@ -171,18 +217,30 @@ def _rec_3_to_6() -> list[EquationRecord]:
     f_H = sp.lambdify((a, x2, u, l1, l2), H, "numpy")
     lam2v = rng.uniform(-5, 5, 200)
     grid = np.linspace(-1.0, 1.0, 201)
-    ok = all(f_H(2.0, 0.3, -np.sign(lv), 0.7, lv) <= np.min(f_H(2.0, 0.3, grid, 0.7, lv)) + 1e-12
-             for lv in lam2v)
-    steps = [f"dH/du = {sp.sstr(dHdu)} does not depend on u: H is affine in u",
-             "an affine function on [-omega_m, omega_m] is minimized at the end point "
-             "-omega_m sgn(dH/du) = -omega_m sgn(lambda2) since a > 0",
-             f"brute force over 201 grid inputs at 200 random lambda2: minimum attained at u* "
-             f"in every case: {ok}"]
+    ok = all(
+        f_H(2.0, 0.3, -np.sign(lv), 0.7, lv) <= np.min(f_H(2.0, 0.3, grid, 0.7, lv)) + 1e-12
+        for lv in lam2v
+    )
+    steps = [
+        f"dH/du = {sp.sstr(dHdu)} does not depend on u: H is affine in u",
+        "an affine function on [-omega_m, omega_m] is minimized at the end point "
+        "-omega_m sgn(dH/du) = -omega_m sgn(lambda2) since a > 0",
+        f"brute force over 201 grid inputs at 200 random lambda2: minimum attained at u* "
+        f"in every case: {ok}",
+    ]
     if not ok:
         j6 = combine([j6, judge(sp.Integer(1), sp.Integer(0), samp6, symbolic=False)])
-    out.append(record_from("6", d6, steps, j6, "u* = -omega_m sgn(dH/du) compared with the "
-                           "printed law (lambda2 = 0, the singular case, has measure zero: "
-                           "lambda2 is a nonzero exponential-plus-constant, see eq. 12)."))
+    out.append(
+        record_from(
+            "6",
+            d6,
+            steps,
+            j6,
+            "u* = -omega_m sgn(dH/du) compared with the "
+            "printed law (lambda2 = 0, the singular case, has measure zero: "
+            "lambda2 is a nonzero exponential-plus-constant, see eq. 12).",
+        )
+    )
     return out
 
 
@@ -190,50 +248,75 @@ def _rec_7_to_11() -> list[EquationRecord]:
     out = []
     X1, X2 = flow(wm)
     p7 = parsed("7")
-    samp = _sampler(a=(1, 500), omega_m=(1, 1000), x10=(-50, 50), x20=(-1000, 1000),
-                    t=(0, 0.05))
+    samp = _sampler(a=(1, 500), omega_m=(1, 1000), x10=(-50, 50), x20=(-1000, 1000), t=(0, 0.05))
     j = judge((rhs(p7[0], x1), rhs(p7[1], x2)), (X1, X2), samp)
-    out.append(record_from("7", (X1, X2), [
-        "dsolve of x1' = x2, x2' = -a x2 + a u with u = omega_m, x(0) = (x10, x20)"], j,
-        "Flow under u = +omega_m from dsolve compared with the printed flow."))
+    out.append(
+        record_from(
+            "7",
+            (X1, X2),
+            ["dsolve of x1' = x2, x2' = -a x2 + a u with u = omega_m, x(0) = (x10, x20)"],
+            j,
+            "Flow under u = +omega_m from dsolve compared with the printed flow.",
+        )
+    )
     for id_, lvl, curve in (("8", wm, "9"), ("10", -wm, "11")):
         R = trajectory_residual(lvl)
         (p,) = parsed(id_)
         sampx = _sampler(a=(1, 500), omega_m=(1, 1000), x1=(-50, 50), x10=(-50, 50))
+
         def samp_traj(rng, n, sampx=sampx):
             pts = sampx(rng, n)
             w = pts[wm]
             pts[x2] = rng.uniform(-0.99, 0.99, n) * w
             pts[x20] = rng.uniform(-0.99, 0.99, n) * w
             return pts
+
         j = judge(p, R, samp_traj)
         # the claim itself: the printed relation holds along the flow of eq. (7)
         F1, F2 = flow(lvl)
         samp_t = _sampler(a=(1, 500), omega_m=(1, 1000), x10=(-50, 50), t=(0, 0.05))
+
         def samp_flow(rng, n, samp_t=samp_t):
             pts = samp_t(rng, n)
             pts[x20] = rng.uniform(-0.99, 0.99, n) * pts[wm]
             return pts
+
         jf = judge(p.subs({x1: F1, x2: F2}), sp.Integer(0), samp_flow)
         sgn = "+" if lvl == wm else "-"
-        out.append(record_from(id_, R, [
-            f"from the flow under u = {sgn}omega_m solve x2(t) = x2 for t",
-            "substitute t into x1(t) and multiply by a"], combine([j, jf]),
-            f"Trajectory of u = {sgn}omega_m with t eliminated, compared with the printed "
-            "relation on |x2|, |x20| < omega_m; also the printed relation evaluated along "
-            "the flow vanishes."))
+        out.append(
+            record_from(
+                id_,
+                R,
+                [
+                    f"from the flow under u = {sgn}omega_m solve x2(t) = x2 for t",
+                    "substitute t into x1(t) and multiply by a",
+                ],
+                combine([j, jf]),
+                f"Trajectory of u = {sgn}omega_m with t eliminated, compared with the printed "
+                "relation on |x2|, |x20| < omega_m; also the printed relation evaluated along "
+                "the flow vanishes.",
+            )
+        )
         (pc,) = parsed(curve)
         Rc = sp.expand_log(R.subs({x10: 0, x20: 0}), force=True)
         samp_c = _sampler(a=(1, 500), omega_m=(1, 1000), x1=(-50, 50))
+
         def samp_curve(rng, n, samp_c=samp_c):
             pts = samp_c(rng, n)
             pts[x2] = rng.uniform(-0.99, 0.99, n) * pts[wm]
             return pts
+
         j = judge(pc, Rc, samp_curve)
         name = "l1" if curve == "9" else "l2"
-        out.append(record_from(curve, Rc, [f"set (x10, x20) = (0, 0) in eq. ({id_})"], j,
-                               f"Curve {name} through the origin compared with the printed "
-                               "form."))
+        out.append(
+            record_from(
+                curve,
+                Rc,
+                [f"set (x10, x20) = (0, 0) in eq. ({id_})"],
+                j,
+                f"Curve {name} through the origin compared with the printed form.",
+            )
+        )
     return out
 
 
@@ -253,17 +336,23 @@ def _rec_12() -> EquationRecord:
     # transversality: H = 0 at t_f (free final time) along the extremal
     H_tf = e["H_tf"].subs(e["t1_symbol"], e["t1"]).subs(e["q_symbol"], q)
     jH = judge(H_tf, sp.Integer(0), _state_sampler(+1))
-    steps = ["costate: lambda1' = -dH/dx1 = 0, lambda2' = -dH/dx2 = -lambda1 + a lambda2",
-             "on the two-arc extremal (-omega_m then +omega_m) the switch at t1 needs "
-             "lambda2(t1) = 0; H(t1) = 0 gives lambda1 = -1/q (q < 0 the switch velocity)",
-             f"lambda2(0) = {sp.sstr(e['lambda2_0'])}",
-             "H(t_f) = 0 checked (free final time); u(0) = -omega_m sgn(lambda2(0)) "
-             "compared with (12) right (S_N) and left (S_P) of l1-o-l2"]
-    return record_from("12", "u = -omega_m*sign(lambda2(0)) of the two-arc extremal", steps,
-                       combine([jN, jP, jH]),
-                       "Consistency of the law with the minimum principle. Reading: S_N is "
-                       "the open region right of l1-o-l2 (a x1 + x2 + omega_m ln(1 - x2/"
-                       "omega_m) > 0 for x2 <= 0, the l2 form for x2 >= 0), S_P left of it.")
+    steps = [
+        "costate: lambda1' = -dH/dx1 = 0, lambda2' = -dH/dx2 = -lambda1 + a lambda2",
+        "on the two-arc extremal (-omega_m then +omega_m) the switch at t1 needs "
+        "lambda2(t1) = 0; H(t1) = 0 gives lambda1 = -1/q (q < 0 the switch velocity)",
+        f"lambda2(0) = {sp.sstr(e['lambda2_0'])}",
+        "H(t_f) = 0 checked (free final time); u(0) = -omega_m sgn(lambda2(0)) "
+        "compared with (12) right (S_N) and left (S_P) of l1-o-l2",
+    ]
+    return record_from(
+        "12",
+        "u = -omega_m*sign(lambda2(0)) of the two-arc extremal",
+        steps,
+        combine([jN, jP, jH]),
+        "Consistency of the law with the minimum principle. Reading: S_N is "
+        "the open region right of l1-o-l2 (a x1 + x2 + omega_m ln(1 - x2/"
+        "omega_m) > 0 for x2 <= 0, the l2 form for x2 >= 0), S_P left of it.",
+    )
 
 
 def _rec_mintime() -> EquationRecord:
@@ -284,22 +373,35 @@ def _rec_mintime() -> EquationRecord:
 
     def samp_q(rng, n):
         w = rng.uniform(1.0, 1000.0, n)
-        return {a: rng.uniform(1.0, 500.0, n), wm: w, qs: -rng.uniform(0.01, 0.99, n) * w,
-                x2: rng.uniform(-0.99, 0.99, n) * w}
+        return {
+            a: rng.uniform(1.0, 500.0, n),
+            wm: w,
+            qs: -rng.uniform(0.01, 0.99, n) * w,
+            x2: rng.uniform(-0.99, 0.99, n) * w,
+        }
+
     j_alt = judge((t1_alt, t2_alt), (t1_q, e["t2"]), samp_q)
     pos = judge(sp.Min(t1, t2, -q) > 0, sp.true, samp, symbolic=False)
-    steps = ["arc 2: +omega_m from (p, q) reaches 0: t2 = " + sp.sstr(t2),
-             "and p on l1 (eq. 9)",
-             "arc 1: -omega_m from (x1, x2) to (p, q); eliminating t1 gives "
-             "omega_m^2 - q^2 = omega_m (omega_m + x2) exp(-(a x1 + x2)/omega_m)",
-             "q = " + sp.sstr(q) + " (the negative root)",
-             "t1 = " + sp.sstr(t1),
-             "check: propagating both arcs with the dsolve flow ends at the origin; "
-             "t1, t2 > 0 and q < 0 at every sampled state right of l1-o-l2"]
-    return record_from("mintime", (q, t1, t2), steps, combine([j_end, j_alt, pos]),
-                       "Minimum time t_f = t1 + t2 and switch time t1 from a state right of "
-                       "l1-o-l2 with |x2| < omega_m (left of it: by odd symmetry). Not in the "
-                       "paper.", printed_str="(not in the paper)")
+    steps = [
+        "arc 2: +omega_m from (p, q) reaches 0: t2 = " + sp.sstr(t2),
+        "and p on l1 (eq. 9)",
+        "arc 1: -omega_m from (x1, x2) to (p, q); eliminating t1 gives "
+        "omega_m^2 - q^2 = omega_m (omega_m + x2) exp(-(a x1 + x2)/omega_m)",
+        "q = " + sp.sstr(q) + " (the negative root)",
+        "t1 = " + sp.sstr(t1),
+        "check: propagating both arcs with the dsolve flow ends at the origin; "
+        "t1, t2 > 0 and q < 0 at every sampled state right of l1-o-l2",
+    ]
+    return record_from(
+        "mintime",
+        (q, t1, t2),
+        steps,
+        combine([j_end, j_alt, pos]),
+        "Minimum time t_f = t1 + t2 and switch time t1 from a state right of "
+        "l1-o-l2 with |x2| < omega_m (left of it: by odd symmetry). Not in the "
+        "paper.",
+        printed_str="(not in the paper)",
+    )
 
 
 @lru_cache(maxsize=None)

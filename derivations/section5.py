@@ -98,19 +98,26 @@ def _rec_36() -> EquationRecord:
             xb = -(v + ov * np.log1p(-v / ov)) / av
             xv = xa + rng.uniform(-1.0, 2.0, n) * (xb - xa)
             return {a: av, wm: wv, w0: ov, x2: v, x1: xv}
+
         return draw
+
     j_lo = judge(inside, between, sampler(0.02, 0.98), symbolic=False)
     j_hi = judge(inside, sp.Integer(0), sampler(1.02, 20.0), symbolic=False)
-    return record_from("36", "x_l1(x2) <= x1 <= x_l1*(x2), x2 < 0", [
-        "x_l1(x2) = -(x2 + omega_m ln(1 - x2/omega_m))/a and x_l1*(x2) likewise with omega0",
-        "for omega0 < omega_m: l1* lies right of l1; indicator of (36) equals the indicator "
-        f"of the band between them: {j_lo.verdict}",
-        "for omega0 > omega_m (what the printed chain (20)-(27) yields at the paper defaults, "
-        f"see 27): the set (36) is empty in the fourth quadrant: {j_hi.verdict}"],
+    return record_from(
+        "36",
+        "x_l1(x2) <= x1 <= x_l1*(x2), x2 < 0",
+        [
+            "x_l1(x2) = -(x2 + omega_m ln(1 - x2/omega_m))/a and x_l1*(x2) likewise with omega0",
+            "for omega0 < omega_m: l1* lies right of l1; indicator of (36) equals the indicator "
+            f"of the band between them: {j_lo.verdict}",
+            "for omega0 > omega_m (what the printed chain (20)-(27) yields at the paper defaults, "
+            f"see 27): the set (36) is empty in the fourth quadrant: {j_hi.verdict}",
+        ],
         combine([j_lo, j_hi]),
         "The first inequality selects the side right of (above) l1, the second the side left "
         "of (below) l1*; together the band between l1 and l1*, as claimed, provided omega0 < "
-        "omega_m. With omega0 > omega_m the zone is empty.")
+        "omega_m. With omega0 > omega_m the zone is empty.",
+    )
 
 
 def _rec_36_claim() -> EquationRecord:
@@ -128,32 +135,43 @@ def _rec_36_claim() -> EquationRecord:
         def draw(rng, n):
             v = -rng.uniform(0.001, 0.999, 10 * n) * wv
             with np.errstate(all="ignore"):
-                keep = f_x1(v, av, om0) > dv          # the claim is for x1 > d only
+                keep = f_x1(v, av, om0) > dv  # the claim is for x1 > d only
             v = v[keep][:n]
             full = np.ones_like(v)
             return {x2: v, a: av * full, wm: wv * full, T: Tv * full, w0: om0 * full}
+
         return draw
+
     pr = intersection(av, wv, Tv, dv, corrected=False)
     co = intersection(av, wv, Tv, dv, corrected=True)
     j_pr = judge(sp.sign(resid), sp.Integer(1), sampler(pr["omega0"]), symbolic=False)
     j_co = judge(sp.sign(resid), sp.Integer(1), sampler(co["omega0"]), symbolic=False)
-    return record_from("36Z", f"sign of the l1 residual one -omega_m sample after l1*: "
-                       f"{sp.sstr(resid)}", [
-                           "state on l1* (level omega0) with x1 > d, |x2| < omega_m; one exact "
-                           "sample of u = -omega_m; l1 residual of the image must be > 0",
-                           f"printed chain (omega0 = {pr['omega0']:.6g} mm/s): {j_pr.verdict}"
-                           f" ({j_pr.n_points} states of l1* with x1 > d in the band)",
-                           f"corrected chain (omega0 = {co['omega0']:.6g} mm/s): "
-                           f"{j_co.verdict} ({j_co.n_points} states)"], j_pr,
-                       "Claim of rule (1) and of Section 5 ('l1* lies above l~1 when |x1| > d'"
-                       "): from l1*, one -omega_m sample does not stride over l1. Judged at "
-                       "the paper defaults for the omega0 of the printed chain. "
-                       + (f"With it, no state of l1* with x1 > d has |x2| < omega_m (l1* "
-                          f"reaches x1 = d at x2 = {pr['x20']:.6g} mm/s), so the claim has no "
-                          "admissible instance (and by 36 the zone is empty for omega0 > "
-                          "omega_m). " if j_pr.n_points == 0 else "")
-                       + f"With the corrected omega0 (19c, 22c): {j_co.verdict}.",
-                       printed_str="(claim in Sections 4-5)")
+    return record_from(
+        "36Z",
+        f"sign of the l1 residual one -omega_m sample after l1*: {sp.sstr(resid)}",
+        [
+            "state on l1* (level omega0) with x1 > d, |x2| < omega_m; one exact "
+            "sample of u = -omega_m; l1 residual of the image must be > 0",
+            f"printed chain (omega0 = {pr['omega0']:.6g} mm/s): {j_pr.verdict}"
+            f" ({j_pr.n_points} states of l1* with x1 > d in the band)",
+            f"corrected chain (omega0 = {co['omega0']:.6g} mm/s): "
+            f"{j_co.verdict} ({j_co.n_points} states)",
+        ],
+        j_pr,
+        "Claim of rule (1) and of Section 5 ('l1* lies above l~1 when |x1| > d'"
+        "): from l1*, one -omega_m sample does not stride over l1. Judged at "
+        "the paper defaults for the omega0 of the printed chain. "
+        + (
+            f"With it, no state of l1* with x1 > d has |x2| < omega_m (l1* "
+            f"reaches x1 = d at x2 = {pr['x20']:.6g} mm/s), so the claim has no "
+            "admissible instance (and by 36 the zone is empty for omega0 > "
+            "omega_m). "
+            if j_pr.n_points == 0
+            else ""
+        )
+        + f"With the corrected omega0 (19c, 22c): {j_co.verdict}.",
+        printed_str="(claim in Sections 4-5)",
+    )
 
 
 def _rec_37_39() -> list[EquationRecord]:
@@ -164,20 +182,40 @@ def _rec_37_39() -> list[EquationRecord]:
     p37 = parsed("37")
 
     def samp(rng, n):
-        return {a: rng.uniform(1, 500, n), k1: rng.uniform(-500, 500, n),
-                k2: rng.uniform(-10, 10, n), x1: rng.uniform(-50, 50, n),
-                x2: rng.uniform(-1000, 1000, n)}
+        return {
+            a: rng.uniform(1, 500, n),
+            k1: rng.uniform(-500, 500, n),
+            k2: rng.uniform(-10, 10, n),
+            x1: rng.uniform(-50, 50, n),
+            x2: rng.uniform(-1000, 1000, n),
+        }
+
     j = judge((rhs(p37[0], S["dx1"]), rhs(p37[1], S["dx2"])), tuple(f), samp)
-    out.append(record_from("37", tuple(f), [
-        "A = [[0, 1], [0, -a]], B = [0, a]^T from eq. (1); u = -k1 x1 - k2 x2 (eq. 34)",
-        f"A - B K = {sp.sstr(Acl.tolist())}"], j,
-        "Closed loop of the linear zone (no saturation)."))
+    out.append(
+        record_from(
+            "37",
+            tuple(f),
+            [
+                "A = [[0, 1], [0, -a]], B = [0, a]^T from eq. (1); u = -k1 x1 - k2 x2 (eq. 34)",
+                f"A - B K = {sp.sstr(Acl.tolist())}",
+            ],
+            j,
+            "Closed loop of the linear zone (no saturation).",
+        )
+    )
     out.append(definition("38", "V - (a*k1*x1**2 + x2**2)", "Lyapunov candidate."))
     p39 = parsed("39")
     Vd = lyapunov_derivative()
     j = combine([judge(p39[1], Vd, samp), judge(p39[2], Vd, samp)])
-    out.append(record_from("39", Vd, ["dV/dt = grad V . (A - B K) x"], j,
-                           "Both lines of (39) compared with the derived derivative."))
+    out.append(
+        record_from(
+            "39",
+            Vd,
+            ["dV/dt = grad V . (A - B K) x"],
+            j,
+            "Both lines of (39) compared with the derived derivative.",
+        )
+    )
     out.append(_rec_39_lasalle(Acl))
     return out
 
@@ -193,14 +231,20 @@ def _rec_39_lasalle(Acl: sp.Matrix) -> EquationRecord:
     re_max = sp.Max(*[sp.re(e) for e in ev])
 
     def samp(rng, n):
-        return {a: rng.uniform(1, 500, n), k1: np.exp(rng.uniform(-5, 7, n)),
-                k2: -1 + np.exp(rng.uniform(-5, 3, n))}
+        return {
+            a: rng.uniform(1, 500, n),
+            k1: np.exp(rng.uniform(-5, 7, n)),
+            k2: -1 + np.exp(rng.uniform(-5, 3, n)),
+        }
+
     j_h = judge(sp.sign(re_max), sp.Integer(-1), samp, symbolic=False)
     V = a * k1 * x1**2 + x2**2
+
     def samp_x(rng, n):
         pts = samp(rng, n)
         pts.update({x1: rng.uniform(-50, 50, n), x2: rng.uniform(-1000, 1000, n)})
         return pts
+
     j_v = judge(sp.sign(V), sp.Integer(1), samp_x, symbolic=False)
     from ptoverify.config import paper_config
 
@@ -208,23 +252,29 @@ def _rec_39_lasalle(Acl: sp.Matrix) -> EquationRecord:
     rho = zoh_spectral_radius(c.plant.a, c.plant.sample_time, c.pto.k1, c.pto.k2)
     u_peak = c.pto.k1 * c.pto.d + abs(c.pto.k2) * c.plant.w_max
     j = combine([j_h, j_v]) if inv_ok else judge(sp.Integer(1), sp.Integer(0), samp)
-    return record_from("39L", f"charpoly = {sp.sstr(charpoly)}; invariant set in "
-                       f"{{x2 = 0}}: {inv}", [
-                           f"characteristic polynomial {sp.sstr(charpoly)}: Hurwitz iff "
-                           "a k1 > 0 and a (1 + k2) > 0, the paper's conditions",
-                           f"LaSalle: solving x2 = 0, dx2/dt = 0 gives {inv} (only the origin)",
-                           "V > 0 away from 0 and eigenvalues in the open left half plane at "
-                           "random k1 > 0, k2 > -1"], j,
-                       "The claim after (39): V > 0, dV/dt <= 0 for k1 > 0, 1 + k2 > 0, hence "
-                       "asymptotic stability. Holds, but the printed reason 'x2 = 0 => x1 = 0' "
-                       "is not true pointwise (any (x1, 0) has x2 = 0); what holds is LaSalle: "
-                       "the only trajectory staying in {x2 = 0} is the origin, since there "
-                       "dx2/dt = -a k1 x1. This is a continuous-time statement for the "
-                       "unsaturated loop: it says nothing about the ZOH-sampled loop (spectral "
-                       f"radius of Ad - Bd K at the paper defaults: {rho:.6g}) nor about "
-                       f"saturation (|u| reaches k1 d + k2 omega_m = {u_peak:.6g} mm/s inside "
-                       "|x1| < d, above omega_m), so it is local and not a proof for the "
-                       "implemented law.", printed_str="(claim after eq. 39)")
+    return record_from(
+        "39L",
+        f"charpoly = {sp.sstr(charpoly)}; invariant set in {{x2 = 0}}: {inv}",
+        [
+            f"characteristic polynomial {sp.sstr(charpoly)}: Hurwitz iff "
+            "a k1 > 0 and a (1 + k2) > 0, the paper's conditions",
+            f"LaSalle: solving x2 = 0, dx2/dt = 0 gives {inv} (only the origin)",
+            "V > 0 away from 0 and eigenvalues in the open left half plane at "
+            "random k1 > 0, k2 > -1",
+        ],
+        j,
+        "The claim after (39): V > 0, dV/dt <= 0 for k1 > 0, 1 + k2 > 0, hence "
+        "asymptotic stability. Holds, but the printed reason 'x2 = 0 => x1 = 0' "
+        "is not true pointwise (any (x1, 0) has x2 = 0); what holds is LaSalle: "
+        "the only trajectory staying in {x2 = 0} is the origin, since there "
+        "dx2/dt = -a k1 x1. This is a continuous-time statement for the "
+        "unsaturated loop: it says nothing about the ZOH-sampled loop (spectral "
+        f"radius of Ad - Bd K at the paper defaults: {rho:.6g}) nor about "
+        f"saturation (|u| reaches k1 d + k2 omega_m = {u_peak:.6g} mm/s inside "
+        "|x1| < d, above omega_m), so it is local and not a proof for the "
+        "implemented law.",
+        printed_str="(claim after eq. 39)",
+    )
 
 
 @lru_cache(maxsize=None)

@@ -68,14 +68,14 @@ def pto(x1: float, x2: float, cfg) -> float:
     d, k1, k2 = cfg.pto.d, cfg.pto.k1, cfg.pto.k2
     if x1 == 0.0 and x2 == 0.0:
         return 0.0
-    if abs(x1) < d:                                     # linear zone, eq. (34), saturated
+    if abs(x1) < d:  # linear zone, eq. (34), saturated
         return max(-w, min(w, -k1 * x1 - k2 * x2))
     sigma = _residual(x1, x2, a, w)
     om = _omega0(cfg)
-    if x2 < 0 and sigma > 0 and _residual(x1, x2, a, om) <= 0:     # S~_P u l1*
+    if x2 < 0 and sigma > 0 and _residual(x1, x2, a, om) <= 0:  # S~_P u l1*
         return _omega_c(x1, x2, a, om, w)
-    if x2 > 0 and sigma < 0 and _residual(x1, x2, a, om) >= 0:     # S~_N u l2*
+    if x2 > 0 and sigma < 0 and _residual(x1, x2, a, om) >= 0:  # S~_N u l2*
         return -_omega_c(x1, x2, a, om, w)
-    if sigma < 0 or (sigma == 0 and x2 < 0):            # S_P u l1
+    if sigma < 0 or (sigma == 0 and x2 < 0):  # S_P u l1
         return w
     return -w

@@ -33,10 +33,20 @@ from ptoverify.errors import InputError
 from ptoverify.laws import Law, Region, make_law
 from ptoverify.verdict import FAIL, NOT_RUN, PASS, UNVERIFIED  # noqa: F401 - re-exported
 
-__all__ = ["DEFAULT_RTOL", "reference", "tie_band", "failure", "conformance_grid", "grid_csv",
-           "read_table", "ties", "agreement", "input_bound"]
+__all__ = [
+    "DEFAULT_RTOL",
+    "reference",
+    "tie_band",
+    "failure",
+    "conformance_grid",
+    "grid_csv",
+    "read_table",
+    "ties",
+    "agreement",
+    "input_bound",
+]
 
-DEFAULT_RTOL = 1e-6            #: agreement tolerance relative to w_max
+DEFAULT_RTOL = 1e-6  #: agreement tolerance relative to w_max
 
 
 @functools.lru_cache(maxsize=8)
@@ -62,8 +72,12 @@ def omega0_ref(cfg: Config) -> float | None:
 
 def failure(prop: str, state, detail: str, **extra) -> dict:
     """Return a failure entry: property, state [x1, x2], detail (and extra keys)."""
-    return {"property": prop, "state": [float(state[0]), float(state[1])], "detail": detail,
-            **extra}
+    return {
+        "property": prop,
+        "state": [float(state[0]), float(state[1])],
+        "detail": detail,
+        **extra,
+    }
 
 
 # ------------------------------------------------------------------ grid and table
@@ -101,13 +115,19 @@ def conformance_grid(cfg: Config, n: int = 61, n_curve: int = 121) -> tuple[NDAr
     band = tie_band(cfg)
     g1, g2 = np.meshgrid(np.linspace(-R, R, n), np.linspace(-w, w, n))
     xs, vs = [g1.ravel()], [g2.ravel()]
-    s = np.unique(np.concatenate([np.geomspace(1e-6 * w, w, n_curve // 2),
-                                  np.linspace(w / n_curve, w, n_curve - n_curve // 2)]))
+    s = np.unique(
+        np.concatenate(
+            [
+                np.geomspace(1e-6 * w, w, n_curve // 2),
+                np.linspace(w / n_curve, w, n_curve - n_curve // 2),
+            ]
+        )
+    )
     rho = band * 10.0 ** np.arange(1, 8)
     offsets = np.concatenate([-rho[::-1], [0.0], rho]) / a
     om = omega0_ref(cfg)
     levels = (w,) if om is None else (w, om)
-    for level in levels:                     # speeds where the curve lies outside |x1| < d
+    for level in levels:  # speeds where the curve lies outside |x1| < d
         s_d = level * float(root_22(a * d / level))
         if s_d < w:
             s = np.concatenate([s, np.linspace(s_d, w, n_curve)])
@@ -123,8 +143,9 @@ def conformance_grid(cfg: Config, n: int = 61, n_curve: int = 121) -> tuple[NDAr
             xs.append((c1[:, None] + f[None, :] * (c2 - c1)[:, None]).ravel())
             vs.append(np.repeat(x2, f.size))
     k = 10.0 ** -np.arange(1, 10)
-    edge = np.concatenate([[d, np.nextafter(d, 0.0), np.nextafter(d, np.inf)],
-                           d * (1 - k), d * (1 + k)])
+    edge = np.concatenate(
+        [[d, np.nextafter(d, 0.0), np.nextafter(d, np.inf)], d * (1 - k), d * (1 + k)]
+    )
     v = np.linspace(-w, w, n_curve)
     for sign in (1.0, -1.0):
         e1, e2 = np.meshgrid(sign * edge, v)
@@ -175,8 +196,9 @@ def read_table(path: str | Path) -> tuple[NDArray, NDArray, NDArray]:
         with open(path, newline="") as fh:
             rows = list(csv.reader(fh))
     except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read table '{path}': {getattr(exc, 'strerror', None) or exc}"
-                         ) from None
+        raise InputError(
+            f"cannot read table '{path}': {getattr(exc, 'strerror', None) or exc}"
+        ) from None
     except csv.Error as exc:
         raise InputError(f"table '{path}': malformed CSV: {exc}") from None
     if not rows:
@@ -185,8 +207,9 @@ def read_table(path: str | Path) -> tuple[NDArray, NDArray, NDArray]:
     cols = {}
     for name in ("x1", "x2", "u"):
         if name not in header:
-            raise InputError(f"table '{path}': no column '{name}' in header {','.join(header)} "
-                             "(need x1, x2, u)")
+            raise InputError(
+                f"table '{path}': no column '{name}' in header {','.join(header)} (need x1, x2, u)"
+            )
         cols[name] = header.index(name)
     data = []
     for line, row in enumerate(rows[1:], start=2):
@@ -200,8 +223,9 @@ def read_table(path: str | Path) -> tuple[NDArray, NDArray, NDArray]:
             except ValueError:
                 v = math.nan
             if not math.isfinite(v):
-                raise InputError(f"table '{path}' line {line}: column {name} = {text!r} is not "
-                                 "a finite number")
+                raise InputError(
+                    f"table '{path}' line {line}: column {name} = {text!r} is not a finite number"
+                )
             vals.append(v)
         data.append(vals)
     if not data:
@@ -222,8 +246,9 @@ def ties(x1: NDArray, x2: NDArray, cfg: Config) -> NDArray[np.bool_]:
     return near & (np.abs(x1) >= cfg.pto.d)
 
 
-def agreement(x1: NDArray, x2: NDArray, u: NDArray, cfg: Config,
-              rtol: float = DEFAULT_RTOL) -> tuple[dict, list[dict]]:
+def agreement(
+    x1: NDArray, x2: NDArray, u: NDArray, cfg: Config, rtol: float = DEFAULT_RTOL
+) -> tuple[dict, list[dict]]:
     """Compare u with the reference PTO law, region by region.
 
     Parameters
@@ -259,31 +284,56 @@ def agreement(x1: NDArray, x2: NDArray, u: NDArray, cfg: Config,
         if not m.any():
             continue
         mj = m & judged
-        entry = {"code": int(code), "points": int(m.sum()), "excluded": int((m & tie).sum()),
-                 "violations": int((m & bad).sum()), "max_abs_du": 0.0, "state": None}
+        entry = {
+            "code": int(code),
+            "points": int(m.sum()),
+            "excluded": int((m & tie).sum()),
+            "violations": int((m & bad).sum()),
+            "max_abs_du": 0.0,
+            "state": None,
+        }
         if mj.any():
             i = int(np.flatnonzero(mj)[np.argmax(du[mj])])
-            entry.update(max_abs_du=float(du[i]), state=[float(x1[i]), float(x2[i])],
-                         u=float(u[i]), u_ref=float(u_ref[i]))
+            entry.update(
+                max_abs_du=float(du[i]),
+                state=[float(x1[i]), float(x2[i])],
+                u=float(u[i]),
+                u_ref=float(u_ref[i]),
+            )
         entry["pass"] = entry["violations"] == 0
         regions[code.name] = entry
     worst = int(np.argmax(np.where(judged, du, -1.0)))
-    summary = {"points": int(x1.size), "excluded": int(tie.sum()), "rtol": rtol,
-               "tolerance_mm_s": tol, "tie_band_mm_s": tie_band(cfg),
-               "max_abs_du": float(du[worst]) if judged.any() else 0.0,
-               "worst": {"state": [float(x1[worst]), float(x2[worst])], "u": float(u[worst]),
-                         "u_ref": float(u_ref[worst]), "region": Region(reg[worst]).name},
-               "violations": int(bad.sum()), "pass": not bad.any(), "regions": regions}
+    summary = {
+        "points": int(x1.size),
+        "excluded": int(tie.sum()),
+        "rtol": rtol,
+        "tolerance_mm_s": tol,
+        "tie_band_mm_s": tie_band(cfg),
+        "max_abs_du": float(du[worst]) if judged.any() else 0.0,
+        "worst": {
+            "state": [float(x1[worst]), float(x2[worst])],
+            "u": float(u[worst]),
+            "u_ref": float(u_ref[worst]),
+            "region": Region(reg[worst]).name,
+        },
+        "violations": int(bad.sum()),
+        "pass": not bad.any(),
+        "regions": regions,
+    }
     failures = []
     if bad.any():
         i = int(np.argmax(bad))
-        failures.append(failure(
-            "agreement", (x1[i], x2[i]),
-            f"|u - u_ref| = {du[i]:.6g} mm/s > {tol:.3g} mm/s ({rtol:g} w_max) in region "
-            f"{Region(reg[i]).name} (u = {u[i]:.10g}, u_ref = {u_ref[i]:.10g}); "
-            f"{int(bad.sum())} of {int(judged.sum())} judged points disagree, worst "
-            f"{du[worst]:.6g} mm/s at ({x1[worst]:.10g}, {x2[worst]:.10g}) in "
-            f"{Region(reg[worst]).name}"))
+        failures.append(
+            failure(
+                "agreement",
+                (x1[i], x2[i]),
+                f"|u - u_ref| = {du[i]:.6g} mm/s > {tol:.3g} mm/s ({rtol:g} w_max) in region "
+                f"{Region(reg[i]).name} (u = {u[i]:.10g}, u_ref = {u_ref[i]:.10g}); "
+                f"{int(bad.sum())} of {int(judged.sum())} judged points disagree, worst "
+                f"{du[worst]:.6g} mm/s at ({x1[worst]:.10g}, {x2[worst]:.10g}) in "
+                f"{Region(reg[worst]).name}",
+            )
+        )
     return summary, failures
 
 
@@ -291,11 +341,20 @@ def input_bound(x1: NDArray, x2: NDArray, u: NDArray, cfg: Config, where: str):
     """Judge |u| <= w_max at the given states; returns (property, failures)."""
     w = cfg.plant.w_max
     over = np.abs(u) > w
-    prop = {"status": FAIL if over.any() else PASS, "measured": float(np.abs(u).max()),
-            "limit": w, "detail": f"max |u| [mm/s] {where}; limit w_max"}
+    prop = {
+        "status": FAIL if over.any() else PASS,
+        "measured": float(np.abs(u).max()),
+        "limit": w,
+        "detail": f"max |u| [mm/s] {where}; limit w_max",
+    }
     fails = []
     if over.any():
         i = int(np.argmax(over))
-        fails.append(failure("input-bound-grid", (x1[i], x2[i]),
-                              f"|u| = {abs(u[i]):.10g} mm/s > w_max = {w:g} mm/s {where}"))
+        fails.append(
+            failure(
+                "input-bound-grid",
+                (x1[i], x2[i]),
+                f"|u| = {abs(u[i]):.10g} mm/s > w_max = {w:g} mm/s {where}",
+            )
+        )
     return prop, fails

@@ -49,8 +49,13 @@ def gate(name: str) -> Callable[[Callable[[Config], CheckResult]], Gate]:
             except SolverError as exc:
                 return CheckResult(name, UNVERIFIED, None, None, f"solver failed: {exc}")
             except Exception as exc:  # noqa: BLE001 - a gate fails closed on any fault
-                return CheckResult(name, UNVERIFIED, None, None,
-                                   f"could not be computed: {type(exc).__name__}: {exc}")
+                return CheckResult(
+                    name,
+                    UNVERIFIED,
+                    None,
+                    None,
+                    f"could not be computed: {type(exc).__name__}: {exc}",
+                )
 
         GATES[name] = safe
         return safe
@@ -61,8 +66,10 @@ def gate(name: str) -> Callable[[Callable[[Config], CheckResult]], Gate]:
 def _random_states(cfg: Config, n: int, seed: int, vmax: float = 1.0) -> tuple[np.ndarray, ...]:
     rng = np.random.default_rng(seed)
     p = cfg.plant
-    return (rng.uniform(-p.position_range, p.position_range, n),
-            rng.uniform(-vmax * p.w_max, vmax * p.w_max, n))
+    return (
+        rng.uniform(-p.position_range, p.position_range, n),
+        rng.uniform(-vmax * p.w_max, vmax * p.w_max, n),
+    )
 
 
 # ------------------------------------------------------------------ core gates
@@ -79,15 +86,26 @@ def _zoh_vs_integrator(cfg: Config) -> CheckResult:
     y1, y2 = step(x1, x2, u, p)
     err = 0.0
     for i in range(40):
-        sol = solve_ivp(lambda _, y, ui=u[i]: [y[1], -p.a * y[1] + p.a * ui], (0, p.T),
-                        [x1[i], x2[i]], rtol=1e-12, atol=1e-12, method="DOP853")
+        sol = solve_ivp(
+            lambda _, y, ui=u[i]: [y[1], -p.a * y[1] + p.a * ui],
+            (0, p.T),
+            [x1[i], x2[i]],
+            rtol=1e-12,
+            atol=1e-12,
+            method="DOP853",
+        )
         scale = 1.0 + abs(x1[i]) + abs(x2[i]) * p.T
-        err = max(err, abs(sol.y[0, -1] - y1[i]) / scale,
-                  abs(sol.y[1, -1] - y2[i]) / (1.0 + abs(x2[i])))
-    return _at_most("zoh-vs-integrator", err, 1e-9,
-                    "max relative difference of the ZOH one-sample map (eq. 7/15) from "
-                    "DOP853 at rtol 1e-12 over 40 random states and inputs; limit 1e-9 is the "
-                    "integrator's accuracy, not the map's")
+        err = max(
+            err, abs(sol.y[0, -1] - y1[i]) / scale, abs(sol.y[1, -1] - y2[i]) / (1.0 + abs(x2[i]))
+        )
+    return _at_most(
+        "zoh-vs-integrator",
+        err,
+        1e-9,
+        "max relative difference of the ZOH one-sample map (eq. 7/15) from "
+        "DOP853 at rtol 1e-12 over 40 random states and inputs; limit 1e-9 is the "
+        "integrator's accuracy, not the map's",
+    )
 
 
 @gate("roots-closed-form-vs-bisection")
@@ -100,9 +118,13 @@ def _roots(cfg: Config) -> CheckResult:
     m = np.concatenate([rng.uniform(0, 0.999, 2000), 10 ** rng.uniform(-12, -0.01, 2000)])
     e22 = np.max(np.abs(root_22(b0) - root_22_bisect(b0)) / root_22_bisect(b0))
     ek = np.max(np.abs(root_k(m) - root_k_bisect(m)) / root_k_bisect(m))
-    return _at_most("roots-closed-form-vs-bisection", max(e22, ek), 1e-13,
-                    f"max relative difference over 4,000 b0 (eq. 22: {e22:.1e}) and 4,000 "
-                    f"k = 1 - m in (0, 1) (eqs. 26, 31: {ek:.1e}); limit: a few hundred ulps")
+    return _at_most(
+        "roots-closed-form-vs-bisection",
+        max(e22, ek),
+        1e-13,
+        f"max relative difference over 4,000 b0 (eq. 22: {e22:.1e}) and 4,000 "
+        f"k = 1 - m in (0, 1) (eqs. 26, 31: {ek:.1e}); limit: a few hundred ulps",
+    )
 
 
 @gate("mintime-closed-form-vs-propagation")
@@ -119,9 +141,13 @@ def _mintime_propagation(cfg: Config) -> CheckResult:
     # a miss of dz in position is a time error of about dz / |x2 near the end|; normalise by
     # the state's scale: round-off of eq. (7) over the two arcs
     miss = np.max(np.abs(z1) / (1 + np.abs(x1)) + np.abs(z2) / (p.w_max + np.abs(x2)))
-    return _at_most("mintime-closed-form-vs-propagation", miss, 1e-11,
-                    "max normalised distance from the origin after propagating the exact flow "
-                    "for the closed-form arc durations, 20,000 states with |x2| <= 1.5 w_max")
+    return _at_most(
+        "mintime-closed-form-vs-propagation",
+        miss,
+        1e-11,
+        "max normalised distance from the origin after propagating the exact flow "
+        "for the closed-form arc durations, 20,000 states with |x2| <= 1.5 w_max",
+    )
 
 
 @gate("input-bound")
@@ -136,13 +162,22 @@ def _input_bound(cfg: Config) -> CheckResult:
     for name in LAW_NAMES:
         u, _ = make_law(name, cfg)(x1, x2)
         if not np.all(np.isfinite(u)):
-            return CheckResult("input-bound", FAIL, math.inf, cfg.plant.w_max,
-                               f"law {name} returned a non-finite input")
+            return CheckResult(
+                "input-bound",
+                FAIL,
+                math.inf,
+                cfg.plant.w_max,
+                f"law {name} returned a non-finite input",
+            )
         worst = max(worst, float(np.max(np.abs(u))))
         names.append(name)
-    return _at_most("input-bound", worst, cfg.plant.w_max,
-                    f"max |u| [mm/s] of {', '.join(names)} over 400,000 states (|x2| <= 2 w_max, "
-                    "also near the origin); limit w_max")
+    return _at_most(
+        "input-bound",
+        worst,
+        cfg.plant.w_max,
+        f"max |u| [mm/s] of {', '.join(names)} over 400,000 states (|x2| <= 2 w_max, "
+        "also near the origin); limit w_max",
+    )
 
 
 @gate("odd-symmetry")
@@ -155,8 +190,12 @@ def _odd_symmetry(cfg: Config) -> CheckResult:
     for name in LAW_NAMES:
         law = make_law(name, cfg)
         worst = max(worst, float(np.max(np.abs(law(x1, x2)[0] + law(-x1, -x2)[0]))))
-    return _at_most("odd-symmetry", worst, 1e-9 * cfg.plant.w_max,
-                    "max |u(x) + u(-x)| [mm/s] over 100,000 states for every law")
+    return _at_most(
+        "odd-symmetry",
+        worst,
+        1e-9 * cfg.plant.w_max,
+        "max |u(x) + u(-x)| [mm/s] over 100,000 states for every law",
+    )
 
 
 # ------------------------------------------------------------ ground-truth gates
@@ -172,8 +211,9 @@ def _gt_states(cfg: Config, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     return _random_states(cfg, n, seed, 0.95)
 
 
-def _ocp_vs_closed_form(name: str, cfg: Config, ocp, n: int, seed: int, limit: float,
-                        detail: str) -> CheckResult:
+def _ocp_vs_closed_form(
+    name: str, cfg: Config, ocp, n: int, seed: int, limit: float, detail: str
+) -> CheckResult:
     """Worst relative t_f difference of an OCP solver from the closed form over n states."""
     from ptoverify.mintime import min_time
 
@@ -183,9 +223,13 @@ def _ocp_vs_closed_form(name: str, cfg: Config, ocp, n: int, seed: int, limit: f
     for i in range(n):
         res = ocp.solve(float(x1[i]), float(x2[i]))
         if not res.success:
-            return CheckResult(name, UNVERIFIED, None, limit,
-                               f"IPOPT did not converge at ({x1[i]:.4g}, {x2[i]:.4g}): "
-                               f"{res.status}")
+            return CheckResult(
+                name,
+                UNVERIFIED,
+                None,
+                limit,
+                f"IPOPT did not converge at ({x1[i]:.4g}, {x2[i]:.4g}): {res.status}",
+            )
         worst = max(worst, abs(res.t_f - mt.t_f[i]) / mt.t_f[i])
     return _at_most(name, worst, limit, detail)
 
@@ -196,9 +240,15 @@ def _two_phase(cfg: Config) -> CheckResult:
     from ptoverify.ocp import TwoPhaseOCP
 
     return _ocp_vs_closed_form(
-        "mintime-closed-form-vs-two-phase", cfg, TwoPhaseOCP(cfg.plant, **_solver_caps()), 30,
-        21, 1e-9, "max relative t_f difference, two-phase OCP vs closed form, 30 random states "
-        "in the envelope; limit 1e-9: IPOPT's tolerance on an exact flow")
+        "mintime-closed-form-vs-two-phase",
+        cfg,
+        TwoPhaseOCP(cfg.plant, **_solver_caps()),
+        30,
+        21,
+        1e-9,
+        "max relative t_f difference, two-phase OCP vs closed form, 30 random states "
+        "in the envelope; limit 1e-9: IPOPT's tolerance on an exact flow",
+    )
 
 
 @gate("mintime-closed-form-vs-collocation")
@@ -207,11 +257,16 @@ def _collocation(cfg: Config) -> CheckResult:
     from ptoverify.ocp import CollocationOCP
 
     return _ocp_vs_closed_form(
-        "mintime-closed-form-vs-collocation", cfg,
-        CollocationOCP(cfg.plant, intervals=100, **_solver_caps()), 8, 22, 5e-4,
+        "mintime-closed-form-vs-collocation",
+        cfg,
+        CollocationOCP(cfg.plant, intervals=100, **_solver_caps()),
+        8,
+        22,
+        5e-4,
         "max relative t_f difference, Radau-3 collocation with N = 100 vs closed form, 8 "
         "random states; limit 5e-4: the discretisation smears the switch over one interval "
-        "(observed order ~2)")
+        "(observed order ~2)",
+    )
 
 
 @gate("discrete-limit-consistency")
@@ -225,29 +280,55 @@ def _discrete(cfg: Config) -> CheckResult:
     for i in range(len(x1)):
         dm = discrete_min_steps(float(x1[i]), float(x2[i]), cfg.plant)
         if not dm.success:
-            return CheckResult("discrete-limit-consistency", UNVERIFIED, None, 0.0,
-                               f"N* search failed at ({x1[i]:.4g}, {x2[i]:.4g}): {dm.status}",
-                               ">=")
+            return CheckResult(
+                "discrete-limit-consistency",
+                UNVERIFIED,
+                None,
+                0.0,
+                f"N* search failed at ({x1[i]:.4g}, {x2[i]:.4g}): {dm.status}",
+                ">=",
+            )
         t_f = float(min_time(x1[i], x2[i], cfg.plant).t_f)
         ok_prev, _, why = reach.feasible(float(x1[i]), float(x2[i]), dm.steps - 1)
         if ok_prev:
-            return CheckResult("discrete-limit-consistency", FAIL, None, 0.0,
-                               f"N* - 1 = {dm.steps - 1} steps feasible at "
-                               f"({x1[i]:.4g}, {x2[i]:.4g})", ">=")
+            return CheckResult(
+                "discrete-limit-consistency",
+                FAIL,
+                None,
+                0.0,
+                f"N* - 1 = {dm.steps - 1} steps feasible at ({x1[i]:.4g}, {x2[i]:.4g})",
+                ">=",
+            )
         if why != "infeasible":
-            return CheckResult("discrete-limit-consistency", UNVERIFIED, None, 0.0,
-                               f"N* - 1 = {dm.steps - 1} steps at ({x1[i]:.4g}, {x2[i]:.4g}): "
-                               f"the LP was inconclusive ({why})", ">=")
+            return CheckResult(
+                "discrete-limit-consistency",
+                UNVERIFIED,
+                None,
+                0.0,
+                f"N* - 1 = {dm.steps - 1} steps at ({x1[i]:.4g}, {x2[i]:.4g}): "
+                f"the LP was inconclusive ({why})",
+                ">=",
+            )
         if abs(dm.end[0]) > 1e-9 or abs(dm.end[1]) > 1e-6:
-            return CheckResult("discrete-limit-consistency", FAIL, None, 0.0,
-                               f"N* sequence ends at {dm.end} from ({x1[i]:.4g}, {x2[i]:.4g})",
-                               ">=")
+            return CheckResult(
+                "discrete-limit-consistency",
+                FAIL,
+                None,
+                0.0,
+                f"N* sequence ends at {dm.end} from ({x1[i]:.4g}, {x2[i]:.4g})",
+                ">=",
+            )
         worst_gap = min(worst_gap, (dm.time_s - t_f) / cfg.plant.T)
-    res = CheckResult("discrete-limit-consistency", PASS if worst_gap >= 0 else FAIL,
-                      worst_gap, 0.0,
-                      "min over 25 states of (N* T - t_f*) / T, which theory keeps >= 0; every "
-                      "N* sequence ends within 1e-9 mm, 1e-6 mm/s of the origin and N* - 1 "
-                      "samples are infeasible (LP status 'infeasible', not inconclusive)", ">=")
+    res = CheckResult(
+        "discrete-limit-consistency",
+        PASS if worst_gap >= 0 else FAIL,
+        worst_gap,
+        0.0,
+        "min over 25 states of (N* T - t_f*) / T, which theory keeps >= 0; every "
+        "N* sequence ends within 1e-9 mm, 1e-6 mm/s of the origin and N* - 1 "
+        "samples are infeasible (LP status 'infeasible', not inconclusive)",
+        ">=",
+    )
     return res
 
 
@@ -270,8 +351,10 @@ def _derivations(cfg: Config) -> CheckResult:
     uu = rng.uniform(-p.w_max, p.w_max, 500)
     tt = rng.uniform(0, 5 * p.T, 500)
     n1, n2 = flow_num(y1, y2, uu, tt, p.a)
-    e_flow = max(np.max(np.abs(fx1(y1, y2, uu, tt, p.a) - n1) / (1 + np.abs(n1))),
-                 np.max(np.abs(fx2(y1, y2, uu, tt, p.a) - n2) / (1 + np.abs(n2))))
+    e_flow = max(
+        np.max(np.abs(fx1(y1, y2, uu, tt, p.a) - n1) / (1 + np.abs(n1))),
+        np.max(np.abs(fx2(y1, y2, uu, tt, p.a) - n2) / (1 + np.abs(n2))),
+    )
     # the SymPy closed form is evaluated in 50-digit arithmetic: as printed by SymPy it
     # subtracts nearly equal numbers near x2 = -omega_m, which the numerics avoid
     import mpmath
@@ -279,19 +362,22 @@ def _derivations(cfg: Config) -> CheckResult:
     mt_sym = min_time_closed_form()
     f_tf = sp.lambdify((S["x1"], S["x2"], a, w), mt_sym["t_f"], "mpmath")
     mt = min_time(y1, y2, p)
-    r1, r2 = mt.side * y1, mt.side * y2               # the SymPy form is for sigma >= 0
+    r1, r2 = mt.side * y1, mt.side * y2  # the SymPy form is for sigma >= 0
     e_tf = 0.0
     with mpmath.workdps(50):
         for i in np.flatnonzero(r2 > -p.w_max)[:200]:  # its logarithms need x2 > -omega_m
-            ref = f_tf(mpmath.mpf(r1[i]), mpmath.mpf(r2[i]), mpmath.mpf(p.a),
-                       mpmath.mpf(p.w_max))
+            ref = f_tf(mpmath.mpf(r1[i]), mpmath.mpf(r2[i]), mpmath.mpf(p.a), mpmath.mpf(p.w_max))
             e_tf = max(e_tf, abs(float(mpmath.re(ref)) - mt.t_f[i]) / mt.t_f[i])
     worst = max(e_flow, e_tf)
-    return _at_most("derivation-identities-vs-numerics", worst, 1e-12,
-                    f"max relative difference of the lambdified SymPy flow of eq. (1) "
-                    f"({e_flow:.1e}, 500 states) and of the SymPy minimum time evaluated in 50 "
-                    f"digits ({e_tf:.1e}, 200 states) from the float64 numerics; limit 1e-12: "
-                    "round-off of the numerics")
+    return _at_most(
+        "derivation-identities-vs-numerics",
+        worst,
+        1e-12,
+        f"max relative difference of the lambdified SymPy flow of eq. (1) "
+        f"({e_flow:.1e}, 500 states) and of the SymPy minimum time evaluated in 50 "
+        f"digits ({e_tf:.1e}, 200 states) from the float64 numerics; limit 1e-12: "
+        "round-off of the numerics",
+    )
 
 
 # ------------------------------------------------------------ PTO / zone / pole gates
@@ -303,12 +389,17 @@ def _zone_valid(cfg: Config) -> CheckResult:
     z = corrected_zone(cfg)
     if not z.valid:
         measured = float(z.grid_violations) if z.grid_violations > 0 else None
-        return CheckResult("zone-corrected-valid", FAIL, measured, 0.0,
-                           f"no valid corrected zone: {z.reason}")
-    return CheckResult("zone-corrected-valid", PASS if z.grid_violations == 0 else FAIL,
-                       float(z.grid_violations), 0.0,
-                       f"omega0 = {z.omega0:.6g} mm/s; principle violations on the 2-D grid "
-                       f"of {z.grid_points} source states outside l1*/l2* (limit 0)")
+        return CheckResult(
+            "zone-corrected-valid", FAIL, measured, 0.0, f"no valid corrected zone: {z.reason}"
+        )
+    return CheckResult(
+        "zone-corrected-valid",
+        PASS if z.grid_violations == 0 else FAIL,
+        float(z.grid_violations),
+        0.0,
+        f"omega0 = {z.omega0:.6g} mm/s; principle violations on the 2-D grid "
+        f"of {z.grid_points} source states outside l1*/l2* (limit 0)",
+    )
 
 
 @functools.lru_cache(maxsize=4)
@@ -323,20 +414,28 @@ def _pto_properties(cfg: Config):
 def _no_stride(cfg: Config) -> CheckResult:
     """Corrected PTO: no sampled state strides over the switching zone."""
     pr = _pto_properties(cfg)
-    return _at_most("no-stride-over", float(pr.stride_overs), 0.0,
-                    f"stride-overs of the corrected PTO over {pr.states} initial states x "
-                    f"{pr.steps} samples (a sample outside the zone and linear zone whose next "
-                    "sample is strictly across l1/l2 and outside the linear zone)")
+    return _at_most(
+        "no-stride-over",
+        float(pr.stride_overs),
+        0.0,
+        f"stride-overs of the corrected PTO over {pr.states} initial states x "
+        f"{pr.steps} samples (a sample outside the zone and linear zone whose next "
+        "sample is strictly across l1/l2 and outside the linear zone)",
+    )
 
 
 @gate("no-limit-cycle")
 def _no_limit_cycle(cfg: Config) -> CheckResult:
     """Corrected PTO: no sustained oscillation at the end of the horizon."""
     pr = _pto_properties(cfg)
-    return _at_most("no-limit-cycle", float(pr.limit_cycles + pr.not_settled), 0.0,
-                    f"states of {pr.states} with sustained oscillation ({pr.limit_cycles}) or "
-                    f"not settled within {pr.band:g} mm ({pr.not_settled}) after {pr.steps} "
-                    "samples, corrected PTO")
+    return _at_most(
+        "no-limit-cycle",
+        float(pr.limit_cycles + pr.not_settled),
+        0.0,
+        f"states of {pr.states} with sustained oscillation ({pr.limit_cycles}) or "
+        f"not settled within {pr.band:g} mm ({pr.not_settled}) after {pr.steps} "
+        "samples, corrected PTO",
+    )
 
 
 def _loop_gate(name: str, which: str, cfg: Config) -> CheckResult:
@@ -345,15 +444,25 @@ def _loop_gate(name: str, which: str, cfg: Config) -> CheckResult:
     lp = all_loop_poles(cfg)[which]
     radius = max(lp.sampled_moduli)
     if lp.pole_mismatch > 1e-9:
-        return CheckResult(name, UNVERIFIED, radius, 1.0,
-                           f"python-control and numpy disagree on the sampled poles by "
-                           f"{lp.pole_mismatch:.2e}")
+        return CheckResult(
+            name,
+            UNVERIFIED,
+            radius,
+            1.0,
+            f"python-control and numpy disagree on the sampled poles by {lp.pole_mismatch:.2e}",
+        )
     status = PASS if radius < 1.0 else FAIL
-    return CheckResult(name, status, radius, 1.0, comparison="<", detail=
-                       f"largest |z| of the ZOH-sampled {which} loop, gains {lp.gains}, "
-                       f"T = {cfg.plant.T:g} s (python-control, cross-checked with numpy "
-                       f"eigenvalues to {lp.pole_mismatch:.1e}); must be < 1; gain margin "
-                       f"{lp.gain_margin:.3g}")
+    return CheckResult(
+        name,
+        status,
+        radius,
+        1.0,
+        comparison="<",
+        detail=f"largest |z| of the ZOH-sampled {which} loop, gains {lp.gains}, "
+        f"T = {cfg.plant.T:g} s (python-control, cross-checked with numpy "
+        f"eigenvalues to {lp.pole_mismatch:.1e}); must be < 1; gain margin "
+        f"{lp.gain_margin:.3g}",
+    )
 
 
 @gate("pd-sampled-stable")
@@ -380,21 +489,33 @@ def _claims_computed(cfg: Config) -> CheckResult:
 
     allowed = {"reproduced", "not reproduced", "ambiguous"}
     results = evaluate_claims(cfg)
+
     def measured(values: dict) -> bool:
-        return any(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-                   for v in values.values())
+        return any(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+            for v in values.values()
+        )
 
-    missing = [c.id for c in results
-               if c.verdict not in allowed or not c.readings
-               or any(not measured(r.values) or r.verdict not in allowed for r in c.readings)]
+    missing = [
+        c.id
+        for c in results
+        if c.verdict not in allowed
+        or not c.readings
+        or any(not measured(r.values) or r.verdict not in allowed for r in c.readings)
+    ]
     readings = sum(len(c.readings) for c in results)
-    return _at_most("claims-computed", float(len(missing)), 0.0,
-                    f"{len(results)} claims, {readings} claim-readings simulated; claims "
-                    f"without computed values: {', '.join(missing) or 'none'}")
+    return _at_most(
+        "claims-computed",
+        float(len(missing)),
+        0.0,
+        f"{len(results)} claims, {readings} claim-readings simulated; claims "
+        f"without computed values: {', '.join(missing) or 'none'}",
+    )
 
 
-def run_checks(cfg: Config, names: list[str] | None = None,
-               max_iter: int | None = None) -> list[CheckResult]:
+def run_checks(
+    cfg: Config, names: list[str] | None = None, max_iter: int | None = None
+) -> list[CheckResult]:
     """Run the gates (all, or the named ones) in registration order.
 
     Parameters

@@ -70,8 +70,15 @@ from ptoverify.config import Config, Plant
 from ptoverify.laws import Law, make_law
 from ptoverify.simulate import SIGNALS, SimResult, simulate
 
-__all__ = ["Reading", "ReadingResult", "ClaimResult", "CLAIMS", "evaluate_claims", "VERDICTS",
-           "numeric_verdict"]
+__all__ = [
+    "Reading",
+    "ReadingResult",
+    "ClaimResult",
+    "CLAIMS",
+    "evaluate_claims",
+    "VERDICTS",
+    "numeric_verdict",
+]
 
 VERDICTS = ("reproduced", "not reproduced", "ambiguous")
 PHASE_FLOOR_DEG = 1.0
@@ -103,11 +110,18 @@ class Reading:
 
     def label(self, cfg: Config) -> str:
         """Describe the reading in words, with the value of a."""
-        parts = [f"a = {_a_value(cfg, self.a):.4g} rad/s"
-                 + {"2pi*f": " (2 pi f)", "f": " (f in rad/s)"}.get(self.a, "")]
+        parts = [
+            f"a = {_a_value(cfg, self.a):.4g} rad/s"
+            + {"2pi*f": " (2 pi f)", "f": " (f in rad/s)"}.get(self.a, "")
+        ]
         if self.tracking is not None:
-            parts.append({"feed-forward": "feed-forward", "none": "no feed-forward",
-                          "error": "law on the error, no feed-forward"}[self.tracking])
+            parts.append(
+                {
+                    "feed-forward": "feed-forward",
+                    "none": "no feed-forward",
+                    "error": "law on the error, no feed-forward",
+                }[self.tracking]
+            )
         if self.pto is not None:
             parts.append(f"PTO {self.pto}")
         if self.band is not None:
@@ -116,8 +130,7 @@ class Reading:
 
     def to_json(self) -> dict:
         """Return the reading as a dict."""
-        return {"a": self.a, "tracking": self.tracking, "pto": self.pto,
-                "band": self.band}
+        return {"a": self.a, "tracking": self.tracking, "pto": self.pto, "band": self.band}
 
 
 @dataclass(frozen=True)
@@ -149,9 +162,14 @@ class ReadingResult:
 
     def to_json(self) -> dict:
         """Return a JSON-able dict."""
-        return {"reading": self.reading.to_json(), "label": self.label,
-                "measured": self.measured, "values": dict(self.values),
-                "verdict": self.verdict, "detail": self.detail}
+        return {
+            "reading": self.reading.to_json(),
+            "label": self.label,
+            "measured": self.measured,
+            "values": dict(self.values),
+            "verdict": self.verdict,
+            "detail": self.detail,
+        }
 
 
 @dataclass(frozen=True)
@@ -198,10 +216,19 @@ class ClaimResult:
 
     def to_json(self) -> dict:
         """Return a JSON-able dict."""
-        return {"id": self.id, "section": self.section, "signal": self.signal,
-                "claim": self.claim, "paper_value": self.paper_value, "unit": self.unit,
-                "rule": self.rule, "verdict": self.verdict, "measured": self.measured,
-                "detail": self.detail, "readings": [r.to_json() for r in self.readings]}
+        return {
+            "id": self.id,
+            "section": self.section,
+            "signal": self.signal,
+            "claim": self.claim,
+            "paper_value": self.paper_value,
+            "unit": self.unit,
+            "rule": self.rule,
+            "verdict": self.verdict,
+            "measured": self.measured,
+            "detail": self.detail,
+            "readings": [r.to_json() for r in self.readings],
+        }
 
 
 # ------------------------------------------------------------------ simulation cache
@@ -264,13 +291,12 @@ class _Ctx:
 
     def sim(self, law: str, signal: str) -> SimResult:
         name = self.pto if law == "pto" else law
-        return _sim(self.cfg, name, signal,
-                    self.tracking if signal != "step" else "feed-forward")
+        return _sim(self.cfg, name, signal, self.tracking if signal != "step" else "feed-forward")
 
     def tail(self, law: str, signal: str, what: str = "e") -> np.ndarray:
         r = self.sim(law, signal)
         y = r.e if what == "e" else r.x2 - r.r_dot
-        return y[y.size // 2:]
+        return y[y.size // 2 :]
 
     def oscillates(self, law: str, signal: str, what: str = "e") -> tuple[bool, float, int]:
         band = mt.TIGHT_BAND if what == "e" else self.vband
@@ -310,19 +336,35 @@ def _ms(x: float) -> str:
 # ------------------------------------------------------------------ the claims
 def _step_to_osc(c: _Ctx) -> Outcome:
     ok, amp, rev = c.oscillates("to", "step")
-    return amp, {"amplitude_mm": amp, "reversals": rev}, ok, \
-        f"TO error over the last half: amplitude {amp:.4f} mm, {rev} sign reversals"
+    return (
+        amp,
+        {"amplitude_mm": amp, "reversals": rev},
+        ok,
+        f"TO error over the last half: amplitude {amp:.4f} mm, {rev} sign reversals",
+    )
 
 
 def _step_pd_31(c: _Ctx) -> Outcome:
     ts_pd, ts_pto = c.settling("pd"), c.settling("pto")
     os_pd, os_pto = c.overshoot("pd"), c.overshoot("pto")
     more = 100.0 * (ts_pd / ts_pto - 1.0) if ts_pto > 0 else math.nan
-    vals = {"settling_pd_s": ts_pd, "settling_pto_s": ts_pto, "overshoot_pd_mm": os_pd,
-            "overshoot_pto_mm": os_pto, "pd_more_percent": more}
+    vals = {
+        "settling_pd_s": ts_pd,
+        "settling_pto_s": ts_pto,
+        "overshoot_pd_mm": os_pd,
+        "overshoot_pto_mm": os_pto,
+        "pd_more_percent": more,
+    }
     ok = numeric_verdict(more, 31.0, PERCENT_FLOOR)
-    return more, vals, ok, (f"settling PD {_ms(ts_pd)} vs PTO {_ms(ts_pto)}: PD takes "
-                            f"{more:+.1f} %; overshoot PD {os_pd:.3f} mm, PTO {os_pto:.3f} mm")
+    return (
+        more,
+        vals,
+        ok,
+        (
+            f"settling PD {_ms(ts_pd)} vs PTO {_ms(ts_pto)}: PD takes "
+            f"{more:+.1f} %; overshoot PD {os_pd:.3f} mm, PTO {os_pto:.3f} mm"
+        ),
+    )
 
 
 def _step_pto_between(c: _Ctx) -> Outcome:
@@ -330,19 +372,39 @@ def _step_pto_between(c: _Ctx) -> Outcome:
     _, a_to, _ = c.oscillates("to", "step")
     ts_pto, ts_pd = c.settling("pto"), c.settling("pd")
     ok = a_pto < a_to and ts_pto < ts_pd
-    return None, {"steady_amplitude_pto_mm": a_pto, "steady_amplitude_to_mm": a_to,
-                  "settling_pto_s": ts_pto, "settling_pd_s": ts_pd}, ok, \
-        (f"steady amplitude PTO {a_pto:.4f} mm vs TO {a_to:.4f} mm; settling PTO {_ms(ts_pto)}"
-         f" vs PD {_ms(ts_pd)}")
+    return (
+        None,
+        {
+            "steady_amplitude_pto_mm": a_pto,
+            "steady_amplitude_to_mm": a_to,
+            "settling_pto_s": ts_pto,
+            "settling_pd_s": ts_pd,
+        },
+        ok,
+        (
+            f"steady amplitude PTO {a_pto:.4f} mm vs TO {a_to:.4f} mm; settling PTO {_ms(ts_pto)}"
+            f" vs PD {_ms(ts_pd)}"
+        ),
+    )
 
 
 def _ramp_to_osc(c: _Ctx) -> Outcome:
     okp, ap, rp = c.oscillates("to", "ramp", "e")
     okv, av, rv = c.oscillates("to", "ramp", "v")
-    return ap, {"position_amplitude_mm": ap, "position_reversals": rp,
-                "velocity_amplitude_mm_s": av, "velocity_reversals": rv}, okp and okv, \
-        (f"TO last half: position error {ap:.4f} mm ({rp} reversals), velocity error "
-         f"{av:.2f} mm/s ({rv} reversals)")
+    return (
+        ap,
+        {
+            "position_amplitude_mm": ap,
+            "position_reversals": rp,
+            "velocity_amplitude_mm_s": av,
+            "velocity_reversals": rv,
+        },
+        okp and okv,
+        (
+            f"TO last half: position error {ap:.4f} mm ({rp} reversals), velocity error "
+            f"{av:.2f} mm/s ({rv} reversals)"
+        ),
+    )
 
 
 def _ramp_pd_lag(c: _Ctx) -> Outcome:
@@ -350,8 +412,12 @@ def _ramp_pd_lag(c: _Ctx) -> Outcome:
     lag = mt.ramp_lag(r.t, r.e, r.r_dot)
     slope = SIGNALS["ramp"].rate
     d = c.cfg.pto.d
-    return lag, {"lag_mm": lag, "lag_s": lag / slope, "d_mm": d}, lag > d, \
-        f"PD mean ramp error {lag:.3f} mm ({1e3 * lag / slope:.2f} ms) vs d = {d:g} mm"
+    return (
+        lag,
+        {"lag_mm": lag, "lag_s": lag / slope, "d_mm": d},
+        lag > d,
+        f"PD mean ramp error {lag:.3f} mm ({1e3 * lag / slope:.2f} ms) vs d = {d:g} mm",
+    )
 
 
 def _ramp_pto_smooth(c: _Ctx) -> Outcome:
@@ -359,24 +425,39 @@ def _ramp_pto_smooth(c: _Ctx) -> Outcome:
     rev = mt.sign_reversals(r.e, mt.TIGHT_BAND)
     ts = mt.settling_time(r.t, r.e, mt.TIGHT_BAND)
     ok = rev == 0 and math.isfinite(ts)
-    return float(rev), {"error_reversals": rev, "settling_tight_s": ts,
-                        "overshoot_mm": mt.overshoot(r.x1, float(r.r[-1]))}, ok, \
-        f"PTO ramp error: {rev} sign reversals outside 0.01 mm; settles to 0.01 mm at {_ms(ts)}"
+    return (
+        float(rev),
+        {
+            "error_reversals": rev,
+            "settling_tight_s": ts,
+            "overshoot_mm": mt.overshoot(r.x1, float(r.r[-1])),
+        },
+        ok,
+        f"PTO ramp error: {rev} sign reversals outside 0.01 mm; settles to 0.01 mm at {_ms(ts)}",
+    )
 
 
 def _sine_to(c: _Ctx) -> Outcome:
     delay, rms = c.sine("to")
     ok = abs(delay) <= PHASE_FLOOR_DEG and rms > mt.TIGHT_BAND
-    return delay, {"phase_delay_deg": delay, "residual_rms_mm": rms}, ok, \
-        f"TO phase delay {delay:.2f} deg; x1 minus fundamental RMS {rms:.4f} mm"
+    return (
+        delay,
+        {"phase_delay_deg": delay, "residual_rms_mm": rms},
+        ok,
+        f"TO phase delay {delay:.2f} deg; x1 minus fundamental RMS {rms:.4f} mm",
+    )
 
 
 def _sine_delay(law: str, paper: float) -> Callable[[_Ctx], Outcome]:
     def measure(c: _Ctx) -> Outcome:
         delay, rms = c.sine(law)
-        return delay, {"phase_delay_deg": delay, "residual_rms_mm": rms}, \
-            numeric_verdict(delay, paper, PHASE_FLOOR_DEG), \
-            f"{law.upper()} phase delay {delay:.2f} deg"
+        return (
+            delay,
+            {"phase_delay_deg": delay, "residual_rms_mm": rms},
+            numeric_verdict(delay, paper, PHASE_FLOOR_DEG),
+            f"{law.upper()} phase delay {delay:.2f} deg",
+        )
+
     return measure
 
 
@@ -384,19 +465,30 @@ def _sine_ratio(c: _Ctx) -> Outcome:
     d_pto, _ = c.sine("pto")
     d_pd, _ = c.sine("pd")
     ratio = 100.0 * d_pto / d_pd if d_pd != 0 else math.nan
-    return ratio, {"phase_delay_pto_deg": d_pto, "phase_delay_pd_deg": d_pd,
-                   "ratio_percent": ratio}, numeric_verdict(ratio, 55.5, PERCENT_FLOOR), \
-        (f"PTO {d_pto:.2f} deg / PD {d_pd:.2f} deg = {ratio:.1f} % (the paper's own numbers "
-         f"give {100 * 4.5 / 8.1:.1f} %)")
+    return (
+        ratio,
+        {"phase_delay_pto_deg": d_pto, "phase_delay_pd_deg": d_pd, "ratio_percent": ratio},
+        numeric_verdict(ratio, 55.5, PERCENT_FLOOR),
+        (
+            f"PTO {d_pto:.2f} deg / PD {d_pd:.2f} deg = {ratio:.1f} % (the paper's own numbers "
+            f"give {100 * 4.5 / 8.1:.1f} %)"
+        ),
+    )
 
 
 def _sine_fluctuant(c: _Ctx) -> Outcome:
     rms = {law: c.sine(law)[1] for law in ("to", "pd", "pto")}
     other = max(rms["pd"], rms["pto"])
     ok = rms["to"] >= MUCH * other
-    return rms["to"], {f"residual_rms_{k}_mm": v for k, v in rms.items()}, ok, \
-        (f"x1 minus fundamental RMS: TO {rms['to']:.4f}, PD {rms['pd']:.4f}, PTO "
-         f"{rms['pto']:.4f} mm")
+    return (
+        rms["to"],
+        {f"residual_rms_{k}_mm": v for k, v in rms.items()},
+        ok,
+        (
+            f"x1 minus fundamental RMS: TO {rms['to']:.4f}, PD {rms['pd']:.4f}, PTO "
+            f"{rms['pto']:.4f} mm"
+        ),
+    )
 
 
 def _conclusion(c: _Ctx) -> Outcome:
@@ -405,12 +497,23 @@ def _conclusion(c: _Ctx) -> Outcome:
     os_pto, os_to = c.overshoot("pto"), c.overshoot("to")
     ts_pto, ts_pd = c.settling("pto"), c.settling("pd")
     ok = (not osc_pto) and osc_to and os_pto <= mt.TIGHT_BAND < os_to and ts_pto < ts_pd
-    return None, {"steady_amplitude_pto_mm": a_pto, "steady_amplitude_to_mm": a_to,
-                  "overshoot_pto_mm": os_pto, "overshoot_to_mm": os_to,
-                  "settling_pto_s": ts_pto, "settling_pd_s": ts_pd}, ok, \
-        (f"step: PTO oscillates {osc_pto} (amplitude {a_pto:.4f} mm), TO {osc_to}; overshoot "
-         f"PTO {os_pto:.3f} mm, TO {os_to:.3f} mm; settling PTO {_ms(ts_pto)} vs PD "
-         f"{_ms(ts_pd)}")
+    return (
+        None,
+        {
+            "steady_amplitude_pto_mm": a_pto,
+            "steady_amplitude_to_mm": a_to,
+            "overshoot_pto_mm": os_pto,
+            "overshoot_to_mm": os_to,
+            "settling_pto_s": ts_pto,
+            "settling_pd_s": ts_pd,
+        },
+        ok,
+        (
+            f"step: PTO oscillates {osc_pto} (amplitude {a_pto:.4f} mm), TO {osc_to}; overshoot "
+            f"PTO {os_pto:.3f} mm, TO {os_to:.3f} mm; settling PTO {_ms(ts_pto)} vs PD "
+            f"{_ms(ts_pd)}"
+        ),
+    )
 
 
 def _quicker(c: _Ctx) -> Outcome:
@@ -419,8 +522,12 @@ def _quicker(c: _Ctx) -> Outcome:
         r = c.sim(law, "step")
         rt[law] = mt.rise_time(r.t, r.x1, float(r.r[-1]))
     ok = rt["pto"] < rt["pd"]
-    return rt["pto"], {"rise_time_pto_s": rt["pto"], "rise_time_pd_s": rt["pd"]}, ok, \
-        f"10-90 % rise time PTO {_ms(rt['pto'])} vs PD {_ms(rt['pd'])}"
+    return (
+        rt["pto"],
+        {"rise_time_pto_s": rt["pto"], "rise_time_pd_s": rt["pd"]},
+        ok,
+        f"10-90 % rise time PTO {_ms(rt['pto'])} vs PD {_ms(rt['pd'])}",
+    )
 
 
 @dataclass(frozen=True)
@@ -438,66 +545,164 @@ class _Claim:
 
 _OSC = "oscillates: last-half amplitude > 0.01 mm (a 0.01 mm/s) and >= 2 sign reversals"
 CLAIMS: tuple[_Claim, ...] = (
-    _Claim("step-to-oscillation", "6.1", "step",
-           "TO: \"there exist persistent oscillations in the steady-state phase\"",
-           None, "mm", _OSC, ("a",), _step_to_osc),
-    _Claim("step-pd-31-percent", "6.1", "step",
-           "PD: \"with the same overshoot, it takes 31% more adjustment time than the PTO\"",
-           31.0, "%", "|measured - 31| <= max(20 % of 31, 5 points); laws as configured",
-           ("a", "pto", "band"), _step_pd_31),
-    _Claim("step-pto-steadier-quicker", "6.1", "step",
-           "PTO: \"a more stable steady-state phase compared with the TO controller and a "
-           "quicker dynamic process compared with the PD controller\"",
-           None, "", "steady amplitude PTO < TO and settling time PTO < PD",
-           ("a", "pto", "band"), _step_pto_between),
-    _Claim("ramp-to-oscillation", "6.2", "ramp",
-           "TO: \"there also exist series position and velocity oscillations\"",
-           None, "mm", _OSC + ", both position and velocity error", ("a", "ff"), _ramp_to_osc),
-    _Claim("ramp-pd-lag", "6.2", "ramp",
-           "PD: \"delays a large value about the command signal\"",
-           None, "mm", "mean ramp error (second half of the ramp) > d", ("a", "ff"),
-           _ramp_pd_lag),
-    _Claim("ramp-pto-smooth", "6.2", "ramp",
-           "PTO: \"the command signal is tracked smoothly in a short time, and the state error "
-           "trajectory reaches zero without any oscillation\"",
-           None, "reversals", "no error sign reversal outside 0.01 mm, and settles to 0.01 mm",
-           ("a", "ff", "pto"), _ramp_pto_smooth),
-    _Claim("sine-to-no-delay-oscillates", "6.3", "sine",
-           "TO: \"there is basically no phase delay but oscillations exist\"",
-           None, "deg", "|delay| <= 1 deg and RMS of x1 minus fundamental > 0.01 mm",
-           ("a", "ff"), _sine_to),
-    _Claim("sine-pto-delay", "6.3", "sine",
-           "PTO: \"the phase delay is about 4.5 deg\"", 4.5, "deg",
-           "|measured - 4.5| <= max(20 % of 4.5, 1 deg)", ("a", "ff", "pto"),
-           _sine_delay("pto", 4.5)),
-    _Claim("sine-pd-delay", "6.3", "sine",
-           "PD: \"the phase delay with the PD controller (about 8.1 deg)\"", 8.1, "deg",
-           "|measured - 8.1| <= max(20 % of 8.1, 1 deg)", ("a", "ff"), _sine_delay("pd", 8.1)),
-    _Claim("sine-pto-vs-pd", "6.3", "sine",
-           "PTO: its phase delay \"is only 55.5% of the phase delay with the PD controller\"",
-           55.5, "%", "|measured - 55.5| <= max(20 % of 55.5, 5 points)", ("a", "ff", "pto"),
-           _sine_ratio),
-    _Claim("sine-to-fluctuant", "6.3", "sine",
-           "Fig. 14: \"the system with the TO controller is much fluctuant than that with the "
-           "PD and PTO controllers\"", None, "mm",
-           "RMS of x1 minus fundamental: TO >= 2 x max(PD, PTO)", ("a", "ff", "pto"),
-           _sine_fluctuant),
-    _Claim("conclusion-vs-to-and-pd", "7", "step",
-           "\"Compared with the TO, our PTO avoids oscillations and overshoots. And compared "
-           "with the PD, our PTO has a shorter adjustment time\"", None, "",
-           "PTO does not oscillate, TO does; overshoot PTO <= 0.01 mm < TO; settling PTO < PD",
-           ("a", "pto", "band"), _conclusion),
-    _Claim("conclusion-quicker-response", "7", "step",
-           "\"compared with the PD, our PTO has ... a quicker dynamic response\"", None, "s",
-           "10-90 % rise time PTO < PD", ("a", "pto"), _quicker),
+    _Claim(
+        "step-to-oscillation",
+        "6.1",
+        "step",
+        'TO: "there exist persistent oscillations in the steady-state phase"',
+        None,
+        "mm",
+        _OSC,
+        ("a",),
+        _step_to_osc,
+    ),
+    _Claim(
+        "step-pd-31-percent",
+        "6.1",
+        "step",
+        'PD: "with the same overshoot, it takes 31% more adjustment time than the PTO"',
+        31.0,
+        "%",
+        "|measured - 31| <= max(20 % of 31, 5 points); laws as configured",
+        ("a", "pto", "band"),
+        _step_pd_31,
+    ),
+    _Claim(
+        "step-pto-steadier-quicker",
+        "6.1",
+        "step",
+        'PTO: "a more stable steady-state phase compared with the TO controller and a '
+        'quicker dynamic process compared with the PD controller"',
+        None,
+        "",
+        "steady amplitude PTO < TO and settling time PTO < PD",
+        ("a", "pto", "band"),
+        _step_pto_between,
+    ),
+    _Claim(
+        "ramp-to-oscillation",
+        "6.2",
+        "ramp",
+        'TO: "there also exist series position and velocity oscillations"',
+        None,
+        "mm",
+        _OSC + ", both position and velocity error",
+        ("a", "ff"),
+        _ramp_to_osc,
+    ),
+    _Claim(
+        "ramp-pd-lag",
+        "6.2",
+        "ramp",
+        'PD: "delays a large value about the command signal"',
+        None,
+        "mm",
+        "mean ramp error (second half of the ramp) > d",
+        ("a", "ff"),
+        _ramp_pd_lag,
+    ),
+    _Claim(
+        "ramp-pto-smooth",
+        "6.2",
+        "ramp",
+        'PTO: "the command signal is tracked smoothly in a short time, and the state error '
+        'trajectory reaches zero without any oscillation"',
+        None,
+        "reversals",
+        "no error sign reversal outside 0.01 mm, and settles to 0.01 mm",
+        ("a", "ff", "pto"),
+        _ramp_pto_smooth,
+    ),
+    _Claim(
+        "sine-to-no-delay-oscillates",
+        "6.3",
+        "sine",
+        'TO: "there is basically no phase delay but oscillations exist"',
+        None,
+        "deg",
+        "|delay| <= 1 deg and RMS of x1 minus fundamental > 0.01 mm",
+        ("a", "ff"),
+        _sine_to,
+    ),
+    _Claim(
+        "sine-pto-delay",
+        "6.3",
+        "sine",
+        'PTO: "the phase delay is about 4.5 deg"',
+        4.5,
+        "deg",
+        "|measured - 4.5| <= max(20 % of 4.5, 1 deg)",
+        ("a", "ff", "pto"),
+        _sine_delay("pto", 4.5),
+    ),
+    _Claim(
+        "sine-pd-delay",
+        "6.3",
+        "sine",
+        'PD: "the phase delay with the PD controller (about 8.1 deg)"',
+        8.1,
+        "deg",
+        "|measured - 8.1| <= max(20 % of 8.1, 1 deg)",
+        ("a", "ff"),
+        _sine_delay("pd", 8.1),
+    ),
+    _Claim(
+        "sine-pto-vs-pd",
+        "6.3",
+        "sine",
+        'PTO: its phase delay "is only 55.5% of the phase delay with the PD controller"',
+        55.5,
+        "%",
+        "|measured - 55.5| <= max(20 % of 55.5, 5 points)",
+        ("a", "ff", "pto"),
+        _sine_ratio,
+    ),
+    _Claim(
+        "sine-to-fluctuant",
+        "6.3",
+        "sine",
+        'Fig. 14: "the system with the TO controller is much fluctuant than that with the '
+        'PD and PTO controllers"',
+        None,
+        "mm",
+        "RMS of x1 minus fundamental: TO >= 2 x max(PD, PTO)",
+        ("a", "ff", "pto"),
+        _sine_fluctuant,
+    ),
+    _Claim(
+        "conclusion-vs-to-and-pd",
+        "7",
+        "step",
+        '"Compared with the TO, our PTO avoids oscillations and overshoots. And compared '
+        'with the PD, our PTO has a shorter adjustment time"',
+        None,
+        "",
+        "PTO does not oscillate, TO does; overshoot PTO <= 0.01 mm < TO; settling PTO < PD",
+        ("a", "pto", "band"),
+        _conclusion,
+    ),
+    _Claim(
+        "conclusion-quicker-response",
+        "7",
+        "step",
+        '"compared with the PD, our PTO has ... a quicker dynamic response"',
+        None,
+        "s",
+        "10-90 % rise time PTO < PD",
+        ("a", "pto"),
+        _quicker,
+    ),
 )
 
 
 def _readings(cfg: Config, dims: tuple[str, ...]) -> list[Reading]:
     a_opts = ["2pi*f", "f"] if cfg.bandwidth_hz is not None else ["given"]
-    opts = {"a": a_opts, "ff": ["feed-forward", "none", "error"],
-            "pto": ["corrected", "printed"],
-            "band": [mt.STEP_FRACTION, 0.05]}
+    opts = {
+        "a": a_opts,
+        "ff": ["feed-forward", "none", "error"],
+        "pto": ["corrected", "printed"],
+        "band": [mt.STEP_FRACTION, 0.05],
+    }
     axes = [opts[d] if d in dims else [None] for d in ("a", "ff", "pto", "band")]
     return [Reading(a, ff, pto, band) for a, ff, pto, band in itertools.product(*axes)]
 
@@ -507,13 +712,27 @@ def _evaluate(cfg: Config, cl: _Claim) -> ClaimResult:
     for rd in _readings(cfg, cl.dims):
         measured, values, ok, detail = cl.measure(_Ctx(cfg, rd))
         m = None if measured is None or not math.isfinite(measured) else float(measured)
-        results.append(ReadingResult(rd, rd.label(cfg), m, values,
-                                     "reproduced" if ok else "not reproduced", detail))
+        results.append(
+            ReadingResult(
+                rd, rd.label(cfg), m, values, "reproduced" if ok else "not reproduced", detail
+            )
+        )
     verdicts = {r.verdict for r in results}
     overall = verdicts.pop() if len(verdicts) == 1 else "ambiguous"
     p = results[0]
-    return ClaimResult(cl.id, cl.section, cl.signal, cl.claim, cl.paper_value, cl.unit, cl.rule,
-                       overall, p.measured, p.detail, tuple(results))
+    return ClaimResult(
+        cl.id,
+        cl.section,
+        cl.signal,
+        cl.claim,
+        cl.paper_value,
+        cl.unit,
+        cl.rule,
+        overall,
+        p.measured,
+        p.detail,
+        tuple(results),
+    )
 
 
 @lru_cache(maxsize=8)

@@ -39,7 +39,8 @@ class _Parser(argparse.ArgumentParser):
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = re.compile(
-            r"^-(\d+\.?\d*([eE][-+]?\d+)?|\.\d+([eE][-+]?\d+)?|inf|nan)$", re.I)
+            r"^-(\d+\.?\d*([eE][-+]?\d+)?|\.\d+([eE][-+]?\d+)?|inf|nan)$", re.I
+        )
 
     def error(self, message: str):  # noqa: D102
         raise InputError(f"{self.prog}: {message}")
@@ -112,19 +113,26 @@ def _config(args: argparse.Namespace) -> Config:
 # ---------------------------------------------------------------- mintime
 def _add_mintime(sub) -> None:
     p = sub.add_parser(
-        "mintime", help="minimum time from a state to the origin",
+        "mintime",
+        help="minimum time from a state to the origin",
         description="Minimum time from (X1, X2) to the origin: the closed form and, where "
-                    "available, the CasADi and discrete-time references.",
-        epilog="example:\n  ptoverify mintime 5 0 --json\n  ptoverify mintime -- -12.5 80")
+        "available, the CasADi and discrete-time references.",
+        epilog="example:\n  ptoverify mintime 5 0 --json\n  ptoverify mintime -- -12.5 80",
+    )
     p.add_argument("x1", type=finite_float, metavar="X1", help="initial position [mm]")
     p.add_argument("x2", type=finite_float, metavar="X2", help="initial velocity [mm/s]")
-    p.add_argument("--intervals", type=positive_int, default=100,
-                   help="collocation intervals N (default 100, at most 2000)")
+    p.add_argument(
+        "--intervals",
+        type=positive_int,
+        default=100,
+        help="collocation intervals N (default 100, at most 2000)",
+    )
     p.set_defaults(handler=_cmd_mintime)
 
 
-def mintime_result(cfg: Config, x1: float, x2: float, intervals: int,
-                   max_iter: int | None = None) -> dict[str, Any]:
+def mintime_result(
+    cfg: Config, x1: float, x2: float, intervals: int, max_iter: int | None = None
+) -> dict[str, Any]:
     """Compute the ``mintime`` JSON object (DESIGN.md keys plus status keys).
 
     A reference whose solver did not converge (or an N* search that failed) is
@@ -146,8 +154,10 @@ def mintime_result(cfg: Config, x1: float, x2: float, intervals: int,
     plant = cfg.plant
     limit = 1e3 * plant.position_range
     if abs(x1) > limit or abs(x2) > 1e3 * plant.w_max:
-        raise InputError(f"state ({x1:g}, {x2:g}) is far outside the envelope "
-                         f"(|x1| <= {limit:g} mm, |x2| <= {1e3 * plant.w_max:g} mm/s accepted)")
+        raise InputError(
+            f"state ({x1:g}, {x2:g}) is far outside the envelope "
+            f"(|x1| <= {limit:g} mm, |x2| <= {1e3 * plant.w_max:g} mm/s accepted)"
+        )
     mt = min_time(x1, x2, plant)
     caps = {} if max_iter is None else {"max_iter": max_iter}
     tp = TwoPhaseOCP(plant, **caps).solve(x1, x2)
@@ -165,11 +175,15 @@ def mintime_result(cfg: Config, x1: float, x2: float, intervals: int,
         z1, z2 = flow(y1, y2, tp.side * plant.w_max, tp.t_f - tp.t_switch, plant.a)
         miss = float(np.hypot(z1, z2 / plant.a))
         if miss > 1e-6 * scale:
-            tp = replace(tp, success=False,
-                         status=f"inaccurate: arcs end {miss:.3g} mm from the origin")
+            tp = replace(
+                tp, success=False, status=f"inaccurate: arcs end {miss:.3g} mm from the origin"
+            )
     if co.success and scale > 0 and co.resim_error > 1e-2 * scale:
-        co = replace(co, success=False, status=f"inaccurate: re-simulation ends "
-                                                f"{co.resim_error:.3g} mm from the origin")
+        co = replace(
+            co,
+            success=False,
+            status=f"inaccurate: re-simulation ends {co.resim_error:.3g} mm from the origin",
+        )
 
     def verified(value: float, ok: bool) -> float | None:
         return float(value) if ok else None
@@ -212,17 +226,28 @@ def _add_simulate(sub) -> None:
     from ptoverify.laws import LAW_NAMES
 
     p = sub.add_parser(
-        "simulate", help="simulate a law on a Section 6 reference",
+        "simulate",
+        help="simulate a law on a Section 6 reference",
         description="Simulate the sampled closed loop (exact ZOH flow) of a law tracking a "
-                    "Section 6 reference: step 5 mm, ramp 0-30 mm at 200 mm/s, sine 5 mm 5 Hz.",
-        epilog="example:\n  ptoverify simulate --law to --signal step --csv to_step.csv")
+        "Section 6 reference: step 5 mm, ramp 0-30 mm at 200 mm/s, sine 5 mm 5 Hz.",
+        epilog="example:\n  ptoverify simulate --law to --signal step --csv to_step.csv",
+    )
     p.add_argument("--law", choices=LAW_NAMES, default="pto", help="control law (default pto)")
-    p.add_argument("--signal", choices=("step", "ramp", "sine"), default="step",
-                   help="reference signal (default step)")
-    p.add_argument("--duration", type=finite_float, default=None,
-                   help="simulated time [s] (default: per signal)")
-    p.add_argument("--no-feedforward", action="store_true",
-                   help="do not feed the reference velocity forward")
+    p.add_argument(
+        "--signal",
+        choices=("step", "ramp", "sine"),
+        default="step",
+        help="reference signal (default step)",
+    )
+    p.add_argument(
+        "--duration",
+        type=finite_float,
+        default=None,
+        help="simulated time [s] (default: per signal)",
+    )
+    p.add_argument(
+        "--no-feedforward", action="store_true", help="do not feed the reference velocity forward"
+    )
     p.add_argument("--csv", metavar="FILE", default=None, help="write the time series as CSV")
     p.set_defaults(handler=_cmd_simulate)
 
@@ -239,25 +264,38 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     if args.csv is not None and (args.csv.strip() == "" or Path(args.csv).is_dir()):
         raise InputError(f"--csv must name a file, got {args.csv!r}")
     if args.duration is not None and args.duration < cfg.plant.sample_time:
-        raise InputError(f"--duration {args.duration:g} s is shorter than one sample "
-                         f"(T = {cfg.plant.sample_time:g} s)")
+        raise InputError(
+            f"--duration {args.duration:g} s is shorter than one sample "
+            f"(T = {cfg.plant.sample_time:g} s)"
+        )
     law = make_law(args.law, cfg)
-    res = simulate(law, cfg.plant, args.signal, duration=args.duration,
-                   feedforward=not args.no_feedforward)
+    res = simulate(
+        law, cfg.plant, args.signal, duration=args.duration, feedforward=not args.no_feedforward
+    )
     cols = res.columns()
     if args.csv is not None:
         buf = io.StringIO()
         writer = csv.writer(buf, lineterminator="\n")
         writer.writerow(list(cols))
         for row in zip(*cols.values(), strict=True):
-            writer.writerow([repr(float(v)) if k != "region" else int(v)
-                             for k, v in zip(cols, row, strict=True)])
+            writer.writerow(
+                [
+                    repr(float(v)) if k != "region" else int(v)
+                    for k, v in zip(cols, row, strict=True)
+                ]
+            )
         write_atomic(args.csv, buf.getvalue())
         return 0
-    tail = res.e[len(res.e) // 2:]
-    summary = {"law": res.law, "signal": res.signal, "feedforward": res.feedforward,
-               "note": law.note, "samples": len(res.t), "final_error_mm": float(res.e[-1]),
-               "max_abs_error_second_half_mm": float(abs(tail).max())}
+    tail = res.e[len(res.e) // 2 :]
+    summary = {
+        "law": res.law,
+        "signal": res.signal,
+        "feedforward": res.feedforward,
+        "note": law.note,
+        "samples": len(res.t),
+        "final_error_mm": float(res.e[-1]),
+        "max_abs_error_second_half_mm": float(abs(tail).max()),
+    }
     if args.json:
         print_json({**summary, "series": cols})
     else:
@@ -269,10 +307,12 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 # ---------------------------------------------------------------- derive
 def _add_derive(sub) -> None:
     p = sub.add_parser(
-        "derive", help="re-derive eqs. (3)-(39) with SymPy and judge them",
+        "derive",
+        help="re-derive eqs. (3)-(39) with SymPy and judge them",
         description="Re-derive each equation from eq. (1) with SymPy and compare it with its "
-                    "printed form; verdicts: verified, erratum, definition, unchecked.",
-        epilog="example:\n  ptoverify derive --json")
+        "printed form; verdicts: verified, erratum, definition, unchecked.",
+        epilog="example:\n  ptoverify derive --json",
+    )
     p.set_defaults(handler=_cmd_derive)
 
 
@@ -292,15 +332,27 @@ def _cmd_derive(args: argparse.Namespace) -> int:
 # ---------------------------------------------------------------- check
 def _add_check(sub) -> None:
     p = sub.add_parser(
-        "check", help="run the verification gates (for CI)",
+        "check",
+        help="run the verification gates (for CI)",
         description="Run every verification as a gate: pass, fail or unverified (a reference "
-                    "that could not be computed). Exit 0 when all pass, 1 otherwise.",
-        epilog="example:\n  ptoverify check\n  ptoverify check --json --config my_axis.toml")
-    p.add_argument("--gate", action="append", default=None, metavar="NAME",
-                   help="run only this gate (repeatable)")
-    p.add_argument("--max-iter", type=positive_int, default=None, metavar="N",
-                   help="cap IPOPT iterations (a solver that then fails makes its gate "
-                        "unverified, and the run fails)")
+        "that could not be computed). Exit 0 when all pass, 1 otherwise.",
+        epilog="example:\n  ptoverify check\n  ptoverify check --json --config my_axis.toml",
+    )
+    p.add_argument(
+        "--gate",
+        action="append",
+        default=None,
+        metavar="NAME",
+        help="run only this gate (repeatable)",
+    )
+    p.add_argument(
+        "--max-iter",
+        type=positive_int,
+        default=None,
+        metavar="N",
+        help="cap IPOPT iterations (a solver that then fails makes its gate "
+        "unverified, and the run fails)",
+    )
     p.set_defaults(handler=_cmd_check)
 
 
@@ -315,31 +367,46 @@ def _cmd_check(args: argparse.Namespace) -> int:
     results = run_checks(cfg, args.gate, max_iter=args.max_iter)
     summary = summarize(results)
     if args.json:
-        print_json({"config": cfg.name, "checks": [r.to_json() for r in results],
-                    "summary": summary})
+        print_json(
+            {"config": cfg.name, "checks": [r.to_json() for r in results], "summary": summary}
+        )
     else:
         for r in results:
             measured = "-" if r.measured is None else f"{r.measured:.3g}"
             limit = "-" if r.limit is None else f"{r.limit:.3g}"
-            print(f"{r.status.upper():<10} {r.name:<36} {measured:>9} {r.comparison:<2} "
-                  f"{limit:<9} {r.detail}")
-        print(f"{summary['pass']}/{summary['total']} passed, {summary['fail']} failed, "
-              f"{summary['unverified']} unverified")
+            print(
+                f"{r.status.upper():<10} {r.name:<36} {measured:>9} {r.comparison:<2} "
+                f"{limit:<9} {r.detail}"
+            )
+        print(
+            f"{summary['pass']}/{summary['total']} passed, {summary['fail']} failed, "
+            f"{summary['unverified']} unverified"
+        )
     return 0 if summary["ok"] else 1
 
 
 # ---------------------------------------------------------------- sweep
 def _add_sweep(sub) -> None:
     p = sub.add_parser(
-        "sweep", help="suboptimality of each law over a grid of initial states",
+        "sweep",
+        help="suboptimality of each law over a grid of initial states",
         description="Settling time of each law (to 0.01 mm and a * 0.01 mm/s, held 0.05 s) from "
-                    "a grid of initial states over the envelope, divided by the continuous "
-                    "minimum time t_f* and by the discrete limit N* T.",
-        epilog="example:\n  ptoverify sweep --json\n  ptoverify sweep --out sweep-paper")
-    p.add_argument("--out", metavar="DIR", default=None,
-                   help="write heat maps and sweep.json into DIR (atomically)")
-    p.add_argument("--grid", type=positive_int, default=50,
-                   help="grid points per axis (default 50: 2,500 states)")
+        "a grid of initial states over the envelope, divided by the continuous "
+        "minimum time t_f* and by the discrete limit N* T.",
+        epilog="example:\n  ptoverify sweep --json\n  ptoverify sweep --out sweep-paper",
+    )
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        default=None,
+        help="write heat maps and sweep.json into DIR (atomically)",
+    )
+    p.add_argument(
+        "--grid",
+        type=positive_int,
+        default=50,
+        help="grid points per axis (default 50: 2,500 states)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     p.set_defaults(handler=_cmd_sweep)
 
@@ -386,19 +453,26 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     if args.json:
         print_json(result)
     else:
-        print(f"sweep over {result['grid']['states']} states, band {result['band_mm']} mm, "
-              f"horizon {result['horizon_s']:.3f} s")
-        print(f"{'law':<12} {'settled':>8} {'median t/tf*':>13} {'worst t/tf*':>12} "
-              f"{'median t/N*T':>13} {'worst t/N*T':>12}  worst state (x1 mm, x2 mm/s)")
+        print(
+            f"sweep over {result['grid']['states']} states, band {result['band_mm']} mm, "
+            f"horizon {result['horizon_s']:.3f} s"
+        )
+        print(
+            f"{'law':<12} {'settled':>8} {'median t/tf*':>13} {'worst t/tf*':>12} "
+            f"{'median t/N*T':>13} {'worst t/N*T':>12}  worst state (x1 mm, x2 mm/s)"
+        )
         for name, r in result["laws"].items():
             ws = r["worst_state_tf"]
-            num = {k: "n/a" if not math.isfinite(r[k]) else f"{r[k]:.3f}" for k in
-                   ("median_ratio_tf", "worst_ratio_tf", "median_ratio_nt", "worst_ratio_nt")}
-            where = "(never settles)" if not math.isfinite(ws[0]) else \
-                f"({ws[0]:.2f}, {ws[1]:.1f})"
-            print(f"{name:<12} {r['fraction_settled']:>8.1%} {num['median_ratio_tf']:>13} "
-                  f"{num['worst_ratio_tf']:>12} {num['median_ratio_nt']:>13} "
-                  f"{num['worst_ratio_nt']:>12}  {where}")
+            num = {
+                k: "n/a" if not math.isfinite(r[k]) else f"{r[k]:.3f}"
+                for k in ("median_ratio_tf", "worst_ratio_tf", "median_ratio_nt", "worst_ratio_nt")
+            }
+            where = "(never settles)" if not math.isfinite(ws[0]) else f"({ws[0]:.2f}, {ws[1]:.1f})"
+            print(
+                f"{name:<12} {r['fraction_settled']:>8.1%} {num['median_ratio_tf']:>13} "
+                f"{num['worst_ratio_tf']:>12} {num['median_ratio_nt']:>13} "
+                f"{num['worst_ratio_nt']:>12}  {where}"
+            )
         for name, why in result["skipped"].items():
             print(f"{name:<12} skipped: {why}")
         for f in result.get("files", []):
@@ -409,16 +483,24 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 # ---------------------------------------------------------------- zone
 def _add_zone(sub) -> None:
     p = sub.add_parser(
-        "zone", help="switching zone: as printed (eqs. 19-27) and corrected",
+        "zone",
+        help="switching zone: as printed (eqs. 19-27) and corrected",
         description="Carry out the switching-zone construction of eqs. (19)-(27) as printed, "
-                    "judge it against the paper's principle (a sampled state must not stride "
-                    "over the zone), and compute the corrected omega0 with its feasible "
-                    "intervals, verified on a grid.",
-        epilog="example:\n  ptoverify zone --json\n  ptoverify zone --config fast.toml")
-    p.add_argument("--no-verify", action="store_true",
-                   help="skip the 2-D grid verification of the corrected zone")
-    p.add_argument("--no-outcome", action="store_true",
-                   help="skip the closed-loop outcome (simulation of both PTO variants)")
+        "judge it against the paper's principle (a sampled state must not stride "
+        "over the zone), and compute the corrected omega0 with its feasible "
+        "intervals, verified on a grid.",
+        epilog="example:\n  ptoverify zone --json\n  ptoverify zone --config fast.toml",
+    )
+    p.add_argument(
+        "--no-verify",
+        action="store_true",
+        help="skip the 2-D grid verification of the corrected zone",
+    )
+    p.add_argument(
+        "--no-outcome",
+        action="store_true",
+        help="skip the closed-loop outcome (simulation of both PTO variants)",
+    )
     p.set_defaults(handler=_cmd_zone)
 
 
@@ -434,34 +516,43 @@ def _cmd_zone(args: argparse.Namespace) -> int:
     if args.json:
         print_json(result)
         return 0
-    print(f"d = {result['d']:g} mm, w_max = {result['w_max']:g} mm/s, a = {result['a']:.6g} "
-          f"rad/s, T = {result['sample_time']:g} s")
+    print(
+        f"d = {result['d']:g} mm, w_max = {result['w_max']:g} mm/s, a = {result['a']:.6g} "
+        f"rad/s, T = {result['sample_time']:g} s"
+    )
     for key in ("printed", "corrected", "corrected_lenient"):
         z = result[key]
-        print(f"\n[{key}] omega0 = {z['omega0']:.6g} mm/s, x20_tilde = {z['x20_tilde']:.6g} "
-              f"mm/s, valid = {z['valid']}, degenerate = {z['degenerate']}")
+        print(
+            f"\n[{key}] omega0 = {z['omega0']:.6g} mm/s, x20_tilde = {z['x20_tilde']:.6g} "
+            f"mm/s, valid = {z['valid']}, degenerate = {z['degenerate']}"
+        )
         for part in z["reason"].split("; "):
             print(f"  - {part}")
     for name, o in result.get("outcome", {}).items():
-        print(f"\n[outcome {name}] enters zone before crossing l1/l2: "
-              f"{o['enters_zone_before_crossing']}; settles without overshoot: "
-              f"{o['settles_without_overshoot']} (stride-overs {o['stride_overs']}, crossings "
-              f"into the linear zone {o['crossings_into_linear']}, overshoots {o['overshoots']}, "
-              f"max {o['max_overshoot_mm']:.3g} mm, limit cycles {o['limit_cycles']})")
+        print(
+            f"\n[outcome {name}] enters zone before crossing l1/l2: "
+            f"{o['enters_zone_before_crossing']}; settles without overshoot: "
+            f"{o['settles_without_overshoot']} (stride-overs {o['stride_overs']}, crossings "
+            f"into the linear zone {o['crossings_into_linear']}, overshoots {o['overshoots']}, "
+            f"max {o['max_overshoot_mm']:.3g} mm, limit cycles {o['limit_cycles']})"
+        )
     return 0
 
 
 # ---------------------------------------------------------------- report
 def _add_report(sub) -> None:
     p = sub.add_parser(
-        "report", help="write the verification report (HTML, Markdown, JSON, figures)",
+        "report",
+        help="write the verification report (HTML, Markdown, JSON, figures)",
         description="Run every verification and write a report folder: index.html (opens "
-                    "offline; MathML equations), report.md, results.json and figures/*.png. "
-                    "Written atomically: a failed run leaves nothing half-written.",
+        "offline; MathML equations), report.md, results.json and figures/*.png. "
+        "Written atomically: a failed run leaves nothing half-written.",
         epilog="example:\n  ptoverify report\n  ptoverify report --config axis.toml --out "
-               "reports/axis")
-    p.add_argument("--out", metavar="DIR", default=None,
-                   help="report folder (default reports/<config name>)")
+        "reports/axis",
+    )
+    p.add_argument(
+        "--out", metavar="DIR", default=None, help="report folder (default reports/<config name>)"
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     p.set_defaults(handler=_cmd_report)
 
@@ -478,8 +569,10 @@ def _cmd_report(args: argparse.Namespace) -> int:
         print_json({"out": str(out), "summary": res["summary"]})
     else:
         g = res["summary"]["gates"]
-        print(f"wrote {out}/index.html, report.md, results.json, "
-              f"{len(res['meta']['figures'])} figures; gates {g['pass']}/{g['total']} pass")
+        print(
+            f"wrote {out}/index.html, report.md, results.json, "
+            f"{len(res['meta']['figures'])} figures; gates {g['pass']}/{g['total']} pass"
+        )
     return 0
 
 
@@ -518,18 +611,31 @@ examples:
 
 def _add_conform(sub) -> None:
     p = sub.add_parser(
-        "conform", help="gate a third-party PTO implementation (callable or table)",
+        "conform",
+        help="gate a third-party PTO implementation (callable or table)",
         description="Check that a third-party implementation of the PTO law agrees with the "
-                    "verified reference and keeps its closed-loop properties.",
-        epilog=_CONFORM_EPILOG)
+        "verified reference and keeps its closed-loop properties.",
+        epilog=_CONFORM_EPILOG,
+    )
     src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument("--law", metavar="MODULE:FUNCTION",
-                     help="callable u = f(x1, x2, cfg) to judge (runs its code)")
+    src.add_argument(
+        "--law",
+        metavar="MODULE:FUNCTION",
+        help="callable u = f(x1, x2, cfg) to judge (runs its code)",
+    )
     src.add_argument("--table", metavar="FILE.csv", help="CSV with columns x1, x2, u")
-    src.add_argument("--emit-grid", metavar="FILE.csv",
-                     help="write the conformance grid (columns x1, x2) and exit")
-    p.add_argument("--tolerance", type=finite_float, default=None, metavar="TOL",
-                   help="agreement tolerance relative to w_max (default 1e-6)")
+    src.add_argument(
+        "--emit-grid",
+        metavar="FILE.csv",
+        help="write the conformance grid (columns x1, x2) and exit",
+    )
+    p.add_argument(
+        "--tolerance",
+        type=finite_float,
+        default=None,
+        metavar="TOL",
+        help="agreement tolerance relative to w_max (default 1e-6)",
+    )
     p.set_defaults(handler=_cmd_conform)
 
 
@@ -544,8 +650,13 @@ def _cmd_conform(args: argparse.Namespace) -> int:
         text = conform.grid_csv(cfg)
         write_atomic(args.emit_grid, text)
         if args.json:
-            print_json({"grid": str(args.emit_grid), "points": text.count("\n") - 1,
-                        "columns": ["x1", "x2"]})
+            print_json(
+                {
+                    "grid": str(args.emit_grid),
+                    "points": text.count("\n") - 1,
+                    "columns": ["x1", "x2"],
+                }
+            )
         return 0
     if args.table:
         result = conform.conform_table(args.table, cfg, rtol=rtol)
@@ -576,15 +687,23 @@ COMMANDS: list[tuple[str, Callable[[Any], None]]] = [
 def build_parser() -> argparse.ArgumentParser:
     """Build the argument parser with every command."""
     common = _Parser(add_help=False)
-    common.add_argument("--config", metavar="FILE", default=None,
-                        help="TOML configuration (default: the paper's Section 6 values)")
+    common.add_argument(
+        "--config",
+        metavar="FILE",
+        default=None,
+        help="TOML configuration (default: the paper's Section 6 values)",
+    )
     common.add_argument("--json", action="store_true", help="print one JSON object on stdout")
-    parser = _Parser(prog="ptoverify", formatter_class=argparse.RawDescriptionHelpFormatter,
-                     description="Verification suite for the proximate time-optimal (PTO) "
-                                 "control law with bandwidth and saturation.",
-                     epilog="example:\n  ptoverify report\n  ptoverify check --json")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True,
-                                parser_class=_Parser)
+    parser = _Parser(
+        prog="ptoverify",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Verification suite for the proximate time-optimal (PTO) "
+        "control law with bandwidth and saturation.",
+        epilog="example:\n  ptoverify report\n  ptoverify check --json",
+    )
+    sub = parser.add_subparsers(
+        dest="command", metavar="COMMAND", required=True, parser_class=_Parser
+    )
     real_add = sub.add_parser
 
     def add_parser(name, **kwargs):
@@ -616,13 +735,16 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("ptoverify: error: interrupted", file=sys.stderr)
         return 130
-    except BrokenPipeError:                          # e.g. `ptoverify ... | head`
+    except BrokenPipeError:  # e.g. `ptoverify ... | head`
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except (MemoryError, OverflowError, ValueError, ZeroDivisionError) as exc:
         # a configuration inside the validated ranges that still breaks a numeric step
-        print(f"ptoverify: error: the computation failed for this input "
-              f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})", file=sys.stderr)
+        print(
+            f"ptoverify: error: the computation failed for this input "
+            f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})",
+            file=sys.stderr,
+        )
         return 2
 
 

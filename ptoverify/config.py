@@ -30,8 +30,15 @@ from typing import Any
 
 from ptoverify.errors import ConfigError
 
-__all__ = ["Plant", "PDGains", "PTOSettings", "Config", "paper_config", "load_config",
-           "config_from_mapping"]
+__all__ = [
+    "Plant",
+    "PDGains",
+    "PTOSettings",
+    "Config",
+    "paper_config",
+    "load_config",
+    "config_from_mapping",
+]
 
 
 @dataclass(frozen=True)
@@ -122,8 +129,11 @@ class Config:
 
     def with_plant(self, **changes: float) -> Config:
         """Return a copy with plant fields replaced (``a``, ``w_max``...)."""
-        return replace(self, plant=replace(self.plant, **changes), bandwidth_hz=None
-                       if "a" in changes else self.bandwidth_hz)
+        return replace(
+            self,
+            plant=replace(self.plant, **changes),
+            bandwidth_hz=None if "a" in changes else self.bandwidth_hz,
+        )
 
     def to_mapping(self) -> dict[str, Any]:
         """Return the configuration as a plain dict (the TOML layout)."""
@@ -134,15 +144,17 @@ class Config:
         else:
             plant["a"] = p.a
         plant.update(w_max=p.w_max, sample_time=p.sample_time, position_range=p.position_range)
-        return {"name": self.name, "plant": plant,
-                "pd": {"kp": self.pd.kp, "kd": self.pd.kd},
-                "pto": {"d": self.pto.d, "k1": self.pto.k1, "k2": self.pto.k2}}
+        return {
+            "name": self.name,
+            "plant": plant,
+            "pd": {"kp": self.pd.kp, "kd": self.pd.kd},
+            "pto": {"d": self.pto.d, "k1": self.pto.k1, "k2": self.pto.k2},
+        }
 
 
 PAPER_MAPPING: dict[str, Any] = {
     "name": "paper",
-    "plant": {"bandwidth_hz": 30.0, "w_max": 300.0, "sample_time": 0.002,
-              "position_range": 50.0},
+    "plant": {"bandwidth_hz": 30.0, "w_max": 300.0, "sample_time": 0.002, "position_range": 50.0},
     "pd": {"kp": 356.0, "kd": 1.15},
     "pto": {"d": 0.5, "k1": 323.0, "k2": 3.6},
 }
@@ -199,8 +211,14 @@ def _section(data: dict[str, Any], name: str) -> dict[str, float]:
 
 #: Ranges beyond which the suite's computations are not meaningful (or would not fit in memory):
 #: they are rejected as out of range, each naming the key.
-LIMITS = {"a": 1e6, "w_max": 1e6, "position_range": 1e6, "sample_time": (1e-7, 1.0),
-          "aT": (1e-6, 20.0), "samples_across_range": 1e6}
+LIMITS = {
+    "a": 1e6,
+    "w_max": 1e6,
+    "position_range": 1e6,
+    "sample_time": (1e-7, 1.0),
+    "aT": (1e-6, 20.0),
+    "samples_across_range": 1e6,
+}
 
 
 def _check_scales(a: float, plant: dict[str, float], a_key: str) -> None:
@@ -209,22 +227,28 @@ def _check_scales(a: float, plant: dict[str, float], a_key: str) -> None:
         raise ConfigError(f"config key '{a_key}' gives a = {a:g} rad/s, above {LIMITS['a']:g}")
     for key in ("w_max", "position_range"):
         if plant[key] > LIMITS[key]:
-            raise ConfigError(f"config key 'plant.{key}' must be <= {LIMITS[key]:g}, "
-                              f"got {plant[key]!r}")
+            raise ConfigError(
+                f"config key 'plant.{key}' must be <= {LIMITS[key]:g}, got {plant[key]!r}"
+            )
     lo, hi = LIMITS["sample_time"]
     T = plant["sample_time"]  # noqa: N806
     if not lo <= T <= hi:
-        raise ConfigError(f"config key 'plant.sample_time' must be in [{lo:g}, {hi:g}] s, "
-                          f"got {T!r}")
+        raise ConfigError(
+            f"config key 'plant.sample_time' must be in [{lo:g}, {hi:g}] s, got {T!r}"
+        )
     lo, hi = LIMITS["aT"]
     if not lo <= a * T <= hi:
-        raise ConfigError(f"config key 'plant.sample_time' gives a T = {a * T:g}, outside "
-                          f"[{lo:g}, {hi:g}] (the sampling is too fast or too slow for the "
-                          f"bandwidth)")
+        raise ConfigError(
+            f"config key 'plant.sample_time' gives a T = {a * T:g}, outside "
+            f"[{lo:g}, {hi:g}] (the sampling is too fast or too slow for the "
+            f"bandwidth)"
+        )
     n = plant["position_range"] / (plant["w_max"] * T)
     if n > LIMITS["samples_across_range"]:
-        raise ConfigError(f"config key 'plant.position_range' needs {n:.3g} samples to cross "
-                          f"at w_max, above {LIMITS['samples_across_range']:g}")
+        raise ConfigError(
+            f"config key 'plant.position_range' needs {n:.3g} samples to cross "
+            f"at w_max, above {LIMITS['samples_across_range']:g}"
+        )
 
 
 def config_from_mapping(data: dict[str, Any]) -> Config:
@@ -250,17 +274,25 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
         if key not in {"name", *_SECTIONS}:
             raise ConfigError(f"unknown config key '{key}'")
     name = data.get("name", "custom")
-    if not isinstance(name, str) or not name or not name.isascii() \
-            or not all(c.isalnum() or c in "-_." for c in name) or name.startswith("."):
-        raise ConfigError(f"config key 'name' must be a non-empty word of letters, digits, "
-                          f"'-', '_' or '.', got {name!r}")
+    if (
+        not isinstance(name, str)
+        or not name
+        or not name.isascii()
+        or not all(c.isalnum() or c in "-_." for c in name)
+        or name.startswith(".")
+    ):
+        raise ConfigError(
+            f"config key 'name' must be a non-empty word of letters, digits, "
+            f"'-', '_' or '.', got {name!r}"
+        )
     plant = _section(data, "plant")
     pd = _section(data, "pd")
     pto = _section(data, "pto")
     has_hz, has_a = "bandwidth_hz" in plant, "a" in plant
     if has_hz == has_a:
-        raise ConfigError("config section '[plant]' needs exactly one of 'plant.bandwidth_hz' "
-                          "and 'plant.a'")
+        raise ConfigError(
+            "config section '[plant]' needs exactly one of 'plant.bandwidth_hz' and 'plant.a'"
+        )
     bandwidth_hz = plant.get("bandwidth_hz")
     if has_hz:
         _positive("plant", "bandwidth_hz", plant["bandwidth_hz"])
@@ -274,12 +306,18 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
     if pto["d"] < 0:
         raise ConfigError(f"config key 'pto.d' must be >= 0, got {pto['d']!r}")
     if pto["d"] > plant["position_range"]:
-        raise ConfigError(f"config key 'pto.d' must be <= plant.position_range "
-                          f"({plant['position_range']!r}), got {pto['d']!r}")
+        raise ConfigError(
+            f"config key 'pto.d' must be <= plant.position_range "
+            f"({plant['position_range']!r}), got {pto['d']!r}"
+        )
     return Config(
         name=name,
-        plant=Plant(a=a, w_max=plant["w_max"], sample_time=plant["sample_time"],
-                    position_range=plant["position_range"]),
+        plant=Plant(
+            a=a,
+            w_max=plant["w_max"],
+            sample_time=plant["sample_time"],
+            position_range=plant["position_range"],
+        ),
         pd=PDGains(kp=pd["kp"], kd=pd["kd"]),
         pto=PTOSettings(d=pto["d"], k1=pto["k1"], k2=pto["k2"]),
         bandwidth_hz=bandwidth_hz,

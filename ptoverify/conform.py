@@ -103,12 +103,26 @@ from ptoverify.config import Config
 from ptoverify.laws import Law
 from ptoverify.userlaw import LawFault, UserLaw, load_callable, wrap_callable
 
-__all__ = ["reference_law", "reference_law_scalar", "load_callable", "UserLaw", "wrap_callable",
-           "LawFault", "conformance_grid", "grid_csv", "read_table", "agreement",
-           "closed_loop", "ConformResult", "conform_callable", "conform_table", "format_result",
-           "DEFAULT_RTOL"]
+__all__ = [
+    "reference_law",
+    "reference_law_scalar",
+    "load_callable",
+    "UserLaw",
+    "wrap_callable",
+    "LawFault",
+    "conformance_grid",
+    "grid_csv",
+    "read_table",
+    "agreement",
+    "closed_loop",
+    "ConformResult",
+    "conform_callable",
+    "conform_table",
+    "format_result",
+    "DEFAULT_RTOL",
+]
 
-_BAND_MM = 1e-3                #: settling / oscillation band [mm], as properties
+_BAND_MM = 1e-3  #: settling / oscillation band [mm], as properties
 
 
 # ------------------------------------------------------------------ reference
@@ -177,8 +191,13 @@ def _sweep_analysis(res, x1: NDArray, cfg: Config, band: float, window: int) -> 
     stride, _ = crossing_masks(res.x1, res.x2, res.region, cfg)
     osc = _oscillating(X1[-window:], band)
     unsettled = np.abs(X1[-1]) > band
-    return {"stride": stride, "osc": osc, "unsettled": unsettled,
-            "over": np.abs(res.u) > w, "max_u": float(np.abs(res.u).max())}
+    return {
+        "stride": stride,
+        "osc": osc,
+        "unsettled": unsettled,
+        "over": np.abs(res.u) > w,
+        "max_u": float(np.abs(res.u).max()),
+    }
 
 
 def _settle_steps(X1: NDArray, band: float) -> NDArray[np.float64]:
@@ -205,8 +224,15 @@ def _settling_reference(cfg: Config) -> dict:
     ok = n_star >= 0
     e_ref = float(np.max(s_ref[ok] - n_star[ok])) if ok.any() else math.inf
     failed = [(float(x1[i]), float(x2[i]), dm[i].status) for i in np.flatnonzero(~ok)]
-    return {"x1": x1, "x2": x2, "n_star": n_star, "steps": steps, "s_ref": s_ref,
-            "e_ref": e_ref, "failed": failed}
+    return {
+        "x1": x1,
+        "x2": x2,
+        "n_star": n_star,
+        "steps": steps,
+        "s_ref": s_ref,
+        "e_ref": e_ref,
+        "failed": failed,
+    }
 
 
 def _settling(law: Law, cfg: Config) -> tuple[dict, list[dict]]:
@@ -216,8 +242,12 @@ def _settling(law: Law, cfg: Config) -> tuple[dict, list[dict]]:
     T = cfg.plant.sample_time
     if ref["failed"] or not math.isfinite(ref["e_ref"]):
         s = ref["failed"][0] if ref["failed"] else (math.nan, math.nan, "reference unsettled")
-        prop = {"status": UNVERIFIED, "measured": None, "limit": None,
-                "detail": f"N* could not be established at ({s[0]:g}, {s[1]:g}): {s[2]}"}
+        prop = {
+            "status": UNVERIFIED,
+            "measured": None,
+            "limit": None,
+            "detail": f"N* could not be established at ({s[0]:g}, {s[1]:g}): {s[2]}",
+        }
         return prop, [failure("settling-vs-discrete-limit", s[:2], prop["detail"])]
     res = simulate_batch(law, cfg.plant, ref["x1"], ref["x2"], ref["steps"])
     s = _settle_steps(res.x1, _BAND_MM)
@@ -226,18 +256,28 @@ def _settling(law: Law, cfg: Config) -> tuple[dict, list[dict]]:
     limit = e_ref + max(2.0, math.ceil(e_ref / 2.0))
     worst = float(np.max(excess))
     ratio = float(np.max(s / np.maximum(ref["n_star"], 1.0)))
-    prop = {"status": PASS if worst <= limit else FAIL, "measured": worst, "limit": limit,
-            "detail": f"worst (settling samples - N*) over {s.size} states (settling: |x1| <= "
-                      f"{_BAND_MM:g} mm for good); reference worst {e_ref:g} samples; "
-                      f"limit E_ref + max(2, ceil(E_ref/2)); worst ratio t_s / (N* T) = "
-                      f"{ratio:.3g}", "sample_time_s": T, "worst_ratio_to_nstar": ratio}
+    prop = {
+        "status": PASS if worst <= limit else FAIL,
+        "measured": worst,
+        "limit": limit,
+        "detail": f"worst (settling samples - N*) over {s.size} states (settling: |x1| <= "
+        f"{_BAND_MM:g} mm for good); reference worst {e_ref:g} samples; "
+        f"limit E_ref + max(2, ceil(E_ref/2)); worst ratio t_s / (N* T) = "
+        f"{ratio:.3g}",
+        "sample_time_s": T,
+        "worst_ratio_to_nstar": ratio,
+    }
     fails = []
     if worst > limit:
         i = int(np.argmax(excess > limit))
-        fails.append(failure(
-            "settling-vs-discrete-limit", (ref["x1"][i], ref["x2"][i]),
-            f"settles in {s[i]:g} samples, N* = {ref['n_star'][i]:g} (reference "
-            f"{ref['s_ref'][i]:g}); excess {excess[i]:g} > {limit:g} samples"))
+        fails.append(
+            failure(
+                "settling-vs-discrete-limit",
+                (ref["x1"][i], ref["x2"][i]),
+                f"settles in {s[i]:g} samples, N* = {ref['n_star'][i]:g} (reference "
+                f"{ref['s_ref'][i]:g}); excess {excess[i]:g} > {limit:g} samples",
+            )
+        )
     return prop, fails
 
 
@@ -247,8 +287,9 @@ def _grid_sizes(mode: str, sweep: tuple[int, int, int] | None) -> tuple[int, int
     return (101, 101, 200) if mode == "vectorized" else (21, 21, 40)
 
 
-def closed_loop(user: UserLaw, cfg: Config, *,
-                sweep: tuple[int, int, int] | None = None) -> tuple[dict, list[dict]]:
+def closed_loop(
+    user: UserLaw, cfg: Config, *, sweep: tuple[int, int, int] | None = None
+) -> tuple[dict, list[dict]]:
     """Closed-loop properties of a user law, as ``check`` gates them.
 
     Parameters
@@ -281,63 +322,100 @@ def closed_loop(user: UserLaw, cfg: Config, *,
         res = simulate_batch(law, cfg.plant, x1, x2, steps)
     except LawFault as fault:
         detail = f"closed-loop simulation stopped: {fault.message}"
-        return ({"evaluation": {"status": FAIL, "measured": None, "limit": None,
-                                "detail": detail}},
-                [failure("evaluation", fault.state, detail)])
+        return (
+            {"evaluation": {"status": FAIL, "measured": None, "limit": None, "detail": detail}},
+            [failure("evaluation", fault.state, detail)],
+        )
     m = _sweep_analysis(res, x1, cfg, _BAND_MM, window)
     where = f"over {x1.size} initial states x {steps} samples"
     props, fails = {}, []
 
     def add(name: str, count: int, mask, detail: str, what: str):
-        props[name] = {"status": PASS if count == 0 else FAIL, "measured": count, "limit": 0,
-                       "detail": f"{detail} {where}"}
+        props[name] = {
+            "status": PASS if count == 0 else FAIL,
+            "measured": count,
+            "limit": 0,
+            "detail": f"{detail} {where}",
+        }
         hit = _first(mask)
         if hit is not None:
             k, j = hit
-            fails.append(failure(name, (x1[j], x2[j]),
-                                  f"{what} (first from initial state ({x1[j]:.6g}, "
-                                  f"{x2[j]:.6g}), sample {k}: ({res.x1[k, j]:.6g}, "
-                                  f"{res.x2[k, j]:.6g})); {count} in all",
-                                  sample=k, at=[float(res.x1[k, j]), float(res.x2[k, j])]))
+            fails.append(
+                failure(
+                    name,
+                    (x1[j], x2[j]),
+                    f"{what} (first from initial state ({x1[j]:.6g}, "
+                    f"{x2[j]:.6g}), sample {k}: ({res.x1[k, j]:.6g}, "
+                    f"{res.x2[k, j]:.6g})); {count} in all",
+                    sample=k,
+                    at=[float(res.x1[k, j]), float(res.x2[k, j])],
+                )
+            )
 
-    add("no-stride-over", int(m["stride"].sum()), m["stride"],
+    add(
+        "no-stride-over",
+        int(m["stride"].sum()),
+        m["stride"],
         "stride-overs (sample outside zone and linear zone whose next sample is strictly "
-        "across l1/l2 and outside the linear zone)", "stride-over")
+        "across l1/l2 and outside the linear zone)",
+        "stride-over",
+    )
     cyc = m["osc"] | m["unsettled"]
     at_end = np.zeros((steps + 1, x1.size), dtype=bool)
     at_end[-1] = cyc
-    add("no-limit-cycle", int(m["osc"].sum() + m["unsettled"].sum()), at_end,
+    add(
+        "no-limit-cycle",
+        int(m["osc"].sum() + m["unsettled"].sum()),
+        at_end,
         f"states with sustained oscillation ({int(m['osc'].sum())}) or not settled within "
-        f"{_BAND_MM:g} mm ({int(m['unsettled'].sum())})", "sustained oscillation or not settled")
-    add("input-bound", int(m["over"].sum()), m["over"],
+        f"{_BAND_MM:g} mm ({int(m['unsettled'].sum())})",
+        "sustained oscillation or not settled",
+    )
+    add(
+        "input-bound",
+        int(m["over"].sum()),
+        m["over"],
         f"samples with |u| > w_max = {cfg.plant.w_max:g} mm/s (max {m['max_u']:.10g})",
-        "|u| > w_max")
+        "|u| > w_max",
+    )
     try:
         props["settling-vs-discrete-limit"], f = _settling(law, cfg)
     except LawFault as fault:
         detail = f"settling simulation stopped: {fault.message}"
-        props["settling-vs-discrete-limit"] = {"status": FAIL, "measured": None,
-                                               "limit": None, "detail": detail}
+        props["settling-vs-discrete-limit"] = {
+            "status": FAIL,
+            "measured": None,
+            "limit": None,
+            "detail": detail,
+        }
         f = [failure("evaluation", fault.state, detail)]
     fails += f
     return props, fails
 
 
-def _odd_symmetry(user: UserLaw, x1: NDArray, x2: NDArray, u: NDArray, cfg: Config,
-                  rtol: float) -> tuple[dict, list[dict]]:
+def _odd_symmetry(
+    user: UserLaw, x1: NDArray, x2: NDArray, u: NDArray, cfg: Config, rtol: float
+) -> tuple[dict, list[dict]]:
     """u(-x) = -u(x) on the grid (tie points excluded), to the agreement tolerance."""
     tol = rtol * cfg.plant.w_max
     um = user(-x1, -x2)
     err = np.where(ties(x1, x2, cfg), 0.0, np.abs(u + um))
     bad = err > tol
-    prop = {"status": FAIL if bad.any() else PASS, "measured": float(err.max()), "limit": tol,
-            "detail": f"max |u(x) + u(-x)| [mm/s] over {x1.size} grid states (curve ties "
-                      "excluded); the plant is odd, so the law must be"}
+    prop = {
+        "status": FAIL if bad.any() else PASS,
+        "measured": float(err.max()),
+        "limit": tol,
+        "detail": f"max |u(x) + u(-x)| [mm/s] over {x1.size} grid states (curve ties "
+        "excluded); the plant is odd, so the law must be",
+    }
     fails = []
     if bad.any():
         i = int(np.argmax(bad))
-        fails.append(failure("odd-symmetry", (x1[i], x2[i]),
-                              f"u(x) = {u[i]:.10g}, u(-x) = {um[i]:.10g} mm/s"))
+        fails.append(
+            failure(
+                "odd-symmetry", (x1[i], x2[i]), f"u(x) = {u[i]:.10g}, u(-x) = {um[i]:.10g} mm/s"
+            )
+        )
     return prop, fails
 
 
@@ -377,19 +455,32 @@ class ConformResult:
 
     def to_json(self) -> dict:
         """Return the JSON object printed by ``--json``."""
-        return {"conforms": self.conforms, "mode": self.mode, "target": self.target,
-                "mode_reason": self.mode_reason, "config": self.config,
-                "agreement": self.agreement, "properties": self.properties,
-                "failures": self.failures, "timings_s": self.timings_s}
+        return {
+            "conforms": self.conforms,
+            "mode": self.mode,
+            "target": self.target,
+            "mode_reason": self.mode_reason,
+            "config": self.config,
+            "agreement": self.agreement,
+            "properties": self.properties,
+            "failures": self.failures,
+            "timings_s": self.timings_s,
+        }
 
     def failed_properties(self) -> list[str]:
         """Names of the failing properties, in order, without repeats."""
         return list(dict.fromkeys(f["property"] for f in self.failures))
 
 
-def conform_callable(fn: Callable, cfg: Config, *, target: str = "", rtol: float = DEFAULT_RTOL,
-                     sweep: tuple[int, int, int] | None = None,
-                     grid: tuple[NDArray, NDArray] | None = None) -> ConformResult:
+def conform_callable(
+    fn: Callable,
+    cfg: Config,
+    *,
+    target: str = "",
+    rtol: float = DEFAULT_RTOL,
+    sweep: tuple[int, int, int] | None = None,
+    grid: tuple[NDArray, NDArray] | None = None,
+) -> ConformResult:
     """Judge a user law ``u = f(x1, x2, cfg)`` against the reference PTO law.
 
     Parameters
@@ -428,10 +519,19 @@ def conform_callable(fn: Callable, cfg: Config, *, target: str = "", rtol: float
     agree: dict = {"pass": False, "detail": "not run: the law failed at a probe state"}
     memory = any(f["property"] == "pure-function" for f in failures)
     if memory:
-        agree = {"pass": False, "detail": "not run: the law has memory, so u is not a "
-                 "function of the state and there is nothing to compare state by state"}
-        for name in ("input-bound-grid", "odd-symmetry", "no-stride-over", "no-limit-cycle",
-                     "input-bound", "settling-vs-discrete-limit"):
+        agree = {
+            "pass": False,
+            "detail": "not run: the law has memory, so u is not a "
+            "function of the state and there is nothing to compare state by state",
+        }
+        for name in (
+            "input-bound-grid",
+            "odd-symmetry",
+            "no-stride-over",
+            "no-limit-cycle",
+            "input-bound",
+            "settling-vs-discrete-limit",
+        ):
             props[name] = {"status": NOT_RUN, "detail": "the law has memory (pure-function)"}
     elif not any(f["property"] == "evaluation" for f in failures):
         t = time.perf_counter()
@@ -457,15 +557,28 @@ def conform_callable(fn: Callable, cfg: Config, *, target: str = "", rtol: float
         props.update(cl)
         failures += f
         timings["closed_loop"] = time.perf_counter() - t
-    props.setdefault("pure-function", {"status": PASS, "detail": "two calls at 8 probe states "
-                                       "returned the same u"})
+    props.setdefault(
+        "pure-function",
+        {"status": PASS, "detail": "two calls at 8 probe states returned the same u"},
+    )
     if any(f["property"] == "pure-function" for f in failures):
-        props["pure-function"] = {"status": FAIL, "detail": "two calls at the same state "
-                                  "returned different u"}
+        props["pure-function"] = {
+            "status": FAIL,
+            "detail": "two calls at the same state returned different u",
+        }
     timings["total"] = time.perf_counter() - t0
     ok = not failures and agree.get("pass", False)
-    return ConformResult(ok, user.mode, target, user.reason, agree, props, failures,
-                         {k: round(v, 4) for k, v in timings.items()}, cfg.name)
+    return ConformResult(
+        ok,
+        user.mode,
+        target,
+        user.reason,
+        agree,
+        props,
+        failures,
+        {k: round(v, 4) for k, v in timings.items()},
+        cfg.name,
+    )
 
 
 def conform_table(path: str | Path, cfg: Config, *, rtol: float = DEFAULT_RTOL) -> ConformResult:
@@ -491,36 +604,59 @@ def conform_table(path: str | Path, cfg: Config, *, rtol: float = DEFAULT_RTOL) 
     props = {}
     props["input-bound-grid"], f = input_bound(x1, x2, u, cfg, "at the table's points")
     failures += f
-    for name in ("odd-symmetry", "no-stride-over", "no-limit-cycle", "input-bound",
-                 "settling-vs-discrete-limit"):
+    for name in (
+        "odd-symmetry",
+        "no-stride-over",
+        "no-limit-cycle",
+        "input-bound",
+        "settling-vs-discrete-limit",
+    ):
         props[name] = {"status": NOT_RUN, "detail": "needs a callable law (--law)"}
     ok = not failures and agree["pass"]
-    return ConformResult(ok, "table", str(path), f"table of {x1.size} points", agree, props,
-                         failures, {"total": round(time.perf_counter() - t0, 4)}, cfg.name)
+    return ConformResult(
+        ok,
+        "table",
+        str(path),
+        f"table of {x1.size} points",
+        agree,
+        props,
+        failures,
+        {"total": round(time.perf_counter() - t0, 4)},
+        cfg.name,
+    )
 
 
 def format_result(r: ConformResult) -> str:
     """Human-readable report: verdict, agreement per region, properties, failures."""
-    lines = [f"{'CONFORMS' if r.conforms else 'DOES NOT CONFORM'}: {r.target} "
-             f"(mode {r.mode}: {r.mode_reason})"]
+    lines = [
+        f"{'CONFORMS' if r.conforms else 'DOES NOT CONFORM'}: {r.target} "
+        f"(mode {r.mode}: {r.mode_reason})"
+    ]
     a = r.agreement
     if "regions" in a:
-        lines.append(f"agreement with reference PTO: {a['points']} points, {a['excluded']} "
-                     f"excluded (within {a['tie_band_mm_s']:.3g} mm/s of l1/l2/l1*/l2*), "
-                     f"tolerance {a['tolerance_mm_s']:.3g} mm/s ({a['rtol']:g} w_max), "
-                     f"max |du| = {a['max_abs_du']:.3g} mm/s")
+        lines.append(
+            f"agreement with reference PTO: {a['points']} points, {a['excluded']} "
+            f"excluded (within {a['tie_band_mm_s']:.3g} mm/s of l1/l2/l1*/l2*), "
+            f"tolerance {a['tolerance_mm_s']:.3g} mm/s ({a['rtol']:g} w_max), "
+            f"max |du| = {a['max_abs_du']:.3g} mm/s"
+        )
         for name, e in a["regions"].items():
-            where = "" if e["state"] is None else f" at ({e['state'][0]:.10g}, " \
-                                                  f"{e['state'][1]:.10g})"
-            lines.append(f"  {'ok  ' if e['pass'] else 'FAIL'} {name:<10} {e['points']:>6} "
-                         f"points ({e['excluded']} excluded) max |du| = "
-                         f"{e['max_abs_du']:.3g} mm/s{where}")
+            where = (
+                "" if e["state"] is None else f" at ({e['state'][0]:.10g}, {e['state'][1]:.10g})"
+            )
+            lines.append(
+                f"  {'ok  ' if e['pass'] else 'FAIL'} {name:<10} {e['points']:>6} "
+                f"points ({e['excluded']} excluded) max |du| = "
+                f"{e['max_abs_du']:.3g} mm/s{where}"
+            )
     else:
         lines.append(f"agreement: {a.get('detail', '')}")
     for name, pr in r.properties.items():
         lines.append(f"  {pr['status'].upper():<10} {name:<28} {pr.get('detail', '')}")
     for f in r.failures:
-        lines.append(f"FAILED {f['property']} at state ({f['state'][0]:.10g}, "
-                     f"{f['state'][1]:.10g}): {f['detail']}")
+        lines.append(
+            f"FAILED {f['property']} at state ({f['state'][0]:.10g}, "
+            f"{f['state'][1]:.10g}): {f['detail']}"
+        )
     lines.append(f"time {r.timings_s.get('total', 0.0):.2f} s")
     return "\n".join(lines)

@@ -36,8 +36,17 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.special import lambertw
 
 __all__ = [
-    "h", "level_residual", "switching_function", "level_curve_x1",
-    "root_22", "root_k", "omega_c", "bisect", "root_22_bisect", "root_k_bisect", "blockwise",
+    "h",
+    "level_residual",
+    "switching_function",
+    "level_curve_x1",
+    "root_22",
+    "root_k",
+    "omega_c",
+    "bisect",
+    "root_22_bisect",
+    "root_k_bisect",
+    "blockwise",
 ]
 
 Array = NDArray[np.float64]
@@ -48,7 +57,7 @@ _H_SERIES = np.array([(-1.0) ** n / n for n in range(2, 26)])
 _E2_SERIES = np.array([1.0 / np.prod(np.arange(1, n + 1, dtype=float)) for n in range(2, 22)])
 
 
-BLOCK = 8192   # states per block: 64 kB per float array, heap-allocated and cache-resident
+BLOCK = 8192  # states per block: 64 kB per float array, heap-allocated and cache-resident
 
 
 def blockwise(fn, *arrays: ArrayLike, block: int = BLOCK):
@@ -78,19 +87,19 @@ def blockwise(fn, *arrays: ArrayLike, block: int = BLOCK):
     arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in arrays))
     shape, n = arrays[0].shape, arrays[0].size
     flat = [a.ravel() for a in arrays]
-    if n <= 2 * block:                            # one block; fn sees 1-D arrays always
+    if n <= 2 * block:  # one block; fn sees 1-D arrays always
         res = fn(*flat)
         if isinstance(res, tuple):
             return tuple(r.reshape(shape) for r in res)
         return res.reshape(shape)
     outs, single = None, False
     for i in range(0, n, block):
-        res = fn(*(a[i:i + block] for a in flat))
+        res = fn(*(a[i : i + block] for a in flat))
         if outs is None:
             single = not isinstance(res, tuple)
             outs = [np.empty(n, dtype=r.dtype) for r in ((res,) if single else res)]
         for o, r in zip(outs, (res,) if single else res, strict=True):
-            o[i:i + block] = r
+            o[i : i + block] = r
     outs = tuple(o.reshape(shape) for o in outs)
     return outs[0] if single else outs
 
@@ -98,7 +107,7 @@ def blockwise(fn, *arrays: ArrayLike, block: int = BLOCK):
 def _series(x: Array, coef: Array, lowest: int) -> Array:
     """Evaluate sum_j coef[j] x^(lowest + j) by Horner's rule."""
     acc = np.zeros_like(x)
-    for c in coef[::-1]:                     # in place: the same roundings as acc * x + c
+    for c in coef[::-1]:  # in place: the same roundings as acc * x + c
         acc *= x
         acc += c
     return acc * x**lowest
@@ -127,7 +136,7 @@ def h(r: ArrayLike) -> Array:
         out = r - np.log1p(r)
     if out.ndim == 0:
         return np.asarray(out if abs(r) >= 0.2 else _series(r, _H_SERIES, 2))
-    small = np.abs(r) < 0.2                      # the series only where it is used
+    small = np.abs(r) < 0.2  # the series only where it is used
     if small.any():
         out[small] = _series(r[small], _H_SERIES, 2)
     return out
@@ -140,7 +149,7 @@ def _e2(u: Array) -> Array:
         out = np.expm1(u) - u
     if out.ndim == 0:
         return np.asarray(out if abs(u) >= 0.5 else _series(u, _E2_SERIES, 2))
-    small = np.abs(u) < 0.5                      # the series only where it is used
+    small = np.abs(u) < 0.5  # the series only where it is used
     if small.any():
         out[small] = _series(u[small], _E2_SERIES, 2)
     return out
@@ -250,14 +259,17 @@ def root_22(b0: ArrayLike, branch: int = -1) -> Array:
     # initial u = ln(1 + y): branch-point series where W is ill-conditioned
     with np.errstate(all="ignore"):
         y_w = -1.0 - _lambertw_real(-np.exp(-1.0 - bb), branch)
-        u = np.where(bb < 1e-3, sign * np.sqrt(2.0 * bb) * (1.0 + sign * np.sqrt(2.0 * bb) / 3.0),
-                     np.log1p(np.maximum(y_w, -1.0 + 1e-300)))
-        big = ~np.isfinite(u)                        # e^{-1-b0} underflowed: y ~ b0 + ln(1+b0)
+        u = np.where(
+            bb < 1e-3,
+            sign * np.sqrt(2.0 * bb) * (1.0 + sign * np.sqrt(2.0 * bb) / 3.0),
+            np.log1p(np.maximum(y_w, -1.0 + 1e-300)),
+        )
+        big = ~np.isfinite(u)  # e^{-1-b0} underflowed: y ~ b0 + ln(1+b0)
         u = np.where(big & (sign > 0), np.log1p(bb + np.log1p(bb)), u)
         u = np.where(big & (sign < 0), -bb - 1.0, u)
         if branch == 0:
-            u = np.maximum(u, -bb - 1.0)             # y > -1: e^u - 1 - u = b0 => u > -b0 - 1
-        for _ in range(4):                           # Newton on E2(u) = b0; E2'(u) = e^u - 1
+            u = np.maximum(u, -bb - 1.0)  # y > -1: e^u - 1 - u = b0 => u > -b0 - 1
+        for _ in range(4):  # Newton on E2(u) = b0; E2'(u) = e^u - 1
             du = (_e2(u) - bb) / np.expm1(u)
             u = np.where(u != 0.0, u - du, u)
     y = np.expm1(u)
@@ -351,11 +363,11 @@ def _u_of_m_positive(m: Array) -> Array:
         for _ in range(2):
             np.expm1(u, out=em1)
             np.multiply(k, em1, out=f)
-            np.subtract(m, f, out=df)                # f'
-            np.subtract(u, f, out=f)                 # f
+            np.subtract(m, f, out=df)  # f'
+            np.subtract(u, f, out=f)  # f
             em1 += 1.0
             em1 *= k
-            np.negative(em1, out=em1)                # f''
+            np.negative(em1, out=em1)  # f''
             np.multiply(2.0, f, out=num)
             num *= df
             np.multiply(2.0, df, out=den)
@@ -365,7 +377,7 @@ def _u_of_m_positive(m: Array) -> Array:
             num /= den
             u -= num
         u[keep] = u_keep
-        np.expm1(u, out=em1)                         # Newton: u - f / (m - k em1)
+        np.expm1(u, out=em1)  # Newton: u - f / (m - k em1)
         np.multiply(k, em1, out=f)
         np.subtract(m, f, out=den)
         np.subtract(u, f, out=f)
@@ -384,9 +396,9 @@ def _u_of_m_negative(m: Array) -> Array:
         u = np.log1p(np.maximum(z_w, -1.0 + 1e-300))
         u = np.where(np.abs(m) < 1e-3, 2.0 * m * (1.0 + m / 3.0), u)
         u = np.where(np.isfinite(u), u, -1.0)
-        for _ in range(4):                                   # Newton on m(u) = m
+        for _ in range(4):  # Newton on m(u) = m
             em1 = np.expm1(u)
-            dm = (u * np.exp(u) - em1) / em1**2              # m'(u)
+            dm = (u * np.exp(u) - em1) / em1**2  # m'(u)
             dm = np.where(np.abs(u) < 1e-4, 0.5 - u / 6.0, dm)
             u = u - (_m_of_u(u) - m) / dm
     return np.where(m < 0, u, 0.0)
@@ -426,7 +438,7 @@ def _omega_c(x1: Array, x2: Array, a: float) -> Array:
     """:func:`omega_c` on broadcast float arrays (one block)."""
     with np.errstate(all="ignore"):
         m = -a * x1 / x2
-        if m.size and ((m > 0) & (m < 1)).all():     # every state has a curve
+        if m.size and ((m > 0) & (m < 1)).all():  # every state has a curve
             return np.abs(x2) / np.expm1(_u_of_m_positive(m))
         w = root_k(np.where((m > 0) & (m < 1), m, 0.5))
         wc = np.abs(x2) / w
@@ -454,8 +466,9 @@ def bisect(f, lo: ArrayLike, hi: ArrayLike, tol: float = 0.0, max_iter: int = 20
     ndarray
         Midpoint of the final bracket.
     """
-    lo, hi = np.broadcast_arrays(np.asarray(lo, dtype=float).copy(),
-                                 np.asarray(hi, dtype=float).copy())
+    lo, hi = np.broadcast_arrays(
+        np.asarray(lo, dtype=float).copy(), np.asarray(hi, dtype=float).copy()
+    )
     lo, hi = lo.copy(), hi.copy()
     f_lo = np.sign(f(lo))
     for _ in range(max_iter):
@@ -507,8 +520,9 @@ def root_k_bisect(m: ArrayLike, tol: float = 0.0) -> Array:
     m = np.asarray(m, dtype=float)
     k = 1.0 - m
     pos = m > 0
-    lo = np.where(pos, m, -1.0)             # phi(m) = m^2 - h(m) > 0 for 0 < m < 1
+    lo = np.where(pos, m, -1.0)  # phi(m) = m^2 - h(m) > 0 for 0 < m < 1
     hi = np.where(pos, 1.0 / np.where(pos, k, 1.0) ** 2 + 1.0, 0.0)
+
     # phi(z) = ln(1+z) - k z = m z - h(z): > 0 between 0 and z* for m > 0; the first form
     # is exact for small k, the second for small m
     def phi(z):

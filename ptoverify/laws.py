@@ -22,24 +22,36 @@ from ptoverify.config import Config
 from ptoverify.curves import blockwise, level_residual, omega_c, switching_function
 from ptoverify.errors import InputError
 
-__all__ = ["Region", "Law", "to_law", "pd_law", "pto_law", "pto_corrected_law",
-           "pto_printed_law", "omega_c_scalar", "make_law", "LAW_NAMES", "h_scalar"]
+__all__ = [
+    "Region",
+    "Law",
+    "to_law",
+    "pd_law",
+    "pto_law",
+    "pto_corrected_law",
+    "pto_printed_law",
+    "omega_c_scalar",
+    "make_law",
+    "LAW_NAMES",
+    "h_scalar",
+]
 
 
 class Region(IntEnum):
     """Branch of a law that produced the input."""
 
-    ORIGIN = 0       #: the origin, u = 0
-    BANG_P = 1       #: S_P or l1, u = +w_max (eq. 12)
-    BANG_N = 2       #: S_N or l2, u = -w_max
-    ZONE_P = 3       #: switching zone S~_P or l1*, u = +omega_c (eq. 28)
-    ZONE_N = 4       #: switching zone S~_N or l2*, u = -omega_c (eq. 33)
-    LINEAR = 5       #: linear (PD) input, unsaturated (eq. 34 or PD)
-    SATURATED = 6    #: linear input clipped at +-w_max
+    ORIGIN = 0  #: the origin, u = 0
+    BANG_P = 1  #: S_P or l1, u = +w_max (eq. 12)
+    BANG_N = 2  #: S_N or l2, u = -w_max
+    ZONE_P = 3  #: switching zone S~_P or l1*, u = +omega_c (eq. 28)
+    ZONE_N = 4  #: switching zone S~_N or l2*, u = -omega_c (eq. 33)
+    LINEAR = 5  #: linear (PD) input, unsaturated (eq. 34 or PD)
+    SATURATED = 6  #: linear input clipped at +-w_max
 
 
-ArrayFn = Callable[[NDArray[np.float64], NDArray[np.float64]],
-                   tuple[NDArray[np.float64], NDArray[np.int8]]]
+ArrayFn = Callable[
+    [NDArray[np.float64], NDArray[np.float64]], tuple[NDArray[np.float64], NDArray[np.int8]]
+]
 ScalarFn = Callable[[float, float], tuple[float, int]]
 
 
@@ -67,14 +79,15 @@ class Law:
     w_max: float
     note: str = ""
 
-    def __call__(self, x1: ArrayLike, x2: ArrayLike) -> tuple[NDArray[np.float64],
-                                                               NDArray[np.int8]]:
+    def __call__(
+        self, x1: ArrayLike, x2: ArrayLike
+    ) -> tuple[NDArray[np.float64], NDArray[np.int8]]:
         """Evaluate the law on arrays; returns (u [mm/s], region codes)."""
         x1, x2 = np.broadcast_arrays(np.asarray(x1, dtype=float), np.asarray(x2, dtype=float))
         return self.vector(x1, x2)
 
 
-_H_COEF = tuple((-1.0) ** n / n for n in range(25, 1, -1))   # Horner order, highest first
+_H_COEF = tuple((-1.0) ** n / n for n in range(25, 1, -1))  # Horner order, highest first
 
 
 def h_scalar(r: float) -> float:
@@ -300,7 +313,7 @@ def pto_law(cfg: Config, omega0: float | None, name: str = "pto", note: str = ""
                     r0 = level_residual(c1, c2, a, om)
                     zp = (c2 < 0) & (r0 <= 0)
                     inz = zp | ((c2 > 0) & (r0 >= 0))
-                    if inz.any():                   # closed form only where it is used
+                    if inz.any():  # closed form only where it is used
                         wc = np.clip(omega_c(c1[inz], c2[inz], a), om, w)
                         zpi = zp[inz]
                         idx = cand[inz]
@@ -356,11 +369,17 @@ def pto_corrected_law(cfg: Config) -> Law:
 
     z = zone_for_law(cfg, "corrected")
     if z.usable and not z.degenerate:
-        note = (f"PTO eq. (35), corrected omega0 = {z.omega0:.6g} mm/s "
-                f"({'valid' if z.valid else 'NOT valid'})")
+        note = (
+            f"PTO eq. (35), corrected omega0 = {z.omega0:.6g} mm/s "
+            f"({'valid' if z.valid else 'NOT valid'})"
+        )
         return pto_law(cfg, z.omega0, "pto", note)
-    return pto_law(cfg, None, "pto", "PTO eq. (35) without switching zone: no corrected omega0 "
-                   f"acts ({z.reason})")
+    return pto_law(
+        cfg,
+        None,
+        "pto",
+        f"PTO eq. (35) without switching zone: no corrected omega0 acts ({z.reason})",
+    )
 
 
 def pto_printed_law(cfg: Config) -> Law:
@@ -384,18 +403,29 @@ def pto_printed_law(cfg: Config) -> Law:
 
     z = zone_for_law(cfg, "printed")
     if z.usable:
-        return pto_law(cfg, z.omega0, "pto-printed",
-                       f"PTO eq. (35), printed omega0 = {z.omega0:.6g} mm/s "
-                       f"({'valid' if z.valid else 'NOT valid'})")
-    return pto_law(cfg, None, "pto-printed",
-                   f"printed omega0 = {z.omega0:.6g} mm/s is not below w_max = {cfg.plant.w_max:g}"
-                   " mm/s: [omega0, w_max] is empty, so no switching zone; time-optimal outside"
-                   " the linear zone, saturated eq. (34) inside")
+        return pto_law(
+            cfg,
+            z.omega0,
+            "pto-printed",
+            f"PTO eq. (35), printed omega0 = {z.omega0:.6g} mm/s "
+            f"({'valid' if z.valid else 'NOT valid'})",
+        )
+    return pto_law(
+        cfg,
+        None,
+        "pto-printed",
+        f"printed omega0 = {z.omega0:.6g} mm/s is not below w_max = {cfg.plant.w_max:g}"
+        " mm/s: [omega0, w_max] is empty, so no switching zone; time-optimal outside"
+        " the linear zone, saturated eq. (34) inside",
+    )
 
 
-_FACTORIES: dict[str, Callable[[Config], Law]] = {"to": to_law, "pd": pd_law,
-                                                  "pto": pto_corrected_law,
-                                                  "pto-printed": pto_printed_law}
+_FACTORIES: dict[str, Callable[[Config], Law]] = {
+    "to": to_law,
+    "pd": pd_law,
+    "pto": pto_corrected_law,
+    "pto-printed": pto_printed_law,
+}
 LAW_NAMES: tuple[str, ...] = ("to", "pd", "pto", "pto-printed")
 
 

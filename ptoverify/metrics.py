@@ -38,9 +38,22 @@ from numpy.typing import ArrayLike, NDArray
 if TYPE_CHECKING:  # pragma: no cover
     from ptoverify.simulate import SimResult
 
-__all__ = ["TIGHT_BAND", "STEP_FRACTION", "settling_time", "overshoot", "oscillation_amplitude",
-           "sign_reversals", "ramp_lag", "SineFit", "sine_fit", "phase_delay", "rise_time",
-           "time_to_linear_zone", "input_switches", "summarize"]
+__all__ = [
+    "TIGHT_BAND",
+    "STEP_FRACTION",
+    "settling_time",
+    "overshoot",
+    "oscillation_amplitude",
+    "sign_reversals",
+    "ramp_lag",
+    "SineFit",
+    "sine_fit",
+    "phase_delay",
+    "rise_time",
+    "time_to_linear_zone",
+    "input_switches",
+    "summarize",
+]
 
 TIGHT_BAND = 0.01
 """Tight settling band [mm]: 2 % of the paper's linear zone d = 0.5 mm."""
@@ -267,20 +280,25 @@ def sine_fit(t: ArrayLike, y: ArrayLike, freq: float, *, t_from: float = 0.0) ->
     """
     t, y = _arr(t), _arr(y)
     dt = t[1] - t[0]
-    per = int(round(1.0 / (freq * dt)))                 # samples per period
+    per = int(round(1.0 / (freq * dt)))  # samples per period
     if abs(per * freq * dt - 1.0) > 1e-9:
         raise ValueError("the period must be a whole number of samples")
     periods = int((t[-1] - max(t_from, t[0]) + 1e-9 * dt) // (per * dt))
     if periods < 1:
         raise ValueError("the steady part holds less than one period")
-    n = periods * per                                   # samples [-n:], whole periods
+    n = periods * per  # samples [-n:], whole periods
     tt, yy = t[-n:], y[-n:]
     w = 2.0 * math.pi * freq
     M = np.column_stack([np.sin(w * tt), np.cos(w * tt), np.ones_like(tt)])
     (A, B, C), *_ = np.linalg.lstsq(M, yy, rcond=None)
     res = yy - M @ np.array([A, B, C])
-    return SineFit(float(math.hypot(A, B)), float(math.degrees(math.atan2(B, A))), float(C),
-                   float(np.sqrt(np.mean(res * res))), periods)
+    return SineFit(
+        float(math.hypot(A, B)),
+        float(math.degrees(math.atan2(B, A))),
+        float(C),
+        float(np.sqrt(np.mean(res * res))),
+        periods,
+    )
 
 
 def phase_delay(ref: SineFit, out: SineFit) -> float:
@@ -302,8 +320,9 @@ def phase_delay(ref: SineFit, out: SineFit) -> float:
     return 180.0 if d == -180.0 else d
 
 
-def rise_time(t: ArrayLike, x: ArrayLike, target: float, *, low: float = 0.1,
-              high: float = 0.9) -> float:
+def rise_time(
+    t: ArrayLike, x: ArrayLike, target: float, *, low: float = 0.1, high: float = 0.9
+) -> float:
     """Rise time from ``low`` to ``high`` of a step from 0 to ``target``.
 
     Parameters
@@ -335,8 +354,9 @@ def rise_time(t: ArrayLike, x: ArrayLike, target: float, *, low: float = 0.1,
     return float(t[k_hi[0]] - t[k_lo[0]])
 
 
-def time_to_linear_zone(t: ArrayLike, region: ArrayLike,
-                        codes: tuple[int, ...] | None = None) -> float:
+def time_to_linear_zone(
+    t: ArrayLike, region: ArrayLike, codes: tuple[int, ...] | None = None
+) -> float:
     """First time the linear scheme acts: "the system enters the linear zone".
 
     Parameters
@@ -392,8 +412,9 @@ def input_switches(u: ArrayLike, *, tol: float = 0.0) -> int:
     return sign_reversals(u, tol)
 
 
-def summarize(res: SimResult, *, band: float = TIGHT_BAND,
-              step_fraction: float = STEP_FRACTION) -> dict[str, float]:
+def summarize(
+    res: SimResult, *, band: float = TIGHT_BAND, step_fraction: float = STEP_FRACTION
+) -> dict[str, float]:
     """All metrics of one simulated response, by name (units in the names).
 
     The steady part is the last half of the record.  For the sine, the fit

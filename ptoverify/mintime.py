@@ -32,8 +32,14 @@ from ptoverify.config import Plant
 from ptoverify.curves import blockwise, h
 from ptoverify.errors import InputError
 
-__all__ = ["MinTime", "min_time", "DiscreteMinTime", "ZOHReach", "discrete_min_steps",
-           "discrete_min_steps_batch"]
+__all__ = [
+    "MinTime",
+    "min_time",
+    "DiscreteMinTime",
+    "ZOHReach",
+    "discrete_min_steps",
+    "discrete_min_steps_batch",
+]
 
 
 @dataclass(frozen=True)
@@ -81,17 +87,18 @@ def min_time(x1: ArrayLike, x2: ArrayLike, plant: Plant) -> MinTime:
     >>> 0.02 < float(mt.t_f) < 0.03, float(mt.t_switch) < float(mt.t_f)
     (True, True)
     """
-    t_f, t_switch, side, q = blockwise(lambda b1, b2: _min_time(b1, b2, plant.a, plant.w_max),
-                                       x1, x2)
+    t_f, t_switch, side, q = blockwise(
+        lambda b1, b2: _min_time(b1, b2, plant.a, plant.w_max), x1, x2
+    )
     return MinTime(t_f=t_f, t_switch=t_switch, side=side, q=q)
 
 
 def _min_time(x1: NDArray, x2: NDArray, a: float, w: float) -> tuple[NDArray, ...]:
     """:func:`min_time` on broadcast float arrays (one block): (t_f, t_switch, side, q)."""
     hr = h(np.abs(x2) / w)
-    sigma = a * x1 + np.sign(x2) * w * hr               # switching_function, eqs. (9), (11)
+    sigma = a * x1 + np.sign(x2) * w * hr  # switching_function, eqs. (9), (11)
     pos = sigma > 0
-    pos |= ~(pos | (sigma < 0)) & (x2 < 0)              # on the curve: the side of x2
+    pos |= ~(pos | (sigma < 0)) & (x2 < 0)  # on the curve: the side of x2
     side = np.where(pos, 1.0, -1.0)
     y1, y2 = side * x1, side * x2
     rho = y2 / w
@@ -103,7 +110,7 @@ def _min_time(x1: NDArray, x2: NDArray, a: float, w: float) -> tuple[NDArray, ..
             hr[redo] = h(np.where(fast[redo], 0.0, rho[redo]))
         g = a * y1 / w + hr
         q2 = -(w * w) * np.expm1(-g)
-        fi = np.flatnonzero(fast)                       # y2 <= -w: the form without cancellation
+        fi = np.flatnonzero(fast)  # y2 <= -w: the form without cancellation
         if fi.size:
             y1f, y2f = y1[fi], y2[fi]
             q2[fi] = w * w - w * (w + y2f) * np.exp(-(a * y1f + y2f) / w)
@@ -160,9 +167,9 @@ class DiscreteMinTime:
         return self.status in ("optimal", "origin")
 
 
-_END_TOL_X1 = 1e-9      # mm: required end position error of the verified sequence
-_END_TOL_X2 = 1e-6      # mm/s: required end velocity error
-_U_TOL = 1e-9           # relative overshoot of |u| <= w_max tolerated after polishing
+_END_TOL_X1 = 1e-9  # mm: required end position error of the verified sequence
+_END_TOL_X2 = 1e-6  # mm/s: required end velocity error
+_U_TOL = 1e-9  # relative overshoot of |u| <= w_max tolerated after polishing
 
 
 class ZOHReach:
@@ -200,7 +207,7 @@ class ZOHReach:
             b1, b2 = self._bd
             a = self.plant.a
             self._gen = np.vstack([a * (b1 + p12 * b2), p22 * b2])  # diag(a/w, 1/w) Ad^m Bd w
-        return self._gen[:, n - 1::-1] if n > 0 else np.zeros((2, 0))
+        return self._gen[:, n - 1 :: -1] if n > 0 else np.zeros((2, 0))
 
     def free(self, x1: float, x2: float, n: int) -> NDArray[np.float64]:
         """Dimensionless Ad^n x0."""
@@ -247,7 +254,7 @@ def _polish(A: NDArray, b: NDArray, v: NDArray) -> NDArray[np.float64]:
     v = v.copy()
     slack = 1.0 - np.abs(v)
     free = np.nonzero(slack > 1e-9)[0]
-    if free.size < 2:                        # pad with the inputs closest to interior
+    if free.size < 2:  # pad with the inputs closest to interior
         free = np.argsort(-slack)[:2]
     v[np.setdiff1d(np.arange(v.size), free)] = np.sign(v[np.setdiff1d(np.arange(v.size), free)])
     for _ in range(3):
@@ -264,8 +271,14 @@ def _simulate_zoh(x1: float, x2: float, u: NDArray, plant: Plant) -> tuple[float
     return float(x1), float(x2)
 
 
-def discrete_min_steps(x1: float, x2: float, plant: Plant, n_max: int = 20000,
-                       reach: ZOHReach | None = None, confirm: bool = True) -> DiscreteMinTime:
+def discrete_min_steps(
+    x1: float,
+    x2: float,
+    plant: Plant,
+    n_max: int = 20000,
+    reach: ZOHReach | None = None,
+    confirm: bool = True,
+) -> DiscreteMinTime:
     """Fewest ZOH samples N* to reach the origin exactly, |u_k| <= w_max.
 
     Linear-programming feasibility (scipy HiGHS, two equality rows from the
@@ -317,7 +330,7 @@ def discrete_min_steps(x1: float, x2: float, plant: Plant, n_max: int = 20000,
     if n0 > n_max:
         return fail(f"not_found: N* > n_max = {n_max}")
     lo, hi, u_hi, step = n0 - 1, n0, None, 1
-    while True:                               # exponential search for a feasible N
+    while True:  # exponential search for a feasible N
         ok, u, st = reach.feasible(x1, x2, hi)
         solves += 1
         if st.startswith("lp_failed"):
@@ -328,7 +341,7 @@ def discrete_min_steps(x1: float, x2: float, plant: Plant, n_max: int = 20000,
         lo, hi, step = hi, hi + step, 2 * step
         if hi > n_max:
             return fail(f"not_found: N* > n_max = {n_max}")
-    while hi - lo > 1:                        # bisection: lo infeasible, hi feasible
+    while hi - lo > 1:  # bisection: lo infeasible, hi feasible
         mid = (lo + hi) // 2
         ok, u, st = reach.feasible(x1, x2, mid)
         solves += 1
@@ -339,7 +352,7 @@ def discrete_min_steps(x1: float, x2: float, plant: Plant, n_max: int = 20000,
         else:
             lo = mid
     status = "optimal"
-    if confirm and hi == n0 and hi > 1:       # N* - 1 was assumed, not solved: check it
+    if confirm and hi == n0 and hi > 1:  # N* - 1 was assumed, not solved: check it
         ok, _, st = reach.feasible(x1, x2, hi - 1)
         solves += 1
         if ok:
@@ -352,8 +365,9 @@ def discrete_min_steps(x1: float, x2: float, plant: Plant, n_max: int = 20000,
     return DiscreteMinTime(hi, hi * plant.sample_time, u_hi, status, end, tf, solves)
 
 
-def discrete_min_steps_batch(x1: ArrayLike, x2: ArrayLike, plant: Plant, n_max: int = 20000,
-                             confirm: bool = True) -> list[DiscreteMinTime]:
+def discrete_min_steps_batch(
+    x1: ArrayLike, x2: ArrayLike, plant: Plant, n_max: int = 20000, confirm: bool = True
+) -> list[DiscreteMinTime]:
     """:func:`discrete_min_steps` for many states, sharing the generators.
 
     Parameters
@@ -374,5 +388,7 @@ def discrete_min_steps_batch(x1: ArrayLike, x2: ArrayLike, plant: Plant, n_max: 
     """
     x1, x2 = np.broadcast_arrays(np.asarray(x1, dtype=float), np.asarray(x2, dtype=float))
     reach = ZOHReach(plant)
-    return [discrete_min_steps(a, b, plant, n_max=n_max, reach=reach, confirm=confirm)
-            for a, b in zip(x1.ravel(), x2.ravel(), strict=True)]
+    return [
+        discrete_min_steps(a, b, plant, n_max=n_max, reach=reach, confirm=confirm)
+        for a, b in zip(x1.ravel(), x2.ravel(), strict=True)
+    ]

@@ -47,8 +47,14 @@ from ptoverify.curves import switching_function
 from ptoverify.errors import InputError
 from ptoverify.plant import flow
 
-__all__ = ["OCPResult", "TwoPhaseOCP", "CollocationOCP", "ConvergenceStudy",
-           "convergence_study", "resimulate"]
+__all__ = [
+    "OCPResult",
+    "TwoPhaseOCP",
+    "CollocationOCP",
+    "ConvergenceStudy",
+    "convergence_study",
+    "resimulate",
+]
 
 _IPOPT_QUIET = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes"}
 
@@ -108,9 +114,18 @@ def _check_state(x1: float, x2: float) -> tuple[float, float]:
 
 
 def _origin_result() -> OCPResult:
-    return OCPResult(t_f=0.0, t_switch=0.0, status="origin", success=True, iterations=0,
-                     side=0.0, t=np.zeros(1), u=np.zeros(0), resim_end=(0.0, 0.0),
-                     resim_error=0.0)
+    return OCPResult(
+        t_f=0.0,
+        t_switch=0.0,
+        status="origin",
+        success=True,
+        iterations=0,
+        side=0.0,
+        t=np.zeros(1),
+        u=np.zeros(0),
+        resim_end=(0.0, 0.0),
+        resim_error=0.0,
+    )
 
 
 def _stats(solver: ca.Function) -> tuple[str, bool, int]:
@@ -121,7 +136,7 @@ def _stats(solver: ca.Function) -> tuple[str, bool, int]:
 
 def _scaled_flow(z1, z2, v, tau):
     """Exact dimensionless flow of eq. (7) under constant v for time tau."""
-    g = -ca.expm1(-tau)                      # 1 - e^{-tau}
+    g = -ca.expm1(-tau)  # 1 - e^{-tau}
     return z1 + v * tau + (z2 - v) * g, z2 - (z2 - v) * g
 
 
@@ -144,9 +159,14 @@ def _two_phase_solver(max_iter: int, tol: float) -> ca.Function:
     y1, y2 = _scaled_flow(z1, z2, -s, w[0])
     y1, y2 = _scaled_flow(y1, y2, s, w[1])
     nlp = {"x": w, "p": p, "f": w[0] + w[1], "g": ca.vertcat(y1, y2) / p[3]}
-    opts = {**_IPOPT_QUIET, "ipopt.max_iter": max_iter, "ipopt.tol": tol,
-            "ipopt.constr_viol_tol": tol, "ipopt.mu_strategy": "adaptive",
-            "ipopt.bound_relax_factor": 0.0}
+    opts = {
+        **_IPOPT_QUIET,
+        "ipopt.max_iter": max_iter,
+        "ipopt.tol": tol,
+        "ipopt.constr_viol_tol": tol,
+        "ipopt.mu_strategy": "adaptive",
+        "ipopt.bound_relax_factor": 0.0,
+    }
     return ca.nlpsol("two_phase", "ipopt", nlp, opts)
 
 
@@ -179,8 +199,9 @@ class TwoPhaseOCP:
     (True, True)
     """
 
-    def __init__(self, plant: Plant, side: str = "switching", max_iter: int = 100,
-                 tol: float = 1e-13):
+    def __init__(
+        self, plant: Plant, side: str = "switching", max_iter: int = 100, tol: float = 1e-13
+    ):
         if side not in ("switching", "both"):
             raise InputError(f"side must be 'switching' or 'both', got {side!r}")
         self.plant = plant
@@ -233,7 +254,7 @@ class TwoPhaseOCP:
         statuses = []
         for s in sides:
             if self.side == "switching" and best is not None:
-                break                       # the other side only if the first one failed
+                break  # the other side only if the first one failed
             tau, status, ok, it = self._solve_side(z1, z2, s)
             iterations += it
             statuses.append(status)
@@ -241,18 +262,32 @@ class TwoPhaseOCP:
                 best = (tau, s, status)
         elapsed = time.perf_counter() - start
         if best is None:
-            return OCPResult(t_f=math.nan, t_switch=math.nan, status=" / ".join(statuses),
-                             success=False, iterations=iterations, side=sides[0],
-                             solve_time_s=elapsed)
+            return OCPResult(
+                t_f=math.nan,
+                t_switch=math.nan,
+                status=" / ".join(statuses),
+                success=False,
+                iterations=iterations,
+                side=sides[0],
+                solve_time_s=elapsed,
+            )
         tau, s, status = best
-        return OCPResult(t_f=float(tau.sum() / a), t_switch=float(tau[0] / a), status=status,
-                         success=True, iterations=iterations, side=s, solve_time_s=elapsed)
+        return OCPResult(
+            t_f=float(tau.sum() / a),
+            t_switch=float(tau[0] / a),
+            status=status,
+            success=True,
+            iterations=iterations,
+            side=s,
+            solve_time_s=elapsed,
+        )
 
 
 # ---------------------------------------------------------------- collocation
 @lru_cache(maxsize=None)
-def _collocation_solver(intervals: int, degree: int, max_iter: int, tol: float,
-                        control: str) -> ca.Function:
+def _collocation_solver(
+    intervals: int, degree: int, max_iter: int, tol: float, control: str
+) -> ca.Function:
     """Build the Radau collocation NLP once per (N, degree, options).
 
     Decision vector: [tau_f, v_0..v_{N-1}, Z (2 x (N (degree + 1) + 1)) column-major];
@@ -260,8 +295,8 @@ def _collocation_solver(intervals: int, degree: int, max_iter: int, tol: float,
     """
     n = intervals
     roots = [0.0, *ca.collocation_points(degree, "radau")]
-    C = np.zeros((degree + 1, degree + 1))    # C[r, j]: d/ds of Lagrange poly r at root j
-    D = np.zeros(degree + 1)                  # D[r]: Lagrange poly r at s = 1
+    C = np.zeros((degree + 1, degree + 1))  # C[r, j]: d/ds of Lagrange poly r at root j
+    D = np.zeros(degree + 1)  # D[r]: Lagrange poly r at s = 1
     for r in range(degree + 1):
         coef = np.poly1d([1.0])
         for j in range(degree + 1):
@@ -296,13 +331,18 @@ def _collocation_solver(intervals: int, degree: int, max_iter: int, tol: float,
     g = ca.vertcat(Z[:, 0] - p, ca.vec(coll), ca.vec(ends - starts), Z[:, -1])
     x = ca.vertcat(tau_f, v, ca.vec(Z))
     nlp = {"x": x, "p": p, "f": tau_f, "g": g}
-    opts = {**_IPOPT_QUIET, "ipopt.max_iter": max_iter, "ipopt.tol": tol,
-            "ipopt.mu_strategy": "adaptive", "ipopt.bound_relax_factor": 0.0, "expand": True}
+    opts = {
+        **_IPOPT_QUIET,
+        "ipopt.max_iter": max_iter,
+        "ipopt.tol": tol,
+        "ipopt.mu_strategy": "adaptive",
+        "ipopt.bound_relax_factor": 0.0,
+        "expand": True,
+    }
     return ca.nlpsol(f"radau{n}", "ipopt", nlp, opts)
 
 
-def resimulate(t: NDArray, u: NDArray, x1: float, x2: float,
-               a: float) -> tuple[float, float]:
+def resimulate(t: NDArray, u: NDArray, x1: float, x2: float, a: float) -> tuple[float, float]:
     """Apply a piecewise-constant input to the exact plant (eq. 7).
 
     Parameters
@@ -358,9 +398,16 @@ class CollocationOCP:
         239 iterations against 97 cold.
     """
 
-    def __init__(self, plant: Plant, intervals: int = 100, degree: int = 3,
-                 max_iter: int = 500, tol: float = 1e-10, warm_start: bool = False,
-                 control: str = "points"):
+    def __init__(
+        self,
+        plant: Plant,
+        intervals: int = 100,
+        degree: int = 3,
+        max_iter: int = 500,
+        tol: float = 1e-10,
+        warm_start: bool = False,
+        control: str = "points",
+    ):
         if intervals < 1:
             raise InputError(f"intervals must be positive, got {intervals}")
         if control not in ("points", "interval"):
@@ -370,15 +417,16 @@ class CollocationOCP:
         self.degree = int(degree)
         self.control = control
         self.warm_start = warm_start
-        self._solver = _collocation_solver(self.intervals, self.degree, int(max_iter),
-                                           float(tol), control)
+        self._solver = _collocation_solver(
+            self.intervals, self.degree, int(max_iter), float(tol), control
+        )
         self._prev: dict[str, NDArray] | None = None
         n, d = self.intervals, self.degree
         self._nu = n * d if control == "points" else n
         self._nz = n * (d + 1) + 1
         self._nx = 1 + self._nu + 2 * self._nz
         roots = np.array(ca.collocation_points(d, "radau"))
-        if control == "points":   # u_kj held for b_j h: same impulse as the quadrature
+        if control == "points":  # u_kj held for b_j h: same impulse as the quadrature
             edges = np.cumsum(radau_weights(roots))
             self._grid = (np.arange(n)[:, None] + edges[None, :]).ravel() / n
             self._grid = np.concatenate([[0.0], self._grid])
@@ -415,8 +463,8 @@ class CollocationOCP:
         lbx = np.full(self._nx, -np.inf)
         ubx = np.full(self._nx, np.inf)
         lbx[0] = tau_lb
-        lbx[1:1 + self._nu] = -1.0
-        ubx[1:1 + self._nu] = 1.0
+        lbx[1 : 1 + self._nu] = -1.0
+        ubx[1 : 1 + self._nu] = 1.0
         kwargs = {}
         if self.warm_start and self._prev is not None:
             x0 = self._prev["x"].copy()
@@ -430,17 +478,29 @@ class CollocationOCP:
         status, ok, it = _stats(self._solver)
         xs = np.asarray(sol["x"]).ravel()
         if ok:
-            self._prev = {"x": xs, "lam_x": np.asarray(sol["lam_x"]).ravel(),
-                          "lam_g": np.asarray(sol["lam_g"]).ravel()}
+            self._prev = {
+                "x": xs,
+                "lam_x": np.asarray(sol["lam_x"]).ravel(),
+                "lam_g": np.asarray(sol["lam_g"]).ravel(),
+            }
         t_f = xs[0] / a
-        u = w * xs[1:1 + self._nu]
+        u = w * xs[1 : 1 + self._nu]
         t = t_f * self._grid
         end = resimulate(t, u, x1, x2, a)
         side, t_sw = _locate_switch(t, u / w)
-        return OCPResult(t_f=float(t_f) if ok else math.nan, t_switch=t_sw if ok else math.nan,
-                         status=status, success=ok, iterations=it, side=side,
-                         solve_time_s=elapsed, t=t, u=u, resim_end=end,
-                         resim_error=float(math.hypot(end[0], end[1] / a)))
+        return OCPResult(
+            t_f=float(t_f) if ok else math.nan,
+            t_switch=t_sw if ok else math.nan,
+            status=status,
+            success=ok,
+            iterations=it,
+            side=side,
+            solve_time_s=elapsed,
+            t=t,
+            u=u,
+            resim_end=end,
+            resim_error=float(math.hypot(end[0], end[1] / a)),
+        )
 
 
 def radau_weights(roots: NDArray) -> NDArray[np.float64]:
@@ -533,8 +593,13 @@ def _slope(logn: NDArray, loge: NDArray) -> float:
     return float(-np.polyfit(logn[ok], loge[ok], 1)[0])
 
 
-def convergence_study(plant: Plant, states, intervals=(10, 20, 40, 80, 100, 200, 400),
-                      degree: int = 3, control: str = "points") -> ConvergenceStudy:
+def convergence_study(
+    plant: Plant,
+    states,
+    intervals=(10, 20, 40, 80, 100, 200, 400),
+    degree: int = 3,
+    control: str = "points",
+) -> ConvergenceStudy:
     """Collocation t_f error vs N and the observed order of convergence.
 
     Parameters
@@ -564,8 +629,9 @@ def convergence_study(plant: Plant, states, intervals=(10, 20, 40, 80, 100, 200,
     ok = np.zeros(tf.shape, dtype=bool)
     profiles = {}
     for j, n in enumerate(ns):
-        ocp = CollocationOCP(plant, intervals=int(n), degree=degree, warm_start=False,
-                             control=control)
+        ocp = CollocationOCP(
+            plant, intervals=int(n), degree=degree, warm_start=False, control=control
+        )
         for i, (x1, x2) in enumerate(states):
             r = ocp.solve(x1, x2)
             tf[i, j], rs[i, j], ok[i, j] = r.t_f, r.resim_error, r.success
@@ -582,7 +648,16 @@ def convergence_study(plant: Plant, states, intervals=(10, 20, 40, 80, 100, 200,
     cent_n = cent_n - np.nanmean(cent_n, axis=1, keepdims=True)
     m = np.isfinite(cent_e) & np.isfinite(cent_n)
     order = float(-(cent_e[m] @ cent_n[m]) / (cent_n[m] @ cent_n[m])) if m.sum() > 1 else math.nan
-    return ConvergenceStudy(intervals=ns, states=states, t_f_exact=exact,
-                            t_switch_exact=np.asarray(mt.t_switch, dtype=float), t_f=tf,
-                            rel_error=rel, resim_error=rs, order_per_state=per_state,
-                            order=order, success=ok, profiles=profiles)
+    return ConvergenceStudy(
+        intervals=ns,
+        states=states,
+        t_f_exact=exact,
+        t_switch_exact=np.asarray(mt.t_switch, dtype=float),
+        t_f=tf,
+        rel_error=rel,
+        resim_error=rs,
+        order_per_state=per_state,
+        order=order,
+        success=ok,
+        profiles=profiles,
+    )

@@ -47,8 +47,10 @@ def check_target(out: str | Path) -> Path:
         if not target.is_dir():
             raise InputError(f"--out '{target}' exists and is not a directory")
         if any(target.iterdir()) and not (target / MARKER).exists():
-            raise InputError(f"--out '{target}' exists and is not a ptoverify output folder "
-                             f"(no {MARKER} marker); refusing to replace it")
+            raise InputError(
+                f"--out '{target}' exists and is not a ptoverify output folder "
+                f"(no {MARKER} marker); refusing to replace it"
+            )
     anchor = _existing_ancestor(target)
     if not anchor.is_dir():
         raise InputError(f"cannot write '{target}': '{anchor}' is not a directory")
@@ -92,7 +94,7 @@ def publish(tmp: Path, target: Path) -> None:
         os.replace(tmp, target)
         umask = os.umask(0)
         os.umask(umask)
-        target.chmod(0o777 & ~umask)               # mkdtemp made it 0700
+        target.chmod(0o777 & ~umask)  # mkdtemp made it 0700
     except OSError as exc:
         if backup is not None and not target.exists():
             os.replace(backup, target)

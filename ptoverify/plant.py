@@ -18,8 +18,9 @@ from ptoverify.config import Plant
 __all__ = ["flow", "step", "zoh_matrices"]
 
 
-def flow(x1: ArrayLike, x2: ArrayLike, u: ArrayLike, t: ArrayLike,
-         a: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def flow(
+    x1: ArrayLike, x2: ArrayLike, u: ArrayLike, t: ArrayLike, a: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Exact state after time t under a constant input, eq. (7).
 
     Parameters
@@ -45,13 +46,14 @@ def flow(x1: ArrayLike, x2: ArrayLike, u: ArrayLike, t: ArrayLike,
     300.0
     """
     x1, x2, u, t = (np.asarray(v, dtype=float) for v in (x1, x2, u, t))
-    g = -np.expm1(-a * t)                      # 1 - e^{-a t}
+    g = -np.expm1(-a * t)  # 1 - e^{-a t}
     dv = x2 - u
     return x1 + u * t + dv * g / a, x2 - dv * g
 
 
-def step(x1: ArrayLike, x2: ArrayLike, u: ArrayLike,
-         plant: Plant) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def step(
+    x1: ArrayLike, x2: ArrayLike, u: ArrayLike, plant: Plant
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """One-sample map of the ZOH plant: hold u for T, eq. (15).
 
     Parameters
@@ -94,7 +96,7 @@ def zoh_matrices(a: float, T: float) -> tuple[NDArray[np.float64], NDArray[np.fl
     >>> Ad.shape, Bd.shape
     ((2, 2), (2, 1))
     """
-    g = -np.expm1(-a * T)                      # 1 - e^{-aT}
+    g = -np.expm1(-a * T)  # 1 - e^{-aT}
     Ad = np.array([[1.0, g / a], [0.0, 1.0 - g]])
     Bd = np.array([[T - g / a], [g]])
     return Ad, Bd

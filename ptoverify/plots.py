@@ -41,22 +41,40 @@ from ptoverify.zones import corrected_zone, printed_zone  # noqa: E402
 if TYPE_CHECKING:
     from ptoverify.ocp import ConvergenceStudy
 
-__all__ = ["plot_fig2", "plot_fig3", "plot_zones", "plot_fig5", "plot_fig6", "plot_response",
-           "plot_state_trajectories", "plot_sweep", "save_all", "save_sweep",
-           "plot_zone_geometry", "plot_convergence", "plot_switch_profiles", "save_ground_truth",
-           "save_zone_geometry"]
+__all__ = [
+    "plot_fig2",
+    "plot_fig3",
+    "plot_zones",
+    "plot_fig5",
+    "plot_fig6",
+    "plot_response",
+    "plot_state_trajectories",
+    "plot_sweep",
+    "save_all",
+    "save_sweep",
+    "plot_zone_geometry",
+    "plot_convergence",
+    "plot_switch_profiles",
+    "save_ground_truth",
+    "save_zone_geometry",
+]
 
 DPI = 110
-STYLE = {"to": dict(color="tab:red", lw=1.0, label="TO"),
-         "pd": dict(color="tab:blue", lw=1.3, label="PD"),
-         "pto": dict(color="tab:green", lw=1.6, label="PTO (corrected zone)"),
-         "pto-printed": dict(color="tab:orange", lw=1.2, ls="--", label="PTO (as printed)")}
-REGION_STYLE = {Region.BANG_P: ("tab:red", "S_P: +w_max"), Region.BANG_N: ("tab:purple",
-                "S_N: -w_max"), Region.ZONE_P: ("tab:orange", "zone: +omega_c"),
-                Region.ZONE_N: ("tab:olive", "zone: -omega_c"),
-                Region.LINEAR: ("tab:green", "linear zone"),
-                Region.SATURATED: ("tab:cyan", "linear, clipped"),
-                Region.ORIGIN: ("k", "origin")}
+STYLE = {
+    "to": dict(color="tab:red", lw=1.0, label="TO"),
+    "pd": dict(color="tab:blue", lw=1.3, label="PD"),
+    "pto": dict(color="tab:green", lw=1.6, label="PTO (corrected zone)"),
+    "pto-printed": dict(color="tab:orange", lw=1.2, ls="--", label="PTO (as printed)"),
+}
+REGION_STYLE = {
+    Region.BANG_P: ("tab:red", "S_P: +w_max"),
+    Region.BANG_N: ("tab:purple", "S_N: -w_max"),
+    Region.ZONE_P: ("tab:orange", "zone: +omega_c"),
+    Region.ZONE_N: ("tab:olive", "zone: -omega_c"),
+    Region.LINEAR: ("tab:green", "linear zone"),
+    Region.SATURATED: ("tab:cyan", "linear, clipped"),
+    Region.ORIGIN: ("k", "origin"),
+}
 
 
 def _ax(ax):
@@ -66,7 +84,7 @@ def _ax(ax):
 
 
 def _curve(ax, a: float, omega: float, x2, drawn: dict, label: str, **kw) -> None:
-    line, = ax.plot(level_curve_x1(x2, a, omega), x2, label=label, **kw)
+    (line,) = ax.plot(level_curve_x1(x2, a, omega), x2, label=label, **kw)
     drawn[label] = line
 
 
@@ -99,29 +117,31 @@ def plot_fig2(cfg: Config, ax=None) -> dict:
     t = np.linspace(0, 6 / a, 200)
     span = 4 * w / a
     for x10 in np.linspace(-span, span, 7):
-        for u, x20, col, lab in ((w, -0.95 * w, "tab:blue", "u = +w_max (eq. 8)"),
-                                 (-w, 0.95 * w, "tab:cyan", "u = -w_max (eq. 10)")):
+        for u, x20, col, lab in (
+            (w, -0.95 * w, "tab:blue", "u = +w_max (eq. 8)"),
+            (-w, 0.95 * w, "tab:cyan", "u = -w_max (eq. 10)"),
+        ):
             x1, x2 = flow(x10, x20, u, t, a)
-            line, = ax.plot(x1, x2, color=col, lw=0.8)
+            (line,) = ax.plot(x1, x2, color=col, lw=0.8)
             drawn.setdefault(lab, line).set_label(lab)
     neg, pos = np.linspace(-0.999 * w, 0, 200), np.linspace(0, 0.999 * w, 200)
-    l1 = {"neg": w * h(-neg / w) / a, "pos": w * h(-pos / w) / a}    # eq. (9) solved for x1
-    l2 = {"neg": -w * h(neg / w) / a, "pos": -w * h(pos / w) / a}    # eq. (11) solved for x1
-    for x1, x2, lab, kw in ((l1["neg"], neg, "l1, x2 <= 0 (kept)", dict(color="k", lw=2)),
-                            (l1["pos"], pos, "l1, x2 > 0 (runs away)",
-                             dict(color="k", lw=1, ls=":")),
-                            (l2["pos"], pos, "l2, x2 >= 0 (kept)",
-                             dict(color="0.3", lw=2, ls="-.")),
-                            (l2["neg"], neg, "l2, x2 < 0 (runs away)",
-                             dict(color="0.3", lw=1, ls=":"))):
-        drawn[lab], = ax.plot(x1, x2, label=lab, **kw)
+    l1 = {"neg": w * h(-neg / w) / a, "pos": w * h(-pos / w) / a}  # eq. (9) solved for x1
+    l2 = {"neg": -w * h(neg / w) / a, "pos": -w * h(pos / w) / a}  # eq. (11) solved for x1
+    for x1, x2, lab, kw in (
+        (l1["neg"], neg, "l1, x2 <= 0 (kept)", dict(color="k", lw=2)),
+        (l1["pos"], pos, "l1, x2 > 0 (runs away)", dict(color="k", lw=1, ls=":")),
+        (l2["pos"], pos, "l2, x2 >= 0 (kept)", dict(color="0.3", lw=2, ls="-.")),
+        (l2["neg"], neg, "l2, x2 < 0 (runs away)", dict(color="0.3", lw=1, ls=":")),
+    ):
+        (drawn[lab],) = ax.plot(x1, x2, label=lab, **kw)
     ax.set_xlim(-span * 1.5, span * 1.5)
     _finish(ax, "Fig. 2: trajectories under +-w_max and the switching curve", drawn)
     return drawn
 
 
-def _finish(ax, title: str, drawn: dict, xlab="position x1 [mm]",
-            ylab="velocity x2 [mm/s]") -> None:
+def _finish(
+    ax, title: str, drawn: dict, xlab="position x1 [mm]", ylab="velocity x2 [mm/s]"
+) -> None:
     ax.set_xlabel(xlab)
     ax.set_ylabel(ylab)
     ax.set_title(title, fontsize=9)
@@ -155,7 +175,7 @@ def plot_fig3(cfg: Config, ax=None, *, steps: int | None = None) -> dict:
     n = steps or int(math.ceil(3 * (2 * R / w + 3 / p.a) / p.T))
     b = simulate_batch(make_law("to", cfg), p, x10, x20, n)
     for j in range(x10.size):
-        line, = ax.plot(b.x1[:, j], b.x2[:, j], color="tab:blue", lw=0.8)
+        (line,) = ax.plot(b.x1[:, j], b.x2[:, j], color="tab:blue", lw=0.8)
         drawn["TO closed loop (sampled)"] = line
     line.set_label("TO closed loop (sampled)")
     _switching(ax, cfg, drawn, lim=0.999 * w)
@@ -175,8 +195,9 @@ def _zone(cfg: Config, variant: str):
 
 def _zone_xlim(cfg: Config, omega0: float) -> float:
     a, w, d = cfg.plant.a, cfg.plant.w_max, cfg.pto.d
-    reach = float(level_curve_x1(-w, a, omega0)) if 0 < omega0 < w else float(
-        level_curve_x1(-w, a, w))
+    reach = (
+        float(level_curve_x1(-w, a, omega0)) if 0 < omega0 < w else float(level_curve_x1(-w, a, w))
+    )
     return max(4 * d, 1.3 * reach)
 
 
@@ -201,23 +222,47 @@ def plot_zones(cfg: Config, variant: str = "corrected", ax=None) -> dict:
     a, w, d = cfg.plant.a, cfg.plant.w_max, cfg.pto.d
     z = _zone(cfg, variant)
     drawn: dict = {}
-    drawn["linear zone |x1| < d"] = ax.axvspan(-d, d, color="tab:green", alpha=0.15,
-                                               label="linear zone |x1| < d")
+    drawn["linear zone |x1| < d"] = ax.axvspan(
+        -d, d, color="tab:green", alpha=0.15, label="linear zone |x1| < d"
+    )
     _switching(ax, cfg, drawn, lim=w)
     neg, pos = np.linspace(-w, 0, 300), np.linspace(0, w, 300)
     if 0 < z.omega0 < w:
         om = z.omega0
-        _curve(ax, a, om, neg, drawn, f"l1* (eq. 13), omega0 = {om:.4g} mm/s", color="tab:orange",
-               lw=1.6)
+        _curve(
+            ax,
+            a,
+            om,
+            neg,
+            drawn,
+            f"l1* (eq. 13), omega0 = {om:.4g} mm/s",
+            color="tab:orange",
+            lw=1.6,
+        )
         _curve(ax, a, om, pos, drawn, "l2* (eq. 14)", color="tab:orange", lw=1.6, ls="-.")
         drawn["switching zone"] = ax.fill_betweenx(
-            neg, level_curve_x1(neg, a, w), level_curve_x1(neg, a, om), color="tab:orange",
-            alpha=0.25, label="switching zone S~_P, S~_N")
-        ax.fill_betweenx(pos, level_curve_x1(pos, a, om), level_curve_x1(pos, a, w),
-                         color="tab:orange", alpha=0.25)
+            neg,
+            level_curve_x1(neg, a, w),
+            level_curve_x1(neg, a, om),
+            color="tab:orange",
+            alpha=0.25,
+            label="switching zone S~_P, S~_N",
+        )
+        ax.fill_betweenx(
+            pos,
+            level_curve_x1(pos, a, om),
+            level_curve_x1(pos, a, w),
+            color="tab:orange",
+            alpha=0.25,
+        )
     else:
-        drawn["no zone"] = ax.text(0.02, 0.04, f"{variant}: omega0 = {z.omega0:.4g} mm/s, "
-                                   f"no switching zone", transform=ax.transAxes, fontsize=7)
+        drawn["no zone"] = ax.text(
+            0.02,
+            0.04,
+            f"{variant}: omega0 = {z.omega0:.4g} mm/s, no switching zone",
+            transform=ax.transAxes,
+            fontsize=7,
+        )
     lim = _zone_xlim(cfg, z.omega0)
     ax.set_xlim(-lim, lim)
     ax.set_ylim(-1.05 * w, 1.05 * w)
@@ -249,18 +294,36 @@ def plot_fig5(cfg: Config, variant: str = "corrected", ax=None) -> dict:
     drawn: dict = {}
     neg = np.linspace(-w, 0, 300)
     _curve(ax, a, w, neg, drawn, "l1 (eq. 9)", color="k", lw=1.8)
-    line, = ax.plot(level_curve_x1(neg, a, w) - 2 * w * T, neg, color="tab:purple", ls="--",
-                    label="l~1 as printed (eq. 19)")
+    (line,) = ax.plot(
+        level_curve_x1(neg, a, w) - 2 * w * T,
+        neg,
+        color="tab:purple",
+        ls="--",
+        label="l~1 as printed (eq. 19)",
+    )
     drawn[line.get_label()] = line
     f1, f2 = flow(level_curve_x1(neg, a, w), neg, -w, T, a)
-    line, = ax.plot(f1, f2, color="tab:purple", label="image of l1 after T under -w_max")
+    (line,) = ax.plot(f1, f2, color="tab:purple", label="image of l1 after T under -w_max")
     drawn[line.get_label()] = line
     if 0 < z.omega0 < w:
-        _curve(ax, a, z.omega0, neg, drawn, f"l1* ({variant}, omega0 = {z.omega0:.4g} mm/s)",
-               color="tab:orange", lw=1.6)
+        _curve(
+            ax,
+            a,
+            z.omega0,
+            neg,
+            drawn,
+            f"l1* ({variant}, omega0 = {z.omega0:.4g} mm/s)",
+            color="tab:orange",
+            lw=1.6,
+        )
     if math.isfinite(z.x20_tilde) and abs(z.x20_tilde) <= w:
-        pt, = ax.plot([d], [z.x20_tilde], "o", color="tab:red",
-                      label=f"(x~10, x~20) = ({d:g}, {z.x20_tilde:.4g})")
+        (pt,) = ax.plot(
+            [d],
+            [z.x20_tilde],
+            "o",
+            color="tab:red",
+            label=f"(x~10, x~20) = ({d:g}, {z.x20_tilde:.4g})",
+        )
         drawn[pt.get_label()] = pt
     drawn["x1 = d"] = ax.axvline(d, color="tab:green", ls=":", label="x1 = d")
     lim = _zone_xlim(cfg, z.omega0)
@@ -270,8 +333,14 @@ def plot_fig5(cfg: Config, variant: str = "corrected", ax=None) -> dict:
     return drawn
 
 
-def plot_fig6(cfg: Config, law: str = "pto", ax=None, *, x0: tuple[float, float] | None = None,
-              steps: int = 60) -> dict:
+def plot_fig6(
+    cfg: Config,
+    law: str = "pto",
+    ax=None,
+    *,
+    x0: tuple[float, float] | None = None,
+    steps: int = 60,
+) -> dict:
     """Fig. 6: a trajectory from the fourth quadrant, each sample marked by region.
 
     Parameters
@@ -297,7 +366,7 @@ def plot_fig6(cfg: Config, law: str = "pto", ax=None, *, x0: tuple[float, float]
     ax = drawn["l1 (eq. 9), x2 <= 0"].axes
     x0 = x0 or (4 * cfg.pto.d, -cfg.plant.w_max / 3)
     b = simulate_batch(make_law(law, cfg), cfg.plant, [x0[0]], [x0[1]], steps)
-    line, = ax.plot(b.x1[:, 0], b.x2[:, 0], color="0.4", lw=0.8, label=f"{law} trajectory")
+    (line,) = ax.plot(b.x1[:, 0], b.x2[:, 0], color="0.4", lw=0.8, label=f"{law} trajectory")
     drawn[line.get_label()] = line
     reg = b.region[:, 0]
     lo, hi = ax.get_xlim()
@@ -307,26 +376,45 @@ def plot_fig6(cfg: Config, law: str = "pto", ax=None, *, x0: tuple[float, float]
         if k.size:
             key = f"sample in {lab}"
             drawn[key] = ax.scatter(b.x1[k, 0], b.x2[k, 0], s=14, color=col, zorder=3, label=key)
-    ax.set_title(f"Fig. 6: {law} from ({x0[0]:g} mm, {x0[1]:g} mm/s), region of each sample",
-                 fontsize=9)
+    ax.set_title(
+        f"Fig. 6: {law} from ({x0[0]:g} mm, {x0[1]:g} mm/s), region of each sample", fontsize=9
+    )
     ax.legend(fontsize=6, loc="lower left")
     return drawn
 
 
 def _sims(cfg: Config, signal: str, feedforward: bool) -> dict[str, SimResult]:
-    return {name: simulate(make_law(name, cfg), cfg.plant, signal, feedforward=feedforward)
-            for name in LAW_NAMES}
+    return {
+        name: simulate(make_law(name, cfg), cfg.plant, signal, feedforward=feedforward)
+        for name in LAW_NAMES
+    }
 
 
-_FIGNUM = {("step", "position"): 7, ("step", "error"): 8, ("ramp", "position"): 9,
-           ("ramp", "velocity"): 10, ("ramp", "error"): 11, ("sine", "position"): 12,
-           ("sine", "velocity"): 13}
-_QUANT = {"position": ("x1", "position x1 [mm]"), "velocity": ("x2", "velocity x2 [mm/s]"),
-          "error": ("e", "error r - x1 [mm]")}
+_FIGNUM = {
+    ("step", "position"): 7,
+    ("step", "error"): 8,
+    ("ramp", "position"): 9,
+    ("ramp", "velocity"): 10,
+    ("ramp", "error"): 11,
+    ("sine", "position"): 12,
+    ("sine", "velocity"): 13,
+}
+_QUANT = {
+    "position": ("x1", "position x1 [mm]"),
+    "velocity": ("x2", "velocity x2 [mm/s]"),
+    "error": ("e", "error r - x1 [mm]"),
+}
 
 
-def plot_response(cfg: Config, signal: str, quantity: str = "position", ax=None, *,
-                  feedforward: bool = True, sims: dict | None = None) -> dict:
+def plot_response(
+    cfg: Config,
+    signal: str,
+    quantity: str = "position",
+    ax=None,
+    *,
+    feedforward: bool = True,
+    sims: dict | None = None,
+) -> dict:
     """Figs. 7-13: position, velocity or error of every law on a reference.
 
     Parameters
@@ -354,12 +442,12 @@ def plot_response(cfg: Config, signal: str, quantity: str = "position", ax=None,
     attr, ylab = _QUANT[quantity]
     drawn: dict = {}
     for name, res in sims.items():
-        line, = ax.plot(res.t, getattr(res, attr), **STYLE[name])
+        (line,) = ax.plot(res.t, getattr(res, attr), **STYLE[name])
         drawn[STYLE[name]["label"]] = line
     any_res = next(iter(sims.values()))
     if quantity in ("position", "velocity"):
         ref = any_res.r if quantity == "position" else any_res.r_dot
-        line, = ax.plot(any_res.t, ref, color="k", lw=0.8, ls=":", label="reference")
+        (line,) = ax.plot(any_res.t, ref, color="k", lw=0.8, ls=":", label="reference")
         drawn["reference"] = line
     else:
         d = cfg.pto.d
@@ -373,13 +461,24 @@ def plot_response(cfg: Config, signal: str, quantity: str = "position", ax=None,
     ff = "feed-forward" if feedforward else "no feed-forward"
     fig = _FIGNUM.get((signal, quantity))
     num = f"Fig. {fig}: " if fig else ""
-    _finish(ax, f"{num}{signal} response: {quantity} ({ff}, a = {cfg.plant.a:.4g} rad/s)", drawn,
-            xlab="time t [s]", ylab=ylab)
+    _finish(
+        ax,
+        f"{num}{signal} response: {quantity} ({ff}, a = {cfg.plant.a:.4g} rad/s)",
+        drawn,
+        xlab="time t [s]",
+        ylab=ylab,
+    )
     return drawn
 
 
-def plot_state_trajectories(cfg: Config, signal: str = "sine", ax=None, *,
-                            feedforward: bool = True, sims: dict | None = None) -> dict:
+def plot_state_trajectories(
+    cfg: Config,
+    signal: str = "sine",
+    ax=None,
+    *,
+    feedforward: bool = True,
+    sims: dict | None = None,
+) -> dict:
     """Fig. 14: state trajectories (x1, x2) of every law, with the reference (r, r').
 
     Parameters
@@ -404,10 +503,10 @@ def plot_state_trajectories(cfg: Config, signal: str = "sine", ax=None, *,
     sims = sims or _sims(cfg, signal, feedforward)
     drawn: dict = {}
     for name, res in sims.items():
-        line, = ax.plot(res.x1, res.x2, **{**STYLE[name], "lw": 0.8})
+        (line,) = ax.plot(res.x1, res.x2, **{**STYLE[name], "lw": 0.8})
         drawn[STYLE[name]["label"]] = line
     res = next(iter(sims.values()))
-    line, = ax.plot(res.r, res.r_dot, color="k", ls=":", lw=0.8, label="reference (r, r')")
+    (line,) = ax.plot(res.r, res.r_dot, color="k", ls=":", lw=0.8, label="reference (r, r')")
     drawn["reference"] = line
     ff = "feed-forward" if feedforward else "no feed-forward"
     _finish(ax, f"Fig. 14: state trajectories, {signal} ({ff})", drawn)
@@ -444,21 +543,35 @@ def plot_sweep(res, law: str, which: str = "tf", ax=None, *, vmax: float | None 
     finite = ratio[np.isfinite(ratio)]
     if vmax is None:
         vmax = max(2.0, float(np.nanpercentile(finite, 99))) if finite.size else 2.0
-    drawn["mesh"] = ax.pcolormesh(res.x1, res.x2, np.ma.masked_invalid(ratio), shading="nearest",
-                                  cmap="viridis", vmin=min(1.0, finite.min()) if finite.size
-                                  else 0.9, vmax=vmax)
+    drawn["mesh"] = ax.pcolormesh(
+        res.x1,
+        res.x2,
+        np.ma.masked_invalid(ratio),
+        shading="nearest",
+        cmap="viridis",
+        vmin=min(1.0, finite.min()) if finite.size else 0.9,
+        vmax=vmax,
+    )
     bad = ~np.isfinite(ls.settle_time)
-    drawn["unsettled"] = ax.pcolormesh(res.x1, res.x2, np.ma.masked_where(~bad, bad.astype(float)),
-                                       shading="nearest", cmap=ListedColormap(["0.6"]))
+    drawn["unsettled"] = ax.pcolormesh(
+        res.x1,
+        res.x2,
+        np.ma.masked_where(~bad, bad.astype(float)),
+        shading="nearest",
+        cmap=ListedColormap(["0.6"]),
+    )
     wr = ls.worst_state_tf if which == "tf" else ls.worst_state_nt
     worst = ls.worst_ratio_tf if which == "tf" else ls.worst_ratio_nt
     if math.isfinite(wr[0]):
-        drawn["worst"], = ax.plot(*wr, "r*", ms=10, label=f"worst ratio {worst:.2f}")
+        (drawn["worst"],) = ax.plot(*wr, "r*", ms=10, label=f"worst ratio {worst:.2f}")
     drawn["colorbar"] = ax.figure.colorbar(drawn["mesh"], ax=ax, label=f"settling time / {den} [-]")
     ax.set_xlabel("initial position x1 [mm]")
     ax.set_ylabel("initial velocity x2 [mm/s]")
-    ax.set_title(f"{law}: settling (0.01 mm) / {den}; grey: never settles "
-                 f"({100 * (1 - ls.fraction_settled):.0f} %)", fontsize=8)
+    ax.set_title(
+        f"{law}: settling (0.01 mm) / {den}; grey: never settles "
+        f"({100 * (1 - ls.fraction_settled):.0f} %)",
+        fontsize=8,
+    )
     if "worst" in drawn:
         ax.legend(fontsize=7, loc="upper right")
     return drawn
@@ -489,7 +602,7 @@ def save_sweep(res, outdir: str | Path) -> list[Path]:
         fig, axes = plt.subplots(rows, cols, figsize=(5.6 * cols, 4.2 * rows), squeeze=False)
         for ax, law in zip(axes.flat, laws, strict=False):
             plot_sweep(res, law, which, ax, vmax=vmax)
-        for ax in list(axes.flat)[len(laws):]:
+        for ax in list(axes.flat)[len(laws) :]:
             ax.set_visible(False)
         _save(fig, outdir / f"sweep_ratio_{which}.png", files)
     return files
@@ -535,13 +648,25 @@ def save_all(cfg: Config, outdir: str | Path) -> list[Path]:
     for ff, sfx in ((True, ""), (False, "_noff")):
         ramp, sine = _sims(cfg, "ramp", ff), _sims(cfg, "sine", ff)
         for num, q in ((9, "position"), (10, "velocity"), (11, "error")):
-            one(f"fig{num:02d}_ramp_{q}{sfx}", lambda ax, q=q, ff=ff, s=ramp: plot_response(
-                cfg, "ramp", q, ax, feedforward=ff, sims=s))
+            one(
+                f"fig{num:02d}_ramp_{q}{sfx}",
+                lambda ax, q=q, ff=ff, s=ramp: plot_response(
+                    cfg, "ramp", q, ax, feedforward=ff, sims=s
+                ),
+            )
         for num, q in ((12, "position"), (13, "velocity")):
-            one(f"fig{num:02d}_sine_{q}{sfx}", lambda ax, q=q, ff=ff, s=sine: plot_response(
-                cfg, "sine", q, ax, feedforward=ff, sims=s))
-        one(f"fig14_sine_states{sfx}", lambda ax, ff=ff, s=sine: plot_state_trajectories(
-            cfg, "sine", ax, feedforward=ff, sims=s))
+            one(
+                f"fig{num:02d}_sine_{q}{sfx}",
+                lambda ax, q=q, ff=ff, s=sine: plot_response(
+                    cfg, "sine", q, ax, feedforward=ff, sims=s
+                ),
+            )
+        one(
+            f"fig14_sine_states{sfx}",
+            lambda ax, ff=ff, s=sine: plot_state_trajectories(
+                cfg, "sine", ax, feedforward=ff, sims=s
+            ),
+        )
     return files
 
 
@@ -571,14 +696,24 @@ def save_zone_geometry(cfg: Config, outdir: str | Path) -> list[Path]:
 
 
 # ------------------------------------------------------------ zone geometry
-_ZONE_MARKERS = {Region.BANG_P: ("^", "tab:red"), Region.BANG_N: ("v", "tab:blue"),
-            Region.ZONE_P: ("s", "tab:orange"), Region.ZONE_N: ("s", "tab:cyan"),
-            Region.LINEAR: ("o", "tab:green"), Region.SATURATED: ("D", "tab:olive"),
-            Region.ORIGIN: ("x", "k")}
+_ZONE_MARKERS = {
+    Region.BANG_P: ("^", "tab:red"),
+    Region.BANG_N: ("v", "tab:blue"),
+    Region.ZONE_P: ("s", "tab:orange"),
+    Region.ZONE_N: ("s", "tab:cyan"),
+    Region.LINEAR: ("o", "tab:green"),
+    Region.SATURATED: ("D", "tab:olive"),
+    Region.ORIGIN: ("x", "k"),
+}
 
 
-def plot_zone_geometry(cfg: Config, ax=None, starts: tuple[tuple[float, float], ...] | None = None,
-                       steps: int = 60, x1_max: float | None = None) -> dict:
+def plot_zone_geometry(
+    cfg: Config,
+    ax=None,
+    starts: tuple[tuple[float, float], ...] | None = None,
+    steps: int = 60,
+    x1_max: float | None = None,
+) -> dict:
     """Draw the zone geometry and sampled PTO trajectories.
 
     Parameters
@@ -612,31 +747,40 @@ def plot_zone_geometry(cfg: Config, ax=None, starts: tuple[tuple[float, float], 
     l1s = level_curve_x1(-s, a, om)
     xmax = x1_max or max(4 * d, 1.3 * float(l1s[-1]))
     lines = {}
-    lines["l1"], = ax.plot(l1, -s, "k-", lw=1.5, label="l1, l2 (eqs. 9, 11)")
+    (lines["l1"],) = ax.plot(l1, -s, "k-", lw=1.5, label="l1, l2 (eqs. 9, 11)")
     ax.plot(-l1, s, "k-", lw=1.5)
-    lines["l1*"], = ax.plot(l1s, -s, "--", color="tab:orange",
-                            label=f"l1*, l2* corrected, omega0 = {om:.4g} mm/s")
+    (lines["l1*"],) = ax.plot(
+        l1s, -s, "--", color="tab:orange", label=f"l1*, l2* corrected, omega0 = {om:.4g} mm/s"
+    )
     ax.plot(-l1s, s, "--", color="tab:orange")
     ax.fill_betweenx(-s, l1, l1s, color="tab:orange", alpha=0.15, label="zones S~_P, S~_N")
     ax.fill_betweenx(s, -l1s, -l1, color="tab:orange", alpha=0.15)
     # printed curve (19): a x1 + x2 + w ln(1 - x2/w) = -2 a w T
     s19 = np.linspace(0.0, max(w, -zp.x20_tilde if np.isfinite(zp.x20_tilde) else w), 400)
     x19 = (-2 * a * w * T + s19 - w * np.log1p(s19 / w)) / a
-    lines["eq19"], = ax.plot(x19, -s19, ":", color="tab:purple", label="printed curve (19)")
+    (lines["eq19"],) = ax.plot(x19, -s19, ":", color="tab:purple", label="printed curve (19)")
     ax.axvspan(-d, d, color="tab:green", alpha=0.08, label=f"linear zone |x1| < {d:g} mm")
     if starts is None:
         x0 = np.linspace(1.2, 0.9 * xmax / max(d, 1e-9), 4) * d
         starts = tuple((float(v), 0.0) for v in x0) + ((float(xmax * 0.9), -w),)
         starts = starts + tuple((-x, -v) for x, v in starts)
-    res = simulate_batch(make_law("pto", cfg), cfg.plant, [p[0] for p in starts],
-                         [p[1] for p in starts], steps)
+    res = simulate_batch(
+        make_law("pto", cfg), cfg.plant, [p[0] for p in starts], [p[1] for p in starts], steps
+    )
     for j in range(len(starts)):
         ax.plot(res.x1[:, j], res.x2[:, j], "-", color="0.6", lw=0.7)
     for reg, (mk, col) in _ZONE_MARKERS.items():
         sel = res.region == reg
         if sel.any():
-            ax.plot(res.x1[:-1][sel], res.x2[:-1][sel], mk, color=col, ms=3, ls="none",
-                    label=f"sample: {reg.name}")
+            ax.plot(
+                res.x1[:-1][sel],
+                res.x2[:-1][sel],
+                mk,
+                color=col,
+                ms=3,
+                ls="none",
+                label=f"sample: {reg.name}",
+            )
     ax.set_xlim(-xmax, xmax)
     ax.set_ylim(-1.1 * w, 1.1 * w)
     ax.set_xlabel("position x1 [mm]")
@@ -678,8 +822,7 @@ def plot_convergence(study: ConvergenceStudy, ax=None):
     return ax
 
 
-def plot_switch_profiles(study: ConvergenceStudy, state: int = 0, ax=None,
-                         window: float = 0.15):
+def plot_switch_profiles(study: ConvergenceStudy, state: int = 0, ax=None, window: float = 0.15):
     """Plot the collocation input near the switch for each N (smearing, chattering).
 
     Parameters

@@ -32,8 +32,14 @@ import numpy as np
 from ptoverify.config import Config
 from ptoverify.plant import zoh_matrices
 
-__all__ = ["LoopPoles", "loop_poles", "all_loop_poles", "sampled_spectral_radius",
-           "critical_gain", "lyapunov_counterexample"]
+__all__ = [
+    "LoopPoles",
+    "loop_poles",
+    "all_loop_poles",
+    "sampled_spectral_radius",
+    "critical_gain",
+    "lyapunov_counterexample",
+]
 
 
 def _pairs(z: np.ndarray) -> list[list[float]]:
@@ -118,6 +124,7 @@ def _plant(a: float) -> tuple[np.ndarray, np.ndarray]:
 
 def _scale_margin(Ad: np.ndarray, Bd: np.ndarray, K: np.ndarray) -> float:  # noqa: N803
     """Scale g of K at which the sampled loop reaches |z| = 1 (inf beyond 1e6)."""
+
     def radius(g: float) -> float:
         return float(np.abs(np.linalg.eigvals(Ad - g * Bd @ K)).max())
 
@@ -188,28 +195,39 @@ def loop_poles(name: str, a: float, T: float, k_x1: float, k_x2: float) -> LoopP
     Ad, Bd = plant_d.A, plant_d.B
     cl_d = ct.ss(Ad - Bd @ K, Bd, np.eye(2), np.zeros((2, 1)), T)
     wn_d, zeta_d, p_d = ct.damp(cl_d, doprint=False)
-    loop = ct.ss(Ad, Bd, K, np.zeros((1, 1)), T)        # broken at the plant input
+    loop = ct.ss(Ad, Bd, K, np.zeros((1, 1)), T)  # broken at the plant input
     # epsw: the plant's integrator puts a pole of L at z = 1; frequencies below
     # 1e-3 rad/s are static gain, not a crossover (avoids a spurious gm at w = 0)
     gm, pm, sm, wpc, wgc, _ = ct.stability_margins(loop, epsw=1e-3)
-    l_nyq = complex(loop(-1.0))                            # L at the Nyquist frequency
+    l_nyq = complex(loop(-1.0))  # L at the Nyquist frequency
     gm_nyq = -1.0 / l_nyq.real if l_nyq.real < 0 else math.inf
     Ad_n, Bd_n = zoh_matrices(a, T)
     p_n = np.linalg.eigvals(Ad_n - Bd_n @ K)
     mismatch = float(np.abs(np.sort_complex(ct.poles(cl_d)) - np.sort_complex(p_n)).max())
     return LoopPoles(
-        name=name, gains=[float(k_x1), float(k_x2)], sample_time=float(T),
-        continuous_poles=_pairs(p_c), continuous_wn=[float(v) for v in wn_c],
-        continuous_zeta=[float(v) for v in zeta_c], sampled_poles=_pairs(p_d),
-        sampled_moduli=[float(v) for v in np.abs(p_d)], sampled_wn=[float(v) for v in wn_d],
-        sampled_zeta=[float(v) for v in zeta_d], numpy_sampled_poles=_pairs(p_n),
-        pole_mismatch=mismatch, gain_margin=float(min(gm, gm_nyq)),
-        gain_margin_python_control=float(gm), gain_margin_eig=_scale_margin(Ad_n, Bd_n, K),
+        name=name,
+        gains=[float(k_x1), float(k_x2)],
+        sample_time=float(T),
+        continuous_poles=_pairs(p_c),
+        continuous_wn=[float(v) for v in wn_c],
+        continuous_zeta=[float(v) for v in zeta_c],
+        sampled_poles=_pairs(p_d),
+        sampled_moduli=[float(v) for v in np.abs(p_d)],
+        sampled_wn=[float(v) for v in wn_d],
+        sampled_zeta=[float(v) for v in zeta_d],
+        numpy_sampled_poles=_pairs(p_n),
+        pole_mismatch=mismatch,
+        gain_margin=float(min(gm, gm_nyq)),
+        gain_margin_python_control=float(gm),
+        gain_margin_eig=_scale_margin(Ad_n, Bd_n, K),
         phase_margin_deg=float(pm),
-        stability_margin=float(sm), phase_crossover=float(wpc), gain_crossover=float(wgc),
+        stability_margin=float(sm),
+        phase_crossover=float(wpc),
+        gain_crossover=float(wgc),
         stable_continuous=bool(np.all(np.real(p_c) < 0)),
         stable_sampled=bool(np.all(np.abs(p_d) < 1)),
-        lyapunov_conditions=bool(k_x1 > 0 and 1 + k_x2 > 0))
+        lyapunov_conditions=bool(k_x1 > 0 and 1 + k_x2 > 0),
+    )
 
 
 def all_loop_poles(cfg: Config) -> dict[str, LoopPoles]:
@@ -226,12 +244,20 @@ def all_loop_poles(cfg: Config) -> dict[str, LoopPoles]:
         ``pd`` and ``linear`` -> :class:`LoopPoles`.
     """
     a, T = cfg.plant.a, cfg.plant.sample_time
-    return {"pd": loop_poles("pd", a, T, cfg.pd.kp, cfg.pd.kd),
-            "linear": loop_poles("linear", a, T, cfg.pto.k1, cfg.pto.k2)}
+    return {
+        "pd": loop_poles("pd", a, T, cfg.pd.kp, cfg.pd.kd),
+        "linear": loop_poles("linear", a, T, cfg.pto.k1, cfg.pto.k2),
+    }
 
 
-def critical_gain(a: float, T: float, k_x1: float, k_x2: float, which: str = "k1",  # noqa: N803
-                  upper: float = 1e7) -> float:
+def critical_gain(
+    a: float,
+    T: float,
+    k_x1: float,
+    k_x2: float,
+    which: str = "k1",  # noqa: N803
+    upper: float = 1e7,
+) -> float:
     """Gain at which a sampled pole of the linear loop reaches |z| = 1.
 
     The gain named by ``which`` is raised from its given value (kept stable) by
@@ -259,9 +285,13 @@ def critical_gain(a: float, T: float, k_x1: float, k_x2: float, which: str = "k1
     float
         The critical value of the raised gain.
     """
+
     def radius(g: float) -> float:
-        return sampled_spectral_radius(a, T, g, k_x2) if which == "k1" else \
-            sampled_spectral_radius(a, T, k_x1, g)
+        return (
+            sampled_spectral_radius(a, T, g, k_x2)
+            if which == "k1"
+            else sampled_spectral_radius(a, T, k_x1, g)
+        )
 
     lo = k_x1 if which == "k1" else k_x2
     lo = max(lo, 1e-9)

@@ -42,8 +42,14 @@ from ptoverify.curves import switching_function
 from ptoverify.laws import Law, Region, make_law
 from ptoverify.simulate import simulate_batch
 
-__all__ = ["LawProperties", "initial_grid", "default_steps", "law_properties", "all_properties",
-           "zone_outcome"]
+__all__ = [
+    "LawProperties",
+    "initial_grid",
+    "default_steps",
+    "law_properties",
+    "all_properties",
+    "zone_outcome",
+]
 
 
 @dataclass(frozen=True)
@@ -122,8 +128,9 @@ class LawProperties:
         return asdict(self)
 
 
-def initial_grid(cfg: Config, n1: int = 101, n2: int = 101,
-                 rest: int = 200) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def initial_grid(
+    cfg: Config, n1: int = 101, n2: int = 101, rest: int = 200
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Return initial states: an n1 x n2 envelope grid plus ``rest`` states at rest.
 
     Parameters
@@ -171,8 +178,12 @@ def _oscillating(x1: np.ndarray, band: float) -> np.ndarray:
     return (changes >= 4) & (second > band) & (second >= 0.5 * first)
 
 
-def crossing_masks(X1: np.ndarray, X2: np.ndarray, R: np.ndarray,  # noqa: N803
-                   cfg: Config) -> tuple[np.ndarray, np.ndarray]:
+def crossing_masks(
+    X1: np.ndarray,
+    X2: np.ndarray,
+    R: np.ndarray,  # noqa: N803
+    cfg: Config,
+) -> tuple[np.ndarray, np.ndarray]:
     """Stride-overs and crossings into the linear zone, per sample transition.
 
     A transition k -> k+1 crosses when sigma changes side strictly beyond a tolerance
@@ -207,9 +218,17 @@ def crossing_masks(X1: np.ndarray, X2: np.ndarray, R: np.ndarray,  # noqa: N803
     return src & cross & out[1:], src & cross & ~out[1:]
 
 
-def law_properties(law: Law, cfg: Config, *, n1: int = 101, n2: int = 101, rest: int = 200,
-                   steps: int | None = None, band: float = 1e-3,
-                   window: int | None = None) -> LawProperties:
+def law_properties(
+    law: Law,
+    cfg: Config,
+    *,
+    n1: int = 101,
+    n2: int = 101,
+    rest: int = 200,
+    steps: int | None = None,
+    band: float = 1e-3,
+    window: int | None = None,
+) -> LawProperties:
     """Simulate ``law`` from the grid and measure the closed-loop properties.
 
     Parameters
@@ -245,7 +264,7 @@ def law_properties(law: Law, cfg: Config, *, n1: int = 101, n2: int = 101, rest:
     first_in = np.where(inside.any(axis=0), inside.argmax(axis=0), -1)
     never = first_in < 0
     t_lin = np.where(never, np.inf, first_in * T)
-    entered = first_in > 0                         # started outside, entered later
+    entered = first_in > 0  # started outside, entered later
     prev = R[np.maximum(first_in - 1, 0), np.arange(x1.size)]
     from_bang = entered & ((prev == Region.BANG_P) | (prev == Region.BANG_N))
     entry = np.where(entered, np.abs(X2[np.maximum(first_in, 0), np.arange(x1.size)]), 0.0)
@@ -254,21 +273,34 @@ def law_properties(law: Law, cfg: Config, *, n1: int = 101, n2: int = 101, rest:
     over = np.where(is_rest, (-np.sign(x1)[None, :] * X1).max(axis=0), 0.0)
     max_u = float(np.abs(res.u).max())
     return LawProperties(
-        law=law.name, note=law.note, states=int(x1.size), steps=int(steps),
-        stride_overs=int(stride.sum()), states_with_stride_over=int(stride.any(axis=0).sum()),
-        crossings_into_linear=int(into_lin.sum()), limit_cycles=int(osc.sum()),
+        law=law.name,
+        note=law.note,
+        states=int(x1.size),
+        steps=int(steps),
+        stride_overs=int(stride.sum()),
+        states_with_stride_over=int(stride.any(axis=0).sum()),
+        crossings_into_linear=int(into_lin.sum()),
+        limit_cycles=int(osc.sum()),
         not_settled=int((np.abs(X1[-1]) > band).sum()),
         time_to_linear_max_s=float(t_lin.max()),
-        time_to_linear_median_s=float(np.median(t_lin)), never_linear=int(never.sum()),
-        chattering=int(chat.sum()), states_chattering=int(chat.any(axis=0).sum()),
-        max_abs_u=max_u, u_within_limit=bool(max_u <= w),
-        overshoots=int((over > band).sum()), max_overshoot_mm=float(max(over.max(), 0.0)),
-        zone_samples=int(zone.sum()), entered_linear_from_bang=int(from_bang.sum()),
-        max_entry_speed=float(entry.max()), band=band)
+        time_to_linear_median_s=float(np.median(t_lin)),
+        never_linear=int(never.sum()),
+        chattering=int(chat.sum()),
+        states_chattering=int(chat.any(axis=0).sum()),
+        max_abs_u=max_u,
+        u_within_limit=bool(max_u <= w),
+        overshoots=int((over > band).sum()),
+        max_overshoot_mm=float(max(over.max(), 0.0)),
+        zone_samples=int(zone.sum()),
+        entered_linear_from_bang=int(from_bang.sum()),
+        max_entry_speed=float(entry.max()),
+        band=band,
+    )
 
 
-def all_properties(cfg: Config, laws: tuple[str, ...] = ("to", "pd", "pto", "pto-printed"),
-                   **kwargs) -> dict[str, LawProperties]:
+def all_properties(
+    cfg: Config, laws: tuple[str, ...] = ("to", "pd", "pto", "pto-printed"), **kwargs
+) -> dict[str, LawProperties]:
     """Run :func:`law_properties` for each named law.
 
     Parameters
@@ -317,12 +349,17 @@ def zone_outcome(cfg: Config, *, n1: int = 41, n2: int = 41, rest: int = 40) -> 
     for name in ("pto", "pto-printed"):
         p = law_properties(make_law(name, cfg), cfg, n1=n1, n2=n2, rest=rest)
         out[name] = {
-            "note": p.note, "states": p.states,
+            "note": p.note,
+            "states": p.states,
             "enters_zone_before_crossing": p.stride_overs == 0 and p.crossings_into_linear == 0,
             "settles_without_overshoot": p.overshoots == 0 and p.limit_cycles == 0,
-            "stride_overs": p.stride_overs, "crossings_into_linear": p.crossings_into_linear,
+            "stride_overs": p.stride_overs,
+            "crossings_into_linear": p.crossings_into_linear,
             "entered_linear_from_bang": p.entered_linear_from_bang,
-            "zone_samples": p.zone_samples, "overshoots": p.overshoots,
-            "max_overshoot_mm": p.max_overshoot_mm, "limit_cycles": p.limit_cycles,
-            "max_entry_speed": p.max_entry_speed}
+            "zone_samples": p.zone_samples,
+            "overshoots": p.overshoots,
+            "max_overshoot_mm": p.max_overshoot_mm,
+            "limit_cycles": p.limit_cycles,
+            "max_entry_speed": p.max_entry_speed,
+        }
     return out

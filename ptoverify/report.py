@@ -32,14 +32,26 @@ import numpy as np
 
 from ptoverify.config import Config
 
-__all__ = ["collect", "build_sections", "render_html", "render_markdown", "write_report",
-           "GROUND_TRUTH_STATES"]
+__all__ = [
+    "collect",
+    "build_sections",
+    "render_html",
+    "render_markdown",
+    "write_report",
+    "GROUND_TRUTH_STATES",
+]
 
 #: States of the ground-truth table [mm], [mm/s]: a step, moves with speed, on/near a
 #: curve, beyond saturation, and near the origin.
 GROUND_TRUTH_STATES: tuple[tuple[float, float], ...] = (
-    (5.0, 0.0), (-5.0, 0.0), (50.0, 0.0), (-20.0, 150.0), (12.0, -250.0), (0.3, -80.0),
-    (-40.0, -290.0), (0.05, 0.0),
+    (5.0, 0.0),
+    (-5.0, 0.0),
+    (50.0, 0.0),
+    (-20.0, 150.0),
+    (12.0, -250.0),
+    (0.3, -80.0),
+    (-40.0, -290.0),
+    (0.05, 0.0),
 )
 CONVERGENCE_INTERVALS = (10, 20, 40, 80, 100, 200, 400)
 _TIMING_KEYS = {"seconds", "timings", "solve_time_s", "elapsed_s", "wall_s"}
@@ -76,28 +88,43 @@ def _ground_truth(cfg: Config) -> dict[str, Any]:
         mt = min_time(x1, x2, p)
         r2, rc, dm = tp.solve(x1, x2), co.solve(x1, x2), discrete_min_steps(x1, x2, p)
         t_f = float(mt.t_f)
-        rows.append({
-            "x0": [x1, x2], "analytic_s": t_f, "switch_time_s": float(mt.t_switch),
-            "two_phase_s": r2.t_f if r2.success else None, "two_phase_status": r2.status,
-            "two_phase_rel_error": abs(r2.t_f - t_f) / t_f if r2.success else None,
-            "collocation_s": rc.t_f if rc.success else None, "collocation_status": rc.status,
-            "collocation_rel_error": abs(rc.t_f - t_f) / t_f if rc.success else None,
-            "collocation_resim_error_mm": rc.resim_error,
-            "discrete_steps": dm.steps if dm.success else None, "discrete_status": dm.status,
-            "discrete_s": dm.time_s if dm.success else None,
-            "discrete_gap_samples": (dm.time_s - t_f) / p.T if dm.success else None})
+        rows.append(
+            {
+                "x0": [x1, x2],
+                "analytic_s": t_f,
+                "switch_time_s": float(mt.t_switch),
+                "two_phase_s": r2.t_f if r2.success else None,
+                "two_phase_status": r2.status,
+                "two_phase_rel_error": abs(r2.t_f - t_f) / t_f if r2.success else None,
+                "collocation_s": rc.t_f if rc.success else None,
+                "collocation_status": rc.status,
+                "collocation_rel_error": abs(rc.t_f - t_f) / t_f if rc.success else None,
+                "collocation_resim_error_mm": rc.resim_error,
+                "discrete_steps": dm.steps if dm.success else None,
+                "discrete_status": dm.status,
+                "discrete_s": dm.time_s if dm.success else None,
+                "discrete_gap_samples": (dm.time_s - t_f) / p.T if dm.success else None,
+            }
+        )
     study = convergence_study(p, np.array(states[:4]), CONVERGENCE_INTERVALS)
-    conv = {"intervals": list(CONVERGENCE_INTERVALS), "states": states[:4],
-            "rel_error": study.rel_error, "order": study.order,
-            "order_per_state": study.order_per_state, "success": study.success}
+    conv = {
+        "intervals": list(CONVERGENCE_INTERVALS),
+        "states": states[:4],
+        "rel_error": study.rel_error,
+        "order": study.order,
+        "order_per_state": study.order_per_state,
+        "success": study.success,
+    }
     return {"states": rows, "convergence": conv, "_study": study}
 
 
 def _poles(cfg: Config) -> dict[str, Any]:
     from ptoverify.poles import all_loop_poles, lyapunov_counterexample
 
-    return {"loops": {k: v.to_json() for k, v in all_loop_poles(cfg).items()},
-            "lyapunov_counterexample": lyapunov_counterexample(cfg)}
+    return {
+        "loops": {k: v.to_json() for k, v in all_loop_poles(cfg).items()},
+        "lyapunov_counterexample": lyapunov_counterexample(cfg),
+    }
 
 
 def _properties(cfg: Config) -> dict[str, Any]:
@@ -114,11 +141,25 @@ def _environment(cfg: Config) -> dict[str, Any]:
 
     here = Path(__file__).resolve().parent
     try:
-        commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
-                                cwd=here, timeout=5, check=False).stdout.strip() or None
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
-                               capture_output=True, text=True, cwd=here, timeout=5,
-                               check=False).stdout.strip()
+        commit = (
+            subprocess.run(
+                ["git", "rev-parse", "HEAD"],
+                capture_output=True,
+                text=True,
+                cwd=here,
+                timeout=5,
+                check=False,
+            ).stdout.strip()
+            or None
+        )
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no"],
+            capture_output=True,
+            text=True,
+            cwd=here,
+            timeout=5,
+            check=False,
+        ).stdout.strip()
         if commit and dirty:
             commit += " (working tree modified)"
     except (OSError, subprocess.SubprocessError):
@@ -126,12 +167,19 @@ def _environment(cfg: Config) -> dict[str, Any]:
     ipopt_version = _ipopt_version(casadi)
     from ptoverify import __version__
 
-    return {"python": platform.python_version(), "ptoverify": __version__,
-            "casadi": casadi.__version__, "ipopt": ipopt_version,
-            "sympy": sympy.__version__, "control": control.__version__,
-            "numpy": np.__version__, "scipy": scipy.__version__,
-            "platform": platform.platform(), "git_commit": commit,
-            "config": cfg.to_mapping()}
+    return {
+        "python": platform.python_version(),
+        "ptoverify": __version__,
+        "casadi": casadi.__version__,
+        "ipopt": ipopt_version,
+        "sympy": sympy.__version__,
+        "control": control.__version__,
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "platform": platform.platform(),
+        "git_commit": commit,
+        "config": cfg.to_mapping(),
+    }
 
 
 def _ipopt_version(casadi) -> str:
@@ -144,8 +192,12 @@ def _ipopt_version(casadi) -> str:
     buf = io.StringIO()
     try:
         with redirect_stdout(buf):
-            casadi.nlpsol("probe", "ipopt", {"x": x, "f": (x - 1) ** 2},
-                          {"ipopt.print_level": 5, "print_time": False})(x0=0)
+            casadi.nlpsol(
+                "probe",
+                "ipopt",
+                {"x": x, "f": (x - 1) ** 2},
+                {"ipopt.print_level": 5, "print_time": False},
+            )(x0=0)
     except Exception:  # noqa: BLE001 - environment probe only
         return "unknown"
     m = re.search(r"Ipopt version (\S+)", buf.getvalue())
@@ -190,10 +242,14 @@ def collect(cfg: Config, progress: Progress | None = None) -> dict[str, Any]:
     out["claims"] = [c.to_json() for c in evaluate_claims(cfg)]
     say("suboptimality sweep")
     sweep = run_sweep(cfg)
-    out["sweep"] = {"laws": {k: v.to_json() for k, v in sweep.laws.items()},
-                    "grid": list(sweep.x1.shape), "steps": sweep.steps,
-                    "velocity_band": sweep.velocity_band, "skipped": sweep.skipped,
-                    "settings": _settings_json(sweep.settings)}
+    out["sweep"] = {
+        "laws": {k: v.to_json() for k, v in sweep.laws.items()},
+        "grid": list(sweep.x1.shape),
+        "steps": sweep.steps,
+        "velocity_band": sweep.velocity_band,
+        "skipped": sweep.skipped,
+        "settings": _settings_json(sweep.settings),
+    }
     out["_sweep"] = sweep
     say("gates")
     checks = run_checks(cfg)
@@ -216,15 +272,20 @@ def _summary(out: dict[str, Any], gates: dict[str, Any]) -> dict[str, Any]:
     claims: dict[str, int] = {}
     for c in out["claims"]:
         claims[c["verdict"]] = claims.get(c["verdict"], 0) + 1
-    return {"gates": gates, "derivation_verdicts": verdicts, "claim_verdicts": claims,
-            "errata": [r["id"] for r in out["derivations"] if r["verdict"] == "erratum"],
-            "claims_not_reproduced": [c["id"] for c in out["claims"]
-                                      if c["verdict"] == "not reproduced"],
-            "claims_ambiguous": [c["id"] for c in out["claims"] if c["verdict"] == "ambiguous"],
-            "printed_zone_valid": bool(out["zone"]["printed"]["valid"]),
-            "corrected_zone_valid": bool(out["zone"]["corrected"]["valid"]),
-            "corrected_omega0": out["zone"]["corrected"]["omega0"],
-            "corrected_zone_margin_mm_s": out["zone"]["corrected"].get("margin_mm_s")}
+    return {
+        "gates": gates,
+        "derivation_verdicts": verdicts,
+        "claim_verdicts": claims,
+        "errata": [r["id"] for r in out["derivations"] if r["verdict"] == "erratum"],
+        "claims_not_reproduced": [
+            c["id"] for c in out["claims"] if c["verdict"] == "not reproduced"
+        ],
+        "claims_ambiguous": [c["id"] for c in out["claims"] if c["verdict"] == "ambiguous"],
+        "printed_zone_valid": bool(out["zone"]["printed"]["valid"]),
+        "corrected_zone_valid": bool(out["zone"]["corrected"]["valid"]),
+        "corrected_omega0": out["zone"]["corrected"]["omega0"],
+        "corrected_zone_margin_mm_s": out["zone"]["corrected"].get("margin_mm_s"),
+    }
 
 
 # ------------------------------------------------------------------ sections
@@ -254,12 +315,14 @@ def _fmt(v: Any, digits: int = 6) -> str:
 
 
 def _table(headers: list[str], rows: list[list[Any]]) -> Block:
-    return Block("table", headers=tuple(headers),
-                 rows=tuple(tuple(_fmt(c) for c in r) for r in rows))
+    return Block(
+        "table", headers=tuple(headers), rows=tuple(tuple(_fmt(c) for c in r) for r in rows)
+    )
 
 
-def build_sections(res: dict[str, Any], figures: dict[str, str]) -> list[tuple[str, str,
-                                                                               list[Block]]]:
+def build_sections(
+    res: dict[str, Any], figures: dict[str, str]
+) -> list[tuple[str, str, list[Block]]]:
     """Turn the results into ordered sections ``(anchor, title, blocks)``.
 
     Parameters
@@ -298,8 +361,18 @@ math{font-size:1.05em}code{font-size:.85em}
 table.derivations{table-layout:fixed;width:100%}table.derivations td{overflow-x:auto;
 overflow-wrap:anywhere}table.derivations td:nth-child(-n+2){width:6em}"""
 
-_STATUS_WORDS = {"pass", "fail", "unverified", "verified", "erratum", "unchecked", "definition",
-                 "reproduced", "not reproduced", "ambiguous"}
+_STATUS_WORDS = {
+    "pass",
+    "fail",
+    "unverified",
+    "verified",
+    "erratum",
+    "unchecked",
+    "definition",
+    "reproduced",
+    "not reproduced",
+    "ambiguous",
+}
 
 
 def _html_block(b: Block) -> str:
@@ -308,8 +381,10 @@ def _html_block(b: Block) -> str:
     if b.kind == "raw":
         return b.html
     if b.kind == "img":
-        return (f'<figure><img src="{html.escape(b.html)}" alt="{html.escape(b.text)}">'
-                f"<figcaption>{html.escape(b.text)}</figcaption></figure>")
+        return (
+            f'<figure><img src="{html.escape(b.html)}" alt="{html.escape(b.text)}">'
+            f"<figcaption>{html.escape(b.text)}</figcaption></figure>"
+        )
     head = "".join(f"<th>{html.escape(h)}</th>" for h in b.headers)
     body = []
     for row in b.rows:
@@ -324,9 +399,12 @@ def _html_block(b: Block) -> str:
 def render_html(sections: list[tuple[str, str, list[Block]]], title: str) -> str:
     """Render the sections as one offline HTML page (MathML, escaped text)."""
     nav = "".join(f'<a href="#{a}">{html.escape(t)}</a>' for a, t, _ in sections)
-    parts = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
-             f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
-             f"<h1>{html.escape(title)}</h1><nav>{nav}</nav>"]
+    parts = [
+        "<!DOCTYPE html>",
+        '<html lang="en"><head><meta charset="utf-8">',
+        f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
+        f"<h1>{html.escape(title)}</h1><nav>{nav}</nav>",
+    ]
     for anchor, heading, blocks in sections:
         parts.append(f'<section id="{anchor}"><h2>{html.escape(heading)}</h2>')
         parts += [_html_block(b) for b in blocks]
@@ -370,8 +448,9 @@ def _figures(res: dict[str, Any], cfg: Config, figdir: Path) -> dict[str, str]:
     return {Path(f).stem: f"figures/{Path(f).name}" for f in files}
 
 
-def write_report(cfg: Config, out: str | Path | None = None,
-                 progress: Progress | None = None) -> Path:
+def write_report(
+    cfg: Config, out: str | Path | None = None, progress: Progress | None = None
+) -> Path:
     """Compute and write the report folder atomically.
 
     Parameters
@@ -397,22 +476,26 @@ def write_report(cfg: Config, out: str | Path | None = None,
     from ptoverify.outdir import check_target, discard, make_temp, publish
 
     out = check_target(out if out is not None else Path("reports") / cfg.name)
-    res = collect(cfg, progress)                      # nothing is written before this ends
+    res = collect(cfg, progress)  # nothing is written before this ends
     tmp = make_temp(out)
     try:
         if progress:
             progress("figures")
         figures = _figures(res, cfg, tmp / "figures")
         public = _clean({k: v for k, v in res.items() if not k.startswith("_")})
-        public["ground_truth"] = _clean({k: v for k, v in res["ground_truth"].items()
-                                         if not k.startswith("_")})
-        public["meta"] = {"name": cfg.name, "figures": sorted(figures.values()),
-                          "generated": _dt.datetime.now(_dt.timezone.utc).isoformat(
-                              timespec="seconds")}
+        public["ground_truth"] = _clean(
+            {k: v for k, v in res["ground_truth"].items() if not k.startswith("_")}
+        )
+        public["meta"] = {
+            "name": cfg.name,
+            "figures": sorted(figures.values()),
+            "generated": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        }
         title = f"ptoverify verification report: {cfg.name}"
         sections = build_sections(public, figures)
-        (tmp / "results.json").write_text(json.dumps(public, indent=1, sort_keys=True,
-                                                     allow_nan=False) + "\n")
+        (tmp / "results.json").write_text(
+            json.dumps(public, indent=1, sort_keys=True, allow_nan=False) + "\n"
+        )
         (tmp / "index.html").write_text(render_html(sections, title))
         (tmp / "report.md").write_text(render_markdown(sections, title))
         publish(tmp, out)
@@ -426,9 +509,17 @@ def stderr_progress(quiet: bool) -> Progress | None:
     """Progress on stderr when it is a terminal and not ``quiet``; else None."""
     if quiet or not sys.stderr.isatty():
         return None
-    stages = ["derivations", "ground truth", "switching zone", "poles",
-              "closed-loop properties", "Section 6 claims", "suboptimality sweep", "gates",
-              "figures"]
+    stages = [
+        "derivations",
+        "ground truth",
+        "switching zone",
+        "poles",
+        "closed-loop properties",
+        "Section 6 claims",
+        "suboptimality sweep",
+        "gates",
+        "figures",
+    ]
 
     def show(stage: str) -> None:
         i = stages.index(stage) + 1 if stage in stages else 0

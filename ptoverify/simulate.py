@@ -25,8 +25,15 @@ from ptoverify.config import Plant
 from ptoverify.errors import InputError
 from ptoverify.laws import Law
 
-__all__ = ["Reference", "reference", "SIGNALS", "SimResult", "simulate", "BatchResult",
-           "simulate_batch"]
+__all__ = [
+    "Reference",
+    "reference",
+    "SIGNALS",
+    "SimResult",
+    "simulate",
+    "BatchResult",
+    "simulate_batch",
+]
 
 
 @dataclass(frozen=True)
@@ -121,12 +128,25 @@ class SimResult:
 
     def columns(self) -> dict[str, NDArray]:
         """Return the time series as named columns (for CSV and JSON)."""
-        return {"t": self.t, "r": self.r, "x1": self.x1, "x2": self.x2, "e": self.e,
-                "u": self.u, "region": self.region}
+        return {
+            "t": self.t,
+            "r": self.r,
+            "x1": self.x1,
+            "x2": self.x2,
+            "e": self.e,
+            "u": self.u,
+            "region": self.region,
+        }
 
 
-def simulate(law: Law, plant: Plant, signal: str | Reference = "step", *,
-             duration: float | None = None, feedforward: bool = True) -> SimResult:
+def simulate(
+    law: Law,
+    plant: Plant,
+    signal: str | Reference = "step",
+    *,
+    duration: float | None = None,
+    feedforward: bool = True,
+) -> SimResult:
     """Simulate the sampled closed loop tracking a reference from rest at 0.
 
     Parameters
@@ -198,8 +218,7 @@ class BatchResult:
     region: NDArray[np.int8]
 
 
-def simulate_batch(law: Law, plant: Plant, x1: ArrayLike, x2: ArrayLike,
-                   steps: int) -> BatchResult:
+def simulate_batch(law: Law, plant: Plant, x1: ArrayLike, x2: ArrayLike, steps: int) -> BatchResult:
     """Simulate the sampled loop to the origin from many initial states at once.
 
     Parameters
@@ -225,7 +244,7 @@ def simulate_batch(law: Law, plant: Plant, x1: ArrayLike, x2: ArrayLike,
     U, R = np.empty((steps, n)), np.empty((steps, n), dtype=np.int8)
     X1[0], X2[0] = x1, x2
     T, a = plant.sample_time, plant.a
-    g = -np.expm1(-a * np.float64(T))        # 1 - e^{-aT}, as plant.flow computes it
+    g = -np.expm1(-a * np.float64(T))  # 1 - e^{-aT}, as plant.flow computes it
     dv = np.empty(n)
     for k in range(steps):
         U[k], R[k] = law(X1[k], X2[k])

@@ -49,8 +49,15 @@ from ptoverify.metrics import TIGHT_BAND
 from ptoverify.mintime import discrete_min_steps_batch, min_time
 from ptoverify.simulate import simulate_batch
 
-__all__ = ["SweepSettings", "LawSweep", "SweepResult", "run_sweep", "settle_steps",
-           "grid_states", "discrete_limit"]
+__all__ = [
+    "SweepSettings",
+    "LawSweep",
+    "SweepResult",
+    "run_sweep",
+    "settle_steps",
+    "grid_states",
+    "discrete_limit",
+]
 
 Progress = Callable[[str, float], None]
 
@@ -129,11 +136,18 @@ class LawSweep:
 
     def to_json(self) -> dict:
         """Return the statistics (not the arrays) as a JSON-able dict."""
-        return {"law": self.law, "fraction_settled": self.fraction_settled,
-                "median_ratio_tf": self.median_ratio_tf, "median_ratio_nt": self.median_ratio_nt,
-                "worst_ratio_tf": self.worst_ratio_tf, "worst_state_tf": list(self.worst_state_tf),
-                "worst_ratio_nt": self.worst_ratio_nt, "worst_state_nt": list(self.worst_state_nt),
-                "p95_ratio_tf": self.p95_ratio_tf, "seconds": self.seconds}
+        return {
+            "law": self.law,
+            "fraction_settled": self.fraction_settled,
+            "median_ratio_tf": self.median_ratio_tf,
+            "median_ratio_nt": self.median_ratio_nt,
+            "worst_ratio_tf": self.worst_ratio_tf,
+            "worst_state_tf": list(self.worst_state_tf),
+            "worst_ratio_nt": self.worst_ratio_nt,
+            "worst_state_nt": list(self.worst_state_nt),
+            "p95_ratio_tf": self.p95_ratio_tf,
+            "seconds": self.seconds,
+        }
 
 
 @dataclass(frozen=True)
@@ -179,14 +193,24 @@ class SweepResult:
     def to_json(self) -> dict:
         """Return the ``sweep --json`` object."""
         s = self.settings
-        return {"grid": {"n1": s.n1, "n2": s.n2, "states": int(self.x1.size),
-                         "x1_range_mm": [float(self.x1.min()), float(self.x1.max())],
-                         "x2_range_mm_s": [float(self.x2.min()), float(self.x2.max())]},
-                "band_mm": s.band, "velocity_band_mm_s": self.velocity_band, "hold_s": s.hold,
-                "horizon_s": self.steps * self.sample_time, "horizon_steps": self.steps,
-                "n_star_computed": int(np.count_nonzero(self.n_star >= 0)),
-                "laws": {name: r.to_json() for name, r in self.laws.items()},
-                "skipped": self.skipped, "timings_s": self.timings}
+        return {
+            "grid": {
+                "n1": s.n1,
+                "n2": s.n2,
+                "states": int(self.x1.size),
+                "x1_range_mm": [float(self.x1.min()), float(self.x1.max())],
+                "x2_range_mm_s": [float(self.x2.min()), float(self.x2.max())],
+            },
+            "band_mm": s.band,
+            "velocity_band_mm_s": self.velocity_band,
+            "hold_s": s.hold,
+            "horizon_s": self.steps * self.sample_time,
+            "horizon_steps": self.steps,
+            "n_star_computed": int(np.count_nonzero(self.n_star >= 0)),
+            "laws": {name: r.to_json() for name, r in self.laws.items()},
+            "skipped": self.skipped,
+            "timings_s": self.timings,
+        }
 
 
 def grid_states(plant: Plant, n1: int, n2: int) -> tuple[NDArray, NDArray]:
@@ -196,8 +220,9 @@ def grid_states(plant: Plant, n1: int, n2: int) -> tuple[NDArray, NDArray]:
     return np.meshgrid(x1, x2)
 
 
-def settle_steps(x1: NDArray, x2: NDArray, band: float, velocity_band: float,
-                 hold_steps: int) -> NDArray[np.int64]:
+def settle_steps(
+    x1: NDArray, x2: NDArray, band: float, velocity_band: float, hold_steps: int
+) -> NDArray[np.int64]:
     """First sample from which every later state lies in the band.
 
     Parameters
@@ -238,12 +263,12 @@ def _stats(ratio: NDArray, x1: NDArray, x2: NDArray) -> tuple[float, float, tupl
     if not ok.any():
         return math.nan, math.nan, (math.nan, math.nan)
     k = int(np.nanargmax(np.where(ok, ratio, -np.inf)))
-    return float(np.median(ratio[ok])), float(ratio.flat[k]), (float(x1.flat[k]),
-                                                                float(x2.flat[k]))
+    return float(np.median(ratio[ok])), float(ratio.flat[k]), (float(x1.flat[k]), float(x2.flat[k]))
 
 
-def run_sweep(cfg: Config, settings: SweepSettings | None = None, *,
-              progress: Progress | None = None) -> SweepResult:
+def run_sweep(
+    cfg: Config, settings: SweepSettings | None = None, *, progress: Progress | None = None
+) -> SweepResult:
     """Run the suboptimality sweep.
 
     Parameters
@@ -312,10 +337,23 @@ def run_sweep(cfg: Config, settings: SweepSettings | None = None, *,
             r_tf, r_nt = st / t_f, st / nt
         med_tf, worst_tf, at_tf = _stats(r_tf, X1, X2)
         med_nt, worst_nt, at_nt = _stats(r_nt, X1, X2)
-        laws[name] = LawSweep(name, st, r_tf, r_nt, float(np.mean(np.isfinite(st))), med_tf,
-                              med_nt, worst_tf, worst_nt, at_tf, at_nt, secs[name],
-                              float(np.percentile(r_tf[np.isfinite(r_tf)], 95))
-                              if np.isfinite(r_tf).any() else math.nan)
+        laws[name] = LawSweep(
+            name,
+            st,
+            r_tf,
+            r_nt,
+            float(np.mean(np.isfinite(st))),
+            med_tf,
+            med_nt,
+            worst_tf,
+            worst_nt,
+            at_tf,
+            at_nt,
+            secs[name],
+            float(np.percentile(r_tf[np.isfinite(r_tf)], 95))
+            if np.isfinite(r_tf).any()
+            else math.nan,
+        )
     timings["total"] = time.perf_counter() - t0
     report("done", 1.0)
     return SweepResult(X1, X2, t_f, n_star, laws, s, vband, steps, T, timings, skipped)

@@ -35,7 +35,7 @@ from ptoverify.errors import InputError
 
 __all__ = ["load_callable", "LawFault", "UserLaw", "wrap_callable"]
 
-_VEC_RTOL = 1e-12              #: vectorized-vs-scalar agreement relative to w_max
+_VEC_RTOL = 1e-12  #: vectorized-vs-scalar agreement relative to w_max
 
 
 # ------------------------------------------------------------------ loading
@@ -77,8 +77,9 @@ def load_callable(spec: str) -> Callable:
     except InputError:
         raise
     except BaseException as exc:  # noqa: BLE001 - user code may raise anything, even SystemExit
-        raise InputError(f"--law '{spec}': importing '{mod_name}' failed: "
-                         f"{type(exc).__name__}: {exc}") from None
+        raise InputError(
+            f"--law '{spec}': importing '{mod_name}' failed: {type(exc).__name__}: {exc}"
+        ) from None
     obj: Any = module
     for part in attr.split("."):
         if not hasattr(obj, part):
@@ -102,13 +103,17 @@ class LawFault(Exception):
 def _as_number(value: Any, state: tuple[float, float]) -> float:
     """Convert a scalar return value to float; wrong type is bad input (exit 2)."""
     if isinstance(value, bool) or np.ndim(value) != 0:
-        raise InputError(f"the law returned {type(value).__name__} (shape {np.shape(value)}) at "
-                         f"state ({state[0]!r}, {state[1]!r}); expected one number u [mm/s]")
+        raise InputError(
+            f"the law returned {type(value).__name__} (shape {np.shape(value)}) at "
+            f"state ({state[0]!r}, {state[1]!r}); expected one number u [mm/s]"
+        )
     try:
         return float(value)
     except (TypeError, ValueError):
-        raise InputError(f"the law returned {type(value).__name__} at state ({state[0]!r}, "
-                         f"{state[1]!r}); expected one number u [mm/s]") from None
+        raise InputError(
+            f"the law returned {type(value).__name__} at state ({state[0]!r}, "
+            f"{state[1]!r}); expected one number u [mm/s]"
+        ) from None
 
 
 @dataclass
@@ -152,22 +157,23 @@ class UserLaw:
         x1 = np.asarray(x1, dtype=float).ravel()
         x2 = np.asarray(x2, dtype=float).ravel()
         if self.mode == "scalar":
-            return np.array([self.scalar(float(a), float(b)) for a, b in zip(x1, x2)],
-                            dtype=float)
+            return np.array([self.scalar(float(a), float(b)) for a, b in zip(x1, x2)], dtype=float)
         self.calls += 1
         try:
             value = self.fn(x1, x2, self.cfg)
         except (Exception, SystemExit) as exc:  # noqa: BLE001 - locate the failing state element-wise
             for a, b in zip(x1, x2):
                 self.scalar(float(a), float(b))
-            raise LawFault((float(x1[0]), float(x2[0])),
-                           f"the law raised {type(exc).__name__} on arrays but no element "
-                           f"raised alone: {exc}") from None
+            raise LawFault(
+                (float(x1[0]), float(x2[0])),
+                f"the law raised {type(exc).__name__} on arrays but no element raised alone: {exc}",
+            ) from None
         try:
             u = np.asarray(value, dtype=float)
         except (TypeError, ValueError):
-            raise InputError(f"the law returned {type(value).__name__} for arrays; expected a "
-                             "float array") from None
+            raise InputError(
+                f"the law returned {type(value).__name__} for arrays; expected a float array"
+            ) from None
         if u.shape != x1.shape:
             raise InputError(f"the law returned shape {u.shape} for {x1.size} states")
         bad = np.flatnonzero(~np.isfinite(u))
@@ -207,7 +213,7 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
     except TypeError as exc:
         raise InputError(f"the law's signature does not accept (x1, x2, cfg): {exc}") from None
     except ValueError:
-        pass                                    # no signature available (builtins): try it
+        pass  # no signature available (builtins): try it
     law = UserLaw(fn, cfg)
     p1, p2 = _probe_states(cfg)
     try:
@@ -219,9 +225,14 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
     diff = np.abs(first - second)
     if np.any(diff > 0):
         i = int(np.argmax(diff > 0))
-        failures.append(failure("pure-function", (p1[i], p2[i]),
-                                 f"two calls at the same state returned {first[i]!r} and "
-                                 f"{second[i]!r} mm/s: the law has memory (e.g. a delay)"))
+        failures.append(
+            failure(
+                "pure-function",
+                (p1[i], p2[i]),
+                f"two calls at the same state returned {first[i]!r} and "
+                f"{second[i]!r} mm/s: the law has memory (e.g. a delay)",
+            )
+        )
     law.reason = ""
     try:
         vec = np.asarray(fn(p1, p2, cfg), dtype=float)
@@ -234,8 +245,10 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
             close = np.abs(vec - first) <= _VEC_RTOL * cfg.plant.w_max
             if not np.all(close):
                 i = int(np.argmin(close))
-                law.reason = (f"array call differs from element-wise calls at ({p1[i]:g}, "
-                              f"{p2[i]:g}): {vec[i]!r} vs {first[i]!r}")
+                law.reason = (
+                    f"array call differs from element-wise calls at ({p1[i]:g}, "
+                    f"{p2[i]:g}): {vec[i]!r} vs {first[i]!r}"
+                )
     if law.reason:
         law.reason += "; wrapped in a scalar loop"
     else:

@@ -63,8 +63,16 @@ from ptoverify.config import Config, PTOSettings
 from ptoverify.curves import level_curve_x1, level_residual, root_22, root_k
 from ptoverify.plant import flow
 
-__all__ = ["PTOZone", "printed_zone", "corrected_zone", "zone_summary", "principle_margin",
-           "principle_violations", "zone_for_law", "READINGS"]
+__all__ = [
+    "PTOZone",
+    "printed_zone",
+    "corrected_zone",
+    "zone_summary",
+    "principle_margin",
+    "principle_violations",
+    "zone_for_law",
+    "READINGS",
+]
 
 READINGS = ("strict", "lenient")
 _NAN = float("nan")
@@ -135,14 +143,25 @@ class PTOZone:
 
     def to_json(self) -> dict:
         """Return the zone as a JSON-able dict (DESIGN keys first)."""
-        return {"omega0": self.omega0, "x20_tilde": self.x20_tilde, "valid": self.valid,
-                "reason": self.reason, "construction": self.construction,
-                "degenerate": self.degenerate, "reading": self.reading, "b0": self.b0,
-                "y_star": self.y_star, "k": self.k, "z_star": self.z_star,
-                "margin_mm_s": self.margin,
-                "feasible_intervals": [list(iv) for iv in self.feasible_intervals],
-                "grid_violations": self.grid_violations, "grid_points": self.grid_points,
-                "d_min": self.d_min, **self.details}
+        return {
+            "omega0": self.omega0,
+            "x20_tilde": self.x20_tilde,
+            "valid": self.valid,
+            "reason": self.reason,
+            "construction": self.construction,
+            "degenerate": self.degenerate,
+            "reading": self.reading,
+            "b0": self.b0,
+            "y_star": self.y_star,
+            "k": self.k,
+            "z_star": self.z_star,
+            "margin_mm_s": self.margin,
+            "feasible_intervals": [list(iv) for iv in self.feasible_intervals],
+            "grid_violations": self.grid_violations,
+            "grid_points": self.grid_points,
+            "d_min": self.d_min,
+            **self.details,
+        }
 
 
 # ------------------------------------------------------------------ principle
@@ -167,16 +186,22 @@ def _source_intervals(cfg: Config, omega0: float, x2: NDArray[np.float64], d: fl
     with np.errstate(all="ignore"):
         l1s = np.where(neg, _l1star_x1(np.where(neg, x2, -1.0), a, min(omega0, w)), 0.0)
         l2 = level_curve_x1(np.where(pos, x2, 1.0), a, w)
-    lo_a = np.where(neg, np.maximum(l1s, d), d)            # right piece: x1 >= d
+    lo_a = np.where(neg, np.maximum(l1s, d), d)  # right piece: x1 >= d
     hi_a = np.full_like(x2, np.inf)
-    lo_b = np.where(pos & (l2 <= -d), l2, np.inf)          # left piece: l2 <= x1 <= -d
+    lo_b = np.where(pos & (l2 <= -d), l2, np.inf)  # left piece: l2 <= x1 <= -d
     hi_b = np.full_like(x2, -d)
     return (lo_a, hi_a), (lo_b, hi_b)
 
 
-def principle_margin(cfg: Config, omega0: float, x2: NDArray[np.float64] | None = None, *,
-                     reading: str = "strict", d: float | None = None,
-                     points: int = 4001) -> NDArray[np.float64]:
+def principle_margin(
+    cfg: Config,
+    omega0: float,
+    x2: NDArray[np.float64] | None = None,
+    *,
+    reading: str = "strict",
+    d: float | None = None,
+    points: int = 4001,
+) -> NDArray[np.float64]:
     """Worst landing residual of the principle at each velocity, exact in x1.
 
     Parameters
@@ -207,11 +232,14 @@ def principle_margin(cfg: Config, omega0: float, x2: NDArray[np.float64] | None 
     if x2 is None:
         x2 = np.linspace(-w, w, points)
     x2 = np.asarray(x2, dtype=float)
-    c1, f2 = flow(0.0, x2, -w, cfg.plant.sample_time, a)   # F1 = x1 + c1, F2 = f2
+    c1, f2 = flow(0.0, x2, -w, cfg.plant.sample_time, a)  # F1 = x1 + c1, F2 = f2
     margin = np.full_like(x2, np.inf)
     for lo, hi in _source_intervals(cfg, omega0, x2, d):
-        cands = [lo] if reading == "strict" else [np.maximum(lo, d - c1),
-                                                  np.where(lo <= -d - c1, lo, np.inf)]
+        cands = (
+            [lo]
+            if reading == "strict"
+            else [np.maximum(lo, d - c1), np.where(lo <= -d - c1, lo, np.inf)]
+        )
         for x1 in cands:
             ok = (x1 <= hi) & np.isfinite(x1)
             with np.errstate(all="ignore"):
@@ -255,13 +283,19 @@ def _worst_margin(cfg: Config, omega0: float, reading: str, d: float | None = No
     extra += [np.linspace(x2[i] - step, x2[i] + step, 201) for i in loc]
     fine = np.clip(np.concatenate(extra), -w, w)
     if fine.size:
-        return float(min(m.min(), principle_margin(cfg, omega0, fine, reading=reading,
-                                                   d=d).min()))
+        return float(min(m.min(), principle_margin(cfg, omega0, fine, reading=reading, d=d).min()))
     return float(m.min())
 
 
-def principle_violations(cfg: Config, omega0: float, *, reading: str = "strict",
-                         n1: int = 801, n2: int = 801, band: int = 201) -> tuple[int, int]:
+def principle_violations(
+    cfg: Config,
+    omega0: float,
+    *,
+    reading: str = "strict",
+    n1: int = 801,
+    n2: int = 801,
+    band: int = 201,
+) -> tuple[int, int]:
     """Count violations of the principle on 2-D grids of source states.
 
     Independent of the monotonicity argument: every grid state in the source set
@@ -296,8 +330,11 @@ def principle_violations(cfg: Config, omega0: float, *, reading: str = "strict",
     x1 = np.concatenate([g1.ravel(), b1.ravel()])
     x2s = np.concatenate([g2.ravel(), b2.ravel()])
     sig = level_residual(x1, x2s, a, w)
-    in_zone = (x2s < 0) & (sig >= 0) & (level_residual(x1, x2s, a, min(omega0, w)) < 0) \
-        if 0 < omega0 < w else np.zeros_like(sig, dtype=bool)
+    in_zone = (
+        (x2s < 0) & (sig >= 0) & (level_residual(x1, x2s, a, min(omega0, w)) < 0)
+        if 0 < omega0 < w
+        else np.zeros_like(sig, dtype=bool)
+    )
     src = (np.abs(x1) >= d) & ((sig > 0) | ((sig == 0) & (x2s > 0))) & ~in_zone
     f1, f2 = flow(x1[src], x2s[src], -w, T, a)
     bad = level_residual(f1, f2, a, w) < -_tol(cfg)
@@ -309,12 +346,12 @@ def principle_violations(cfg: Config, omega0: float, *, reading: str = "strict",
 # ------------------------------------------------------------------ printed
 def _printed_numbers(a: float, w: float, T: float, d: float) -> dict:  # noqa: N803
     """Eqs. (21)-(27) exactly as printed."""
-    b0 = a * d / w + 2.0 * a * T                       # eq. (21), x~10 = d
-    y = float(root_22(b0))                             # eq. (22)
-    x20 = -y * w                                       # eq. (23)
-    k = 1.0 + a * d / x20                              # eq. (25)
-    z = float(root_k(-a * d / x20))                    # eq. (26), m = 1 - k
-    omega0 = -x20 / z if z != 0 else _NAN              # eq. (27)
+    b0 = a * d / w + 2.0 * a * T  # eq. (21), x~10 = d
+    y = float(root_22(b0))  # eq. (22)
+    x20 = -y * w  # eq. (23)
+    k = 1.0 + a * d / x20  # eq. (25)
+    z = float(root_k(-a * d / x20))  # eq. (26), m = 1 - k
+    omega0 = -x20 / z if z != 0 else _NAN  # eq. (27)
     return {"b0": b0, "y_star": y, "x20_tilde": x20, "k": k, "z_star": z, "omega0": omega0}
 
 
@@ -325,11 +362,13 @@ def _image_residuals(cfg: Config) -> dict:
     x1 = level_curve_x1(x2, a, w)
     fp1, fp2 = flow(x1, x2, w, T, a)
     fn = flow(x1, x2, -w, T, a)
-    rp = a * fp1 + fp2 + w * np.log1p(-fp2 / w)      # eq. (9) itself, valid also for x2 > 0
+    rp = a * fp1 + fp2 + w * np.log1p(-fp2 / w)  # eq. (9) itself, valid also for x2 > 0
     rn = level_residual(fn[0], fn[1], a, w)
-    return {"image_plus_residual_max_abs": float(np.abs(rp).max()),
-            "image_minus_residual_range": [float(rn.min()), float(rn.max())],
-            "eq19_residual": -2.0 * a * w * T}
+    return {
+        "image_plus_residual_max_abs": float(np.abs(rp).max()),
+        "image_minus_residual_range": [float(rn.min()), float(rn.max())],
+        "eq19_residual": -2.0 * a * w * T,
+    }
 
 
 def printed_zone(cfg: Config) -> PTOZone:
@@ -361,34 +400,58 @@ def printed_zone(cfg: Config) -> PTOZone:
     num = _printed_numbers(a, w, T, d)
     om, x20 = num["omega0"], num["x20_tilde"]
     img = _image_residuals(cfg)
-    reasons = [f"eq. (16) sign: with the +w_max flow of (15), a x1 + x2 grows by a w_max T "
-               f"and the image of l1 is l1 itself (max |sigma| = "
-               f"{img['image_plus_residual_max_abs']:.2e} mm/s), not the curve (19) at "
-               f"sigma = -2 a w_max T = {img['eq19_residual']:.4g} mm/s; under -w_max the image "
-               f"has sigma in [{img['image_minus_residual_range'][0]:.4g}, "
-               f"{img['image_minus_residual_range'][1]:.4g}] mm/s, not a constant"]
+    reasons = [
+        f"eq. (16) sign: with the +w_max flow of (15), a x1 + x2 grows by a w_max T "
+        f"and the image of l1 is l1 itself (max |sigma| = "
+        f"{img['image_plus_residual_max_abs']:.2e} mm/s), not the curve (19) at "
+        f"sigma = -2 a w_max T = {img['eq19_residual']:.4g} mm/s; under -w_max the image "
+        f"has sigma in [{img['image_minus_residual_range'][0]:.4g}, "
+        f"{img['image_minus_residual_range'][1]:.4g}] mm/s, not a constant"
+    ]
     if x20 < -w:
-        reasons.append(f"x~20 = {x20:.6g} mm/s lies beyond -w_max = {-w:g} mm/s, outside the "
-                       "envelope |x2| <= w_max that a sampled state can reach")
+        reasons.append(
+            f"x~20 = {x20:.6g} mm/s lies beyond -w_max = {-w:g} mm/s, outside the "
+            "envelope |x2| <= w_max that a sampled state can reach"
+        )
     usable = math.isfinite(om) and 0.0 < om < w
     if not usable:
-        reasons.append(f"omega0 = {om:.6g} mm/s is not in (0, w_max = {w:g}): the interval "
-                       "[omega0, w_max] of eq. (28) is empty and l1* lies on the S_P side of "
-                       "l1, so the zone between l1 and l1* is empty; eq. (35) reduces to the "
-                       "time-optimal law outside the linear zone")
-    om_eff = om if usable else w                       # no zone: u = -w_max up to l1
+        reasons.append(
+            f"omega0 = {om:.6g} mm/s is not in (0, w_max = {w:g}): the interval "
+            "[omega0, w_max] of eq. (28) is empty and l1* lies on the S_P side of "
+            "l1, so the zone between l1 and l1* is empty; eq. (35) reduces to the "
+            "time-optimal law outside the linear zone"
+        )
+    om_eff = om if usable else w  # no zone: u = -w_max up to l1
     margin = _worst_margin(cfg, om_eff, "strict")
     margin_l = _worst_margin(cfg, om_eff, "lenient")
     holds = margin >= -_tol(cfg)
-    reasons.append(f"principle (strict) {'holds' if holds else 'fails'} for the zone it "
-                   f"defines: worst landing sigma = {margin:.6g} mm/s (lenient reading: "
-                   f"{margin_l:.6g} mm/s)")
+    reasons.append(
+        f"principle (strict) {'holds' if holds else 'fails'} for the zone it "
+        f"defines: worst landing sigma = {margin:.6g} mm/s (lenient reading: "
+        f"{margin_l:.6g} mm/s)"
+    )
     degenerate = usable and _degenerate(cfg, om)
     valid = usable and holds and not degenerate
     details = {"usable": usable, "margin_lenient_mm_s": margin_l, **img}
-    return PTOZone("printed", om, x20, num["b0"], num["y_star"], num["k"], num["z_star"],
-                   valid, degenerate, "; ".join(reasons), (), "strict", margin, -1, 0,
-                   smallest_d(cfg, "strict"), details)
+    return PTOZone(
+        "printed",
+        om,
+        x20,
+        num["b0"],
+        num["y_star"],
+        num["k"],
+        num["z_star"],
+        valid,
+        degenerate,
+        "; ".join(reasons),
+        (),
+        "strict",
+        margin,
+        -1,
+        0,
+        smallest_d(cfg, "strict"),
+        details,
+    )
 
 
 # ------------------------------------------------------------------ corrected
@@ -403,8 +466,9 @@ def _degenerate(cfg: Config, omega0: float) -> bool:
 def _feasible_intervals(cfg: Config, reading: str, scan: int) -> list[tuple[float, float]]:
     """Scan omega0 over (0, w_max], then bisect every edge of the feasible set."""
     w, tol = cfg.plant.w_max, _tol(cfg)
-    grid = np.unique(np.concatenate([np.geomspace(1e-4 * w, w, scan // 2),
-                                     np.linspace(w / scan, w, scan // 2)]))
+    grid = np.unique(
+        np.concatenate([np.geomspace(1e-4 * w, w, scan // 2), np.linspace(w / scan, w, scan // 2)])
+    )
     ok = np.array([_worst_margin(cfg, float(om), reading) >= -tol for om in grid])
 
     def edge(good: float, bad: float) -> float:
@@ -465,8 +529,9 @@ def smallest_d(cfg: Config, reading: str = "strict") -> float:
     return hi
 
 
-def corrected_zone(cfg: Config, *, reading: str = "strict", scan: int = 200,
-                   verify: bool = True) -> PTOZone:
+def corrected_zone(
+    cfg: Config, *, reading: str = "strict", scan: int = 200, verify: bool = True
+) -> PTOZone:
     """Largest omega0 < w_max for which the principle holds, verified on a grid.
 
     omega0 is scanned over (0, w_max] (``scan`` points, geometric and linear),
@@ -505,38 +570,79 @@ def corrected_zone(cfg: Config, *, reading: str = "strict", scan: int = 200,
     dmin = smallest_d(cfg, reading)
     shown = ", ".join(f"({lo:.6g}, {hi:.6g}]" for lo, hi in intervals)
     if not intervals:
-        reason = (f"no omega0 in (0, w_max] meets the {reading} principle for d = {d:g} mm, "
-                  f"T = {cfg.plant.sample_time:g} s, a = {a:.6g} rad/s; the smallest d for "
-                  f"which one does is {dmin:.6g} mm")
-        return PTOZone("corrected", _NAN, _NAN, _NAN, _NAN, _NAN, _NAN, False, False, reason,
-                       (), reading, _worst_margin(cfg, 0.0, reading), -1, 0, dmin,
-                       {"usable": False})
+        reason = (
+            f"no omega0 in (0, w_max] meets the {reading} principle for d = {d:g} mm, "
+            f"T = {cfg.plant.sample_time:g} s, a = {a:.6g} rad/s; the smallest d for "
+            f"which one does is {dmin:.6g} mm"
+        )
+        return PTOZone(
+            "corrected",
+            _NAN,
+            _NAN,
+            _NAN,
+            _NAN,
+            _NAN,
+            _NAN,
+            False,
+            False,
+            reason,
+            (),
+            reading,
+            _worst_margin(cfg, 0.0, reading),
+            -1,
+            0,
+            dmin,
+            {"usable": False},
+        )
     top = intervals[-1][1]
     no_zone_needed = top >= w
     omega0 = (w if no_zone_needed else top) * (1.0 - 1e-6)
     margin = _worst_margin(cfg, omega0, reading)
     degenerate = _degenerate(cfg, omega0)
     viol, pts = principle_violations(cfg, omega0, reading=reading) if verify else (-1, 0)
-    y = float(root_22(a * d / omega0))                 # l1* meets x1 = d: h(y) = a d / omega0
+    y = float(root_22(a * d / omega0))  # l1* meets x1 = d: h(y) = a d / omega0
     x20 = -y * omega0 if y * omega0 <= w else _NAN
     k = 1.0 + a * d / x20 if math.isfinite(x20) else _NAN
-    parts = [f"{reading} principle holds for omega0 in {shown} mm/s; chosen omega0 = "
-             f"{omega0:.6g} mm/s, worst landing sigma = {margin:.4g} mm/s"]
+    parts = [
+        f"{reading} principle holds for omega0 in {shown} mm/s; chosen omega0 = "
+        f"{omega0:.6g} mm/s, worst landing sigma = {margin:.4g} mm/s"
+    ]
     if no_zone_needed:
         parts.append("the principle holds with no zone at all (omega0 = w_max)")
     if degenerate:
-        parts.append(f"l1* reaches only x1 = {float(level_curve_x1(-w, a, omega0)):.4g} mm at "
-                     f"x2 = -w_max, inside the linear zone d = {d:g} mm: the zone never acts "
-                     "(degenerate)")
+        parts.append(
+            f"l1* reaches only x1 = {float(level_curve_x1(-w, a, omega0)):.4g} mm at "
+            f"x2 = -w_max, inside the linear zone d = {d:g} mm: the zone never acts "
+            "(degenerate)"
+        )
     if verify:
         parts.append(f"grid check: {viol} violations in {pts} source states")
     valid = (not degenerate) and omega0 < w and margin >= -_tol(cfg) and viol <= 0
-    details = {"usable": 0 < omega0 < w, "no_zone_needed": no_zone_needed,
-               "l1star_x1_at_wmax_mm": float(level_curve_x1(-w, a, omega0)),
-               "l1_x1_at_wmax_mm": float(level_curve_x1(-w, a, w))}
-    return PTOZone("corrected", omega0, x20, a * d / omega0, y if math.isfinite(x20) else _NAN,
-                   k, y if math.isfinite(x20) else _NAN, valid, degenerate, "; ".join(parts),
-                   tuple(intervals), reading, margin, viol, pts, dmin, details)
+    details = {
+        "usable": 0 < omega0 < w,
+        "no_zone_needed": no_zone_needed,
+        "l1star_x1_at_wmax_mm": float(level_curve_x1(-w, a, omega0)),
+        "l1_x1_at_wmax_mm": float(level_curve_x1(-w, a, w)),
+    }
+    return PTOZone(
+        "corrected",
+        omega0,
+        x20,
+        a * d / omega0,
+        y if math.isfinite(x20) else _NAN,
+        k,
+        y if math.isfinite(x20) else _NAN,
+        valid,
+        degenerate,
+        "; ".join(parts),
+        tuple(intervals),
+        reading,
+        margin,
+        viol,
+        pts,
+        dmin,
+        details,
+    )
 
 
 @functools.lru_cache(maxsize=32)
@@ -563,9 +669,12 @@ def zone_summary(cfg: Config, *, verify: bool = True) -> dict:
         ``w_max`` [mm/s], ``a`` [rad/s], ``sample_time`` [s].
     """
     p: PTOSettings = cfg.pto
-    return {"printed": printed_zone(cfg).to_json(),
-            "corrected": corrected_zone(cfg, verify=verify).to_json(),
-            "corrected_lenient": corrected_zone(cfg, reading="lenient",
-                                                verify=verify).to_json(),
-            "d": p.d, "w_max": cfg.plant.w_max, "a": cfg.plant.a,
-            "sample_time": cfg.plant.sample_time}
+    return {
+        "printed": printed_zone(cfg).to_json(),
+        "corrected": corrected_zone(cfg, verify=verify).to_json(),
+        "corrected_lenient": corrected_zone(cfg, reading="lenient", verify=verify).to_json(),
+        "d": p.d,
+        "w_max": cfg.plant.w_max,
+        "a": cfg.plant.a,
+        "sample_time": cfg.plant.sample_time,
+    }

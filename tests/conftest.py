@@ -17,10 +17,18 @@ def paper_cfg() -> Config:
 def other_configs() -> list[Config]:
     """Two more plants: the 'a = 30 rad/s' reading, and a slower, finer-sampled axis."""
     return [
-        Config("slow-a", Plant(a=30.0, w_max=300.0, sample_time=0.002, position_range=50.0),
-               PDGains(), PTOSettings()),
-        Config("fine-T", Plant(a=100.0, w_max=100.0, sample_time=0.001, position_range=20.0),
-               PDGains(kp=100.0, kd=0.5), PTOSettings(d=0.2, k1=100.0, k2=1.0)),
+        Config(
+            "slow-a",
+            Plant(a=30.0, w_max=300.0, sample_time=0.002, position_range=50.0),
+            PDGains(),
+            PTOSettings(),
+        ),
+        Config(
+            "fine-T",
+            Plant(a=100.0, w_max=100.0, sample_time=0.001, position_range=20.0),
+            PDGains(kp=100.0, kd=0.5),
+            PTOSettings(d=0.2, k1=100.0, k2=1.0),
+        ),
     ]
 
 

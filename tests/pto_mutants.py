@@ -84,7 +84,7 @@ def _root_z(k, f):
     """Non-trivial root of ln(1 + z) = k z (eqs. 26, 31), 0 < k < 1."""
     if "bisect_loose" in f or "bisect_exact" in f:
         tol = 1e-2 if "bisect_loose" in f else 0.0
-        lo, hi = 1.0 - k, 1.0 / k**2 + 1.0            # g(z) = ln(1+z) - k z: > 0, < 0
+        lo, hi = 1.0 - k, 1.0 / k**2 + 1.0  # g(z) = ln(1+z) - k z: > 0, < 0
         for _ in range(2000):
             mid = 0.5 * (lo + hi)
             active = (hi - lo > tol) & (mid > lo) & (mid < hi)
@@ -96,7 +96,7 @@ def _root_z(k, f):
         return 0.5 * (lo + hi)
     branch = 0 if "wrong_branch" in f else -1
     z = -1.0 - np.real(lambertw(-k * np.exp(-k), branch)) / k
-    for _ in range(2):                                # Newton polish on ln(1+z) - k z
+    for _ in range(2):  # Newton polish on ln(1+z) - k z
         z = z - (_ln(1.0 + z, f) - k * z) / (1.0 / (1.0 + z) - k)
     return z
 
@@ -159,8 +159,11 @@ class _Delayed:
 
     def __call__(self, x1, x2, cfg):
         u = self.inner(x1, x2, cfg)
-        out = self.prev if self.prev is not None and np.shape(self.prev) == np.shape(u) \
+        out = (
+            self.prev
+            if self.prev is not None and np.shape(self.prev) == np.shape(u)
             else np.zeros_like(u)
+        )
         self.prev = u
         return out
 

@@ -20,16 +20,30 @@ from ptoverify.simulate import simulate_batch
 
 ROOT = Path(__file__).resolve().parent.parent
 
-KEYS = {"law_vector_evals_per_s", "law_scalar_us", "omega_c_bisection_vs_closed_form",
-        "mintime_vector_evals_per_s", "sim_state_steps_per_s", "two_phase_ms",
-        "collocation_ms", "collocation_vs_two_phase_error_ratio", "discrete_ms", "check_s",
-        "report_s"}
+KEYS = {
+    "law_vector_evals_per_s",
+    "law_scalar_us",
+    "omega_c_bisection_vs_closed_form",
+    "mintime_vector_evals_per_s",
+    "sim_state_steps_per_s",
+    "two_phase_ms",
+    "collocation_ms",
+    "collocation_vs_two_phase_error_ratio",
+    "discrete_ms",
+    "check_s",
+    "report_s",
+}
 
 
 @pytest.fixture(scope="module")
 def small_run() -> dict:
-    p = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "run.py"), "--json",
-                        "--small"], cwd=ROOT, capture_output=True, text=True, timeout=240)
+    p = subprocess.run(
+        [sys.executable, str(ROOT / "benchmarks" / "run.py"), "--json", "--small"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=240,
+    )
     assert p.returncode == 0, p.stderr
     return json.loads(p.stdout)
 
@@ -67,7 +81,7 @@ def _states(cfg, n, seed):
 
 def _pieces(fn, x1, x2, size=997):
     """Evaluate fn on small slices (one block each) and concatenate."""
-    parts = [fn(x1[i:i + size], x2[i:i + size]) for i in range(0, x1.size, size)]
+    parts = [fn(x1[i : i + size], x2[i : i + size]) for i in range(0, x1.size, size)]
     return tuple(np.concatenate(p) for p in zip(*parts, strict=True))
 
 
@@ -75,22 +89,25 @@ def test_blockwise_law_mintime_omega_c_bit_for_bit(any_cfg):
     """Blockwise evaluation of large arrays equals evaluation slice by slice, bit for bit."""
     x1, x2 = _states(any_cfg, 5 * BLOCK + 123, 7)
     law = make_law("pto", any_cfg)
-    for got, want, what in zip(law.vector(x1, x2), _pieces(law.vector, x1, x2),
-                               ("u", "region"), strict=True):
+    for got, want, what in zip(
+        law.vector(x1, x2), _pieces(law.vector, x1, x2), ("u", "region"), strict=True
+    ):
         np.testing.assert_array_equal(got, want, err_msg=f"PTO law {what}, blockwise")
 
     def mt(a, b):
         m = min_time(a, b, any_cfg.plant)
         return m.t_f, m.t_switch, m.side, m.q
 
-    for got, want, what in zip(mt(x1, x2), _pieces(mt, x1, x2), ("t_f", "t_switch", "side", "q"),
-                               strict=True):
+    for got, want, what in zip(
+        mt(x1, x2), _pieces(mt, x1, x2), ("t_f", "t_switch", "side", "q"), strict=True
+    ):
         np.testing.assert_array_equal(got, want, err_msg=f"min_time {what}, blockwise")
     with np.errstate(all="ignore"):
         np.testing.assert_array_equal(
             omega_c(x1, x2, any_cfg.plant.a),
             _pieces(lambda a, b: (omega_c(a, b, any_cfg.plant.a),), x1, x2)[0],
-            err_msg="omega_c, blockwise")
+            err_msg="omega_c, blockwise",
+        )
 
 
 def test_simulate_batch_is_the_exact_flow(any_cfg):

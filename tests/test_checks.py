@@ -5,9 +5,13 @@ from ptoverify.cli import main
 
 
 def test_core_gates_pass_on_paper(paper_cfg):
-    names = ["zoh-vs-integrator", "roots-closed-form-vs-bisection",
-             "mintime-closed-form-vs-propagation", "mintime-closed-form-vs-two-phase",
-             "discrete-limit-consistency"]
+    names = [
+        "zoh-vs-integrator",
+        "roots-closed-form-vs-bisection",
+        "mintime-closed-form-vs-propagation",
+        "mintime-closed-form-vs-two-phase",
+        "discrete-limit-consistency",
+    ]
     results = run_checks(paper_cfg, names)
     assert [r.name for r in results] == names
     for r in results:
@@ -16,12 +20,16 @@ def test_core_gates_pass_on_paper(paper_cfg):
 
 def test_forced_solver_failure_is_unverified(paper_cfg, capsys):
     """A real IPOPT run capped at 1 iteration does not converge: unverified, exit 1."""
-    results = run_checks(paper_cfg, ["mintime-closed-form-vs-two-phase",
-                                     "mintime-closed-form-vs-collocation"], max_iter=1)
+    results = run_checks(
+        paper_cfg,
+        ["mintime-closed-form-vs-two-phase", "mintime-closed-form-vs-collocation"],
+        max_iter=1,
+    )
     assert all(r.status == UNVERIFIED and r.measured is None for r in results), results
     assert not summarize(results)["ok"]
-    code = main(["check", "--gate", "mintime-closed-form-vs-collocation", "--max-iter", "1",
-                 "--json"])
+    code = main(
+        ["check", "--gate", "mintime-closed-form-vs-collocation", "--max-iter", "1", "--json"]
+    )
     data = json.loads(capsys.readouterr().out)
     assert code == 1 and data["checks"][0]["status"] == UNVERIFIED
     assert data["summary"]["unverified"] == 1
@@ -43,10 +51,12 @@ def test_unstable_sampled_loop_fails_its_gate(paper_cfg):
     """Gains that meet Section 5's Lyapunov conditions but are unstable when sampled fail."""
     from dataclasses import replace
 
-    cfg = replace(paper_cfg, pd=replace(paper_cfg.pd, kp=5000.0),
-                  pto=replace(paper_cfg.pto, k1=5000.0))
-    results = {r.name: r for r in run_checks(cfg, ["pd-sampled-stable",
-                                                   "linear-zone-sampled-stable"])}
+    cfg = replace(
+        paper_cfg, pd=replace(paper_cfg.pd, kp=5000.0), pto=replace(paper_cfg.pto, k1=5000.0)
+    )
+    results = {
+        r.name: r for r in run_checks(cfg, ["pd-sampled-stable", "linear-zone-sampled-stable"])
+    }
     assert results["pd-sampled-stable"].status == FAIL
     assert results["linear-zone-sampled-stable"].status == FAIL
     assert results["pd-sampled-stable"].measured > 1.0

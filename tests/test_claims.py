@@ -12,9 +12,17 @@ from ptoverify.metrics import settling_time
 from ptoverify.simulate import simulate
 
 REQUIRED = {
-    "step-to-oscillation", "step-pd-31-percent", "step-pto-steadier-quicker",
-    "ramp-to-oscillation", "ramp-pd-lag", "ramp-pto-smooth", "sine-to-no-delay-oscillates",
-    "sine-pto-delay", "sine-pd-delay", "sine-pto-vs-pd", "conclusion-vs-to-and-pd",
+    "step-to-oscillation",
+    "step-pd-31-percent",
+    "step-pto-steadier-quicker",
+    "ramp-to-oscillation",
+    "ramp-pd-lag",
+    "ramp-pto-smooth",
+    "sine-to-no-delay-oscillates",
+    "sine-pto-delay",
+    "sine-pd-delay",
+    "sine-pto-vs-pd",
+    "conclusion-vs-to-and-pd",
 }
 
 
@@ -29,8 +37,9 @@ def test_every_issue_claim_present_with_a_verdict(results):
     assert len(ids) == len(results), "claim ids are unique"
     for r in results:
         assert r.verdict in cl.VERDICTS, r.id
-        assert r.readings and all(x.verdict in ("reproduced", "not reproduced")
-                                  for x in r.readings), r.id
+        assert r.readings and all(
+            x.verdict in ("reproduced", "not reproduced") for x in r.readings
+        ), r.id
         agree = {x.verdict for x in r.readings}
         expect = agree.pop() if len(agree) == 1 else "ambiguous"
         assert r.verdict == expect, f"{r.id}: overall verdict follows the readings"
@@ -52,15 +61,20 @@ def test_readings_cover_the_ambiguities(results):
     for r in results:
         assert {x.reading.a for x in r.readings} == {"2pi*f", "f"}, r.id
     assert {x.reading.tracking for x in by["sine-pd-delay"].readings} == {
-        "feed-forward", "none", "error"}
+        "feed-forward",
+        "none",
+        "error",
+    }
     assert {x.reading.pto for x in by["sine-pto-delay"].readings} == {"corrected", "printed"}
     assert {x.reading.tracking for x in by["step-to-oscillation"].readings} == {None}
     first = by["sine-pto-delay"].readings[0].reading
-    assert (first.a, first.tracking, first.pto) == ("2pi*f", "feed-forward", "corrected"), \
+    assert (first.a, first.tracking, first.pto) == ("2pi*f", "feed-forward", "corrected"), (
         "primary reading"
+    )
     one = cl.evaluate_claims(paper_config().with_plant(a=100.0))
-    assert all({x.reading.a for x in r.readings} == {"given"} for r in one), \
+    assert all({x.reading.a for x in r.readings} == {"given"} for r in one), (
         "a config giving a in rad/s has a single a-reading"
+    )
 
 
 def test_measured_value_is_recomputed_from_simulation(results):
@@ -70,11 +84,11 @@ def test_measured_value_is_recomputed_from_simulation(results):
     pd = simulate(make_law("pd", cfg), cfg.plant, "step")
     pto = simulate(make_law("pto", cfg), cfg.plant, "step")
     ts_pd, ts_pto = (settling_time(r.t, r.e, 0.02 * 5.0) for r in (pd, pto))
-    assert by["step-pd-31-percent"].measured == pytest.approx(100 * (ts_pd / ts_pto - 1),
-                                                              rel=1e-12)
+    assert by["step-pd-31-percent"].measured == pytest.approx(100 * (ts_pd / ts_pto - 1), rel=1e-12)
     other = {r.id: r for r in cl.evaluate_claims(cfg.with_plant(w_max=250.0))}
-    changed = [i for i in REQUIRED if by[i].measured is not None
-               and other[i].measured != by[i].measured]
+    changed = [
+        i for i in REQUIRED if by[i].measured is not None and other[i].measured != by[i].measured
+    ]
     assert len(changed) >= 5, f"measured values must follow the simulation; changed: {changed}"
     for i in REQUIRED:
         m = by[i].measured

@@ -19,19 +19,22 @@ def test_mintime_json(capsys):
     assert 0 < data["switch_time_s"] < data["analytic_s"]
 
 
-@pytest.mark.parametrize("argv", [
-    ["mintime", "abc", "0"],
-    ["mintime", "nan", "0"],
-    ["mintime", "1", "inf"],
-    ["mintime", "1"],
-    ["mintime", "1e12", "0"],
-    ["simulate", "--law", "nope"],
-    ["simulate", "--signal", "square"],
-    ["simulate", "--duration", "-1"],
-    ["nosuchcommand"],
-    [],
-    ["mintime", "1", "0", "--config", "/nonexistent/file.toml"],
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["mintime", "abc", "0"],
+        ["mintime", "nan", "0"],
+        ["mintime", "1", "inf"],
+        ["mintime", "1"],
+        ["mintime", "1e12", "0"],
+        ["simulate", "--law", "nope"],
+        ["simulate", "--signal", "square"],
+        ["simulate", "--duration", "-1"],
+        ["nosuchcommand"],
+        [],
+        ["mintime", "1", "0", "--config", "/nonexistent/file.toml"],
+    ],
+)
 def test_bad_input_exit_2_one_line(capsys, argv):
     code, out, err = run(capsys, *argv)
     assert code == 2
@@ -42,25 +45,29 @@ def test_bad_input_exit_2_one_line(capsys, argv):
 
 def test_bad_config_values(capsys, tmp_path):
     f = tmp_path / "c.toml"
-    f.write_text('name = "x"\n[plant]\na = -1.0\nw_max = 1.0\nsample_time = 0.1\n'
-                 'position_range = 1.0\n[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\n'
-                 'k2 = 1.0\n')
+    f.write_text(
+        'name = "x"\n[plant]\na = -1.0\nw_max = 1.0\nsample_time = 0.1\n'
+        "position_range = 1.0\n[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\n"
+        "k2 = 1.0\n"
+    )
     code, _, err = run(capsys, "mintime", "1", "0", "--config", str(f))
     assert code == 2 and "plant.a" in err and len(err.strip().splitlines()) == 1
 
 
 def test_simulate_csv(capsys, tmp_path):
     out_file = tmp_path / "pd.csv"
-    code, out, _ = run(capsys, "simulate", "--law", "pd", "--signal", "ramp", "--csv",
-                       str(out_file))
+    code, out, _ = run(
+        capsys, "simulate", "--law", "pd", "--signal", "ramp", "--csv", str(out_file)
+    )
     assert code == 0
     lines = out_file.read_text().splitlines()
     assert lines[0] == "t,r,x1,x2,e,u,region" and len(lines) == 202
 
 
 def test_simulate_csv_unwritable(capsys, tmp_path):
-    code, _, err = run(capsys, "simulate", "--law", "pd", "--csv",
-                       str(tmp_path / "no" / "such" / "dir.csv"))
+    code, _, err = run(
+        capsys, "simulate", "--law", "pd", "--csv", str(tmp_path / "no" / "such" / "dir.csv")
+    )
     assert code == 2 and "cannot write" in err
     assert not (tmp_path / "no").exists()
 
@@ -73,22 +80,33 @@ def test_simulate_json(capsys):
 
 BAD_CONFIGS = {
     "not_toml": "this is [not toml",
-    "unknown_key": '[plant]\na = 1.0\nw_max = 1.0\nsample_time = 0.1\nposition_range = 1.0\n'
-                   'colour = 2.0\n[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n',
-    "nan": '[plant]\na = nan\nw_max = 1.0\nsample_time = 0.1\nposition_range = 1.0\n'
-           '[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n',
+    "unknown_key": "[plant]\na = 1.0\nw_max = 1.0\nsample_time = 0.1\nposition_range = 1.0\n"
+    "colour = 2.0\n[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n",
+    "nan": "[plant]\na = nan\nw_max = 1.0\nsample_time = 0.1\nposition_range = 1.0\n"
+    "[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n",
     "non_numeric": '[plant]\na = "fast"\nw_max = 1.0\nsample_time = 0.1\nposition_range = 1.0\n'
-                   '[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n',
-    "out_of_range": '[plant]\na = 1.0\nw_max = 1.0\nsample_time = -0.1\nposition_range = 1.0\n'
-                    '[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n',
+    "[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n",
+    "out_of_range": "[plant]\na = 1.0\nw_max = 1.0\nsample_time = -0.1\nposition_range = 1.0\n"
+    "[pd]\nkp = 1.0\nkd = 1.0\n[pto]\nd = 0.1\nk1 = 1.0\nk2 = 1.0\n",
 }
 
 
 @pytest.mark.parametrize("kind", sorted(BAD_CONFIGS))
-@pytest.mark.parametrize("command", [["report", "--quiet"], ["check"], ["sweep", "--quiet"],
-                                     ["zone"], ["derive"], ["simulate"], ["mintime", "1", "0"]])
-def test_bad_config_every_command_exit_2_writes_nothing(capsys, tmp_path, monkeypatch, kind,
-                                                        command):
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["report", "--quiet"],
+        ["check"],
+        ["sweep", "--quiet"],
+        ["zone"],
+        ["derive"],
+        ["simulate"],
+        ["mintime", "1", "0"],
+    ],
+)
+def test_bad_config_every_command_exit_2_writes_nothing(
+    capsys, tmp_path, monkeypatch, kind, command
+):
     monkeypatch.chdir(tmp_path)
     cfg = tmp_path / "bad.toml"
     cfg.write_text(BAD_CONFIGS[kind])
@@ -120,9 +138,11 @@ MORE_BAD = {
     "huge_T": ("sample_time = 0.002", "sample_time = 1e300"),
     "missing_section": ("[pd]\nkp = 356.0\nkd = 1.15\n", ""),
 }
-GOOD_TEXT = ('name = "x"\n[plant]\nbandwidth_hz = 30.0\nw_max = 300.0\nsample_time = 0.002\n'
-             'position_range = 50.0\n[pd]\nkp = 356.0\nkd = 1.15\n[pto]\nd = 0.5\nk1 = 323.0\n'
-             'k2 = 3.6\n')
+GOOD_TEXT = (
+    'name = "x"\n[plant]\nbandwidth_hz = 30.0\nw_max = 300.0\nsample_time = 0.002\n'
+    "position_range = 50.0\n[pd]\nkp = 356.0\nkd = 1.15\n[pto]\nd = 0.5\nk1 = 323.0\n"
+    "k2 = 3.6\n"
+)
 
 
 @pytest.mark.parametrize("kind", sorted(MORE_BAD))
@@ -135,8 +155,12 @@ def test_more_bad_configs_in_a_subprocess_no_traceback(tmp_path, kind):
     assert old in GOOD_TEXT
     cfg = tmp_path / "c.toml"
     cfg.write_text(GOOD_TEXT.replace(old, new))
-    proc = subprocess.run([sys.executable, "-m", "ptoverify", "simulate", "--law", "pd",
-                           "--config", str(cfg)], capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [sys.executable, "-m", "ptoverify", "simulate", "--law", "pd", "--config", str(cfg)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 2, proc.stderr
     assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
 

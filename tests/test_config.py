@@ -40,25 +40,28 @@ def test_a_instead_of_hz(tmp_path):
     assert load_config(f).plant.a == 30.0
 
 
-@pytest.mark.parametrize("old,new,key", [
-    ("w_max = 300.0", "w_max = 0.0", "plant.w_max"),
-    ("w_max = 300.0", "w_max = -1.0", "plant.w_max"),
-    ("sample_time = 0.002", "sample_time = 0", "plant.sample_time"),
-    ("bandwidth_hz = 30.0", "bandwidth_hz = -30.0", "plant.bandwidth_hz"),
-    ("bandwidth_hz = 30.0", "a = 0.0", "plant.a"),
-    ("bandwidth_hz = 30.0", "bandwidth_hz = 30.0\na = 3.0", "exactly one"),
-    ("bandwidth_hz = 30.0", "", "exactly one"),
-    ("d = 0.5", "d = -0.5", "pto.d"),
-    ("d = 0.5", "d = 51.0", "pto.d"),
-    ("kp = 356.0", "kp = nan", "pd.kp"),
-    ("kp = 356.0", "kp = inf", "pd.kp"),
-    ("kp = 356.0", 'kp = "356"', "pd.kp"),
-    ("kp = 356.0", "kp = true", "pd.kp"),
-    ("kd = 1.15", "kd = 1.15\nki = 2.0", "pd.ki"),
-    ("[pto]", "[pto2]", "pto2"),
-    ("k2 = 3.6", "", "pto.k2"),
-    ('name = "paper"', 'name = "../x"', "name"),
-])
+@pytest.mark.parametrize(
+    "old,new,key",
+    [
+        ("w_max = 300.0", "w_max = 0.0", "plant.w_max"),
+        ("w_max = 300.0", "w_max = -1.0", "plant.w_max"),
+        ("sample_time = 0.002", "sample_time = 0", "plant.sample_time"),
+        ("bandwidth_hz = 30.0", "bandwidth_hz = -30.0", "plant.bandwidth_hz"),
+        ("bandwidth_hz = 30.0", "a = 0.0", "plant.a"),
+        ("bandwidth_hz = 30.0", "bandwidth_hz = 30.0\na = 3.0", "exactly one"),
+        ("bandwidth_hz = 30.0", "", "exactly one"),
+        ("d = 0.5", "d = -0.5", "pto.d"),
+        ("d = 0.5", "d = 51.0", "pto.d"),
+        ("kp = 356.0", "kp = nan", "pd.kp"),
+        ("kp = 356.0", "kp = inf", "pd.kp"),
+        ("kp = 356.0", 'kp = "356"', "pd.kp"),
+        ("kp = 356.0", "kp = true", "pd.kp"),
+        ("kd = 1.15", "kd = 1.15\nki = 2.0", "pd.ki"),
+        ("[pto]", "[pto2]", "pto2"),
+        ("k2 = 3.6", "", "pto.k2"),
+        ('name = "paper"', 'name = "../x"', "name"),
+    ],
+)
 def test_rejections_name_the_key(tmp_path, old, new, key):
     f = tmp_path / "c.toml"
     f.write_text(GOOD.replace(old, new))
@@ -68,8 +71,13 @@ def test_rejections_name_the_key(tmp_path, old, new, key):
 
 def test_missing_section():
     with pytest.raises(ConfigError, match=r"\[pd\]"):
-        config_from_mapping({"name": "x", "plant": {"a": 1.0, "w_max": 1.0, "sample_time": 1.0,
-                                                    "position_range": 1.0}, "pto": {}})
+        config_from_mapping(
+            {
+                "name": "x",
+                "plant": {"a": 1.0, "w_max": 1.0, "sample_time": 1.0, "position_range": 1.0},
+                "pto": {},
+            }
+        )
 
 
 def test_missing_file_and_not_toml(tmp_path):

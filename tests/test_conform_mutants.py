@@ -12,7 +12,7 @@ from pto_mutants import BENIGN, MUTANTS, make_law, mutation_score
 
 from ptoverify.conform import conform_callable
 
-SWEEP = (11, 11, 20)   # 141 closed-loop states: every mutant is killed well inside this grid
+SWEEP = (11, 11, 20)  # 141 closed-loop states: every mutant is killed well inside this grid
 
 # faults that change the dynamics: the closed loop alone (without agreement) must see them
 DYNAMIC = {"l1_sign", "l2_sign", "k_swapped", "k2_sign", "bang_sign_q4"}
@@ -50,8 +50,7 @@ def test_mutant_rejected(score, name):
 @pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(DYNAMIC))
 def test_dynamic_faults_seen_by_closed_loop(score, name):
-    closed_loop = {"no-stride-over", "no-limit-cycle", "input-bound",
-                   "settling-vs-discrete-limit"}
+    closed_loop = {"no-stride-over", "no-limit-cycle", "input-bound", "settling-vs-discrete-limit"}
     assert closed_loop & set(score[2][name]), f"{name}: closed loop alone passes"
 
 

@@ -21,7 +21,7 @@ from ptoverify.plant import flow
 def test_h_against_mpmath():
     r = np.concatenate([10 ** np.linspace(-150, 3, 400), -(10 ** np.linspace(-150, -1e-3, 300))])
     # below ~1e-154, h = r^2/2 underflows: not an admissible range
-    with mpmath.workdps(400):          # r - ln(1 + r) cancels ~2 log10(1/r) digits
+    with mpmath.workdps(400):  # r - ln(1 + r) cancels ~2 log10(1/r) digits
         ref = np.array([float(mpmath.mpf(x) - mpmath.log1p(mpmath.mpf(x))) for x in r])
     # h is evaluated by a series or by r - log1p(r); both within a few ulps of the value
     assert_allclose(h(r), ref, rtol=4e-15, atol=0, err_msg="h(r) = r - ln(1 + r)")
@@ -36,19 +36,24 @@ def test_state_on_curve_rides_it_to_origin(any_cfg, sign):
         x2 = -sign * s
         x1 = float(level_curve_x1(x2, p.a, w))
         u = sign * w
-        t_hit = np.log1p(s / w) / p.a          # x2(t) = u + (x2 - u) e^{-at} = 0
+        t_hit = np.log1p(s / w) / p.a  # x2(t) = u + (x2 - u) e^{-at} = 0
         ts = np.linspace(0, t_hit, 7)
         y1, y2 = flow(x1, x2, u, ts, p.a)
         scale = p.a * abs(x1) + s
         assert np.abs(level_residual(y1, y2, p.a, w)).max() < 1e-13 * scale, "left the curve"
-        assert_allclose([y1[-1], y2[-1]], [0, 0], atol=1e-12 * (abs(x1) + s),
-                        err_msg="end of the curve is not the origin")
+        assert_allclose(
+            [y1[-1], y2[-1]],
+            [0, 0],
+            atol=1e-12 * (abs(x1) + s),
+            err_msg="end of the curve is not the origin",
+        )
 
 
 def test_root_22_against_bisection():
     rng = np.random.default_rng(3)
-    b0 = np.concatenate([rng.uniform(0, 20, 5000), 10 ** rng.uniform(-14, 4, 5000),
-                         [1e-300, 1e-15, 1.0, 1e300]])
+    b0 = np.concatenate(
+        [rng.uniform(0, 20, 5000), 10 ** rng.uniform(-14, 4, 5000), [1e-300, 1e-15, 1.0, 1e300]]
+    )
     y, yb = root_22(b0), root_22_bisect(b0)
     # bisection to the last bit; the closed form is Newton-polished: a few ulps
     assert_allclose(y, yb, rtol=2e-15, err_msg="eq. (22) positive root, Lambert W vs bisection")
@@ -56,7 +61,7 @@ def test_root_22_against_bisection():
 
 
 def test_root_22_negative_branch_satisfies_equation():
-    b0 = 10 ** np.linspace(-10, 0.5, 200)     # beyond, 1 + y = O(e^{-1-b0}) is below round-off
+    b0 = 10 ** np.linspace(-10, 0.5, 200)  # beyond, 1 + y = O(e^{-1-b0}) is below round-off
     y = root_22(b0, branch=0)
     assert np.all((y > -1) & (y < 0))
     assert_allclose(h(y), b0, rtol=1e-13, err_msg="eq. (22) root in (-1, 0)")
@@ -64,9 +69,15 @@ def test_root_22_negative_branch_satisfies_equation():
 
 def test_root_k_against_bisection():
     rng = np.random.default_rng(4)
-    m = np.concatenate([rng.uniform(0, 1, 4000), 10 ** rng.uniform(-15, 0, 3000),
-                        1 - 10 ** rng.uniform(-12, -0.5, 2000), -(10 ** rng.uniform(-15, 3, 2000)),
-                        [1e-100, -1e-100]])
+    m = np.concatenate(
+        [
+            rng.uniform(0, 1, 4000),
+            10 ** rng.uniform(-15, 0, 3000),
+            1 - 10 ** rng.uniform(-12, -0.5, 2000),
+            -(10 ** rng.uniform(-15, 3, 2000)),
+            [1e-100, -1e-100],
+        ]
+    )
     m = m[(m != 0) & (m < 1)]
     z, zb = root_k(m), root_k_bisect(m)
     # conditioning of z in m is ~1/(k |ln k|) near k -> 0: allow 1e-13 there, ulps elsewhere
@@ -87,18 +98,24 @@ def test_omega_c_solves_eq_28(any_cfg):
     p = any_cfg.plant
     rng = np.random.default_rng(5)
     x2 = -rng.uniform(1, 2 * p.w_max, 2000)
-    x1 = rng.uniform(0.001, 0.999, 2000) * (-x2) / p.a       # 0 < m < 1
+    x1 = rng.uniform(0.001, 0.999, 2000) * (-x2) / p.a  # 0 < m < 1
     wc = omega_c(x1, x2, p.a)
     for i in range(0, 2000, 97):
-        ref = brentq(lambda om: p.a * x1[i] + x2[i] + om * np.log1p(-x2[i] / om), 1e-9, 1e12,
-                     xtol=1e-14, rtol=1e-15, maxiter=500)
+        ref = brentq(
+            lambda om: p.a * x1[i] + x2[i] + om * np.log1p(-x2[i] / om),
+            1e-9,
+            1e12,
+            xtol=1e-14,
+            rtol=1e-15,
+            maxiter=500,
+        )
         assert_allclose(wc[i], ref, rtol=1e-11, err_msg="omega_c vs brentq on eq. (28)")
     assert_allclose(omega_c(-x1, -x2, p.a), wc, rtol=0, err_msg="mirror (eq. 33)")
 
 
 def test_switching_function_sign_convention(paper_cfg):
     p = paper_cfg.plant
-    assert switching_function(1.0, 0.0, p.a, p.w_max) > 0     # right: u = -w_max
+    assert switching_function(1.0, 0.0, p.a, p.w_max) > 0  # right: u = -w_max
     assert switching_function(-1.0, 0.0, p.a, p.w_max) < 0
     x2 = -100.0
     x1 = level_curve_x1(x2, p.a, p.w_max)

@@ -42,6 +42,7 @@ def _mp(expr, syms):
     def call(*cols):
         with mpmath.workdps(30):
             return np.array([float(mpmath.re(f(*map(mpmath.mpf, row)))) for row in zip(*cols)])
+
     return call
 
 
@@ -96,10 +97,18 @@ def test_erratum_path_carries_counterexample(records):
     printed_line1 = p["a"] * p["x1"] + p["x2"] - p["a"] * p["omega_m"] * p["T"]
     # the two differ by 2 a omega_m T, which is O(1) or larger at the stored point
     assert abs(lhs - printed_line1) > 1.0
-    assert_allclose(lhs - printed_line1, 2 * p["a"] * p["omega_m"] * p["T"], rtol=1e-9,
-                    err_msg="(16) discrepancy is 2 a omega_m T (double precision, O(10) ops)")
-    assert_allclose(ce["derived"][0], lhs, rtol=1e-9,
-                    err_msg="stored derived value of a x~1 + x~2 vs numeric plant flow")
+    assert_allclose(
+        lhs - printed_line1,
+        2 * p["a"] * p["omega_m"] * p["T"],
+        rtol=1e-9,
+        err_msg="(16) discrepancy is 2 a omega_m T (double precision, O(10) ops)",
+    )
+    assert_allclose(
+        ce["derived"][0],
+        lhs,
+        rtol=1e-9,
+        err_msg="stored derived value of a x~1 + x~2 vs numeric plant flow",
+    )
     assert r.corrected and r.inherits
     for id_ in ("18", "19"):
         assert records[id_].verdict == "erratum"
@@ -136,10 +145,18 @@ def test_erratum_16_at_paper_defaults(records):
     ce = records["16"].counterexample["at_paper_defaults"]
     p = ce["point"]
     tx1, tx2 = np_flow(p["x1"], p["x2"], p["omega_m"], p["T"], p["a"])
-    assert_allclose(ce["derived"], p["a"] * tx1 + tx2, rtol=1e-12,
-                    err_msg="a x~1 + x~2 under +w_max at the paper defaults (a few ulps)")
-    assert_allclose(ce["derived"] - ce["printed"], 2 * p["a"] * p["omega_m"] * p["T"],
-                    rtol=1e-9, err_msg="(16) error is 2 a omega_m T at the paper defaults")
+    assert_allclose(
+        ce["derived"],
+        p["a"] * tx1 + tx2,
+        rtol=1e-12,
+        err_msg="a x~1 + x~2 under +w_max at the paper defaults (a few ulps)",
+    )
+    assert_allclose(
+        ce["derived"] - ce["printed"],
+        2 * p["a"] * p["omega_m"] * p["T"],
+        rtol=1e-9,
+        err_msg="(16) error is 2 a omega_m T at the paper defaults",
+    )
 
 
 def test_verdicts_follow_the_transcription():
@@ -149,9 +166,14 @@ def test_verdicts_follow_the_transcription():
     printed_line = printed("16")[1]
 
     def samp(rng, n):
-        return {a: rng.uniform(1, 500, n), wm: rng.uniform(1, 1000, n),
-                T: rng.uniform(1e-4, 4e-3, n), x1: rng.uniform(-50, 50, n),
-                x2: rng.uniform(-900, 900, n)}
+        return {
+            a: rng.uniform(1, 500, n),
+            wm: rng.uniform(1, 1000, n),
+            T: rng.uniform(1e-4, 4e-3, n),
+            x1: rng.uniform(-50, 50, n),
+            x2: rng.uniform(-900, 900, n),
+        }
+
     assert judge(fixed, sp.expand(a * m1 + m2), samp).verdict == "verified"
     assert judge(printed_line, sp.expand(a * m1 + m2), samp).verdict == "erratum"
 
@@ -164,16 +186,27 @@ def test_flow_matches_plant_flow():
     rng = np.random.default_rng(RNG_SEED)
     n = 300
     av = rng.uniform(1, 500, n)
-    cols = (rng.uniform(-50, 50, n), rng.uniform(-300, 300, n), rng.uniform(-300, 300, n),
-            rng.uniform(1e-3, 10, n) / av, av)
+    cols = (
+        rng.uniform(-50, 50, n),
+        rng.uniform(-300, 300, n),
+        rng.uniform(-300, 300, n),
+        rng.uniform(1e-3, 10, n) / av,
+        av,
+    )
     ref1, ref2 = _mp(X1, syms)(*cols), _mp(X2, syms)(*cols)
     got1, got2 = np_flow(*cols)
     scale1 = np.abs(cols[0]) + np.abs(cols[2]) * cols[3] + np.abs(cols[1] - cols[2]) / av
     # float64 closed form: a few ulps of the largest term
-    assert_allclose(got1, ref1, rtol=0, atol=1e-14 * scale1.max() * 10,
-                    err_msg="x1 of plant.flow vs dsolve flow (eq. 7)")
-    assert_allclose(got2, ref2, rtol=0, atol=1e-13 * 600,
-                    err_msg="x2 of plant.flow vs dsolve flow (eq. 7)")
+    assert_allclose(
+        got1,
+        ref1,
+        rtol=0,
+        atol=1e-14 * scale1.max() * 10,
+        err_msg="x1 of plant.flow vs dsolve flow (eq. 7)",
+    )
+    assert_allclose(
+        got2, ref2, rtol=0, atol=1e-13 * 600, err_msg="x2 of plant.flow vs dsolve flow (eq. 7)"
+    )
 
 
 def test_curves_match_level_residual():
@@ -188,8 +221,13 @@ def test_curves_match_level_residual():
         ref = _mp(R, (x1, x2, a, wm))(xs, v, av, w)
         got = level_residual(xs, v, av, w)
         # level_residual is exact to round-off of its terms a x1 and omega h(|x2|/omega)
-        assert_allclose(got, ref, rtol=0, atol=1e-13 * np.max(av * 50 + w),
-                        err_msg=f"level_residual vs derived curve, x2 sign {sgn}")
+        assert_allclose(
+            got,
+            ref,
+            rtol=0,
+            atol=1e-13 * np.max(av * 50 + w),
+            err_msg=f"level_residual vs derived curve, x2 sign {sgn}",
+        )
 
 
 def test_lambert_roots_match_curves():
@@ -200,13 +238,23 @@ def test_lambert_roots_match_curves():
         ref = _mp(section4.root_22_W(b0, br), (b0,))(bv)
         # root_22 is polished by Newton to round-off; conditioning near the branch
         # point (b0 -> 0) costs at most ~sqrt(eps)-free digits here: 1e-10 relative
-        assert_allclose(root_22(bv, br), ref, rtol=1e-10, atol=1e-14,
-                        err_msg=f"root_22 vs Lambert-W closed form, branch {br}")
+        assert_allclose(
+            root_22(bv, br),
+            ref,
+            rtol=1e-10,
+            atol=1e-14,
+            err_msg=f"root_22 vs Lambert-W closed form, branch {br}",
+        )
     for lo, hi, br in ((0.01, 0.999, -1), (1.001, 20.0, 0)):
         kv = rng.uniform(lo, hi, 300)
         ref = _mp(section4.root_k_W(k, br), (k,))(kv)
-        assert_allclose(root_k(1.0 - kv), ref, rtol=1e-10, atol=1e-14,
-                        err_msg=f"root_k vs Lambert-W closed form, branch {br}")
+        assert_allclose(
+            root_k(1.0 - kv),
+            ref,
+            rtol=1e-10,
+            atol=1e-14,
+            err_msg=f"root_k vs Lambert-W closed form, branch {br}",
+        )
 
 
 def test_omega_c_matches_derivation():
@@ -217,15 +265,20 @@ def test_omega_c_matches_derivation():
     av = rng.uniform(1, 500, n)
     v = -rng.uniform(1, 1000, n)
     m = rng.uniform(0.01, 0.99, n)
-    xs = -m * v / av                                  # m = -a x1 / x2
+    xs = -m * v / av  # m = -a x1 / x2
     wstar = _mp(section4.root_k_W(k, -1), (k,))(1 - m)
     ref = -v / wstar
-    assert_allclose(omega_c(xs, v, av), ref, rtol=1e-10,
-                    err_msg="curves.omega_c vs Lambert-W closed form of (31)-(32)")
+    assert_allclose(
+        omega_c(xs, v, av),
+        ref,
+        rtol=1e-10,
+        err_msg="curves.omega_c vs Lambert-W closed form of (31)-(32)",
+    )
     R28 = printed("28")[0]
     res = _mp(R28, (x1, x2, a, S["omega_c"]))(xs, v, av, ref)
-    assert_allclose(res, 0, atol=1e-12 * np.max(np.abs(v)),
-                    err_msg="(28) residual at the derived omega_c")
+    assert_allclose(
+        res, 0, atol=1e-12 * np.max(np.abs(v)), err_msg="(28) residual at the derived omega_c"
+    )
 
 
 def _states(rng, n, side):
@@ -249,6 +302,7 @@ def test_min_time_closed_form_matches_mintime():
         q = _mp(mt["q"], syms)(ys, vs, av, w)
         for i in range(len(av)):
             from ptoverify.config import Plant
+
             res = min_time(xs[i], v[i], Plant(av[i], w[i], 0.002, 50.0))
             # min_time evaluates the same closed form in float64 with cancellation-free
             # forms; the states are >= 0.05 w/a from the curve, so 1e-9 relative is ample
@@ -269,8 +323,12 @@ def test_min_time_arc_by_arc_with_plant_flow():
     p1, p2 = np_flow(xs, v, -w, t1, av)
     e1, e2 = np_flow(p1, p2, w, t2, av)
     # float64 propagation: round-off of the position terms (|x1| + w t) and velocity (w)
-    assert_allclose(e1, 0, atol=1e-11 * np.max(np.abs(xs) + w * (t1 + t2)),
-                    err_msg="final position after the two derived arcs")
+    assert_allclose(
+        e1,
+        0,
+        atol=1e-11 * np.max(np.abs(xs) + w * (t1 + t2)),
+        err_msg="final position after the two derived arcs",
+    )
     assert_allclose(e2, 0, atol=1e-11 * np.max(w), err_msg="final velocity after both arcs")
 
 
@@ -287,13 +345,23 @@ def test_one_step_map_and_inverse_match_zoh():
         f = sp.lambdify((x1, x2), [m1.subs(num), m2.subs(num)], "numpy")
         got = np.array(f(x[0], x[1]))
         ref = Ad @ x + Bd * (sgn * c.w_max)
-        assert_allclose(got, ref, rtol=1e-12, atol=1e-10,
-                        err_msg=f"one-step map (15), u = {sgn} w_max, vs ZOH matrices")
+        assert_allclose(
+            got,
+            ref,
+            rtol=1e-12,
+            atol=1e-10,
+            err_msg=f"one-step map (15), u = {sgn} w_max, vs ZOH matrices",
+        )
         i1, i2 = section4.one_step_inverse(sgn)
         g = sp.lambdify((tx1, tx2), [i1.subs(num), i2.subs(num)], "numpy")
         back = np.array(g(got[0], got[1]))
-        assert_allclose(back, x, rtol=1e-10, atol=1e-9,
-                        err_msg=f"inverse map (17) undoes the step, u = {sgn} w_max")
+        assert_allclose(
+            back,
+            x,
+            rtol=1e-10,
+            atol=1e-9,
+            err_msg=f"inverse map (17) undoes the step, u = {sgn} w_max",
+        )
 
 
 def test_corrected_curve_reaches_l1_in_one_step():
@@ -305,8 +373,12 @@ def test_corrected_curve_reaches_l1_in_one_step():
     v = -np.linspace(1.0, 290.0, 200)
     xs = x1_on(v)
     n1, n2 = np_flow(xs, v, -c.w_max, c.sample_time, c.a)
-    assert_allclose(level_residual(n1, n2, c.a, c.w_max), 0, atol=1e-9,
-                    err_msg="l1 residual after one -w_max sample from the corrected curve")
+    assert_allclose(
+        level_residual(n1, n2, c.a, c.w_max),
+        0,
+        atol=1e-9,
+        err_msg="l1 residual after one -w_max sample from the corrected curve",
+    )
     assert np.all(level_residual(xs, v, c.a, c.w_max) > 0)
 
 
@@ -330,9 +402,12 @@ def test_closed_loop_and_lyapunov():
     Ad, Bd = zoh_matrices(c.plant.a, c.plant.sample_time)
     M = Ad - Bd @ np.array([[c.pto.k1, c.pto.k2]])
     rho = max(abs(np.linalg.eigvals(M)))
-    assert_allclose(section5.zoh_spectral_radius(c.plant.a, c.plant.sample_time, c.pto.k1,
-                                                 c.pto.k2), rho, rtol=1e-10,
-                    err_msg="spectral radius of the sampled linear zone")
+    assert_allclose(
+        section5.zoh_spectral_radius(c.plant.a, c.plant.sample_time, c.pto.k1, c.pto.k2),
+        rho,
+        rtol=1e-10,
+        err_msg="spectral radius of the sampled linear zone",
+    )
 
 
 # ------------------------------------------------------------------ renderers

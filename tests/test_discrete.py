@@ -56,9 +56,9 @@ def zonotope_margin(x1: float, x2: float, plant: Plant, n: int) -> float:
     for _ in range(n):
         gens.append(P @ Bd[:, 0] * plant.w_max)
         P = Ad @ P
-    G = np.array(gens).T                          # columns Ad^m Bd w
-    b = -(P @ np.array([x1, x2]))                 # Ad^n x0 + G v = 0
-    scale = np.array([plant.a, 1.0])              # mm -> mm/s-like units for the normals
+    G = np.array(gens).T  # columns Ad^m Bd w
+    b = -(P @ np.array([x1, x2]))  # Ad^n x0 + G v = 0
+    scale = np.array([plant.a, 1.0])  # mm -> mm/s-like units for the normals
     Gs, bs = G * scale[:, None], b * scale
     normals = np.vstack([-Gs[1], Gs[0]])
     normals /= np.linalg.norm(normals, axis=0)
@@ -98,9 +98,9 @@ def test_grid_aligned_bang_bang_state():
     plant = PLANTS["paper"]
     w, T, a = plant.w_max, plant.sample_time, plant.a
     x1, x2 = 0.0, 0.0
-    for _ in range(3):                                   # backwards along l1 (u = +w)
+    for _ in range(3):  # backwards along l1 (u = +w)
         x1, x2 = flow(x1, x2, w, -T, a)
-    for _ in range(9):                                   # backwards under u = -w
+    for _ in range(9):  # backwards under u = -w
         x1, x2 = flow(x1, x2, -w, -T, a)
     x1, x2 = float(x1), float(x2)
     t_f = float(min_time(x1, x2, plant).t_f)
@@ -114,7 +114,7 @@ def test_edge_states():
     plant = PLANTS["paper"]
     d = discrete_min_steps(0.0, 0.0, plant)
     assert d.steps == 0 and d.time_s == 0.0 and d.status == "origin" and d.success
-    d = discrete_min_steps(1e-6, 0.0, plant)               # two states need two inputs
+    d = discrete_min_steps(1e-6, 0.0, plant)  # two states need two inputs
     assert d.steps == 2 and d.success
     for x1, x2 in ((10.0, -600.0), (-5.0, 300.0), (20.0, 900.0), (0.0, -300.0)):
         d = discrete_min_steps(x1, x2, plant)

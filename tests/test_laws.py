@@ -30,7 +30,7 @@ def test_to_law_on_curves_and_origin():
     from ptoverify.curves import level_curve_x1
 
     x2 = -150.0
-    x1 = float(level_curve_x1(x2, CFG.plant.a, W))      # on l1: +w_max (eq. 12)
+    x1 = float(level_curve_x1(x2, CFG.plant.a, W))  # on l1: +w_max (eq. 12)
     assert law.scalar(x1, x2)[0] == W or abs(law.scalar(x1, x2)[0]) == W
     assert law.scalar(0.0, 0.0) == (0.0, Region.ORIGIN)
     assert law.scalar(1.0, 0.0) == (-W, Region.BANG_N)

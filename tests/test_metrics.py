@@ -28,10 +28,13 @@ def test_settling_time_of_exponential():
 def test_overshoot_of_second_order_step():
     """Underdamped step: overshoot = exp(-pi zeta / sqrt(1 - zeta^2)) of the step (closed form)."""
     zeta, wn, step = 0.3, 60.0, 5.0
-    tt = np.linspace(0, 1, 200001)               # fine grid: peak found to ~1e-8 relative
+    tt = np.linspace(0, 1, 200001)  # fine grid: peak found to ~1e-8 relative
     wd = wn * math.sqrt(1 - zeta**2)
-    x = step * (1 - np.exp(-zeta * wn * tt) * (np.cos(wd * tt) + zeta / math.sqrt(1 - zeta**2)
-                                                * np.sin(wd * tt)))
+    x = step * (
+        1
+        - np.exp(-zeta * wn * tt)
+        * (np.cos(wd * tt) + zeta / math.sqrt(1 - zeta**2) * np.sin(wd * tt))
+    )
     expect = step * math.exp(-math.pi * zeta / math.sqrt(1 - zeta**2))
     assert_allclose(m.overshoot(x, step), expect, rtol=1e-6, err_msg="overshoot")
     assert m.overshoot(-x, -step) == pytest.approx(expect, rel=1e-6), "downward step"
@@ -39,9 +42,13 @@ def test_overshoot_of_second_order_step():
 
 
 def test_oscillation_amplitude_and_reversals():
-    e = 0.3 * np.sin(2 * np.pi * 25 * t)          # 25 whole periods
-    assert_allclose(m.oscillation_amplitude(e), 0.3, rtol=1e-3,
-                    err_msg="amplitude of a sampled sine (samples reach the peak within 0.3 %)")
+    e = 0.3 * np.sin(2 * np.pi * 25 * t)  # 25 whole periods
+    assert_allclose(
+        m.oscillation_amplitude(e),
+        0.3,
+        rtol=1e-3,
+        err_msg="amplitude of a sampled sine (samples reach the peak within 0.3 %)",
+    )
     assert m.sign_reversals(e, 0.01) == 49, "two reversals per period, 25 periods, minus one"
     assert m.sign_reversals(np.exp(-t), 0.01) == 0
     assert m.sign_reversals(1e-3 * np.sin(100 * t), 0.01) == 0, "wiggles inside the band"
@@ -63,8 +70,11 @@ def test_phase_of_delayed_sine(delay_deg):
     """x = A sin(wt - phi) + C + harmonic: the fit returns phi exactly (orthogonal harmonics)."""
     f, amp = 5.0, 5.0
     r = amp * np.sin(2 * np.pi * f * t)
-    x = 0.9 * amp * np.sin(2 * np.pi * f * t - math.radians(delay_deg)) + 0.2 \
+    x = (
+        0.9 * amp * np.sin(2 * np.pi * f * t - math.radians(delay_deg))
+        + 0.2
         + 0.1 * np.sin(2 * np.pi * 3 * f * t)
+    )
     fr, fx = m.sine_fit(t, r, f, t_from=0.2), m.sine_fit(t, x, f, t_from=0.2)
     assert_allclose(m.phase_delay(fr, fx), delay_deg, atol=1e-9, err_msg="phase delay [deg]")
     assert_allclose(fx.amplitude / fr.amplitude, 0.9, rtol=1e-9, err_msg="amplitude ratio")
@@ -101,9 +111,14 @@ def test_summarize_on_simulations(paper_cfg):
     assert to["steady_amplitude_mm"] > m.TIGHT_BAND > pd["steady_amplitude_mm"]
     sine = m.summarize(simulate(make_law("pd", paper_cfg), paper_cfg.plant, "sine"))
     assert 0 < sine["phase_delay_deg"] < 45 and 0.5 < sine["amplitude_ratio"] < 2
-    ramp = m.summarize(simulate(make_law("pd", paper_cfg), paper_cfg.plant, "ramp",
-                                feedforward=False))
+    ramp = m.summarize(
+        simulate(make_law("pd", paper_cfg), paper_cfg.plant, "ramp", feedforward=False)
+    )
     kp, kd, v = paper_cfg.pd.kp, paper_cfg.pd.kd, 200.0
     # steady ramp without feed-forward: kp e = (1 + kd) v  =>  e = (1 + kd) v / kp
-    assert_allclose(ramp["ramp_lag_mm"], (1 + kd) * v / kp, rtol=0.02,
-                    err_msg="PD ramp lag vs its steady-state value (2 %: transient tail)")
+    assert_allclose(
+        ramp["ramp_lag_mm"],
+        (1 + kd) * v / kp,
+        rtol=0.02,
+        err_msg="PD ramp lag vs its steady-state value (2 %: transient tail)",
+    )

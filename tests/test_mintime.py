@@ -21,8 +21,7 @@ def arc_by_arc(x1, x2, plant):
     t_hi = 1e-3
     while np.sign(sigma_after(t_hi)) == np.sign(sig) and sig != 0:
         t_hi *= 2
-    t1 = 0.0 if sig == 0 else brentq(sigma_after, 0.0, t_hi, xtol=1e-300, rtol=8.9e-16,
-                                    maxiter=500)
+    t1 = 0.0 if sig == 0 else brentq(sigma_after, 0.0, t_hi, xtol=1e-300, rtol=8.9e-16, maxiter=500)
     y1, y2 = flow(x1, x2, -s * w, t1, a)
     # second arc under +s w: x2(t) = s w + (y2 - s w) e^{-a t} = 0
     t2 = np.log((y2 - s * w) / (-s * w)) / a
@@ -33,15 +32,22 @@ def arc_by_arc(x1, x2, plant):
 def test_closed_form_vs_arc_by_arc(any_cfg):
     p = any_cfg.plant
     rng = np.random.default_rng(6)
-    pts = np.c_[rng.uniform(-p.position_range, p.position_range, 150),
-                rng.uniform(-1.5 * p.w_max, 1.5 * p.w_max, 150)]
+    pts = np.c_[
+        rng.uniform(-p.position_range, p.position_range, 150),
+        rng.uniform(-1.5 * p.w_max, 1.5 * p.w_max, 150),
+    ]
     mt = min_time(pts[:, 0], pts[:, 1], p)
     for i, (x1, x2) in enumerate(pts):
         t1, t2, miss = arc_by_arc(x1, x2, p)
         # both sides are round-off exact; the brentq crossing is found to ~1 ulp of t
         assert_allclose(mt.t_f[i], t1 + t2, rtol=1e-12, err_msg=f"t_f at {x1, x2}")
-        assert_allclose(mt.t_switch[i], t1, rtol=1e-10, atol=1e-12 * (t1 + t2),
-                        err_msg=f"switch time at {x1, x2}")
+        assert_allclose(
+            mt.t_switch[i],
+            t1,
+            rtol=1e-10,
+            atol=1e-12 * (t1 + t2),
+            err_msg=f"switch time at {x1, x2}",
+        )
         assert abs(miss) < 1e-9 * max(1.0, abs(x1)), "arc-by-arc does not end at the origin"
 
 
@@ -56,7 +62,7 @@ def test_closed_form_vs_brute_force_switch_search(paper_cfg):
         t1 = np.linspace(0, 2 * float(mt.t_f) + 0.01, 200001)
         y1, y2 = flow(x1, x2, -s * w, t1, a)
         with np.errstate(invalid="ignore"):
-            t2 = np.log((y2 - s * w) / (-s * w)) / a    # second arc until x2 = 0
+            t2 = np.log((y2 - s * w) / (-s * w)) / a  # second arc until x2 = 0
         z1, _ = flow(y1, y2, s * w, t2, a)
         i = np.nanargmin(np.abs(z1))
         dt = t1[1] - t1[0]
@@ -71,8 +77,9 @@ def test_edges(paper_cfg):
     # symmetry t(-x) = t(x)
     rng = np.random.default_rng(8)
     x1, x2 = rng.uniform(-50, 50, 1000), rng.uniform(-900, 900, 1000)
-    assert_allclose(min_time(-x1, -x2, p).t_f, min_time(x1, x2, p).t_f, rtol=1e-14,
-                    err_msg="t_f symmetry")
+    assert_allclose(
+        min_time(-x1, -x2, p).t_f, min_time(x1, x2, p).t_f, rtol=1e-14, err_msg="t_f symmetry"
+    )
     # exactly at x2 = -w_max the closed form stays finite and consistent
     mt = min_time(10.0, -p.w_max, p)
     t1, t2, _ = arc_by_arc(10.0, -p.w_max, p)

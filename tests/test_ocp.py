@@ -45,10 +45,20 @@ def test_two_phase_matches_closed_form(name):
     res = [ocp.solve(x1, x2) for x1, x2 in states]
     assert all(r.success for r in res), [r.status for r in res if not r.success]
     mt = min_time(states[:, 0], states[:, 1], plant)
-    assert_allclose([r.t_f for r in res], mt.t_f, rtol=1e-9, atol=0,
-                    err_msg=f"two-phase t_f vs closed form ({name})")
-    assert_allclose([r.t_switch for r in res], mt.t_switch, rtol=0, atol=1e-9,
-                    err_msg=f"two-phase switch time vs closed form ({name})")
+    assert_allclose(
+        [r.t_f for r in res],
+        mt.t_f,
+        rtol=1e-9,
+        atol=0,
+        err_msg=f"two-phase t_f vs closed form ({name})",
+    )
+    assert_allclose(
+        [r.t_switch for r in res],
+        mt.t_switch,
+        rtol=0,
+        atol=1e-9,
+        err_msg=f"two-phase switch time vs closed form ({name})",
+    )
     assert_allclose([r.side for r in res], mt.side, err_msg="first-arc side")
 
 
@@ -59,8 +69,12 @@ def test_two_phase_both_sides_agrees():
     res = [ocp.solve(x1, x2) for x1, x2 in states]
     assert all(r.success for r in res)
     mt = min_time(states[:, 0], states[:, 1], plant)
-    assert_allclose([r.t_f for r in res], mt.t_f, rtol=1e-9,
-                    err_msg="two-phase t_f, side chosen by solving both sides")
+    assert_allclose(
+        [r.t_f for r in res],
+        mt.t_f,
+        rtol=1e-9,
+        err_msg="two-phase t_f, side chosen by solving both sides",
+    )
     assert_allclose([r.side for r in res], mt.side, err_msg="side kept by 'both'")
 
 
@@ -73,8 +87,12 @@ def test_collocation_matches_closed_form(name):
     res = [ocp.solve(x1, x2) for x1, x2 in states]
     assert all(r.success for r in res), [r.status for r in res if not r.success]
     mt = min_time(states[:, 0], states[:, 1], plant)
-    assert_allclose([r.t_f for r in res], mt.t_f, rtol=5e-4,
-                    err_msg=f"collocation N=100 t_f vs closed form ({name})")
+    assert_allclose(
+        [r.t_f for r in res],
+        mt.t_f,
+        rtol=5e-4,
+        err_msg=f"collocation N=100 t_f vs closed form ({name})",
+    )
     for r in res:
         assert r.u.shape == (300,) and r.t.shape == (301,)
         assert np.all(np.abs(r.u) <= plant.w_max * (1 + 1e-9)), "collocation |u| <= w_max"
@@ -129,8 +147,9 @@ def test_edge_states(name):
         r = tp.solve(x1, x2)
         assert r.success, r.status
         assert_allclose(r.t_f, mt.t_f, rtol=1e-9, err_msg="two-phase t_f for |x2| >= w_max")
-        assert_allclose(r.t_switch, mt.t_switch, atol=1e-9,
-                        err_msg="two-phase switch for |x2| >= w_max")
+        assert_allclose(
+            r.t_switch, mt.t_switch, atol=1e-9, err_msg="two-phase switch for |x2| >= w_max"
+        )
         rc = co.solve(x1, x2)
         assert rc.success
         assert_allclose(rc.t_f, mt.t_f, rtol=5e-4, err_msg="collocation t_f for |x2| >= w_max")
@@ -162,8 +181,16 @@ def test_collocation_one_interval_per_interval_control_is_infeasible():
 def test_cli_mintime_keys_and_agreement(capsys):
     assert main(["mintime", "5", "0", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    for key in ("x0", "analytic_s", "switch_time_s", "two_phase_s", "collocation_s",
-                "collocation_intervals", "discrete_steps", "discrete_s"):
+    for key in (
+        "x0",
+        "analytic_s",
+        "switch_time_s",
+        "two_phase_s",
+        "collocation_s",
+        "collocation_intervals",
+        "discrete_steps",
+        "discrete_s",
+    ):
         assert key in out, key
     assert_allclose(out["two_phase_s"], out["analytic_s"], rtol=1e-9, err_msg="CLI two-phase")
     assert_allclose(out["collocation_s"], out["analytic_s"], rtol=5e-4, err_msg="CLI colloc.")

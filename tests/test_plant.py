@@ -24,12 +24,24 @@ def test_flow_matches_expm_and_solve_ivp(any_cfg):
         t = rng.uniform(0, 0.1)
         x = np.array(flow(x0[0], x0[1], u, t, p.a))
         # expm: rounding of the 3x3 Pade approximant, about 1e-13 relative to |x|
-        assert_allclose(x, augmented_expm(p.a, u, t, x0), rtol=1e-12, atol=1e-11,
-                        err_msg="flow vs expm of the augmented matrix")
-        sol = solve_ivp(lambda _, y: [y[1], -p.a * y[1] + p.a * u], (0, t), x0,
-                        rtol=1e-12, atol=1e-12, method="DOP853")
-        assert_allclose(x, sol.y[:, -1], rtol=1e-9, atol=1e-9,
-                        err_msg="flow vs solve_ivp at rtol 1e-12")
+        assert_allclose(
+            x,
+            augmented_expm(p.a, u, t, x0),
+            rtol=1e-12,
+            atol=1e-11,
+            err_msg="flow vs expm of the augmented matrix",
+        )
+        sol = solve_ivp(
+            lambda _, y: [y[1], -p.a * y[1] + p.a * u],
+            (0, t),
+            x0,
+            rtol=1e-12,
+            atol=1e-12,
+            method="DOP853",
+        )
+        assert_allclose(
+            x, sol.y[:, -1], rtol=1e-9, atol=1e-9, err_msg="flow vs solve_ivp at rtol 1e-12"
+        )
 
 
 def test_zoh_matrices_match_expm(any_cfg):
@@ -41,8 +53,12 @@ def test_zoh_matrices_match_expm(any_cfg):
     assert_allclose(Ad, E[:2, :2], rtol=1e-13, atol=1e-16, err_msg="Ad")
     assert_allclose(Bd[:, 0], E[:2, 2], rtol=1e-12, atol=1e-16, err_msg="Bd")
     x = np.array([3.0, -120.0])
-    assert_allclose(Ad @ x + Bd[:, 0] * 250.0, np.array(step(x[0], x[1], 250.0, p)),
-                    rtol=1e-13, err_msg="one-sample map vs ZOH matrices")
+    assert_allclose(
+        Ad @ x + Bd[:, 0] * 250.0,
+        np.array(step(x[0], x[1], 250.0, p)),
+        rtol=1e-13,
+        err_msg="one-sample map vs ZOH matrices",
+    )
 
 
 def test_flow_vectorized_broadcasts(paper_cfg):

@@ -17,11 +17,16 @@ def test_plot_zone_geometry(tmp_path):
     out = plot_zone_geometry(cfg)
     a, w = cfg.plant.a, cfg.plant.w_max
     x, y = out["lines"]["l1"].get_data()
-    assert_allclose(level_residual(x[1:], y[1:], a, w), 0.0, atol=1e-9,
-                    err_msg="plotted l1 lies on eq. (9)")
+    assert_allclose(
+        level_residual(x[1:], y[1:], a, w), 0.0, atol=1e-9, err_msg="plotted l1 lies on eq. (9)"
+    )
     x, y = out["lines"]["l1*"].get_data()
-    assert_allclose(level_residual(x[1:], y[1:], a, out["zone"].omega0), 0.0, atol=1e-9,
-                    err_msg="plotted l1* lies on eq. (13)")
+    assert_allclose(
+        level_residual(x[1:], y[1:], a, out["zone"].omega0),
+        0.0,
+        atol=1e-9,
+        err_msg="plotted l1* lies on eq. (13)",
+    )
     assert out["ax"].get_xlabel().endswith("[mm]")
     out["figure"].savefig(tmp_path / "zone.png")
     assert (tmp_path / "zone.png").stat().st_size > 1000

@@ -9,8 +9,11 @@ from ptoverify.config import paper_config
 from ptoverify.poles import all_loop_poles, critical_gain, loop_poles, lyapunov_counterexample
 
 PAPER = paper_config()
-CONFIGS = {"paper": PAPER, "a30": PAPER.with_plant(a=30.0),
-           "T1ms": PAPER.with_plant(sample_time=0.001)}
+CONFIGS = {
+    "paper": PAPER,
+    "a30": PAPER.with_plant(a=30.0),
+    "T1ms": PAPER.with_plant(sample_time=0.001),
+}
 
 
 def expm_closed_loop(a, T, K):
@@ -32,11 +35,19 @@ def test_sampled_poles_vs_numpy_expm(name):
     for lp in all_loop_poles(cfg).values():
         ref = np.sort_complex(np.linalg.eigvals(expm_closed_loop(a, T, lp.gains)))
         # eigenvalues of a 2x2 matrix with entries O(1): a few ulps
-        assert_allclose(as_complex(lp.sampled_poles), ref, atol=1e-12,
-                        err_msg=f"{lp.name} sampled poles vs numpy/expm")
+        assert_allclose(
+            as_complex(lp.sampled_poles),
+            ref,
+            atol=1e-12,
+            err_msg=f"{lp.name} sampled poles vs numpy/expm",
+        )
         assert lp.pole_mismatch < 1e-12
-        assert_allclose(lp.sampled_moduli, np.sort(np.abs(ref))[::-1], atol=1e-12,
-                        err_msg=f"{lp.name} pole moduli")
+        assert_allclose(
+            lp.sampled_moduli,
+            np.sort(np.abs(ref))[::-1],
+            atol=1e-12,
+            err_msg=f"{lp.name} pole moduli",
+        )
 
 
 @pytest.mark.parametrize("name", list(CONFIGS))
@@ -47,19 +58,28 @@ def test_continuous_poles_closed_form(name):
     for lp in all_loop_poles(cfg).values():
         k1, k2 = lp.gains
         ref = np.sort_complex(np.roots([1.0, a * (1 + k2), a * k1]).astype(complex))
-        assert_allclose(as_complex(lp.continuous_poles), ref, rtol=1e-10,
-                        err_msg=f"{lp.name} continuous poles vs eq. (37)")
+        assert_allclose(
+            as_complex(lp.continuous_poles),
+            ref,
+            rtol=1e-10,
+            err_msg=f"{lp.name} continuous poles vs eq. (37)",
+        )
         wn = np.sqrt(a * k1)
-        assert_allclose(np.prod(lp.continuous_wn), wn**2, rtol=1e-10,
-                        err_msg="product of natural frequencies")
+        assert_allclose(
+            np.prod(lp.continuous_wn), wn**2, rtol=1e-10, err_msg="product of natural frequencies"
+        )
 
 
 @pytest.mark.parametrize("name", list(CONFIGS))
 def test_margins(name):
     for lp in all_loop_poles(CONFIGS[name]).values():
         assert lp.stable_continuous and lp.stable_sampled and lp.lyapunov_conditions
-        assert_allclose(lp.gain_margin, lp.gain_margin_eig, rtol=1e-9,
-                        err_msg=f"{lp.name} gain margin vs eigenvalue scaling")
+        assert_allclose(
+            lp.gain_margin,
+            lp.gain_margin_eig,
+            rtol=1e-9,
+            err_msg=f"{lp.name} gain margin vs eigenvalue scaling",
+        )
         assert 0 < lp.phase_margin_deg < 180
 
 

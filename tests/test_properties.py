@@ -16,8 +16,12 @@ def with_d(cfg, d):
     return dataclasses.replace(cfg, pto=dataclasses.replace(cfg.pto, d=d))
 
 
-CONFIGS = {"paper": PAPER, "a30": PAPER.with_plant(a=30.0),
-           "T1ms": PAPER.with_plant(sample_time=0.001), "d1": with_d(PAPER, 1.0)}
+CONFIGS = {
+    "paper": PAPER,
+    "a30": PAPER.with_plant(a=30.0),
+    "T1ms": PAPER.with_plant(sample_time=0.001),
+    "d1": with_d(PAPER, 1.0),
+}
 
 
 def test_grid_size():

@@ -39,8 +39,13 @@ def test_printed_variant_falls_back_and_says_so():
     # outside the linear zone it is the time-optimal law
     to = make_law("to", PAPER)
     x1, x2 = np.linspace(0.6, 50, 300), np.linspace(-300, 300, 300)
-    assert_allclose(law(x1, x2)[0], to(x1, x2)[0], rtol=0, atol=0,
-                    err_msg="pto-printed equals TO outside the linear zone")
+    assert_allclose(
+        law(x1, x2)[0],
+        to(x1, x2)[0],
+        rtol=0,
+        atol=0,
+        err_msg="pto-printed equals TO outside the linear zone",
+    )
 
 
 @settings(max_examples=300, deadline=None)
@@ -87,9 +92,8 @@ def test_omega_c_scalar_against_bisection():
     rng = np.random.default_rng(3)
     om = rng.uniform(5.0, 300.0, 400)
     s = rng.uniform(1.0, 300.0, 400)
-    x1 = om * h(s / om) / A                  # on the level-om curve
-    ref = bisect(lambda w: level_residual(x1, -s, A, w), np.full(400, 1e-3),
-                 np.full(400, 1e6))
+    x1 = om * h(s / om) / A  # on the level-om curve
+    ref = bisect(lambda w: level_residual(x1, -s, A, w), np.full(400, 1e-3), np.full(400, 1e6))
     got = np.array([omega_c_scalar(a, -b, A) for a, b in zip(x1, s)])
     assert_allclose(got, om, rtol=1e-10, err_msg="omega_c scalar recovers the level")
     assert_allclose(got, ref, rtol=1e-10, err_msg="omega_c scalar vs bisection")
@@ -109,16 +113,23 @@ def test_zone_state_rides_its_curve_under_zoh():
         u, r = law.scalar(x1, -s)
         assert r == Region.ZONE_P
         y = E @ np.array([x1, -s, u])
-        assert_allclose(level_residual(y[0], y[1], A, u), 0.0, atol=1e-9,
-                        err_msg="residual of the omega_c curve after one sample")
+        assert_allclose(
+            level_residual(y[0], y[1], A, u),
+            0.0,
+            atol=1e-9,
+            err_msg="residual of the omega_c curve after one sample",
+        )
 
 
 def test_scalar_path_agrees_on_zone_states():
     law = LAWS["pto"]
-    pts = [(0.5 * (OMEGA0 * float(h(s / OMEGA0)) + W * float(h(s / W))) / A, -s)
-           for s in np.linspace(150, 300, 200)]
-    pts += [(float(a), float(b)) for a, b in zip(np.linspace(-50, 50, 200),
-                                                 np.linspace(300, -300, 200))]
+    pts = [
+        (0.5 * (OMEGA0 * float(h(s / OMEGA0)) + W * float(h(s / W))) / A, -s)
+        for s in np.linspace(150, 300, 200)
+    ]
+    pts += [
+        (float(a), float(b)) for a, b in zip(np.linspace(-50, 50, 200), np.linspace(300, -300, 200))
+    ]
     # speed is measured in benchmarks/ (law_scalar_us); here: the scalar path agrees with the
     # vector path on these states
     x1 = np.array([p[0] for p in pts])

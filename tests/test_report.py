@@ -38,8 +38,18 @@ def test_report_folder_complete_and_reproducible(two_reports):
     assert len(figs) >= 20 and all(f.stat().st_size > 5000 for f in figs)
     assert _without_meta(one) == _without_meta(two), "two runs differ beyond the timestamp"
     data = _without_meta(one)
-    for key in ("derivations", "ground_truth", "zone", "poles", "properties", "claims",
-                "sweep", "checks", "summary", "environment"):
+    for key in (
+        "derivations",
+        "ground_truth",
+        "zone",
+        "poles",
+        "properties",
+        "claims",
+        "sweep",
+        "checks",
+        "summary",
+        "environment",
+    ):
         assert key in data, key
     html_text = (one / "index.html").read_text()
     assert html_text.count("<math") > 30 and "<script" not in html_text
@@ -85,9 +95,19 @@ def test_committed_report_matches_fresh_computation(two_reports):
 
 
 def test_html_escapes_text():
-    page = render_html([("s", "<b>title</b>", [Block("p", text="<script>alert(1)</script>"),
-                                                Block("table", headers=("<h>",),
-                                                      rows=(("a&b",),))])], "t<i>")
+    page = render_html(
+        [
+            (
+                "s",
+                "<b>title</b>",
+                [
+                    Block("p", text="<script>alert(1)</script>"),
+                    Block("table", headers=("<h>",), rows=(("a&b",),)),
+                ],
+            )
+        ],
+        "t<i>",
+    )
     assert "<script>" not in page and "&lt;script&gt;" in page and "a&amp;b" in page
     assert "<b>title</b>" not in page
 
@@ -124,29 +144,49 @@ def _chromium() -> str | None:
 def test_report_renders_in_headless_chromium(two_reports, tmp_path):
     browser = _chromium()
     if browser is None:
-        pytest.skip("chromium is not installed (.ci/run installs Debian's chromium): "
-                    "browser rendering NOT verified")
+        pytest.skip(
+            "chromium is not installed (.ci/run installs Debian's chromium): "
+            "browser rendering NOT verified"
+        )
     index = two_reports[0] / "index.html"
-    flags = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-             "--disable-background-networking", "--disable-component-update", "--disable-sync",
-             f"--user-data-dir={tmp_path / 'profile'}"]
-    probe = ("<script>window.onload=()=>{const imgs=[...document.images];"
-             "const ok=imgs.filter(i=>i.complete&&i.naturalWidth>0).length;"
-             "const m=[...document.querySelectorAll('math')];"
-             "const mh=m.filter(e=>e.getBoundingClientRect().height>0).length;"
-             "const rows=document.querySelectorAll('#summary table tr').length;"
-             "document.title=`IMAGES ${ok}/${imgs.length} MATH ${mh}/${m.length} ROWS ${rows}`;"
-             "}</script>")
+    flags = [
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        f"--user-data-dir={tmp_path / 'profile'}",
+    ]
+    probe = (
+        "<script>window.onload=()=>{const imgs=[...document.images];"
+        "const ok=imgs.filter(i=>i.complete&&i.naturalWidth>0).length;"
+        "const m=[...document.querySelectorAll('math')];"
+        "const mh=m.filter(e=>e.getBoundingClientRect().height>0).length;"
+        "const rows=document.querySelectorAll('#summary table tr').length;"
+        "document.title=`IMAGES ${ok}/${imgs.length} MATH ${mh}/${m.length} ROWS ${rows}`;"
+        "}</script>"
+    )
     probe_page = index.parent / "probe.html"
     probe_page.write_text(index.read_text().replace("</body>", probe + "</body>"))
     try:
-        dom = subprocess.run([browser, *flags, "--virtual-time-budget=5000", "--dump-dom",
-                              probe_page.as_uri()], capture_output=True, text=True, timeout=120,
-                             check=False).stdout
+        dom = subprocess.run(
+            [browser, *flags, "--virtual-time-budget=5000", "--dump-dom", probe_page.as_uri()],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            check=False,
+        ).stdout
         shot = tmp_path / "shot.png"
-        subprocess.run([browser, *flags, "--window-size=1200,1600", f"--screenshot={shot}",
-                        index.as_uri()], capture_output=True, timeout=120, check=False,
-                       cwd=tmp_path)
+        subprocess.run(
+            [browser, *flags, "--window-size=1200,1600", f"--screenshot={shot}", index.as_uri()],
+            capture_output=True,
+            timeout=120,
+            check=False,
+            cwd=tmp_path,
+        )
     finally:
         probe_page.unlink()
     title = dom.split("<title>")[1].split("</title>")[0]

@@ -39,8 +39,13 @@ def test_batch_matches_single(paper_cfg):
             assert u == b.u[k, j]
             Ad, Bd = zoh_matrices(p.a, p.T)
             y1, y2 = Ad @ [y1, y2] + Bd[:, 0] * u
-        assert_allclose([y1, y2], [b.x1[-1, j], b.x2[-1, j]], rtol=1e-9, atol=1e-9,
-                        err_msg="batch vs one-by-one")
+        assert_allclose(
+            [y1, y2],
+            [b.x1[-1, j], b.x2[-1, j]],
+            rtol=1e-9,
+            atol=1e-9,
+            err_msg="batch vs one-by-one",
+        )
 
 
 def test_pd_step_settles_and_to_keeps_oscillating(paper_cfg):

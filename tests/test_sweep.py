@@ -49,12 +49,20 @@ def test_small_sweep_agrees_with_single_state_runs(small):
                 continue
             assert ts == pytest.approx(k * p.T, abs=1e-12), f"{law} settle time at ({x1},{x2})"
             tf = float(min_time(x1, x2, p).t_f)
-            assert_allclose(small.laws[law].ratio_tf.flat[j], ts / tf, rtol=1e-12,
-                            err_msg=f"{law}: ratio to t_f*")
+            assert_allclose(
+                small.laws[law].ratio_tf.flat[j],
+                ts / tf,
+                rtol=1e-12,
+                err_msg=f"{law}: ratio to t_f*",
+            )
             ns = discrete_min_steps(x1, x2, p).steps
             assert small.n_star.flat[j] == ns, "N* from the LP reference"
-            assert_allclose(small.laws[law].ratio_nt.flat[j], ts / (ns * p.T), rtol=1e-12,
-                            err_msg=f"{law}: ratio to N* T")
+            assert_allclose(
+                small.laws[law].ratio_nt.flat[j],
+                ts / (ns * p.T),
+                rtol=1e-12,
+                err_msg=f"{law}: ratio to N* T",
+            )
 
 
 def test_discrete_limit_bounds(small):
@@ -74,12 +82,28 @@ def test_pd_settles_everywhere_and_to_chatters(small):
 def test_sweep_json_keys(capsys):
     assert main(["sweep", "--json", "--grid", "4", "--quiet"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert {"grid", "band_mm", "velocity_band_mm_s", "hold_s", "horizon_s", "laws",
-            "timings_s", "skipped", "n_star_computed"} <= set(out)
+    assert {
+        "grid",
+        "band_mm",
+        "velocity_band_mm_s",
+        "hold_s",
+        "horizon_s",
+        "laws",
+        "timings_s",
+        "skipped",
+        "n_star_computed",
+    } <= set(out)
     assert set(out["laws"]) == {"to", "pd", "pto", "pto-printed"}
     for r in out["laws"].values():
-        assert {"fraction_settled", "median_ratio_tf", "median_ratio_nt", "worst_ratio_tf",
-                "worst_state_tf", "worst_ratio_nt", "worst_state_nt"} <= set(r)
+        assert {
+            "fraction_settled",
+            "median_ratio_tf",
+            "median_ratio_nt",
+            "worst_ratio_tf",
+            "worst_state_tf",
+            "worst_ratio_nt",
+            "worst_state_nt",
+        } <= set(r)
 
 
 def test_sweep_out_writes_atomically(tmp_path, capsys):

@@ -47,8 +47,9 @@ def expm_step(x1, x2, u, a, T):
     M = np.zeros((3, 3))
     M[0, 1], M[1, 1], M[1, 2] = 1.0, -a, a
     E = expm(M * T)
-    X = np.stack(np.broadcast_arrays(np.asarray(x1, float), np.asarray(x2, float),
-                                     np.asarray(u, float)))
+    X = np.stack(
+        np.broadcast_arrays(np.asarray(x1, float), np.asarray(x2, float), np.asarray(u, float))
+    )
     Y = np.tensordot(E, X, axes=1)
     return Y[0], Y[1]
 
@@ -103,8 +104,12 @@ def test_eq16_sign_error():
     assert_allclose(res, 0.0, atol=1e-9, err_msg="image of l1 under +w_max is on l1")
     assert np.all(np.abs(res + 2 * a * w * T) > 100), "not on the printed curve (19)"
     # a x1 + x2 grows by a w T under +w_max (eq. 16 prints a decrease)
-    assert_allclose(a * f1 + f2 - (a * x1 + x2), a * w * T, rtol=1e-9,
-                    err_msg="a x1 + x2 after one sample of +w_max")
+    assert_allclose(
+        a * f1 + f2 - (a * x1 + x2),
+        a * w * T,
+        rtol=1e-9,
+        err_msg="a x1 + x2 after one sample of +w_max",
+    )
 
 
 def brute_margin(cfg, omega0, x2, reading, n=2001):
@@ -140,8 +145,13 @@ def test_margin_matches_brute_force(name, reading):
         fin = np.isfinite(exact)
         assert np.array_equal(fin, np.isfinite(brute)), "same velocities have sources"
         assert np.all(brute[fin] >= exact[fin] - 1e-9), "exact margin is a lower bound"
-        assert_allclose(brute[fin], exact[fin], atol=step * 1.01, rtol=0,
-                        err_msg=f"principle margin, omega0 = {omega0}")
+        assert_allclose(
+            brute[fin],
+            exact[fin],
+            atol=step * 1.01,
+            rtol=0,
+            err_msg=f"principle margin, omega0 = {omega0}",
+        )
 
 
 @pytest.mark.parametrize("name", ["paper", "a30", "T1ms", "d1"])
