@@ -248,13 +248,21 @@ def _add_simulate(sub) -> None:
     p.add_argument(
         "--no-feedforward", action="store_true", help="do not feed the reference velocity forward"
     )
+    for flag, metavar, text in (
+        ("--step", "MM", "step height [mm] (default 5)"),
+        ("--ramp-speed", "MM_S", "ramp speed [mm/s] (default 200)"),
+        ("--ramp-to", "MM", "ramp end value [mm] (default 30)"),
+        ("--amplitude", "MM", "sine amplitude [mm] (default 5)"),
+        ("--frequency", "HZ", "sine frequency [Hz] (default 5)"),
+    ):
+        p.add_argument(flag, type=finite_float, metavar=metavar, default=None, help=text)
     p.add_argument("--csv", metavar="FILE", default=None, help="write the time series as CSV")
     p.set_defaults(handler=_cmd_simulate)
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from ptoverify.laws import make_law
-    from ptoverify.simulate import simulate
+    from ptoverify.simulate import reference, simulate
 
     cfg = _config(args)
     if args.duration is not None and not 0 < args.duration <= 100:
@@ -268,10 +276,16 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
             f"--duration {args.duration:g} s is shorter than one sample "
             f"(T = {cfg.plant.sample_time:g} s)"
         )
-    law = make_law(args.law, cfg)
-    res = simulate(
-        law, cfg.plant, args.signal, duration=args.duration, feedforward=not args.no_feedforward
+    ref = reference(
+        args.signal,
+        step=args.step,
+        ramp_speed=args.ramp_speed,
+        ramp_to=args.ramp_to,
+        amplitude=args.amplitude,
+        frequency=args.frequency,
     )
+    law = make_law(args.law, cfg)
+    res = simulate(law, cfg.plant, ref, duration=args.duration, feedforward=not args.no_feedforward)
     cols = res.columns()
     if args.csv is not None:
         buf = io.StringIO()

@@ -230,12 +230,76 @@ SIGNALS: dict[str, Reference] = {
 """The Section 6 references: 5 mm step, ramp to 30 mm at 200 mm/s, 5 mm 5 Hz sine."""
 
 
-def reference(name: str) -> Reference:
-    """Return the Section 6 reference called ``name`` (step, ramp, sine)."""
-    try:
-        return SIGNALS[name]
-    except KeyError:
-        raise InputError(f"unknown signal '{name}' (choose from step, ramp, sine)") from None
+_OPTIONS = {
+    "step": ("step",),
+    "ramp": ("ramp_speed", "ramp_to"),
+    "sine": ("amplitude", "frequency"),
+}
+
+
+def reference(
+    name: str,
+    *,
+    step: float | None = None,
+    ramp_speed: float | None = None,
+    ramp_to: float | None = None,
+    amplitude: float | None = None,
+    frequency: float | None = None,
+) -> Reference:
+    """Return the Section 6 reference ``name``, with any of its parameters changed.
+
+    The keywords are those of ``ptoverify simulate`` (``--step``, ``--ramp-speed``,
+    ``--ramp-to``, ``--amplitude``, ``--frequency``); one that does not belong to
+    ``name`` raises :class:`~ptoverify.errors.InputError`.  With none given this is
+    the Section 6 reference of :data:`SIGNALS`.
+
+    Parameters
+    ----------
+    name : str
+        ``step``, ``ramp`` or ``sine``.
+    step : float, optional
+        Step height [mm] (Section 6: 5).
+    ramp_speed, ramp_to : float, optional
+        Ramp speed [mm/s] and end value [mm] (Section 6: 200, 30).
+    amplitude, frequency : float, optional
+        Sine amplitude [mm] and frequency [Hz] (Section 6: 5, 5).
+
+    Returns
+    -------
+    Reference
+        The reference; its duration is the default of its constructor.
+
+    Examples
+    --------
+    >>> reference("sine", frequency=2.0)
+    Reference(name='sine', amplitude=5.0, frequency=2.0, speed=None, duration=2.5)
+    """
+    if name not in SIGNALS:
+        raise InputError(f"unknown signal '{name}' (choose from step, ramp, sine)")
+    given = {
+        "step": step,
+        "ramp_speed": ramp_speed,
+        "ramp_to": ramp_to,
+        "amplitude": amplitude,
+        "frequency": frequency,
+    }
+    for key, value in given.items():
+        if value is not None and key not in _OPTIONS[name]:
+            raise InputError(f"--{key.replace('_', '-')} does not apply to the {name}")
+    base = SIGNALS[name]
+    if all(given[k] is None for k in _OPTIONS[name]):
+        return base
+    if name == "step":
+        return Reference.step(step)
+    if name == "ramp":
+        return Reference.ramp(
+            base.speed if ramp_speed is None else ramp_speed,
+            base.amplitude if ramp_to is None else ramp_to,
+        )
+    return Reference.sine(
+        base.amplitude if amplitude is None else amplitude,
+        base.frequency if frequency is None else frequency,
+    )
 
 
 @dataclass(frozen=True)

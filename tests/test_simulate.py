@@ -1,14 +1,23 @@
 import dataclasses
+import json
 
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from ptoverify.cli import main
 from ptoverify.errors import InputError
 from ptoverify.laws import make_law
 from ptoverify.plant import step as plant_step
 from ptoverify.plant import zoh_matrices
-from ptoverify.simulate import SIGNALS, TRACKING, Reference, simulate, simulate_batch
+from ptoverify.simulate import (
+    SIGNALS,
+    TRACKING,
+    Reference,
+    reference,
+    simulate,
+    simulate_batch,
+)
 
 
 def test_simulate_matches_zoh_matrices(paper_cfg):
@@ -168,3 +177,37 @@ def test_result_carries_its_reference(paper_cfg):
     assert res.reference.duration == 1.0 and res.t[-1] == pytest.approx(1.0), "time simulated"
     assert (res.signal, res.tracking, res.feedforward) == ("sine", "error", False)
     assert_allclose(res.r, ref.r(res.t), rtol=0, atol=0, err_msg="r from the reference carried")
+
+
+def test_reference_overrides_section6_values():
+    assert reference("step") is SIGNALS["step"], "no override: the Section 6 reference"
+    assert reference("ramp", ramp_to=-12.0) == Reference.ramp(200.0, -12.0), "speed kept"
+    assert reference("sine", amplitude=3.0) == Reference.sine(3.0, 5.0), "frequency kept"
+    with pytest.raises(InputError, match="--frequency does not apply to the step"):
+        reference("step", frequency=2.0)
+    with pytest.raises(InputError):
+        reference("square")
+
+
+def test_cli_simulate_custom_sine(capsys):
+    """--amplitude/--frequency reach the simulation: r is 3 sin(2 pi 2 t) over five periods."""
+    argv = ["simulate", "--law", "pd", "--signal", "sine", "--amplitude", "3", "--frequency", "2"]
+    assert main([*argv, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    t, r = np.array(out["series"]["t"]), np.array(out["series"]["r"])
+    assert_allclose(t[-1], 2.5, rtol=1e-12, err_msg="default duration: five periods [s]")
+    assert_allclose(r, 3.0 * np.sin(4 * np.pi * t), rtol=0, atol=1e-12, err_msg="r [mm]")
+    assert sorted(out) == sorted(
+        [
+            "law",
+            "signal",
+            "feedforward",
+            "note",
+            "samples",
+            "final_error_mm",
+            "max_abs_error_second_half_mm",
+            "series",
+        ]
+    ), "JSON keys unchanged"
+    assert main(["simulate", "--signal", "ramp", "--step", "3"]) == 2
+    assert "does not apply" in capsys.readouterr().err
