@@ -35,6 +35,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ptoverify.errors import InputError
+
 if TYPE_CHECKING:  # pragma: no cover
     from ptoverify.simulate import SimResult
 
@@ -434,6 +436,11 @@ def summarize(
     -------
     dict
         Metric name -> value (NaN where undefined for this signal).
+
+    Raises
+    ------
+    InputError
+        For a sine whose period is not a whole number of samples.
     """
     t, e, ref = res.t, res.e, res.reference
     half = t.size // 2
@@ -455,6 +462,12 @@ def summarize(
         out["ramp_lag_mm"] = ramp_lag(t, e, res.r_dot)
     if ref.name == "sine":
         freq = ref.frequency  # the simulated sine's, never a global table's
+        per = 1.0 / (freq * (t[1] - t[0]))
+        if abs(per - round(per)) > 1e-9 * per:
+            raise InputError(
+                f"the phase of a {freq:g} Hz sine is fitted over whole periods: its period must "
+                f"be a whole number of samples, got {per:.6g} (T = {t[1] - t[0]:g} s)"
+            )
         fit_r = sine_fit(t, res.r, freq, t_from=1.0 / freq)
         pos = sine_fit(t, res.x1, freq, t_from=1.0 / freq)
         out["phase_delay_deg"] = phase_delay(fit_r, pos)

@@ -8,6 +8,7 @@ from numpy.testing import assert_allclose
 from scipy.signal import cont2discrete
 
 from ptoverify import metrics as m
+from ptoverify.errors import InputError
 from ptoverify.laws import Region, make_law
 from ptoverify.simulate import Reference, simulate
 
@@ -180,3 +181,10 @@ def test_phase_delay_of_a_2hz_sine_is_the_sampled_frequency_response(paper_cfg, 
     got = m.summarize(res)
     assert_allclose(got["phase_delay_deg"], expect, atol=1e-7, err_msg="phase delay [deg]")
     assert_allclose(got["amplitude_ratio"], abs(X[0]) / A, rtol=1e-9, err_msg="gain")
+
+
+def test_summarize_rejects_a_sine_of_fractional_period(paper_cfg):
+    """7 Hz at T = 2 ms is 71.4 samples a period: no whole-period fit, a clear input error."""
+    res = simulate(make_law("pd", paper_cfg), paper_cfg.plant, Reference.sine(1.0, 7.0))
+    with pytest.raises(InputError, match="whole number of samples"):
+        m.summarize(res)
