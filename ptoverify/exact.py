@@ -507,7 +507,7 @@ def overshoot(tr: Trajectory, target: float) -> tuple[float, float]:
     >>> tr = Trajectory.from_samples([0.0, 0.1], [0.0, x1], [20.0, x2], [-1.0], 100.0)
     >>> ov, tp = overshoot(tr, 0.15)  # both samples are below 0.15 mm
     >>> round(ov, 6), round(tp, 6)  # peak at s* = ln(21) / 100
-    (0.019554, 0.030445)
+    (0.019555, 0.030445)
     """
     t0, h, x1, x2, u = tr.t[:-1], np.diff(tr.t), tr.x1[:-1], tr.x2[:-1], tr.u
     sgn = 1.0 if target >= tr.x1[0] else -1.0
