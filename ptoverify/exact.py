@@ -340,80 +340,61 @@ def _cos_roots(theta0, dtheta, c):
     return out
 
 
-def _newton(f, df, lo, hi, flo, tol):
-    """Vectorized safeguarded Newton on brackets [lo, hi] with one sign change."""
+def _newton(fdf, lo, hi, flo, tol):
+    """Vectorized safeguarded Newton on brackets [lo, hi] with one sign change.
+
+    ``fdf(x)`` returns (f, f').  A Newton step that leaves the bracket is
+    replaced by bisection; iteration stops within ``tol`` of the root.
+    """
     x = 0.5 * (lo + hi)
     live = np.ones(x.shape, dtype=bool)
     for _ in range(200):
-        fx, dfx = f(x), df(x)
+        fx, dfx = fdf(x)
         same = np.sign(fx) == np.sign(flo)
         lo, flo = np.where(same, x, lo), np.where(same, fx, flo)
         hi = np.where(same, hi, x)
         with np.errstate(divide="ignore", invalid="ignore"):
             xn = x - fx / dfx
-        bad = ~((xn > lo) & (xn < hi))
-        xn = np.where(bad, 0.5 * (lo + hi), xn)
+        xn = np.where((xn > lo) & (xn < hi), xn, 0.5 * (lo + hi))
         done = (fx == 0) | (np.abs(xn - x) <= tol) | (hi - lo <= tol)
-        x = np.where(live, np.where(fx == 0, x, xn), x)
+        x = np.where(live & (fx != 0), xn, x)
         live &= ~done
         if not live.any():
             break
     return x
 
 
-def _roots_on(brk, f, df, tol):
-    """Roots of f on each piece of brk (m, K) where f changes sign; (m, K - 1), NaN if none."""
-    lo, hi = brk[:, :-1], brk[:, 1:]
-    flo, fhi = f(lo), f(hi)
-    has = (flo * fhi < 0) & (hi > lo)
-    out = np.where(flo == 0, lo, np.nan)
-    if has.any():
-        idx = np.nonzero(has)
-        rows = idx[0]
-
-        def fi(s):
-            return f(s, rows)
-
-        def dfi(s):
-            return df(s, rows)
-
-        out[idx] = _newton(fi, dfi, lo[idx], hi[idx], flo[idx], tol)
-    return out
-
-
-def _e_derivs(p: _Pieces, s, rows=None):
-    """e'(s) and e''(s) on interval rows (all rows if None), s shaped like rows."""
-    sl = slice(None) if rows is None else rows
-    c = (sl,) + (None,) * (np.ndim(s) - (0 if rows is not None else 1))
-    x2, u, t0 = p.x2[c], p.u[c], p.t0[c]
-    sig = p.sig
-    amp = sig.amplitude * (sig.kind == "sine") if sig else 0.0
-    w = sig.omega if sig else 0.0
-    slope = sig.slope(p.t0 + 0.5 * p.h)[c] if sig else 0.0
-    ex = np.exp(-p.a * s)
+def _derivs(x2, u, t0, slope, amp, w, a, s, order):
+    """e^(order) and e^(order + 1) at offsets s [s] (order 1 or 2), per-interval parameters."""
+    dv = (x2 - u) * np.exp(-a * s)
     th = w * (t0 + s)
-    d1 = slope + amp * w * np.cos(th) - u - (x2 - u) * ex
-    d2 = -amp * w * w * np.sin(th) + p.a * (x2 - u) * ex
-    return d1, d2
+    c, sn = np.cos(th), np.sin(th)
+    d2 = -amp * w * w * sn + a * dv
+    if order == 1:
+        return slope + amp * w * c - u - dv, d2
+    return d2, -amp * w**3 * c - a * a * dv
+
+
+def _ref_parts(p: _Pieces):
+    """Per-interval slope [mm/s], sine amplitude [mm] and omega [rad/s] of the reference."""
+    sig = p.sig
+    if sig is None:
+        return np.zeros(p.h.size), 0.0, 0.0
+    return sig.slope(p.t0 + 0.5 * p.h), sig.amplitude * (sig.kind == "sine"), sig.omega
+
+
+def _e_derivs(p: _Pieces, s):
+    """e'(s) [mm/s] and e''(s) [mm/s^2] at offsets s of shape (m, K)."""
+    slope, amp, w = _ref_parts(p)
+    c = (slice(None), None)
+    return _derivs(p.x2[c], p.u[c], p.t0[c], slope[c], amp, w, p.a, s, 1)
 
 
 def _extrema(p0: _Pieces, order: int) -> NDArray[np.float64]:
     """Zeros in (0, h) of e' (order 1) or e'' (order 2) per interval, shape (m, 3)."""
-    sig, a, h = p0.sig, p0.a, p0.h
+    a, h = p0.a, p0.h
     m = h.size
-    w = sig.omega if sig else 0.0
-    amp = sig.amplitude * (sig.kind == "sine") if sig else 0.0
-    slope = sig.slope(p0.t0 + 0.5 * h) if sig else np.zeros(m)
-    brk = np.zeros((m, 4))
-    brk[:, 1:] = h[:, None]
-    if w > 0.0 and amp != 0.0:  # e^{as} e^(order) is monotone between cos roots
-        big_r = math.hypot(a, w)
-        phi = math.atan2(w, a)
-        psi = 0.0 if order == 1 else 0.5 * math.pi
-        cc = (a * (p0.u - slope) / (abs(amp) * w**order * big_r)) if order == 1 else np.zeros(m)
-        shift = 0.0 if amp > 0 else math.pi
-        r = _cos_roots(w * p0.t0 + psi + phi + shift, w * h, cc) / w
-        brk[:, 1:3] = np.sort(np.where(np.isnan(r), h[:, None], r), axis=1)
+    slope, amp, w = _ref_parts(p0)
     if not (w > 0.0 and amp != 0.0):  # e' = v - x2(s): one closed-form root; e'' != 0
         out = np.full((m, 3), np.nan)
         if order == 1:
@@ -423,22 +404,30 @@ def _extrema(p0: _Pieces, order: int) -> NDArray[np.float64]:
         return out
     if w * float(h.max()) >= 2.0 * math.pi:
         raise InputError("a sine reference needs more than one sample per period")
-    sel = 0 if order == 1 else 1
-
-    def f(s, rows=None):
-        return _e_derivs(p0, s, rows)[sel]
-
-    def df(s, rows=None):
-        if sel == 1:  # e''' = -A w^3 cos - a^2 (x2 - u) e^{-as}
-            sl = slice(None) if rows is None else rows
-            c = (sl,) + (None,) * (np.ndim(s) - (0 if rows is not None else 1))
-            th = w * (p0.t0[c] + s)
-            return -amp * w**3 * np.cos(th) - a * a * (p0.x2[c] - p0.u[c]) * np.exp(-a * s)
-        return _e_derivs(p0, s, rows)[1]
-
-    roots = _roots_on(brk, f, df, 8.0 * np.finfo(float).eps * float(h.max()))
-    roots = np.where((roots > 0) & (roots < h[:, None]), roots, np.nan)
-    return roots
+    # e^{as} e^(order) is monotone between the closed-form roots of
+    # cos(w t + psi + phi) = c: at most one zero of e^(order) between them
+    psi = 0.0 if order == 1 else 0.5 * math.pi
+    cc = a * (p0.u - slope) / (abs(amp) * w * math.hypot(a, w)) if order == 1 else np.zeros(m)
+    shift = 0.0 if amp > 0 else math.pi
+    r = _cos_roots(w * p0.t0 + psi + math.atan2(w, a) + shift, w * h, cc) / w
+    brk = np.zeros((m, 4))
+    brk[:, 1:] = h[:, None]
+    brk[:, 1:3] = np.sort(np.where(np.isnan(r), h[:, None], r), axis=1)
+    lo, hi = brk[:, :-1], brk[:, 1:]
+    c = (slice(None), None)
+    args = (p0.x2[c], p0.u[c], p0.t0[c], slope[c], amp, w, a)
+    flo = _derivs(*args, lo, order)[0]
+    fhi = _derivs(*args, hi, order)[0]
+    out = np.full(lo.shape, np.nan)
+    has = (flo * fhi < 0) & (hi > lo)
+    if has.any():
+        idx = np.nonzero(has)
+        k = idx[0]
+        g = (p0.x2[k], p0.u[k], p0.t0[k], slope[k], amp, w, a)
+        # a few ulps of the absolute time t0 + s: the precision any time of the record has
+        tol = 4.0 * np.finfo(float).eps * float(np.max(np.abs(p0.t0) + h))
+        out[idx] = _newton(lambda x: _derivs(*g, x, order), lo[idx], hi[idx], flo[idx], tol)
+    return np.where((out > 0) & (out < h[:, None]), out, np.nan)
 
 
 def _pieces(tr: Trajectory, sig: Signal | None, what: str = "e") -> _Pieces:
@@ -458,17 +447,19 @@ def _value(p: _Pieces, s, what: str):
 
 def _crossing(p: _Pieces, k: int, s0: float, s1: float, level: float, what: str) -> float:
     """Exact time [s] where the monotone e (or x1) of interval k crosses level in [s0, s1]."""
+    x1k, dv, uk, a, t0 = float(p.x1[k]), float(p.x2[k] - p.u[k]), float(p.u[k]), p.a, float(p.t0[k])
+    sig = p.sig if what == "e" else None
+    kind = sig.kind if sig else ""
+    amp, w = (sig.amplitude, sig.omega) if sig else (0.0, 0.0)
+    r0 = float(sig.r(t0)) if sig else 0.0
+    slope = float(sig.slope(t0 + 0.5 * float(p.h[k]))) if sig else 0.0
 
-    def f(s: float) -> float:
-        y1, _ = _flow(p.x1[k], p.x2[k], p.u[k], s, p.a)
-        if what == "x1":
-            return float(y1) - level
-        r = (
-            p.sig.r(p.t0[k] + s)
-            if p.sig.kind != "ramp"
-            else p.sig.r(p.t0[k]) + p.sig.slope(p.t0[k] + 0.5 * p.h[k]) * s
-        )
-        return float(r - y1) - level
+    def f(s: float) -> float:  # eq. (7) in scalar arithmetic, as _flow
+        y1 = x1k + uk * s + dv * -math.expm1(-a * s) / a
+        if sig is None:
+            return y1 - level
+        r = amp * math.sin(w * (t0 + s)) if kind == "sine" else r0 + slope * s
+        return r - y1 - level
 
     f0, f1 = f(s0), f(s1)
     if f0 == 0.0 or s1 <= s0:
@@ -554,9 +545,9 @@ def settling_time(tr: Trajectory, ref: Any, band: float) -> float:
     return _settling(p, band) - float(tr.t[0])
 
 
-def _settling(p: _Pieces, band: float) -> float:
+def _settling(p: _Pieces, band: float, ev=None) -> float:
     """Absolute last exit time [s] of |e| from the band on pieces p (t0[0] if never out)."""
-    ev = _value(p, p.brk, "e")
+    ev = _value(p, p.brk, "e") if ev is None else ev
     out = np.abs(ev) > band
     if not out.any():
         return float(p.t0[0])
@@ -568,9 +559,10 @@ def _settling(p: _Pieces, band: float) -> float:
     return _crossing(p, k, float(p.brk[k, j]), float(p.brk[k, j + 1]), lvl, "e")
 
 
-def _first_reach(p: _Pieces, level: float, sgn: float) -> float:
+def _first_reach(p: _Pieces, level: float, sgn: float, xv=None) -> float:
     """First time [s] with sgn (x1(t) - level) >= 0 on x1-pieces p, exactly; NaN if never."""
-    v = sgn * (_value(p, p.brk, "x1") - level) >= 0
+    xv = _value(p, p.brk, "x1") if xv is None else xv
+    v = sgn * (xv - level) >= 0
     if not v.any():
         return math.nan
     k = int(np.nonzero(v.any(axis=1))[0][0])
@@ -609,10 +601,14 @@ def rise_time(tr: Trajectory, target: float, *, low: float = 0.1, high: float = 
     x0 = float(tr.x1[0])
     if target == x0:
         return math.nan
+    return _rise(_pieces(tr, None, "x1"), x0, target, low, high)
+
+
+def _rise(p: _Pieces, x0: float, target: float, low: float, high: float, xv=None) -> float:
     sgn = 1.0 if target > x0 else -1.0
-    p = _pieces(tr, None, "x1")
-    t_lo = _first_reach(p, x0 + low * (target - x0), sgn)
-    t_hi = _first_reach(p, x0 + high * (target - x0), sgn)
+    xv = _value(p, p.brk, "x1") if xv is None else xv
+    t_lo = _first_reach(p, x0 + low * (target - x0), sgn, xv)
+    t_hi = _first_reach(p, x0 + high * (target - x0), sgn, xv)
     return t_hi - t_lo
 
 
@@ -632,8 +628,11 @@ def _cross_generic(p, k, s0, s1, level, what):
     if what == "e":
         return _crossing(p, k, s0, s1, level, "e")
 
+    slope, amp, w = _ref_parts(p)
+    g = (float(p.x2[k]), float(p.u[k]), float(p.t0[k]), float(slope[k]), amp, w, p.a)
+
     def f(s: float) -> float:
-        return float(_e_derivs(p, np.array([s]), np.array([k]))[0][0]) - level
+        return float(_derivs(*g, s, 1)[0]) - level
 
     f0, f1 = f(s0), f(s1)
     if f0 * f1 > 0:
@@ -675,13 +674,20 @@ def linear_zone_time(tr: Trajectory, ref: Any, d: float, *, v_max: float = math.
     >>> round(linear_zone_time(tr, Signal("step", 1.0), 0.5), 6)  # ln(2) / 20
     0.034657
     """
-    sig = as_signal(ref)
-    p = _pieces(tr, sig)
-    z2 = _extrema(p, 2) if math.isfinite(v_max) else np.full((p.h.size, 3), np.nan)
-    brk = np.sort(np.concatenate([p.brk, np.where(np.isnan(z2), p.h[:, None], z2)], 1), 1)
-    q = _Pieces(p.t0, p.h, p.x1, p.x2, p.u, p.a, sig, brk)
-    e = _value(q, brk, "e")
-    e2 = -_e_derivs(q, brk)[0]
+    return _linear_zone(_pieces(tr, as_signal(ref)), d, v_max) - float(tr.t[0])
+
+
+def _linear_zone(p: _Pieces, d: float, v_max: float, ev=None) -> float:
+    """Absolute first entry time [s] into the zone on e-pieces p; NaN if never."""
+    if math.isfinite(v_max):  # refine so that e' is monotone on every piece too
+        z2 = np.where(np.isnan(z := _extrema(p, 2)), p.h[:, None], z)
+        brk = np.sort(np.concatenate([p.brk, z2], 1), 1)
+        q = _Pieces(p.t0, p.h, p.x1, p.x2, p.u, p.a, p.sig, brk)
+        e, e2 = _value(q, brk, "e"), -_e_derivs(q, brk)[0]
+    else:
+        q, brk = p, p.brk
+        e = _value(p, brk, "e") if ev is None else ev
+        e2 = np.zeros_like(e)
     lo, hi = brk[:, :-1], brk[:, 1:]
 
     def meets(v, lim):  # a monotone piece meets the band [-lim, lim] somewhere
@@ -698,7 +704,7 @@ def linear_zone_time(tr: Trajectory, ref: Any, d: float, *, v_max: float = math.
             if a2 is None or max(a1[0], a2[0]) > min(a1[1], a2[1]):
                 continue
             a1 = (max(a1[0], a2[0]), 0.0)
-        return float(q.t0[k] + a1[0] - tr.t[0])
+        return float(q.t0[k] + a1[0])
     return math.nan
 
 
@@ -782,8 +788,8 @@ def _grid_phase(t, x1, r, freq: float, ta: float) -> float:
     sel = t > ta + 1e-9 * (t[1] - t[0])
     w = 2.0 * math.pi * abs(freq)
     M = np.column_stack([np.sin(w * t[sel]), np.cos(w * t[sel]), np.ones(int(sel.sum()))])
-    (ar, br, _), *_ = np.linalg.lstsq(M, r[sel], rcond=None)
-    (ax, bx, _), *_ = np.linalg.lstsq(M, x1[sel], rcond=None)
+    coef, *_ = np.linalg.lstsq(M, np.column_stack([r[sel], x1[sel]]), rcond=None)
+    (ar, ax), (br, bx) = coef[0], coef[1]
     return _wrap_deg(math.degrees(math.atan2(br, ar) - math.atan2(bx, ax)))
 
 
@@ -923,10 +929,11 @@ def metrics_from_arrays(
     band2 = big * abs(sig.amplitude)
     nan = math.nan
     p = _pieces(tr, sig)
+    ev = _value(p, p.brk, "e")
     vals: dict[str, Compared] = {}
     details: dict[str, float] = {"band_2pct_mm": band2, "t_peak_s": nan}
     for key, b in (("settling_2pct_s", band2), ("settling_0p01mm_s", band)):
-        ex = _settling(p, b) - float(tt[0]) if b > 0 else nan
+        ex = _settling(p, b, ev) - float(tt[0]) if b > 0 else nan
         vals[key] = Compared(
             ex, _grid_settling(tt, e_grid, b) if b > 0 else nan, TIME_TOL_SAMPLES * T
         )
@@ -938,7 +945,10 @@ def metrics_from_arrays(
             ov, max(0.0, float(np.max(sgn * (y1 - target)))), POSITION_TOL
         )
         details["t_peak_s"] = tp
-        rt = rise_time(tr, target) if target != y1[0] else nan
+        if sig.kind == "step":  # r constant: the e-pieces are the x1-pieces
+            rt = _rise(p, float(y1[0]), target, 0.1, 0.9, target - ev) if target != y1[0] else nan
+        else:
+            rt = rise_time(tr, target)
         lo, hi = (y1[0] + f * (target - y1[0]) for f in (0.1, 0.9))
         g = _grid_first(tt, sgn * (y1 - hi) >= 0) - _grid_first(tt, sgn * (y1 - lo) >= 0)
         vals["rise_time_s"] = Compared(rt, g, TIME_TOL_SAMPLES * T)
@@ -955,7 +965,7 @@ def metrics_from_arrays(
     if d is None:
         vals["linear_zone_s"] = Compared(nan, nan, TIME_TOL_SAMPLES * T)
     else:
-        ez = linear_zone_time(tr, sig, d, v_max=v_max)
+        ez = _linear_zone(p, d, v_max, ev) - float(tt[0])
         inside = (np.abs(e_grid) < d) & (np.abs(y2 - sig.r_dot(tt)) <= v_max)
         gz = _grid_first(tt, inside) - float(tt[0])
         vals["linear_zone_s"] = Compared(ez, gz, TIME_TOL_SAMPLES * T)
