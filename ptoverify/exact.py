@@ -353,7 +353,7 @@ def _newton(fdf, lo, hi, flo, tol):
         same = np.sign(fx) == np.sign(flo)
         lo, flo = np.where(same, x, lo), np.where(same, fx, flo)
         hi = np.where(same, hi, x)
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             xn = x - fx / dfx
         xn = np.where((xn > lo) & (xn < hi), xn, 0.5 * (lo + hi))
         done = (fx == 0) | (np.abs(xn - x) <= tol) | (hi - lo <= tol)
@@ -398,7 +398,7 @@ def _extrema(p0: _Pieces, order: int) -> NDArray[np.float64]:
     if not (w > 0.0 and amp != 0.0):  # e' = v - x2(s): one closed-form root; e'' != 0
         out = np.full((m, 3), np.nan)
         if order == 1:
-            with np.errstate(divide="ignore", invalid="ignore"):
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 out[:, 0] = np.log1p((p0.x2 - slope) / (slope - p0.u)) / a
             out = np.where((out > 0) & (out < h[:, None]), out, np.nan)
         return out
@@ -502,7 +502,7 @@ def overshoot(tr: Trajectory, target: float) -> tuple[float, float]:
     """
     t0, h, x1, x2, u = tr.t[:-1], np.diff(tr.t), tr.x1[:-1], tr.x2[:-1], tr.u
     sgn = 1.0 if target >= tr.x1[0] else -1.0
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         s_star = np.log1p(-x2 / u) / tr.a
     inner = np.isfinite(s_star) & (s_star > 0) & (s_star < h)
     s_star = np.where(inner, s_star, 0.0)
