@@ -171,7 +171,8 @@ def as_signal(ref: Any) -> Signal:
     ----------
     ref : Signal, object or tuple
         A :class:`Signal`; any object with ``name`` (or ``kind``), ``amplitude``
-        and ``rate`` attributes (``ptoverify.simulate.Reference``); or a tuple
+        and ``rate`` (or ``speed``, ``frequency``) attributes, as
+        ``ptoverify.simulate.Reference``; or a tuple
         ``(kind, amplitude[, rate])``.
 
     Returns
@@ -190,7 +191,8 @@ def as_signal(ref: Any) -> Signal:
     kind = getattr(ref, "kind", None) or getattr(ref, "name", None)
     if kind is None or not hasattr(ref, "amplitude"):
         raise InputError(f"cannot read a reference from {type(ref).__name__}")
-    return Signal(str(kind), float(ref.amplitude), float(getattr(ref, "rate", 0.0)))
+    rate = next((getattr(ref, n) for n in ("rate", "speed", "frequency") if hasattr(ref, n)), 0.0)
+    return Signal(str(kind), float(ref.amplitude), float(rate))
 
 
 def _arr(x: ArrayLike) -> NDArray[np.float64]:
@@ -865,6 +867,15 @@ class ExactMetrics:
     def grid(self) -> dict[str, float]:
         """Sample-grid values by key."""
         return {k: v.grid for k, v in self.values.items()}
+
+    def json_metrics(self) -> dict[str, float | None]:
+        """Return ``simulate --json`` ``metrics`` (DESIGN.md): exact values, None if undefined.
+
+        Keys ``overshoot_mm``, ``settling_2pct_s``, ``settling_0p01mm_s``,
+        ``rise_time_s``, and ``phase_delay_deg`` for a sine only.
+        """
+        keys = [k for k in METRIC_KEYS[:5] if k != "phase_delay_deg" or self.signal.kind == "sine"]
+        return {k: None if math.isnan(v := self.values[k].exact) else v for k in keys}
 
     def differing(self) -> list[str]:
         """Keys whose exact and grid values differ beyond tolerance."""

@@ -308,3 +308,14 @@ def test_duck_typed_result_and_inferred_reference():
     for k in exact.METRIC_KEYS:
         a, b = m1.values[k].exact, m2.values[k].exact
         assert (math.isnan(a) and math.isnan(b)) or a == b, k
+
+
+@pytest.mark.parametrize("sig", ["step", "sine"])
+def test_json_metrics_follow_design_keys(sig):
+    import json
+
+    res = response("to", sig)
+    j = exact.exact_metrics(res, PLANT, reference(sig)).json_metrics()
+    keys = {"overshoot_mm", "settling_2pct_s", "settling_0p01mm_s", "rise_time_s"}
+    assert set(j) == (keys | {"phase_delay_deg"} if sig == "sine" else keys)
+    json.dumps(j, allow_nan=False)  # undefined values are null, not NaN
