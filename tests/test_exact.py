@@ -319,3 +319,15 @@ def test_json_metrics_follow_design_keys(sig):
     keys = {"overshoot_mm", "settling_2pct_s", "settling_0p01mm_s", "rise_time_s"}
     assert set(j) == (keys | {"phase_delay_deg"} if sig == "sine" else keys)
     json.dumps(j, allow_nan=False)  # undefined values are null, not NaN
+
+
+def test_trajectory_state_is_the_flow_between_samples():
+    res = response("pto", "step")
+    tr = exact.Trajectory.from_result(res, PLANT)
+    x1, x2 = tr.state(res.t)
+    assert_allclose(x1, res.x1, rtol=0, atol=1e-12, err_msg="x1 at the samples")
+    mid = res.t[:-1] + 0.3 * np.diff(res.t)
+    y1, y2 = flow(res.x1[:-1], res.x2[:-1], res.u[:-1], mid - res.t[:-1], PLANT.a)
+    z1, z2 = tr.state(mid)
+    assert_allclose(z1, y1, rtol=1e-15, atol=1e-15, err_msg="x1 between samples")
+    assert_allclose(z2, y2, rtol=1e-15, atol=1e-12, err_msg="x2 between samples")
