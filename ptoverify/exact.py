@@ -19,9 +19,9 @@ Definitions (the sample-grid value, returned side by side, is the same
 definition restricted to the samples t_k):
 
 * overshoot: max(0, max_t s (x1(t) - r_end)), s = sign(r_end - x1(t_0)) [mm];
-* settling to a band: the last exit time of |e(t)| from the band, t_0 if never
-  outside, NaN if the record ends outside [s] (bands: 2 % of the reference's
-  size -- step height, ramp end value, sine amplitude -- and 0.01 mm);
+* settling to a band: the last exit time of |e(t)| from the band, measured from
+  t_0; 0 if never outside, NaN if the record ends outside [s] (bands: 2 % of the
+  reference's size -- step height, ramp end value, sine amplitude -- and 0.01 mm);
 * rise time: first time x1 reaches 90 % minus first time it reaches 10 % of the
   way from x1(t_0) to r_end [s] (step and ramp);
 * linear zone: the first time the state is in {|x1 - r| <= d, |x2 - r'| <= v_max}
