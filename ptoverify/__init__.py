@@ -20,6 +20,9 @@ poles       PD and linear-zone (eq. 37) loops: poles, damping, margins (python-c
 metrics     settling_time (2 % and 0.01 mm bands), overshoot, oscillation_amplitude,
             sign_reversals, ramp_lag, sine_fit/phase_delay (whole periods), rise_time,
             time_to_linear_zone, input_switches, summarize
+exact       metrics between samples on the exact ZOH flow: overshoot, settling (last exit),
+            rise time, linear-zone entry, sine phase; exact_metrics / metrics_from_arrays give
+            exact and sample-grid values side by side (ExactMetrics, Compared)
 claims      Section 6 and conclusion claims, each measured under every reading
             (a = 2 pi f or f, feed-forward, PTO printed/corrected, band); evaluate_claims
 sweep       run_sweep: settling time / t_f* and / N* T over a 50 x 50 grid of initial states
