@@ -17,7 +17,10 @@ The configuration format is the one in ``shared/DESIGN.md``::
     k2 = 3.6
 
 Every rejection is a :class:`~ptoverify.errors.ConfigError` whose message
-names the key and the value.
+names the key and the value.  Ranges: a, w_max, position_range <= 1e6;
+1e-7 <= sample_time <= 1 s and 1e-6 <= a T <= 20; 0 <= d <= position_range;
+gains 0 <= kp T, k1 T <= 1e4 and 0 <= kd, k2 <= 1e4 (far beyond the sampled
+stability limits, so unstable gains reach the gates; see ``_check_gains``).
 """
 
 from __future__ import annotations
