@@ -15,6 +15,7 @@ LAW = f"{Path(__file__).with_name('my_pto.py')}:pto"  # or "mypkg.control:pto"
 
 @pytest.mark.slow
 def test_my_law_conforms():
+    """The example third-party law conforms (exit 0 of ``conform``, as a test)."""
     assert_conforms(LAW)
 
 
