@@ -170,6 +170,7 @@ _SIGTERM_SCRIPT = textwrap.dedent(
 )
 
 
+@pytest.mark.slow
 def test_sigterm_cleans_up_and_exits_143(tmp_path):
     out = tmp_path / "out"
     env = {**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"}
@@ -225,3 +226,25 @@ def test_concurrent_publishes_serialize(tmp_path):
     assert int((target / "id.txt").read_text()) in range(24)
     assert json.loads((target / MARKER).read_text())["files"] == ["id.txt", "pad.txt"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+def test_report_default_folder_refuses_another_configuration(tmp_path, monkeypatch, capsys):
+    """A config copied from the README keeps name = "paper": with other gains, `report`
+    without --out must not replace reports/paper/ (exit 2 at once, asks for --out)."""
+    from ptoverify.config import paper_config
+
+    monkeypatch.chdir(tmp_path)
+    committed = tmp_path / "reports" / "paper"
+    _write_output(committed, "committed", config_hash=paper_config().digest(), default=True)
+    toml = tmp_path / "my.toml"
+    toml.write_text(
+        'name = "paper"\n[plant]\nbandwidth_hz = 30.0\nw_max = 300.0\nsample_time = 0.002\n'
+        "position_range = 50.0\n[pd]\nkp = 356.0\nkd = 1.15\n[pto]\nd = 0.5\nk1 = 300.0\n"
+        "k2 = 3.6\n"
+    )
+    t0 = time.perf_counter()
+    assert main(["report", "--config", str(toml), "--quiet"]) == 2
+    assert time.perf_counter() - t0 < 3.0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "different configuration" in err[0] and "--out" in err[0]
+    assert (committed / "result.txt").read_text() == "committed"
