@@ -155,6 +155,13 @@ def _foreign(folder: Path, marker: dict) -> list[str]:
 
 
 def _check_replaceable(target: Path, config_hash: str | None, default: bool) -> None:
+    try:
+        _replaceable(target, config_hash, default)
+    except FileNotFoundError:
+        pass  # replaced by a concurrent run while we looked: it is checked again under the lock
+
+
+def _replaceable(target: Path, config_hash: str | None, default: bool) -> None:
     if not target.exists():
         return
     if not target.is_dir() or target.is_symlink():
@@ -271,8 +278,11 @@ def remove_stale(target: Path) -> list[Path]:
             pid = int(m.group(2))
             if pid == os.getpid() or _pid_alive(pid):
                 continue
-            if read_marker(entry) is None and any(entry.iterdir()):
-                continue  # not ours: only marked (or empty) folders are removed
+            try:
+                if read_marker(entry) is None and any(entry.iterdir()):
+                    continue  # not ours: only marked (or empty) folders are removed
+            except OSError:
+                continue  # removed by a concurrent run meanwhile
             shutil.rmtree(entry, ignore_errors=True)
             removed.append(entry)
     return removed
