@@ -694,7 +694,8 @@ def _cmd_conform(args: argparse.Namespace) -> int:
 
         verdicts, states = conform_verdicts(result)
         props = {"config": cfg.name, "target": result.target, "mode": result.mode}
-        write_atomic(args.junit, junit_xml(verdicts, "ptoverify.conform", states, props))
+        xml = junit_xml(verdicts, "ptoverify.conform", states, props, result.conforms)
+        write_atomic(args.junit, xml)
     if args.json:
         print_json(result.to_json())
     else:

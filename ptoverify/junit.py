@@ -4,7 +4,9 @@ One ``testcase`` per gate or property (``classname`` the suite, ``name`` the
 verdict's name).  ``pass`` is a passing test case; ``fail`` carries a
 ``failure`` element; ``unverified`` and ``not_run`` carry an ``error``
 element (fail closed: a figure that could not be computed is never a pass,
-and never ``skipped``, which CI systems count as green).  The message carries
+and never ``skipped``, which CI systems count as green).  The one exception,
+``skip_not_run``, is for properties that do not apply to a run whose verdict
+passed without them (a ``conform --table`` has no closed loop to judge).  The message carries
 the measured figure, the comparison, the limit, the unit and, when known, the
 first failing state; the element's text is the full detail.
 """
@@ -16,7 +18,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Iterable, Sequence
 from typing import Any
 
-from ptoverify.verdict import FAIL, PASS, Verdict
+from ptoverify.verdict import FAIL, NOT_RUN, PASS, Verdict
 
 __all__ = ["junit_xml", "conform_verdicts", "failure_message"]
 
@@ -57,6 +59,7 @@ def junit_xml(
     suite: str,
     states: dict[str, Sequence[float]] | None = None,
     properties: dict[str, Any] | None = None,
+    skip_not_run: bool = False,
 ) -> str:
     """Return JUnit XML with one ``testcase`` per verdict.
 
@@ -71,6 +74,11 @@ def junit_xml(
     properties : dict, optional
         Suite properties (configuration name, target...), written as
         ``<property name= value=>``.
+    skip_not_run : bool
+        Report ``not_run`` verdicts as ``skipped`` (with their reason) instead
+        of ``error``.  Only for a run whose verdict already passed without
+        them (``conform --table``: the closed-loop properties need a callable),
+        so the XML agrees with the exit code.
 
     Returns
     -------
@@ -88,14 +96,15 @@ def junit_xml(
     """
     verdicts = list(verdicts)
     states = states or {}
+    skipped = sum(v.status == NOT_RUN for v in verdicts) if skip_not_run else 0
     failures = sum(v.status == FAIL for v in verdicts)
-    errors = sum(v.status not in (PASS, FAIL) for v in verdicts)
+    errors = sum(v.status not in (PASS, FAIL) for v in verdicts) - skipped
     attrs = {
         "name": suite,
         "tests": str(len(verdicts)),
         "failures": str(failures),
         "errors": str(errors),
-        "skipped": "0",
+        "skipped": str(skipped),
     }
     root = ET.Element("testsuites", attrs)
     ts = ET.SubElement(root, "testsuite", attrs)
@@ -106,6 +115,9 @@ def junit_xml(
     for v in verdicts:
         tc = ET.SubElement(ts, "testcase", {"classname": suite, "name": v.name})
         if v.status == PASS:
+            continue
+        if skip_not_run and v.status == NOT_RUN:
+            ET.SubElement(tc, "skipped", {"message": f"not run: {v.detail}"})
             continue
         tag = "failure" if v.status == FAIL else "error"
         el = ET.SubElement(

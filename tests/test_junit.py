@@ -126,3 +126,16 @@ def test_conform_verdicts_carry_regions_properties_and_states():
     quiet = {**result, "agreement": {"regions": {}, "pass": True}, "properties": {}}
     v2, _ = conform_verdicts(quiet)
     assert any(not v.passed for v in v2)
+
+
+def test_not_run_is_skipped_only_when_asked():
+    v = [
+        Verdict("a", "pass", 0.0, 1.0, ""),
+        Verdict("cl", "not_run", None, None, "needs a callable"),
+    ]
+    _, suite, cases = _cases(junit_xml(v, "s"))
+    assert cases["cl"][0] == "error" and suite.get("errors") == "1"
+    _, suite, cases = _cases(junit_xml(v, "s", skip_not_run=True))
+    assert (
+        cases["cl"][0] == "skipped" and suite.get("errors") == "0" and suite.get("skipped") == "1"
+    )
