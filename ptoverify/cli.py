@@ -24,7 +24,15 @@ from typing import Any
 
 from ptoverify.config import Config, load_config
 from ptoverify.errors import InputError, PtoverifyError, SolverError
-from ptoverify.outdir import check_target, discard, make_temp, publish
+from ptoverify.outdir import (
+    OutputBusy,
+    Terminated,
+    check_target,
+    discard,
+    make_temp,
+    publish,
+    sigterm_raises,
+)
 
 __all__ = ["main", "build_parser"]
 
@@ -343,6 +351,27 @@ def _cmd_derive(args: argparse.Namespace) -> int:
     return 0
 
 
+# ---------------------------------------------------------------- junit
+def _add_junit(p) -> None:
+    p.add_argument(
+        "--junit",
+        metavar="FILE",
+        default=None,
+        help="also write JUnit XML (one testcase per gate/property; unverified is an error)",
+    )
+
+
+def _check_junit(args: argparse.Namespace) -> None:
+    """Validate --junit FILE before any computation."""
+    if args.junit is None:
+        return
+    path = Path(args.junit)
+    if args.junit.strip() == "" or path.is_dir():
+        raise InputError(f"--junit must name a file, got {args.junit!r}")
+    if not path.absolute().parent.is_dir():
+        raise InputError(f"--junit '{args.junit}': folder '{path.parent}' does not exist")
+
+
 # ---------------------------------------------------------------- check
 def _add_check(sub) -> None:
     p = sub.add_parser(
@@ -367,6 +396,7 @@ def _add_check(sub) -> None:
         help="cap IPOPT iterations (a solver that then fails makes its gate "
         "unverified, and the run fails)",
     )
+    _add_junit(p)
     p.set_defaults(handler=_cmd_check)
 
 
@@ -378,8 +408,13 @@ def _cmd_check(args: argparse.Namespace) -> int:
         unknown = [g for g in args.gate if g not in GATES]
         if unknown:
             raise InputError(f"unknown gate '{unknown[0]}' (choose from {', '.join(GATES)})")
+    _check_junit(args)
     results = run_checks(cfg, args.gate, max_iter=args.max_iter)
     summary = summarize(results)
+    if args.junit:
+        from ptoverify.junit import junit_xml
+
+        write_atomic(args.junit, junit_xml(results, "ptoverify.check", None, {"config": cfg.name}))
     if args.json:
         print_json(
             {"config": cfg.name, "checks": [r.to_json() for r in results], "summary": summary}
@@ -425,21 +460,6 @@ def _add_sweep(sub) -> None:
     p.set_defaults(handler=_cmd_sweep)
 
 
-def _progress_bar(enabled: bool):
-    """Return a progress callback drawing on stderr, or None."""
-    if not enabled:
-        return None
-
-    def show(stage: str, frac: float) -> None:
-        n = int(round(30 * frac))
-        sys.stderr.write(f"\r[{'#' * n}{'.' * (30 - n)}] {stage:<24}")
-        if frac >= 1.0:
-            sys.stderr.write("\n")
-        sys.stderr.flush()
-
-    return show
-
-
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from ptoverify.sweep import SweepSettings, run_sweep
 
@@ -448,9 +468,11 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         raise InputError(f"--grid must be in [2, 400], got {args.grid}")
     target = tmp = None
     if args.out is not None:
-        target = check_target(args.out)
+        target = check_target(args.out, config_hash=cfg.digest())
     try:
-        bar = _progress_bar(sys.stderr.isatty() and not args.quiet)
+        from ptoverify.progress import stderr_bar
+
+        bar = stderr_bar(args.quiet)
         res = run_sweep(cfg, SweepSettings(n1=args.grid, n2=args.grid), progress=bar)
         result = res.to_json()
         if args.out is not None:
@@ -460,7 +482,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
             files = save_sweep(res, tmp)
             (tmp / "sweep.json").write_text(json.dumps(to_jsonable(result), indent=2) + "\n")
             result["files"] = [str(target / f.name) for f in files] + [str(target / "sweep.json")]
-            publish(tmp, target)
+            publish(tmp, target, config_hash=cfg.digest(), name=cfg.name)
             tmp = None
     finally:
         discard(tmp)
@@ -650,6 +672,7 @@ def _add_conform(sub) -> None:
         metavar="TOL",
         help="agreement tolerance relative to w_max (default 1e-6)",
     )
+    _add_junit(p)
     p.set_defaults(handler=_cmd_conform)
 
 
@@ -660,6 +683,7 @@ def _cmd_conform(args: argparse.Namespace) -> int:
     rtol = conform.DEFAULT_RTOL if args.tolerance is None else args.tolerance
     if not 0 < rtol < 1:
         raise InputError(f"--tolerance must be in (0, 1), got {rtol:g}")
+    _check_junit(args)
     if args.emit_grid:
         text = conform.grid_csv(cfg)
         write_atomic(args.emit_grid, text)
@@ -679,6 +703,13 @@ def _cmd_conform(args: argparse.Namespace) -> int:
         with contextlib.redirect_stdout(sys.stderr):
             fn = conform.load_callable(args.law)
             result = conform.conform_callable(fn, cfg, target=args.law, rtol=rtol)
+    if args.junit:
+        from ptoverify.junit import conform_verdicts, junit_xml
+
+        verdicts, states = conform_verdicts(result)
+        props = {"config": cfg.name, "target": result.target, "mode": result.mode}
+        xml = junit_xml(verdicts, "ptoverify.conform", states, props, result.conforms)
+        write_atomic(args.junit, xml)
     if args.json:
         print_json(result.to_json())
     else:
@@ -738,7 +769,14 @@ def main(argv: list[str] | None = None) -> int:
             # numeric caveats belong in the results, not on stderr (one line on error)
             warnings.simplefilter("ignore")
             args = build_parser().parse_args(argv)
-            return int(args.handler(args))
+            with sigterm_raises():
+                return int(args.handler(args))
+    except Terminated:
+        print("ptoverify: error: terminated (SIGTERM); nothing written", file=sys.stderr)
+        return 143
+    except OutputBusy as exc:
+        print(f"ptoverify: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 1
     except SolverError as exc:
         print(f"ptoverify: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 1
