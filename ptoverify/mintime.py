@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 from ptoverify.config import Plant
 from ptoverify.curves import blockwise, h
 from ptoverify.errors import InputError
+from ptoverify.reach import DiscreteLimit
 
 __all__ = [
     "MinTime",
@@ -39,6 +40,7 @@ __all__ = [
     "ZOHReach",
     "discrete_min_steps",
     "discrete_min_steps_batch",
+    "DiscreteLimit",
 ]
 
 
@@ -366,29 +368,62 @@ def discrete_min_steps(
 
 
 def discrete_min_steps_batch(
-    x1: ArrayLike, x2: ArrayLike, plant: Plant, n_max: int = 20000, confirm: bool = True
-) -> list[DiscreteMinTime]:
-    """:func:`discrete_min_steps` for many states, sharing the generators.
+    x1: ArrayLike, x2: ArrayLike, plant: Plant, n_max: int = 20000
+) -> DiscreteLimit:
+    """N* for many states at once: exact 2-D zonotope membership, vectorized.
+
+    The production path for many states (:mod:`ptoverify.reach`: the states
+    that reach the origin in N ZOH samples with |u_k| <= w_max form a 2-D
+    zonotope, tested facet by facet; N* by exponential search and bisection on
+    N from ceil(t_f* / T), per state).  No LP and no input sequence:
+    :func:`discrete_min_steps` (linear programs) is its independent reference.
+    A state counts as reaching the origin in N samples if it does so with
+    |u_k| <= (1 + 1e-9) w_max (:data:`ptoverify.reach.MARGIN`, the LP's own
+    acceptance rule), so states on a boundary in exact arithmetic are inside.
 
     Parameters
     ----------
     x1, x2 : array_like
-        Initial positions [mm] and velocities [mm/s]; broadcast, flattened.
+        Initial positions [mm] and velocities [mm/s], finite; broadcast.
     plant : Plant
         The plant (a [rad/s], w_max [mm/s], sample_time T [s]).
     n_max : int
-        Largest N tried.
-    confirm : bool
-        Check N* - 1 by LP where it was not solved during the search.
+        Largest N tried [samples]; N* = -1 beyond.
 
     Returns
     -------
-    list of DiscreteMinTime
-        One per state, in flattened order.
+    DiscreteLimit
+        ``steps`` (N*, int64, -1 where > n_max) and ``time_s`` (N* T [s], NaN
+        where not found), of the broadcast shape.
+
+    Raises
+    ------
+    InputError
+        A state that is not finite.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> plant = paper_config().plant
+    >>> d = discrete_min_steps_batch([5.0, 0.0], [0.0, 0.0], plant)
+    >>> d.steps.tolist() == [discrete_min_steps(5.0, 0.0, plant).steps, 0]
+    True
     """
+    from dataclasses import replace
+
+    from ptoverify.reach import zonotope_steps
+
     x1, x2 = np.broadcast_arrays(np.asarray(x1, dtype=float), np.asarray(x2, dtype=float))
-    reach = ZOHReach(plant)
-    return [
-        discrete_min_steps(a, b, plant, n_max=n_max, reach=reach, confirm=confirm)
-        for a, b in zip(x1.ravel(), x2.ravel(), strict=True)
-    ]
+    if not (np.isfinite(x1).all() and np.isfinite(x2).all()):
+        raise InputError("a state is not finite")
+    shape = x1.shape
+    t_f = min_time(x1, x2, plant).t_f
+    n0 = np.maximum(np.ceil(t_f.ravel() / plant.sample_time - 1e-9), 1.0)
+    n0 = np.minimum(n0, n_max + 1.0).astype(np.int64)  # beyond n_max: not found
+    d = zonotope_steps(x1, x2, n0, plant, n_max)
+    return replace(
+        d,
+        steps=d.steps.reshape(shape),
+        time_s=d.time_s.reshape(shape),
+        below_bound=d.below_bound.reshape(shape),
+    )
