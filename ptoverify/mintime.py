@@ -420,7 +420,7 @@ def discrete_min_steps_batch(
     t_f = min_time(x1, x2, plant).t_f
     n0 = np.maximum(np.ceil(t_f.ravel() / plant.sample_time - 1e-9), 1.0)
     n0 = np.minimum(n0, n_max + 1.0).astype(np.int64)  # beyond n_max: not found
-    d = zonotope_steps(x1, x2, n0, plant, n_max)
+    d = zonotope_steps(x1.ravel(), x2.ravel(), n0, plant, n_max)
     return replace(
         d,
         steps=d.steps.reshape(shape),

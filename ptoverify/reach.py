@@ -195,7 +195,7 @@ _TABLES: dict[tuple[float, float], ZonotopeTable] = {}
 
 
 def zonotope_table(plant: Plant, n: int) -> ZonotopeTable:
-    """A cached :class:`ZonotopeTable` of ``plant`` serving at least N <= n."""
+    """Return a cached :class:`ZonotopeTable` of ``plant`` serving N <= n."""
     key = (plant.a, plant.sample_time)
     tab = _TABLES.get(key)
     if tab is None or tab.n < n:
