@@ -404,8 +404,8 @@ def _add_sweep(sub) -> None:
     p.add_argument(
         "--grid",
         type=positive_int,
-        default=50,
-        help="grid points per axis (default 50: 2,500 states)",
+        default=200,
+        help="grid points per axis (default 200: 40,000 states; at most 1000)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     p.set_defaults(handler=_cmd_sweep)
@@ -430,8 +430,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     from ptoverify.sweep import SweepSettings, run_sweep
 
     cfg = _config(args)
-    if args.grid < 2 or args.grid > 400:
-        raise InputError(f"--grid must be in [2, 400], got {args.grid}")
+    if args.grid < 2 or args.grid > 1000:
+        raise InputError(f"--grid must be in [2, 1000], got {args.grid}")
     target = tmp = None
     if args.out is not None:
         target = check_target(args.out)
