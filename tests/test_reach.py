@@ -246,3 +246,29 @@ def test_shape_and_non_finite():
         discrete_min_steps_batch([1.0, math.nan], [0.0, 0.0], plant)
     with pytest.raises(InputError):
         discrete_min_steps_batch([1.0], [math.inf], plant)
+
+
+def test_gate_compares_zonotope_with_lp(monkeypatch, capsys):
+    """The discrete-limit-consistency gate passes, and fails on a mutated batch N*."""
+    import json
+    from dataclasses import replace
+
+    import ptoverify.mintime as mintime
+    from ptoverify.cli import main
+
+    argv = ["check", "--gate", "discrete-limit-consistency", "--json"]
+    assert main(argv) == 0
+    gate = json.loads(capsys.readouterr().out)["checks"][0]
+    assert gate["status"] == "pass" and "zonotope" in gate["detail"]
+    real = mintime.discrete_min_steps_batch
+
+    def off_by_one(x1, x2, plant, n_max=20000):
+        d = real(x1, x2, plant, n_max)
+        steps = d.steps.copy()
+        steps[3] += 1
+        return replace(d, steps=steps)
+
+    monkeypatch.setattr(mintime, "discrete_min_steps_batch", off_by_one)
+    assert main(argv) == 1
+    gate = json.loads(capsys.readouterr().out)["checks"][0]
+    assert gate["status"] == "fail" and "1 of 25 states disagree" in gate["detail"]
