@@ -227,6 +227,14 @@ def zonotope_steps(
     -------
     DiscreteLimit
         N*, N* T and the search's diagnostics, flattened order.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> plant = paper_config().plant
+    >>> d = zonotope_steps([5.0, 5.0], [0.0, 0.0], [1, 40], plant)  # any start: same N*
+    >>> int(d.steps[0]) == int(d.steps[1]), bool(d.below_bound[1])
+    (True, True)
     """
     x1, x2, n0 = np.broadcast_arrays(
         np.asarray(x1, dtype=float), np.asarray(x2, dtype=float), np.asarray(n0)

@@ -272,3 +272,16 @@ def test_gate_compares_zonotope_with_lp(monkeypatch, capsys):
     assert main(argv) == 1
     gate = json.loads(capsys.readouterr().out)["checks"][0]
     assert gate["status"] == "fail" and "1 of 25 states disagree" in gate["detail"]
+
+
+def test_any_start_gives_the_same_n_star():
+    """The search does not trust its start: n0 above N* is tested and flagged, n0 = 1 works."""
+    from ptoverify.reach import zonotope_steps
+
+    plant = PLANTS["paper"]
+    x1, x2 = random_states(plant, 40, 10, seed=12)
+    ref = discrete_min_steps_batch(x1, x2, plant)
+    for n0 in (np.ones_like(ref.steps), ref.steps + 7, 3 * ref.steps):
+        d = zonotope_steps(x1, x2, n0, plant)
+        assert np.array_equal(d.steps, ref.steps)
+        assert np.array_equal(d.below_bound, n0 - 1 >= ref.steps)
