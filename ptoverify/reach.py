@@ -202,6 +202,8 @@ def zonotope_table(plant: Plant, n: int) -> ZonotopeTable:
         size = 256
         while size < n:
             size *= 2
+        if len(_TABLES) >= 16:  # many plants (e.g. a parameter sweep): drop the oldest
+            del _TABLES[next(iter(_TABLES))]
         tab = _TABLES[key] = ZonotopeTable(plant, size)
     return tab
 
