@@ -218,3 +218,72 @@ def test_mintime_converged_but_inaccurate_ocp_is_not_truth(capsys):
     data = json.loads(capsys.readouterr().out)
     assert data["analytic_s"] > 0
     assert data["two_phase_s"] is None and data["two_phase_status"].startswith("inaccurate")
+
+
+def test_internal_error_is_exit_1_one_line_not_bad_input(capsys, monkeypatch):
+    """An injected bug in a numeric function is an internal error (exit 1), not exit 2."""
+    import ptoverify.groundtruth as gt
+
+    def broken(*args, **kwargs):
+        return 1 / 0
+
+    monkeypatch.setattr(gt, "min_time", broken)
+    code, out, err = run(capsys, "mintime", "5", "0", "--json")
+    assert code == 1 and out == ""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("ptoverify: internal error: ZeroDivisionError: division by zero")
+    assert "--debug" in lines[0] and "Traceback" not in err
+
+
+@pytest.mark.parametrize("where", ["before", "after"])
+def test_debug_shows_the_traceback(capsys, monkeypatch, where):
+    import ptoverify.groundtruth as gt
+
+    monkeypatch.setattr(gt, "min_time", lambda *a, **k: 1 / 0)
+    argv = ["mintime", "5", "0"]
+    argv = ["--debug", *argv] if where == "before" else [*argv, "--debug"]
+    with pytest.raises(ZeroDivisionError):
+        main(argv)
+
+
+def test_debug_in_a_subprocess_prints_a_traceback(tmp_path):
+    """A real process: without --debug one line, with it the traceback; exit 1 both ways."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, ptoverify.groundtruth as g\n"
+        "g.min_time = lambda *a, **k: 1 / 0\n"
+        "from ptoverify.cli import main\n"
+        "sys.exit(main(sys.argv[1:]))\n"
+    )
+    for flag, want_trace in (([], False), (["--debug"], True)):
+        proc = subprocess.run(
+            [sys.executable, "-c", code, *flag, "mintime", "5", "0"],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        assert proc.returncode == 1, proc.stderr
+        assert ("Traceback" in proc.stderr) == want_trace, proc.stderr
+        assert "ZeroDivisionError" in proc.stderr
+
+
+def test_version(capsys):
+    import re
+
+    import ptoverify
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    assert out == f"ptoverify {ptoverify.__version__}\n"
+    assert re.fullmatch(r"\d+\.\d+\.\d+", ptoverify.__version__)
+
+
+def test_usage_error_has_one_prefix(capsys):
+    code, out, err = run(capsys, "mintime", "1")
+    assert code == 2 and out == ""
+    assert err.startswith("ptoverify: error: mintime: ") and "ptoverify mintime" not in err
