@@ -287,3 +287,33 @@ def test_usage_error_has_one_prefix(capsys):
     code, out, err = run(capsys, "mintime", "1")
     assert code == 2 and out == ""
     assert err.startswith("ptoverify: error: mintime: ") and "ptoverify mintime" not in err
+
+
+def test_cli_imports_no_solver_and_no_simulator():
+    """cli.py parses, calls and formats: it imports no solver, simulator or law directly."""
+    import ast
+    from pathlib import Path
+
+    import ptoverify
+
+    src = Path(ptoverify.__file__).with_name("cli.py").read_text()
+    names = set()
+    for node in ast.walk(ast.parse(src)):
+        if isinstance(node, ast.Import):
+            names.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            names.add(node.module)
+            names.update(f"{node.module}.{a.name}" for a in node.names)
+    forbidden = {
+        "casadi",
+        "scipy",
+        "ptoverify.ocp",
+        "ptoverify.simulate",
+        "ptoverify.mintime",
+        "ptoverify.plant",
+        "ptoverify.properties",
+        "ptoverify.zones",
+    }
+    assert not names & forbidden, names & forbidden
+    private = [n for n in names if n.rsplit(".", 1)[-1][:1] == "_" and "__" not in n]
+    assert not private, private
