@@ -75,17 +75,16 @@ def _clean(obj: Any) -> Any:
 
 # ------------------------------------------------------------------ collection
 def _ground_truth(cfg: Config) -> dict[str, Any]:
-    from ptoverify.mintime import discrete_min_steps, min_time
-    from ptoverify.ocp import CollocationOCP, TwoPhaseOCP, convergence_study
+    from ptoverify.groundtruth import verified_mintime
+    from ptoverify.ocp import convergence_study
 
     p = cfg.plant
     scale = (p.position_range / 50.0, p.w_max / 300.0)
     states = [(x1 * scale[0], x2 * scale[1]) for x1, x2 in GROUND_TRUTH_STATES]
-    tp, co = TwoPhaseOCP(p), CollocationOCP(p, intervals=100)
     rows = []
     for x1, x2 in states:
-        mt = min_time(x1, x2, p)
-        r2, rc, dm = tp.solve(x1, x2), co.solve(x1, x2), discrete_min_steps(x1, x2, p)
+        gt = verified_mintime(x1, x2, cfg, intervals=100)  # checked a posteriori, as mintime
+        mt, r2, rc, dm = gt.closed_form, gt.two_phase, gt.collocation, gt.discrete
         t_f = float(mt.t_f)
         rows.append(
             {

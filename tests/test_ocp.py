@@ -16,9 +16,10 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from ptoverify.cli import main, mintime_result
+from ptoverify.cli import main
 from ptoverify.config import Config, PDGains, Plant, PTOSettings, paper_config
 from ptoverify.curves import level_curve_x1
+from ptoverify.groundtruth import verified_mintime
 from ptoverify.mintime import min_time
 from ptoverify.ocp import CollocationOCP, TwoPhaseOCP, convergence_study
 
@@ -165,7 +166,7 @@ def test_forced_failure_is_never_a_pass():
 
 def test_mintime_result_reports_failures_as_null():
     """Two IPOPT iterations cannot converge: the numbers are null, the status says why."""
-    out = mintime_result(paper_config(), 30.0, 100.0, 50, max_iter=2)
+    out = verified_mintime(30.0, 100.0, paper_config(), intervals=50, max_iter=2).to_json()
     for key in ("two_phase_s", "collocation_s", "two_phase_switch_time_s"):
         assert out[key] is None, key
     assert "Maximum" in out["two_phase_status"] and "Maximum" in out["collocation_status"]
@@ -206,7 +207,7 @@ def test_cli_rejects_far_outside(capsys):
 
 def test_mintime_result_other_config():
     cfg = Config("fine-T", PLANTS["fine-T"], PDGains(), PTOSettings())
-    out = mintime_result(cfg, 3.0, -20.0, 60)
+    out = verified_mintime(3.0, -20.0, cfg, intervals=60).to_json()
     assert out["collocation_intervals"] == 60
     assert_allclose(out["two_phase_s"], out["analytic_s"], rtol=1e-9, err_msg="two-phase")
     assert out["discrete_steps"] * cfg.plant.sample_time == pytest.approx(out["discrete_s"])

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.linalg import expm
 
-from ptoverify import cli
+from ptoverify.cli import main
 from ptoverify.config import paper_config
 from ptoverify.curves import bisect, h, level_residual, omega_c
 from ptoverify.laws import LAW_NAMES, Region, make_law, omega_c_scalar, pto_law
@@ -150,6 +150,6 @@ def test_no_zone_when_omega0_none():
 def test_cli_simulate(name, capsys):
     import json
 
-    assert cli.main(["simulate", "--law", name, "--signal", "step", "--json"]) == 0
+    assert main(["simulate", "--law", name, "--signal", "step", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["law"] == name and abs(out["final_error_mm"]) < 1e-3

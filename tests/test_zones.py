@@ -10,7 +10,7 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.linalg import expm
 
-from ptoverify import cli
+from ptoverify.cli import main
 from ptoverify.config import paper_config
 from ptoverify.curves import level_curve_x1, level_residual, root_22_bisect, root_k_bisect
 from ptoverify.plant import flow
@@ -229,7 +229,7 @@ def test_violations_counted_above_edge():
 
 
 def test_cli_zone_json(capsys):
-    assert cli.main(["zone", "--json", "--no-verify"]) == 0
+    assert main(["zone", "--json", "--no-verify"]) == 0
     out = json.loads(capsys.readouterr().out)
     for key in ("printed", "corrected", "d", "w_max"):
         assert key in out
@@ -240,5 +240,5 @@ def test_cli_zone_json(capsys):
 
 
 def test_cli_zone_bad_config(tmp_path, capsys):
-    assert cli.main(["zone", "--config", str(tmp_path / "missing.toml")]) == 2
+    assert main(["zone", "--config", str(tmp_path / "missing.toml")]) == 2
     assert capsys.readouterr().err.startswith("ptoverify: error:")
