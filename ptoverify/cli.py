@@ -158,13 +158,13 @@ def _add_mintime(sub) -> None:
 
 
 def _mintime_states(args: argparse.Namespace, cfg: Config) -> int:
-    from ptoverify.mintime import batch_table
+    from ptoverify.commands import mintime_states
 
     if args.x1 is not None:
         raise InputError("give either X1 X2 or --states, not both")
     if args.out is not None and args.json:
         raise InputError("--out and --json are alternatives")
-    cols = batch_table(args.states, cfg)
+    cols = mintime_states(args.states, cfg)
     names = list(cols)
     # N* not found (-1, NaN): null in JSON, an empty field in CSV; floats as repr (round trip)
     rows = [

@@ -21,7 +21,7 @@ from ptoverify.errors import InputError
 from ptoverify.laws import make_law
 from ptoverify.simulate import SimResult, reference, simulate
 
-__all__ = ["SimulationRun", "run_simulation", "run_zone", "MAX_DURATION_S"]
+__all__ = ["SimulationRun", "run_simulation", "run_zone", "mintime_states", "MAX_DURATION_S"]
 
 #: Longest simulated time accepted from a user [s].
 MAX_DURATION_S = 100.0
@@ -166,3 +166,24 @@ def run_zone(cfg: Config, *, verify: bool = True, outcome: bool = True) -> dict[
     if outcome:
         result["outcome"] = zone_outcome(cfg)
     return result
+
+
+def mintime_states(path: str, cfg: Config) -> dict[str, np.ndarray]:
+    """Return the ``mintime --states`` columns for the states of a CSV file.
+
+    Parameters
+    ----------
+    path : str
+        CSV with columns x1 [mm], x2 [mm/s].
+    cfg : Config
+        Configuration (the plant).
+
+    Returns
+    -------
+    dict
+        :func:`ptoverify.mintime.batch_table`: ``x1``, ``x2``, ``analytic_s``,
+        ``switch_time_s``, ``discrete_steps``, ``discrete_s``.
+    """
+    from ptoverify.mintime import batch_table
+
+    return batch_table(path, cfg)

@@ -284,7 +284,7 @@ def test_version(capsys):
 
 
 def test_usage_error_has_one_prefix(capsys):
-    code, out, err = run(capsys, "mintime", "1")
+    code, out, err = run(capsys, "mintime", "1", "2", "--intervals", "many")
     assert code == 2 and out == ""
     assert err.startswith("ptoverify: error: mintime: ") and "ptoverify mintime" not in err
 
