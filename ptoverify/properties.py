@@ -162,7 +162,18 @@ def initial_grid(
 
 
 def default_steps(cfg: Config) -> int:
-    """Horizon: 2 R / w_max + 60 / a seconds, in samples (room to settle)."""
+    """Horizon: 2 R / w_max + 60 / a seconds, in samples (room to settle).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (position_range R [mm], w_max [mm/s], a [rad/s], T [s]).
+
+    Returns
+    -------
+    int
+        Number of samples [-].
+    """
     p = cfg.plant
     return int(math.ceil((2.0 * p.position_range / p.w_max + 60.0 / p.a) / p.sample_time))
 

@@ -214,7 +214,20 @@ class SweepResult:
 
 
 def grid_states(plant: Plant, n1: int, n2: int) -> tuple[NDArray, NDArray]:
-    """Even grid over the envelope, shape (n2, n1) each: (x1 [mm], x2 [mm/s])."""
+    """Even grid over the envelope, shape (n2, n1) each: (x1 [mm], x2 [mm/s]).
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant (position_range [mm], w_max [mm/s]).
+    n1, n2 : int
+        Grid points along x1 and x2 [-].
+
+    Returns
+    -------
+    x1, x2 : ndarray, shape (n2, n1)
+        Positions [mm] and velocities [mm/s] (meshgrid, x1 along columns).
+    """
     x1 = np.linspace(-plant.position_range, plant.position_range, n1)
     x2 = np.linspace(-plant.w_max, plant.w_max, n2)
     return np.meshgrid(x1, x2)
@@ -253,7 +266,20 @@ def _n_star_cached(plant: Plant, x1: tuple[float, ...], x2: tuple[float, ...]) -
 
 
 def discrete_limit(plant: Plant, x1: NDArray, x2: NDArray) -> NDArray[np.int64]:
-    """N* for each state (-1 where the LP search failed), cached per plant and states."""
+    """N* for each state (-1 where the LP search failed), cached per plant and states.
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant (a [rad/s], w_max [mm/s], T [s]).
+    x1, x2 : ndarray
+        Initial states [mm], [mm/s] (any shape; raveled).
+
+    Returns
+    -------
+    ndarray of int64
+        Fewest ZOH samples to the origin [-], flat.
+    """
     x1, x2 = np.ravel(x1), np.ravel(x2)
     return np.array(_n_star_cached(plant, tuple(x1.tolist()), tuple(x2.tolist())), dtype=np.int64)
 

@@ -296,14 +296,14 @@ def principle_violations(
     reading: str = "strict",
     n1: int = 801,
     n2: int = 801,
-    band: int = 201,
+    n_band: int = 201,
 ) -> tuple[int, int]:
     """Count violations of the principle on 2-D grids of source states.
 
     Independent of the monotonicity argument: every grid state in the source set
     is stepped with u = -w_max and its landing is judged.  Two grids: the
     envelope |x1| <= position_range, |x2| <= w_max (``n1`` x ``n2``), and the
-    band from max(l1*, d) out to 3 w_max T to its right (``n2`` x ``band``).
+    band from max(l1*, d) out to 3 w_max T to its right (``n2`` x ``n_band``).
 
     Parameters
     ----------
@@ -313,8 +313,8 @@ def principle_violations(
         Level of l1* [mm/s].
     reading : {"strict", "lenient"}
         Landing rule.
-    n1, n2, band : int
-        Grid sizes in x1, x2 and across the band.
+    n1, n2, n_band : int
+        Grid sizes in x1, x2 and across the band [-].
 
     Returns
     -------
@@ -326,7 +326,7 @@ def principle_violations(
     x2 = np.linspace(-w, w, n2)
     g1, g2 = np.meshgrid(np.linspace(-R, R, n1), x2)
     (lo_a, _), _ = _source_intervals(cfg, omega0, x2, d)
-    off = np.linspace(0.0, 3.0 * w * T, band)
+    off = np.linspace(0.0, 3.0 * w * T, n_band)
     b1 = lo_a[:, None] + off[None, :]
     b2 = np.broadcast_to(x2[:, None], b1.shape)
     x1 = np.concatenate([g1.ravel(), b1.ravel()])

@@ -253,7 +253,7 @@ def test_degenerate_large_d():
 def test_violations_counted_above_edge():
     cfg = PAPER
     z = cz("paper")
-    bad, pts = principle_violations(cfg, 2 * z.omega0, n1=201, n2=201, band=51)
+    bad, pts = principle_violations(cfg, 2 * z.omega0, n1=201, n2=201, n_band=51)
     assert bad > 0 and pts > 0
 
 
