@@ -463,7 +463,7 @@ def _zone_valid(ctx: GateContext) -> Verdict:
     cfg = ctx.cfg
     z = corrected_zone(cfg)
     if not z.valid:
-        measured = float(z.grid_violations) if z.grid_violations > 0 else None
+        measured = float(z.grid_violations) if (z.grid_violations or 0) > 0 else None
         return Verdict(
             "zone-corrected-valid", FAIL, measured, 0.0, f"no valid corrected zone: {z.reason}"
         )

@@ -303,8 +303,13 @@ def _add_derive(sub) -> None:
 def _cmd_derive(args: argparse.Namespace) -> int:
     import derivations
 
-    _config(args)
-    records = derivations.all_records()
+    cfg = _config(args)
+    p = cfg.plant
+    records = derivations.all_records(
+        derivations.PlantNumbers(
+            a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
+        )
+    )
     if args.json:
         print_json({"equations": [r.to_json() for r in records]})
     else:

@@ -227,7 +227,11 @@ def collect(cfg: Config, progress: Progress | None = None) -> dict[str, Any]:
     say = progress or (lambda stage: None)
     out: dict[str, Any] = {}
     say("derivations")
-    out["derivations"] = [r.to_json() for r in derivations.all_records()]
+    p = cfg.plant
+    plant = derivations.PlantNumbers(
+        a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
+    )
+    out["derivations"] = [r.to_json() for r in derivations.all_records(plant)]
     say("ground truth")
     out["ground_truth"] = _ground_truth(cfg)
     say("switching zone")
