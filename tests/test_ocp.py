@@ -18,7 +18,7 @@ from conftest import PLANTS, random_states
 from numpy.testing import assert_allclose
 
 from ptoverify.cli import main
-from ptoverify.config import Config, PDGains, Plant, PTOSettings, paper_config
+from ptoverify.config import Config, PDGains, PTOSettings, paper_config
 from ptoverify.curves import level_curve_x1
 from ptoverify.groundtruth import verified_mintime
 from ptoverify.mintime import min_time
