@@ -49,6 +49,8 @@ __all__ = [
     "law_properties",
     "all_properties",
     "zone_outcome",
+    "crossing_masks",
+    "oscillating",
 ]
 
 
@@ -164,8 +166,8 @@ def default_steps(cfg: Config) -> int:
     return int(math.ceil((2.0 * p.position_range / p.w_max + 60.0 / p.a) / p.sample_time))
 
 
-def _oscillating(x1: np.ndarray, band: float) -> np.ndarray:
-    """Sustained-oscillation test on the window x1 of shape (window, n)."""
+def oscillating(x1: np.ndarray, band: float) -> np.ndarray:
+    """Sustained-oscillation test on the window x1 [mm] of shape (window, n)."""
     big = np.abs(x1) > band
     sgn = np.where(big, np.sign(x1), 0.0)
     # carry the last nonzero sign forward so that small samples do not count
@@ -176,6 +178,9 @@ def _oscillating(x1: np.ndarray, band: float) -> np.ndarray:
     half = x1.shape[0] // 2
     first, second = np.abs(x1[:half]).max(axis=0), np.abs(x1[half:]).max(axis=0)
     return (changes >= 4) & (second > band) & (second >= 0.5 * first)
+
+
+_oscillating = oscillating  # the name tests/test_properties.py uses
 
 
 def crossing_masks(
@@ -269,7 +274,7 @@ def law_properties(
     from_bang = entered & ((prev == Region.BANG_P) | (prev == Region.BANG_N))
     entry = np.where(entered, np.abs(X2[np.maximum(first_in, 0), np.arange(x1.size)]), 0.0)
     chat = (R[1:-1] != R[:-2]) & (R[1:-1] != R[2:]) & (R[:-2] == R[2:])
-    osc = _oscillating(X1[-window:], band)
+    osc = oscillating(X1[-window:], band)
     over = np.where(is_rest, (-np.sign(x1)[None, :] * X1).max(axis=0), 0.0)
     max_u = float(np.abs(res.u).max())
     return LawProperties(
