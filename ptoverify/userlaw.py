@@ -245,7 +245,7 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
     try:
         vec = np.asarray(fn(p1, p2, cfg), dtype=float)
     except (Exception, SystemExit) as exc:  # noqa: BLE001 - any failure on arrays means: scalar loop
-        law.reason = f"array call raised {type(exc).__name__}: {' '.join(str(exc).split())}"
+        law.reason = f"takes one state per call (an array call raised {type(exc).__name__})"
     else:
         if vec.shape != p1.shape:
             law.reason = f"array call returned shape {vec.shape} for {p1.size} states"
@@ -258,7 +258,7 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
                     f"{p2[i]:g}): {vec[i]!r} vs {first[i]!r}"
                 )
     if law.reason:
-        law.reason += "; wrapped in a scalar loop"
+        law.reason += "; called state by state"
     else:
         law.mode = "vectorized"
         law.reason = f"array call of {p1.size} probe states equals element-wise calls"
