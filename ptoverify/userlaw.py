@@ -237,8 +237,8 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
             failure(
                 "pure-function",
                 (p1[i], p2[i]),
-                f"two calls at the same state returned {first[i]!r} and "
-                f"{second[i]!r} mm/s: the law has memory (e.g. a delay)",
+                f"has memory or is not deterministic: two calls at the same state returned "
+                f"{float(first[i])!r} and {float(second[i])!r} mm/s",
             )
         )
     law.reason = ""
