@@ -562,7 +562,7 @@ class ConformResult:
     unverified : list of str
         Properties that could not be evaluated (``unverified``).
     law_output : str
-        What an isolated law printed (stdout and stderr), last 4000 characters.
+        What an isolated law printed (stdout and stderr), first and last 2000 characters.
     """
 
     conforms: bool
@@ -616,7 +616,10 @@ def _judge(user, failures: list[dict], cfg: Config, rtol, sweep, grid, n_random)
     if blocked is None:
         t = time.perf_counter()
         d1, d2 = _determinism_states(cfg, grid)
-        u_det, f = determinism(user, d1, d2)
+        try:
+            u_det, f = determinism(user, d1, d2)
+        except LawFault as fault:
+            f = [failure("evaluation", fault.state, fault.message)]
         failures += f
         blocked = f[0] if f else None
         timings["determinism"] = time.perf_counter() - t
@@ -670,7 +673,10 @@ def _judge(user, failures: list[dict], cfg: Config, rtol, sweep, grid, n_random)
         agree["gap"] = largest_gap(x1, x2, cfg)
         failures += f
         props["agreement"] = _agreement_verdict(agree)
-    props["pure-function"], f = _recheck(user, d1, d2, u_det, props["pure-function"])
+    try:
+        props["pure-function"], f = _recheck(user, d1, d2, u_det, props["pure-function"])
+    except LawFault as fault:
+        f = [failure("evaluation", fault.state, f"at the determinism re-check: {fault.message}")]
     failures += f
     timings["agreement"] = time.perf_counter() - t
     return props, agree, timings
@@ -698,7 +704,7 @@ def _finish(user, props, failures, agree, timings, t0, cfg, target, output="") -
         failures,
         {k: round(v, 4) for k, v in timings.items()},
         cfg.name,
-        output[-4000:],
+        _clip(output),
     )
 
 
@@ -821,8 +827,15 @@ def _aborted(user, props, failures, ab, timings, t0, cfg, target, output) -> Con
         failures,
         {k: round(v, 4) for k, v in timings.items()},
         cfg.name,
-        output[-4000:],
+        _clip(output),
     )
+
+
+def _clip(text: str, n: int = 2000) -> str:
+    """Keep the first and last n characters of what the law printed."""
+    if len(text) <= 2 * n:
+        return text
+    return f"{text[:n]}\n[... {len(text) - 2 * n} characters left out ...]\n{text[-n:]}"
 
 
 def _coverage(agree: dict, cfg: Config) -> Verdict:

@@ -47,6 +47,21 @@ _VEC_RTOL = 1e-12  #: vectorized-vs-scalar agreement relative to w_max
 
 
 # ------------------------------------------------------------------ loading
+def check_spec(spec: str) -> None:
+    """Check the form of ``MODULE:FUNCTION`` / ``file.py:FUNCTION`` without running code.
+
+    Raises
+    ------
+    InputError
+        Malformed spec or a ``.py`` file that does not exist.
+    """
+    mod_name, sep, attr = spec.rpartition(":")
+    if not sep or not mod_name or not attr:
+        raise InputError(f"--law '{spec}': expected MODULE:FUNCTION or path/file.py:FUNCTION")
+    if mod_name.endswith(".py") and not Path(mod_name).is_file():
+        raise InputError(f"--law '{spec}': no such file '{mod_name}'")
+
+
 def load_callable(spec: str) -> Callable:
     """Import ``MODULE:FUNCTION`` or load ``path/file.py:FUNCTION`` (runs user code).
 
@@ -376,6 +391,7 @@ class IsolatedLaw:
         import time
 
         self.cfg, self.timeout, self.calls = cfg, timeout, 0
+        check_spec(spec)
         self._deadline = time.monotonic() + timeout
         fd, self._out = tempfile.mkstemp(prefix="ptoverify-law-", suffix=".log")
         os.close(fd)
