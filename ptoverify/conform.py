@@ -88,6 +88,7 @@ from ptoverify.agreement import (
     ties,
 )
 from ptoverify.config import Config
+from ptoverify.errors import InputError
 from ptoverify.laws import Law, Region
 from ptoverify.userlaw import (
     DEFAULT_TIMEOUT_S,
@@ -791,11 +792,15 @@ def conform_spec(
         ``isolation`` and leaves the properties not yet evaluated ``unverified``.
     """
     t0 = time.perf_counter()
-    grid = conformance_grid(cfg) if grid is None else grid
+    user = IsolatedLaw(spec, cfg, timeout=timeout)
+    grid = conformance_grid(cfg) if grid is None else grid  # while the child loads
     try:
-        user = IsolatedLaw(spec, cfg, timeout=timeout)
+        user.ready()
     except LawAborted as ab:
-        return _aborted(None, {}, [], ab, {}, t0, cfg, spec, "")
+        return _aborted(None, {}, [], ab, {}, t0, cfg, spec, user.close())
+    except InputError:
+        user.close()
+        raise
     failures = list(user.init_failures)
     timings = {"detect": time.perf_counter() - t0}
     props: dict[str, Verdict] = {}

@@ -359,7 +359,8 @@ class IsolatedLaw:
     """A user law loaded and called in a child process (spawned), with time and memory limits.
 
     Same interface as :class:`UserLaw` (``mode``, ``reason``, ``calls``,
-    ``__call__(x1, x2)``, ``scalar``): calls are sent as arrays, the child
+    ``__call__(x1, x2)``, ``scalar``) once :meth:`ready` has returned (the
+    child loads while the caller prepares its states): calls are sent as arrays, the child
     loops over states in scalar mode.  The law's stdout and stderr go to a
     file, returned by :meth:`close`.  A timeout (the whole ``timeout`` or the
     per-call budget ``CALL_BASE_S + 1 ms`` per state), any exit of the child
@@ -403,6 +404,18 @@ class IsolatedLaw:
         self._proc.start()
         child.close()
         self.init_failures: list[dict] = []
+        self.mode, self.reason = "unknown", "not loaded yet"
+
+    def ready(self) -> None:
+        """Wait until the child has loaded the law and detected its mode.
+
+        Raises
+        ------
+        InputError
+            The law cannot be loaded or has a bad interface (exit 2).
+        LawAborted
+            The child hung, crashed or exited while loading.
+        """
         msg = self._recv("loading the law and detecting its mode", self.timeout)
         if msg[0] == "input":
             self.close()
