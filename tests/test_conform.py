@@ -203,8 +203,8 @@ def test_stride_over_count_against_independent_simulation(paper_cfg):
     # at the paper's d, l1 and l2 stay inside |x1| < d: shrink d so that strides can happen
     cfg = replace(paper_cfg, pto=replace(paper_cfg.pto, d=0.02))
     a, w, d = cfg.plant.a, cfg.plant.w_max, cfg.pto.d
-    props, _ = closed_loop(UserLaw(_time_optimal, cfg, mode="vectorized"), cfg, sweep=(21, 21, 40))
-    x1, x2, _ = initial_grid(cfg, 21, 21, 40)
+    props, _ = closed_loop(UserLaw(_time_optimal, cfg, mode="vectorized"), cfg, sweep=(11, 11, 20))
+    x1, x2, _ = initial_grid(cfg, 11, 11, 20)
     A, B = _zoh(cfg)
     om = zone_for_law(cfg, "corrected").omega0
     tol = 1e-9 * (w + a * cfg.plant.position_range)

@@ -137,6 +137,7 @@ def test_memory_hog_is_a_finding(tmp_path):
     assert not data["conforms"] and "MemoryError" in json.dumps(data["failures"])
 
 
+@pytest.mark.slow
 def test_import_error_stays_bad_input(tmp_path):
     spec = law_file(tmp_path, "raise ImportError('no bindings')\ndef f(x1, x2, cfg):\n    pass\n")
     code, out, err = cli("conform", "--law", spec, "--timeout", "30")
