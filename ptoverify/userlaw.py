@@ -363,7 +363,8 @@ class IsolatedLaw:
     child loads while the caller prepares its states): calls are sent as arrays, the child
     loops over states in scalar mode.  The law's stdout and stderr go to a
     file, returned by :meth:`close`.  A timeout (the whole ``timeout`` or the
-    per-call budget ``CALL_BASE_S + 1 ms`` per state), any exit of the child
+    per-call budget of 10 s + 1 ms per state, the 1 ms scaled up by
+    ``timeout`` / 120 s for a longer ``timeout``), any exit of the child
     (code 0 included), a signal or a lost pipe raises :class:`LawAborted`.
 
     Parameters
@@ -458,7 +459,8 @@ class IsolatedLaw:
         except (OSError, EOFError, ValueError):
             raise LawAborted(f"{_ended(self._proc)} (sending {what})") from None
         self.calls += 1 if self.mode == "vectorized" else x1.size
-        msg = self._recv(what, CALL_BASE_S + _CALL_PER_STATE_S * x1.size)
+        per_state = _CALL_PER_STATE_S * max(1.0, self.timeout / DEFAULT_TIMEOUT_S)
+        msg = self._recv(what, CALL_BASE_S + per_state * x1.size)
         if msg[0] == "ok":
             u = np.asarray(msg[1], dtype=float)
             if u.shape != x1.shape:
