@@ -15,7 +15,6 @@ version.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import csv
 import io
 import json
@@ -574,7 +573,10 @@ def _cmd_report(args: argparse.Namespace) -> int:
 # ---------------------------------------------------------------- conform
 _CONFORM_EPILOG = """\
 Loading a callable RUNS USER CODE: --law imports the named module (or executes the named
-.py file) in this process. Only the module or file you name is loaded; no path is searched
+.py file) in a child process (spawned; stdout/stderr captured and shown on stderr; memory
+limited to 4 GiB where the OS allows; --timeout for everything, 10 s + 1 ms per state per
+batch); a hang, crash or any exit of it is a finding (exit 1) and the properties it left
+unevaluated are "unverified". Only the module or file you name is loaded; no path is searched
 (MODULE must be importable from sys.path as it stands; give path/to/file.py:FUNCTION for a
 file). The callable is u = f(x1, x2, cfg) with x1 [mm], x2 [mm/s], cfg the ptoverify Config;
 it must accept Python floats and may accept numpy arrays (vectorized use is detected: an
@@ -631,6 +633,14 @@ def _add_conform(sub) -> None:
         metavar="TOL",
         help="agreement tolerance relative to w_max (default 1e-6)",
     )
+    p.add_argument(
+        "--timeout",
+        type=finite_float,
+        default=120.0,
+        metavar="S",
+        help="budget for the whole conformance of a --law [s] (default 120); the law runs "
+        "in a child process, and a hang, crash or exit of it is a finding",
+    )
     _add_junit(p)
     p.set_defaults(handler=_cmd_conform)
 
@@ -655,13 +665,14 @@ def _cmd_conform(args: argparse.Namespace) -> int:
                 }
             )
         return 0
+    if not 0 < args.timeout <= 86400:
+        raise InputError(f"--timeout must be in (0, 86400] s, got {args.timeout:g}")
     if args.table:
         result = conform.conform_table(args.table, cfg, rtol=rtol)
-    else:
-        # user code may print: keep stdout for the one JSON object / the report
-        with contextlib.redirect_stdout(sys.stderr):
-            fn = conform.load_callable(args.law)
-            result = conform.conform_callable(fn, cfg, target=args.law, rtol=rtol)
+    else:  # the law runs in a child process; what it prints goes to stderr afterwards
+        result = conform.conform_spec(args.law, cfg, rtol=rtol, timeout=args.timeout)
+        if result.law_output:
+            print(result.law_output, end="", file=sys.stderr)
     if args.junit:
         from ptoverify.junit import conform_verdicts, junit_xml
 

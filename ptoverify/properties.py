@@ -212,10 +212,6 @@ def oscillating(x1: np.ndarray, band: float) -> np.ndarray:
     return (changes >= 4) & (second > band) & (second >= 0.5 * first)
 
 
-# kept until ``conform`` imports the public name (issue 14); do not use in new code
-_oscillating = oscillating
-
-
 def crossing_masks(
     X1: np.ndarray,
     X2: np.ndarray,
