@@ -8,6 +8,7 @@ must agree within that spacing.
 """
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -66,14 +67,14 @@ RESPONSES = {}
 
 def response(law, sig):
     """Simulated responses, cached per (law, signal)."""
-    key = (law, sig if isinstance(sig, str) else sig.name + str(sig.rate))
+    key = (law, sig if isinstance(sig, str) else repr(sig))
     if key not in RESPONSES:
         RESPONSES[key] = simulate(make_law(law, CFG), PLANT, sig)
     return RESPONSES[key]
 
 
 # a ramp whose end (30 / 170 s) falls inside a sample interval
-RAMP_OFF_GRID = Reference("ramp", 30.0, 170.0, 0.4)
+RAMP_OFF_GRID = Reference.ramp(speed=170.0, target=30.0, duration=0.4)
 CASES = [
     ("pd", "step"),
     ("to", "step"),
@@ -127,7 +128,7 @@ def test_sine_metrics_match_dense_flow_and_curve_fit(law):
     inside = (np.abs(e) <= CFG.pto.d) & (np.abs(x2 - ref.r_dot(t)) <= 50.0)
     close_or_both_nan(m.values["linear_zone_s"].exact, dense_first(t, inside), dt * 1.001, "zone")
     # phase: an independent nonlinear fit of the dense output over the same whole periods
-    f = ref.rate
+    f = ref.frequency
     n_per = math.floor((res.t[-1] - 1.0 / f) * f + 1e-9)
     sel = t >= res.t[-1] - n_per / f
     w = 2 * math.pi * f
@@ -293,8 +294,14 @@ def test_bad_input_is_input_error():
         exact.Trajectory.from_samples([0.0, 1.0], [0, 0], [0, 0], [0, 0, 0], 10.0)
     with pytest.raises(InputError):
         exact.Signal("chirp", 1.0)
-    with pytest.raises(InputError):  # a sine's frequency is not guessed
-        exact.exact_metrics(response("pd", "sine"), PLANT)
+    # a sine's frequency is read from the result's own reference, never guessed
+    res = response("pd", "sine")
+    assert exact.exact_metrics(res, PLANT).exact() == exact.exact_metrics(
+        res, PLANT, res.reference
+    ).exact()
+    bare = SimpleNamespace(t=res.t, x1=res.x1, x2=res.x2, u=res.u, r=res.r, signal="sine")
+    with pytest.raises(InputError):
+        exact.exact_metrics(bare, PLANT)
     with pytest.raises(InputError):  # fewer than one sample per period
         exact.metrics_from_arrays([0, 1.0], [0, 0], [0, 0], [0], 10.0, ("sine", 1.0, 2.0))
 
