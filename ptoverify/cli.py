@@ -269,6 +269,7 @@ def _add_simulate(sub) -> None:
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
+    from ptoverify.exact import exact_metrics
     from ptoverify.laws import make_law
     from ptoverify.simulate import reference, simulate
 
@@ -318,11 +319,16 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         "final_error_mm": float(res.e[-1]),
         "max_abs_error_second_half_mm": float(abs(tail).max()),
     }
+    # metrics between samples (DESIGN.md), and the same definitions on the sample grid
+    em = exact_metrics(res, cfg.plant, res.reference)
+    metrics, grid = em.json_metrics(), em.json_metrics(grid=True)
     if args.json:
-        print_json({**summary, "series": cols})
+        print_json({**summary, "metrics": metrics, "metrics_grid": grid, "series": cols})
     else:
         for key, value in summary.items():
             print(f"{key:>30}: {value}")
+        for key, value in metrics.items():
+            print(f"{key:>30}: {value} (sample grid: {grid[key]})")
     return 0
 
 

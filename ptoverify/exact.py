@@ -1026,14 +1026,17 @@ class ExactMetrics:
         """Sample-grid values by key."""
         return {k: v.grid for k, v in self.values.items()}
 
-    def json_metrics(self) -> dict[str, float | None]:
+    def json_metrics(self, *, grid: bool = False) -> dict[str, float | None]:
         """Return ``simulate --json`` ``metrics`` (DESIGN.md): exact values, None if undefined.
 
         Keys ``overshoot_mm``, ``settling_2pct_s``, ``settling_0p01mm_s``,
-        ``rise_time_s``, and ``phase_delay_deg`` for a sine only.
+        ``rise_time_s``, and ``phase_delay_deg`` for a sine only.  With
+        ``grid=True`` the same keys hold the sample-grid values
+        (``simulate --json`` ``metrics_grid``).
         """
         keys = [k for k in METRIC_KEYS[:5] if k != "phase_delay_deg" or self.signal.kind == "sine"]
-        return {k: None if math.isnan(v := self.values[k].exact) else v for k in keys}
+        pick = self.grid() if grid else self.exact()
+        return {k: None if math.isnan(v := pick[k]) else v for k in keys}
 
     def differing(self) -> list[str]:
         """Keys whose exact and grid values differ beyond tolerance."""
