@@ -476,7 +476,16 @@ def _crossing(p: _Pieces, k: int, s0: float, s1: float, level: float, what: str)
         return float(p.t0[k] + s0)
     if f1 == 0.0 or f0 * f1 > 0:  # touching the level at the end of the piece
         return float(p.t0[k] + s1)
-    s = brentq(f, s0, s1, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=200)
+    # time resolution: 4 ulps of the piece's length (about 1e-18 s for T = 2 ms), so
+    # bisection ends in about 50 steps even for a crossing next to s0
+    s = brentq(
+        f,
+        s0,
+        s1,
+        xtol=4.0 * np.finfo(float).eps * (s1 - s0),
+        rtol=4.0 * np.finfo(float).eps,
+        maxiter=200,
+    )
     return float(p.t0[k] + s)
 
 
@@ -653,7 +662,16 @@ def _cross_generic(p, k, s0, s1, level, what):
     f0, f1 = f(s0), f(s1)
     if f0 * f1 > 0:
         return float(p.t0[k] + (s0 if abs(f0) < abs(f1) else s1))
-    s = brentq(f, s0, s1, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=200)
+    # time resolution: 4 ulps of the piece's length (about 1e-18 s for T = 2 ms), so
+    # bisection ends in about 50 steps even for a crossing next to s0
+    s = brentq(
+        f,
+        s0,
+        s1,
+        xtol=4.0 * np.finfo(float).eps * (s1 - s0),
+        rtol=4.0 * np.finfo(float).eps,
+        maxiter=200,
+    )
     return float(p.t0[k] + s)
 
 
