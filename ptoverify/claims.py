@@ -49,6 +49,19 @@ verdicts and the rule texts read them from there.
 * "Lags by a large value": the mean ramp error exceeds d, the paper's linear
   zone (1 % of the position range, its own scale for "close to the target").
 * "Faster", "more stable", "quicker": strict inequalities of the metric.
+* Time metrics (settling, rise time), overshoots and phase delays are measured
+  between the samples, on the exact continuous trajectory
+  (:mod:`ptoverify.exact`), and every verdict is decided on those values.  Two
+  exact values closer than the sum of their accuracies (:attr:`Compared.accuracy
+  <ptoverify.exact.Compared.accuracy>`: brentq's tolerance and the round-off of
+  the flow over the crossed signal's slope, ~1e-15 s here) are a true tie: the
+  strict inequality does not hold, and the reading lists the tie in ``ties`` and
+  its detail.  The same rule is also applied to the sample-grid values (which
+  tie when equal, at one sample); each reading carries ``measured_grid``,
+  ``values_grid``, ``verdict_grid`` and ``verdict_differs_on_grid``, so a reader
+  sees where reading the samples would have decided otherwise.  Oscillation
+  amplitudes, sign reversals, ramp lag and the fit residual stay properties of
+  the sampled sequence.
 * A qualitative claim whose metric cannot be measured (a law never settles)
   is ``not reproduced`` under that reading, and the detail says why.
 

@@ -1105,7 +1105,7 @@ def metrics_from_arrays(
         (overshoot) is exact up to the round-off of evaluating eq. (7),
         dx = 8 eps X with X = max|x1| + |amplitude| + max|u| h + max|x2 - u| / a
         (every term of the evaluation is at most X); a crossing time t* up to
-        brentq's relative tolerance on the offset in its sample (4 eps h) plus
+        brentq's tolerance on the offset in its sample (xtol + rtol s <= 8 eps h) plus
         the round-off of t_k + s (2 eps t*) plus dx over the slope of the crossed
         signal there (|r' - x2| for e, |x2| for x1); a rise time is the sum of its
         two crossings'; the phase up to 16 N eps rad for its N quadrature terms.
@@ -1192,7 +1192,7 @@ class _Accuracy:
             return math.nan
         _, v = self.tr.state(np.array([t]))
         slope = abs(float(v[0]) - (float(self.sig.r_dot(t)) if what == "e" else 0.0))
-        root = 4.0 * self.eps * self.h + 2.0 * self.eps * abs(t)
+        root = 8.0 * self.eps * self.h + 2.0 * self.eps * abs(t)
         return root + (self.position / slope if slope > 0 else math.inf)
 
     def phase_deg(self, sig: Signal) -> float:
