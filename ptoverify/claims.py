@@ -92,6 +92,7 @@ __all__ = [
     "ClaimResult",
     "CLAIMS",
     "evaluate_claims",
+    "response_metrics",
     "VERDICTS",
     "numeric_verdict",
 ]
@@ -872,3 +873,48 @@ def evaluate_claims(cfg: Config, claims: tuple[_Claim, ...] | None = None) -> li
     True
     """
     return list(_evaluate_all(cfg, CLAIMS if claims is None else tuple(claims)))
+
+
+@lru_cache(maxsize=8)
+def _response_metrics(cfg: Config) -> dict[str, dict[str, dict[str, float]]]:
+    out: dict[str, dict[str, dict[str, float]]] = {}
+    for law in ("to", "pd", "pto", "pto-printed"):
+        d = {"to": None, "pd": math.inf}.get(law, cfg.pto.d)
+        out[law] = {
+            sig: mt.summarize(_sim(cfg, law, sig, "feed-forward"), cfg.plant, d=d)
+            for sig in ("step", "ramp", "sine")
+        }
+    return out
+
+
+def response_metrics(cfg: Config) -> dict[str, dict[str, dict[str, float]]]:
+    """Metrics of every Section 6 response under the primary reading, exact and on the grid.
+
+    The responses the claims are measured on (a as configured, feed-forward),
+    summarized by :func:`ptoverify.metrics.summarize`: each time metric between
+    samples with its sample-grid twin under ``<key>_grid``, and the linear-zone
+    entry with the law's zone (PTO: |r - x1| <= d; PD: linear everywhere, 0;
+    TO: none, NaN).  For a report to show both values where they differ.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    dict
+        law (``to``, ``pd``, ``pto``, ``pto-printed``) -> signal (``step``,
+        ``ramp``, ``sine``) -> metric name -> value (a new dict over cached values).
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> m = response_metrics(paper_config())["pd"]["step"]
+    >>> m["overshoot_mm"] >= m["overshoot_mm_grid"]
+    True
+    """
+    return {
+        law: {sig: dict(v) for sig, v in by_sig.items()}
+        for law, by_sig in _response_metrics(cfg).items()
+    }

@@ -330,3 +330,25 @@ def test_a_true_tie_is_reported_and_is_not_quicker(monkeypatch, fresh_claim_cach
         assert 0 < x.values["rise_time_pd_s"] - x.values["rise_time_pto_s"] < 1e-12
     for x in beyond.readings:
         assert x.verdict == "reproduced" and not x.ties, x.label
+
+
+def test_response_metrics_show_exact_and_grid_for_every_section6_response():
+    """The report's table: every law and signal, each time metric with its grid twin; the exact
+    overshoot is >= the samples', the PTO linear-zone entry precedes the law's first linear
+    sample by less than one sample, PD is linear from the start and TO never.
+    """
+    cfg = paper_config()
+    got = cl.response_metrics(cfg)
+    assert set(got) == {"to", "pd", "pto", "pto-printed"}
+    T = cfg.plant.T
+    for law, by_sig in got.items():
+        assert set(by_sig) == {"step", "ramp", "sine"}
+        for sig, m in by_sig.items():
+            exact_keys = [k for k in m if k + "_grid" in m]
+            assert "settling_tight_s" in exact_keys and "linear_zone_s" in exact_keys
+            if sig != "sine":
+                assert m["overshoot_mm"] >= m["overshoot_mm_grid"], (law, sig)
+            if law.startswith("pto"):
+                assert m["linear_zone_s_grid"] - T < m["linear_zone_s"] <= m["linear_zone_s_grid"]
+    assert got["pd"]["step"]["linear_zone_s"] == 0.0
+    assert math.isnan(got["to"]["step"]["linear_zone_s"])
