@@ -284,6 +284,9 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     else:
         for key, value in run.summary().items():
             print(f"{key:>30}: {value}")
+        metrics, grid = run.metrics()
+        for key, value in metrics.items():
+            print(f"{key:>30}: {value} (sample grid: {grid[key]})")
     return 0
 
 

@@ -16,7 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from ptoverify.config import Config
+from ptoverify.config import Config, Plant
+from ptoverify.exact import exact_metrics
 from ptoverify.errors import InputError
 from ptoverify.laws import make_law
 from ptoverify.simulate import SimResult, reference, simulate
@@ -37,10 +38,13 @@ class SimulationRun:
         The sampled closed-loop response.
     note : str
         What the law is (e.g. which omega0 the PTO law uses).
+    plant : Plant
+        The simulated plant (a [rad/s] for the flow between samples).
     """
 
     result: SimResult
     note: str
+    plant: Plant
 
     def summary(self) -> dict[str, Any]:
         """Return the summary of ``ptoverify simulate --json`` (without the series).
@@ -64,9 +68,28 @@ class SimulationRun:
             "max_abs_error_second_half_mm": float(np.abs(tail).max()),
         }
 
+    def metrics(self) -> tuple[dict[str, float | None], dict[str, float | None]]:
+        """Return the DESIGN.md metrics between samples and the same on the sample grid.
+
+        Returns
+        -------
+        tuple of dict
+            ``overshoot_mm`` [mm], ``settling_2pct_s``, ``settling_0p01mm_s``,
+            ``rise_time_s`` [s], and ``phase_delay_deg`` [deg] for a sine (None where
+            undefined): measured on the exact trajectory, then on the samples.
+        """
+        em = exact_metrics(self.result, self.plant, self.result.reference)
+        return em.json_metrics(), em.json_metrics(grid=True)
+
     def to_json(self) -> dict[str, Any]:
-        """Return the ``ptoverify simulate --json`` object: the summary plus ``series``."""
-        return {**self.summary(), "series": self.result.columns()}
+        """Return the ``ptoverify simulate --json`` object: summary, metrics and ``series``."""
+        metrics, grid = self.metrics()
+        return {
+            **self.summary(),
+            "metrics": metrics,
+            "metrics_grid": grid,
+            "series": self.result.columns(),
+        }
 
 
 def run_simulation(
@@ -138,7 +161,7 @@ def run_simulation(
     )
     fn = make_law(law, cfg)
     res = simulate(fn, cfg.plant, ref, duration=duration, feedforward=feedforward)
-    return SimulationRun(res, fn.note)
+    return SimulationRun(res, fn.note, cfg.plant)
 
 
 def run_zone(cfg: Config, *, verify: bool = True, outcome: bool = True) -> dict[str, Any]:
