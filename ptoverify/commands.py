@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 
 from ptoverify.config import Config, Plant
-from ptoverify.exact import exact_metrics
 from ptoverify.errors import InputError
+from ptoverify.exact import exact_metrics
 from ptoverify.laws import make_law
 from ptoverify.simulate import SimResult, reference, simulate
 
