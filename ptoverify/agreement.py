@@ -317,7 +317,20 @@ def _reference_chunked(x1, x2, cfg: Config, chunk: int = 1_000_000):
 
 
 def region_counts(x1: NDArray, x2: NDArray, cfg: Config) -> dict[str, int]:
-    """Count states per reference region (regions with none left out)."""
+    """Count states per reference region (regions with none left out).
+
+    Parameters
+    ----------
+    x1, x2 : ndarray
+        States [mm], [mm/s].
+    cfg : Config
+        Configuration of the reference law.
+
+    Returns
+    -------
+    dict
+        Region name -> number of states.
+    """
     _, reg, _ = _reference_chunked(np.asarray(x1, float), np.asarray(x2, float), cfg)
     counts = np.bincount(reg, minlength=len(Region))
     return {code.name: int(counts[code]) for code in Region if counts[code]}

@@ -116,7 +116,18 @@ def _existing_ancestor(path: Path) -> Path:
 
 
 def read_marker(folder: Path) -> dict | None:
-    """Return the marker of ``folder`` as a dict, ``{}`` for a legacy marker, None if absent."""
+    """Return the marker of ``folder`` as a dict, ``{}`` for a legacy marker, None if absent.
+
+    Parameters
+    ----------
+    folder : Path
+        An output folder.
+
+    Returns
+    -------
+    dict or None
+        The marker's content (manifest and config hash).
+    """
     marker = Path(folder) / MARKER
     if not marker.is_file():
         return None
@@ -264,6 +275,16 @@ def remove_stale(target: Path) -> list[Path]:
 
     Only folders named ``.NAME.tmp-PID-*`` or ``.NAME.old-PID-*`` that carry
     the marker and whose PID is not a live process are removed.
+
+    Parameters
+    ----------
+    target : Path
+        The output folder whose leftovers are looked for.
+
+    Returns
+    -------
+    list of Path
+        The folders removed.
     """
     target = Path(target)
     removed = []

@@ -195,7 +195,20 @@ _TABLES: dict[tuple[float, float], ZonotopeTable] = {}
 
 
 def zonotope_table(plant: Plant, n: int) -> ZonotopeTable:
-    """Return a cached :class:`ZonotopeTable` of ``plant`` serving N <= n."""
+    """Return a cached :class:`ZonotopeTable` of ``plant`` serving N <= n.
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant (a [rad/s], w_max [mm/s], T [s]).
+    n : int
+        Largest number of samples [-] the table must serve.
+
+    Returns
+    -------
+    ZonotopeTable
+        The generator tables.
+    """
     key = (plant.a, plant.sample_time)
     tab = _TABLES.get(key)
     if tab is None or tab.n < n:

@@ -50,6 +50,11 @@ _VEC_RTOL = 1e-12  #: vectorized-vs-scalar agreement relative to w_max
 def check_spec(spec: str) -> None:
     """Check the form of ``MODULE:FUNCTION`` / ``file.py:FUNCTION`` without running code.
 
+    Parameters
+    ----------
+    spec : str
+        The ``--law`` argument.
+
     Raises
     ------
     InputError
@@ -293,6 +298,11 @@ class LawAborted(Exception):
     """The isolated law's process hung, ended or lost its pipe: nothing more can be evaluated.
 
     A finding (exit 1): every property not evaluated yet is ``unverified``.
+
+    Parameters
+    ----------
+    message : str
+        What happened to the law's process.
     """
 
     def __init__(self, message: str):

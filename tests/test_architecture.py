@@ -178,7 +178,7 @@ def _pending(part: str):
 #: these at merge); the ``*_except_pending`` tests keep new offenders out meanwhile.
 PENDING = {
     "cycles": [["ptoverify.report", "ptoverify.report_sections"]],
-    "cli": {"ptoverify.cli"},
+    "cli": set(),
     "plots": {"ptoverify.plots"},
     "private": {"ptoverify.conform", "ptoverify.report_sections"},
 }
@@ -231,7 +231,6 @@ def test_derivations_import_nothing_from_ptoverify():
 _solver = _is(["ptoverify.ocp", "casadi"])
 
 
-@_pending("cli/checks/groundtruth")
 def test_cli_imports_no_solver():
     assert offenders(lambda m: m == "ptoverify.cli", _solver) == []
 
