@@ -164,8 +164,21 @@ def default_steps(cfg: Config) -> int:
     return int(math.ceil((2.0 * p.position_range / p.w_max + 60.0 / p.a) / p.sample_time))
 
 
-def _oscillating(x1: np.ndarray, band: float) -> np.ndarray:
-    """Sustained-oscillation test on the window x1 of shape (window, n)."""
+def oscillating(x1: np.ndarray, band: float) -> np.ndarray:
+    """Sustained-oscillation test on a window of trajectories (see module docstring).
+
+    Parameters
+    ----------
+    x1 : ndarray, shape (window, n)
+        Positions over the window [mm].
+    band : float
+        Samples with |x1| <= band do not count [mm].
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+        Whether each trajectory oscillates without decaying.
+    """
     big = np.abs(x1) > band
     sgn = np.where(big, np.sign(x1), 0.0)
     # carry the last nonzero sign forward so that small samples do not count
@@ -269,7 +282,7 @@ def law_properties(
     from_bang = entered & ((prev == Region.BANG_P) | (prev == Region.BANG_N))
     entry = np.where(entered, np.abs(X2[np.maximum(first_in, 0), np.arange(x1.size)]), 0.0)
     chat = (R[1:-1] != R[:-2]) & (R[1:-1] != R[2:]) & (R[:-2] == R[2:])
-    osc = _oscillating(X1[-window:], band)
+    osc = oscillating(X1[-window:], band)
     over = np.where(is_rest, (-np.sign(x1)[None, :] * X1).max(axis=0), 0.0)
     max_u = float(np.abs(res.u).max())
     return LawProperties(
@@ -363,3 +376,6 @@ def zone_outcome(cfg: Config, *, n1: int = 41, n2: int = 41, rest: int = 40) -> 
             "max_entry_speed": p.max_entry_speed,
         }
     return out
+
+
+_oscillating = oscillating  # former private name, kept while callers move
