@@ -631,8 +631,9 @@ def worst_case(
     # the grid's worst cells were evaluated first, so best >= the grid's worst
     searched = best["value"]
     return {
-        "grid": grid_value if math.isfinite(grid_value) else None,
-        "searched": searched if math.isfinite(searched) else None,
+        "grid": grid_value if grid_value > -math.inf else None,
+        "searched": searched if searched > -math.inf else None,
+        "unbounded": searched == math.inf,  # e.g. never settles: JSON shows searched null
         "state": [float(z[0]), float(z[1])] if z is not None else None,
         "params": {
             "a_ratio": float(z[2]) if z is not None else None,
