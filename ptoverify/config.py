@@ -451,7 +451,9 @@ def robustness_from_mapping(raw: Any, plant: dict[str, float]) -> Robustness:
         scalars[key] = v
     seed = raw.get("seed", base.seed)
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**32:
-        raise ConfigError(f"config key 'robustness.seed' must be an integer in [0, 2^32), got {seed!r}")
+        raise ConfigError(
+            f"config key 'robustness.seed' must be an integer in [0, 2^32), got {seed!r}"
+        )
     return Robustness(
         a_ratio=a_ratio, w_max_ratio=w_ratio, delay_samples=delay, seed=seed, **scalars
     )

@@ -198,6 +198,10 @@ def test_search_finds_planted_worst_case_the_grid_misses():
     )
     again = trajectory_properties(_trap_law, cfg, np.array([x1]), np.array([x2]), m)
     assert again["settling_ratio_nt"][0] == math.inf
+    end = simulate_batch(_trap_law(cfg), cfg.plant, [x1], [x2], 400, mismatch=m)
+    assert 40.0 <= end.x1[-1, 0] <= 46.0, (
+        f"the counterexample {w['state']} does not end in the trap"
+    )
 
 
 @pytest.mark.slow
