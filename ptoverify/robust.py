@@ -50,6 +50,7 @@ from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import crossing_masks, oscillating
 from ptoverify.simulate import Mismatch, simulate_batch
 from ptoverify.sweep import settle_steps
+from ptoverify.verdict import FAIL, PASS, UNVERIFIED, Verdict
 
 __all__ = [
     "LAWS",
@@ -67,6 +68,7 @@ __all__ = [
     "most_robust",
     "RobustResult",
     "run_robust",
+    "robust_gates",
 ]
 
 LAWS = ("to", "pd", "pto", "pto-printed")
@@ -819,3 +821,91 @@ def run_robust(
     timings["worst_case"] = time.perf_counter() - t2
     timings["total"] = time.perf_counter() - t0
     return RobustResult(cfg, s, maps, margins, worst, timings, dask or "in-process")
+
+
+# -- gates ---------------------------------------------------------------------
+
+GATE_LAW = "pto"  #: the law the robustness gates judge (the corrected PTO)
+
+
+def robust_gates(result: RobustResult, law: str = GATE_LAW) -> list[Verdict]:
+    """Judge the box: ``robust-no-limit-cycle`` and ``robust-settling`` for ``law``.
+
+    Parameters
+    ----------
+    result : RobustResult
+        A study that includes ``law``.
+    law : str
+        The law judged.
+
+    Returns
+    -------
+    list of Verdict
+        ``robust-no-limit-cycle``: the worst searched limit-cycle amplitude [mm]
+        must be 0 (no limit cycle anywhere in the box); ``robust-settling``: the
+        worst searched settling / N*T [-] must be within ``settling_ratio_limit``
+        (a trajectory that never settles fails).  A property the search could not
+        evaluate is ``unverified``.
+    """
+    box = result.config.robustness
+    worst = result.worst.get(law, {})
+    out = []
+    lc = worst.get("limit_cycle_mm", {})
+    v = lc.get("searched")
+    where = f" at x0 = {lc.get('state')} with {lc.get('params')}" if v else ""
+    if v is None:
+        out.append(
+            Verdict(
+                "robust-no-limit-cycle",
+                UNVERIFIED,
+                None,
+                0.0,
+                f"{law}: the worst-case search did not evaluate the limit-cycle amplitude",
+                "<=",
+                "mm",
+            )
+        )
+    else:
+        out.append(
+            Verdict(
+                "robust-no-limit-cycle",
+                PASS if v <= 0.0 else FAIL,
+                float(v),
+                0.0,
+                f"{law}: largest limit-cycle amplitude found in the box (grid, then "
+                f"differential evolution){where}",
+                "<=",
+                "mm",
+            )
+        )
+    st = worst.get("settling_ratio_nt", {})
+    v = st.get("searched")
+    limit = box.settling_ratio_limit
+    if v is None and not st.get("unbounded"):
+        out.append(
+            Verdict(
+                "robust-settling",
+                UNVERIFIED,
+                None,
+                limit,
+                f"{law}: the worst-case search did not evaluate settling / N*T",
+                "<=",
+                "1",
+            )
+        )
+    else:
+        value = math.inf if st.get("unbounded") else float(v)
+        out.append(
+            Verdict(
+                "robust-settling",
+                PASS if value <= limit else FAIL,
+                value,
+                limit,
+                f"{law}: worst settling time / N*T of the true plant found in the box "
+                f"(inf: never settles) at x0 = {st.get('state')} with {st.get('params')}; "
+                f"limit from [robustness] settling_ratio_limit",
+                "<=",
+                "1",
+            )
+        )
+    return out
