@@ -41,7 +41,12 @@ if sys.path[0] != str(ROOT):
 from ptoverify.config import paper_config  # noqa: E402
 from ptoverify.curves import blockwise, omega_c  # noqa: E402
 from ptoverify.laws import make_law  # noqa: E402
-from ptoverify.mintime import discrete_min_steps, min_time  # noqa: E402
+from ptoverify.mintime import (  # noqa: E402
+    ZOHReach,
+    discrete_min_steps,
+    discrete_min_steps_batch,
+    min_time,
+)
 from ptoverify.simulate import simulate_batch  # noqa: E402
 
 TARGETS = {  # key: (target, ">=" or "<=")
@@ -54,6 +59,9 @@ TARGETS = {  # key: (target, ">=" or "<=")
     "collocation_ms": (150.0, "<="),
     "collocation_vs_two_phase_error_ratio": (None, ""),
     "discrete_ms": (50.0, "<="),
+    "discrete_batch_states_per_s": (5e5, ">="),
+    "discrete_lp_states_per_s": (None, ""),
+    "discrete_batch_vs_lp_ratio": (None, ""),
     "check_s": (60.0, "<="),
     "report_s": (120.0, "<="),
 }
@@ -67,6 +75,8 @@ FULL = {
     "sim_steps": 250,
     "two_phase": 50,
     "collocation": 20,
+    "discrete_batch": 10**6,
+    "discrete_lp": 30,
     "repeat": 7,
     "cli_repeat": 3,
 }
@@ -79,6 +89,8 @@ SMALL = {
     "sim_steps": 20,
     "two_phase": 3,
     "collocation": 2,
+    "discrete_batch": 2000,
+    "discrete_lp": 3,
     "repeat": 2,
     "cli_repeat": 1,
 }
@@ -266,6 +278,39 @@ def bench_discrete(cfg, size: dict) -> float:
     )
 
 
+def bench_discrete_batch(cfg, size: dict) -> dict:
+    """N* for many envelope states: zonotopes (batch) vs the LP search, same run.
+
+    The LP side is the per-state wall time of ``discrete_min_steps`` (with its
+    N* - 1 confirmation, as the CLI and the gate call it) over the first
+    ``discrete_lp`` states; the two N* are compared on those states.
+    """
+    plant = cfg.plant
+    x1, x2 = envelope_states(cfg, size["discrete_batch"], 7)
+    n_lp = size["discrete_lp"]
+    reach = ZOHReach(plant)
+
+    def lp():
+        return [discrete_min_steps(a, b, plant, reach=reach) for a, b in zip(x1[:n_lp], x2[:n_lp])]
+
+    t_batch, t_lp = median_times(
+        [lambda: discrete_min_steps_batch(x1, x2, plant), lp], max(3, size["repeat"] // 2)
+    )
+    d = discrete_min_steps_batch(x1, x2, plant)
+    ref = lp()
+    disagree = int(sum(r.steps != s for r, s in zip(ref, d.steps[:n_lp].tolist())))
+    batch, lp_rate = x1.size / t_batch, n_lp / t_lp
+    return {
+        "batch_states_per_s": batch,
+        "lp_states_per_s": lp_rate,
+        "ratio": batch / lp_rate,
+        "lp_states": n_lp,
+        "batch_states": int(x1.size),
+        "disagreements": disagree,
+        "tests_per_state": d.tests / x1.size,
+    }
+
+
 # ---------------------------------------------------------------- whole process
 def run_cli(args: list[str], repeat: int) -> tuple[float | None, str]:
     """Median wall time [s] of ``python -m ptoverify ARGS`` (cwd repo root)."""
@@ -344,6 +389,11 @@ def run(small: bool) -> tuple[dict, dict]:
     out["collocation_vs_two_phase_error_ratio"] = oc["ratio"]
     extra["ocp"] = oc
     out["discrete_ms"] = bench_discrete(cfg, size)
+    db = bench_discrete_batch(cfg, size)
+    out["discrete_batch_states_per_s"] = db["batch_states_per_s"]
+    out["discrete_lp_states_per_s"] = db["lp_states_per_s"]
+    out["discrete_batch_vs_lp_ratio"] = db["ratio"]
+    extra["discrete_batch"] = db
     check = ["check", "--gate", "roots-closed-form-vs-bisection"] if small else ["check"]
     out["check_s"], extra["check_note"] = run_cli(check, size["cli_repeat"])
     with tempfile.TemporaryDirectory() as tmp:  # never the tracked reports/ folder
@@ -376,6 +426,11 @@ def table(out: dict, extra: dict) -> str:
         f"t_f rel error median: collocation {oc['collocation_err']:.3g}, two-phase "
         f"{oc['two_phase_err']:.3g}; solver failures {oc['failures']}",
         f"vector law vs scalar law (per-state speed-up): {extra['vector_vs_scalar']:.3g}",
+        f"N* zonotope batch {extra['discrete_batch']['batch_states_per_s']:.3g} states/s vs LP "
+        f"{extra['discrete_batch']['lp_states_per_s']:.3g} states/s: ratio "
+        f"{extra['discrete_batch']['ratio']:.3g}; "
+        f"{extra['discrete_batch']['disagreements']} disagreements on "
+        f"{extra['discrete_batch']['lp_states']} states",
         f"scalar law on switching-zone states only (omega_c by Newton): "
         f"{extra['law_scalar_zone_us']:.3g} us",
     ]

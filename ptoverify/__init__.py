@@ -9,7 +9,9 @@ plant       flow (eq. 7), step (one-sample map, eq. 15), zoh_matrices
 curves      switching_function, level_residual (eqs. 9, 11, 13, 14, 28, 33), Lambert-W roots
             root_22 (eq. 22), root_k (eqs. 26, 31), omega_c (eq. 32), bisection references
 mintime     min_time: closed-form minimum time and switch time from any state;
-            discrete_min_steps (N*, the discrete-time limit, by LPs), ZOHReach
+            discrete_min_steps (N*, the discrete-time limit, by LPs), ZOHReach;
+            discrete_min_steps_batch (N* for many states by zonotopes, see reach)
+reach       ZonotopeTable, zonotope_steps: N-step null-controllable sets as 2-D zonotopes
 ocp         TwoPhaseOCP, CollocationOCP (CasADi + IPOPT), convergence_study
 zones       PTOZone; printed_zone (eqs. 19-27 as printed, judged), corrected_zone (largest
             omega0 meeting the no-stride-over principle, verified on a grid), zone_summary
@@ -20,9 +22,12 @@ poles       PD and linear-zone (eq. 37) loops: poles, damping, margins (python-c
 metrics     settling_time (2 % and 0.01 mm bands), overshoot, oscillation_amplitude,
             sign_reversals, ramp_lag, sine_fit/phase_delay (whole periods), rise_time,
             time_to_linear_zone, input_switches, summarize
+exact       metrics between samples on the exact ZOH flow: overshoot, settling (last exit),
+            rise time, linear-zone entry, sine phase; exact_metrics / metrics_from_arrays give
+            exact and sample-grid values side by side (ExactMetrics, Compared)
 claims      Section 6 and conclusion claims, each measured under every reading
             (a = 2 pi f or f, feed-forward, PTO printed/corrected, band); evaluate_claims
-sweep       run_sweep: settling time / t_f* and / N* T over a 50 x 50 grid of initial states
+sweep       run_sweep: settling time / t_f* and / N* T over a 200 x 200 grid of initial states
 plots       Figs. 2-14 for TO, PD, PTO (both), sweep heat maps, zone geometry, collocation
             convergence (the only module importing matplotlib)
 checks      the gates of ``ptoverify check``: CheckResult, GATES, run_checks

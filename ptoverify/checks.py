@@ -271,12 +271,12 @@ def _collocation(cfg: Config) -> CheckResult:
 
 @gate("discrete-limit-consistency")
 def _discrete(cfg: Config) -> CheckResult:
-    """N*: N* T >= t_f*, the sequence reaches the origin, N* - 1 is infeasible."""
-    from ptoverify.mintime import ZOHReach, discrete_min_steps, min_time
+    """N*: N* T >= t_f*, the sequence reaches the origin, N* - 1 infeasible, zonotope = LP."""
+    from ptoverify.mintime import ZOHReach, discrete_min_steps, discrete_min_steps_batch, min_time
 
     x1, x2 = _gt_states(cfg, 25, 23)
     reach = ZOHReach(cfg.plant)
-    worst_gap = math.inf
+    worst_gap, lp_steps = math.inf, []
     for i in range(len(x1)):
         dm = discrete_min_steps(float(x1[i]), float(x2[i]), cfg.plant)
         if not dm.success:
@@ -319,6 +319,20 @@ def _discrete(cfg: Config) -> CheckResult:
                 ">=",
             )
         worst_gap = min(worst_gap, (dm.time_s - t_f) / cfg.plant.T)
+        lp_steps.append(dm.steps)
+    zono = discrete_min_steps_batch(x1, x2, cfg.plant).steps  # the production path
+    off = np.flatnonzero(zono != np.array(lp_steps))
+    if off.size:
+        i = int(off[0])
+        return CheckResult(
+            "discrete-limit-consistency",
+            FAIL,
+            None,
+            0.0,
+            f"zonotope N* = {zono[i]} but LP N* = {lp_steps[i]} at ({x1[i]:.4g}, {x2[i]:.4g}) "
+            f"({off.size} of {len(x1)} states disagree)",
+            ">=",
+        )
     res = CheckResult(
         "discrete-limit-consistency",
         PASS if worst_gap >= 0 else FAIL,
@@ -326,7 +340,8 @@ def _discrete(cfg: Config) -> CheckResult:
         0.0,
         "min over 25 states of (N* T - t_f*) / T, which theory keeps >= 0; every "
         "N* sequence ends within 1e-9 mm, 1e-6 mm/s of the origin and N* - 1 "
-        "samples are infeasible (LP status 'infeasible', not inconclusive)",
+        "samples are infeasible (LP status 'infeasible', not inconclusive); the zonotope "
+        "N* (discrete_min_steps_batch, the production path) equals the LP's at every state",
         ">=",
     )
     return res

@@ -24,7 +24,15 @@ from typing import Any
 
 from ptoverify.config import Config, load_config
 from ptoverify.errors import InputError, PtoverifyError, SolverError
-from ptoverify.outdir import check_target, discard, make_temp, publish
+from ptoverify.outdir import (
+    OutputBusy,
+    Terminated,
+    check_target,
+    discard,
+    make_temp,
+    publish,
+    sigterm_raises,
+)
 
 __all__ = ["main", "build_parser"]
 
@@ -117,10 +125,20 @@ def _add_mintime(sub) -> None:
         help="minimum time from a state to the origin",
         description="Minimum time from (X1, X2) to the origin: the closed form and, where "
         "available, the CasADi and discrete-time references.",
-        epilog="example:\n  ptoverify mintime 5 0 --json\n  ptoverify mintime -- -12.5 80",
+        epilog="example:\n  ptoverify mintime 5 0 --json\n  ptoverify mintime -- -12.5 80\n"
+        "  ptoverify mintime --states states.csv --out times.csv",
     )
-    p.add_argument("x1", type=finite_float, metavar="X1", help="initial position [mm]")
-    p.add_argument("x2", type=finite_float, metavar="X2", help="initial velocity [mm/s]")
+    p.add_argument("x1", type=finite_float, nargs="?", metavar="X1", help="initial position [mm]")
+    p.add_argument("x2", type=finite_float, nargs="?", metavar="X2", help="initial velocity [mm/s]")
+    p.add_argument(
+        "--states",
+        metavar="IN.csv",
+        default=None,
+        help="many states (CSV, columns x1, x2): closed form and exact N* per row, no solver",
+    )
+    p.add_argument(
+        "--out", metavar="OUT.csv", default=None, help="with --states: write the table here"
+    )
     p.add_argument(
         "--intervals",
         type=positive_int,
@@ -208,8 +226,43 @@ def mintime_result(
     }
 
 
+def _mintime_states(args: argparse.Namespace, cfg: Config) -> int:
+    from ptoverify.mintime import batch_table
+
+    if args.x1 is not None:
+        raise InputError("give either X1 X2 or --states, not both")
+    if args.out is not None and args.json:
+        raise InputError("--out and --json are alternatives")
+    cols = batch_table(args.states, cfg)
+    names = list(cols)
+    # N* not found (-1, NaN): null in JSON, an empty field in CSV; floats as repr (round trip)
+    rows = [
+        [None if (v != v or v == -1) else v for v in r]
+        for r in zip(*(cols[k].tolist() for k in names), strict=True)
+    ]
+    if args.json:  # compact: the C encoder (indent would take seconds at 10^5 rows)
+        obj = {"states": [dict(zip(names, r, strict=True)) for r in rows]}
+        sys.stdout.write(json.dumps(obj, allow_nan=False) + "\n")
+        return 0
+    out = [",".join(names)]
+    out += [",".join("" if v is None else repr(v) for v in r) for r in rows]
+    text = "\n".join(out) + "\n"
+    if args.out is None:
+        sys.stdout.write(text)
+    else:
+        write_atomic(args.out, text)
+        print(f"wrote {len(out) - 1} rows to {args.out}")
+    return 0
+
+
 def _cmd_mintime(args: argparse.Namespace) -> int:
     cfg = _config(args)
+    if args.states is not None:
+        return _mintime_states(args, cfg)
+    if args.out is not None:
+        raise InputError("--out needs --states")
+    if args.x1 is None or args.x2 is None:
+        raise InputError("mintime needs X1 X2 or --states IN.csv")
     if args.intervals > 2000:
         raise InputError(f"--intervals must be at most 2000, got {args.intervals}")
     result = mintime_result(cfg, args.x1, args.x2, args.intervals)
@@ -248,13 +301,21 @@ def _add_simulate(sub) -> None:
     p.add_argument(
         "--no-feedforward", action="store_true", help="do not feed the reference velocity forward"
     )
+    for flag, metavar, text in (
+        ("--step", "MM", "step height [mm] (default 5)"),
+        ("--ramp-speed", "MM_S", "ramp speed [mm/s] (default 200)"),
+        ("--ramp-to", "MM", "ramp end value [mm] (default 30)"),
+        ("--amplitude", "MM", "sine amplitude [mm] (default 5)"),
+        ("--frequency", "HZ", "sine frequency [Hz] (default 5)"),
+    ):
+        p.add_argument(flag, type=finite_float, metavar=metavar, default=None, help=text)
     p.add_argument("--csv", metavar="FILE", default=None, help="write the time series as CSV")
     p.set_defaults(handler=_cmd_simulate)
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from ptoverify.laws import make_law
-    from ptoverify.simulate import simulate
+    from ptoverify.simulate import reference, simulate
 
     cfg = _config(args)
     if args.duration is not None and not 0 < args.duration <= 100:
@@ -268,10 +329,16 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
             f"--duration {args.duration:g} s is shorter than one sample "
             f"(T = {cfg.plant.sample_time:g} s)"
         )
-    law = make_law(args.law, cfg)
-    res = simulate(
-        law, cfg.plant, args.signal, duration=args.duration, feedforward=not args.no_feedforward
+    ref = reference(
+        args.signal,
+        step=args.step,
+        ramp_speed=args.ramp_speed,
+        ramp_to=args.ramp_to,
+        amplitude=args.amplitude,
+        frequency=args.frequency,
     )
+    law = make_law(args.law, cfg)
+    res = simulate(law, cfg.plant, ref, duration=args.duration, feedforward=not args.no_feedforward)
     cols = res.columns()
     if args.csv is not None:
         buf = io.StringIO()
@@ -329,6 +396,27 @@ def _cmd_derive(args: argparse.Namespace) -> int:
     return 0
 
 
+# ---------------------------------------------------------------- junit
+def _add_junit(p) -> None:
+    p.add_argument(
+        "--junit",
+        metavar="FILE",
+        default=None,
+        help="also write JUnit XML (one testcase per gate/property; unverified is an error)",
+    )
+
+
+def _check_junit(args: argparse.Namespace) -> None:
+    """Validate --junit FILE before any computation."""
+    if args.junit is None:
+        return
+    path = Path(args.junit)
+    if args.junit.strip() == "" or path.is_dir():
+        raise InputError(f"--junit must name a file, got {args.junit!r}")
+    if not path.absolute().parent.is_dir():
+        raise InputError(f"--junit '{args.junit}': folder '{path.parent}' does not exist")
+
+
 # ---------------------------------------------------------------- check
 def _add_check(sub) -> None:
     p = sub.add_parser(
@@ -353,6 +441,7 @@ def _add_check(sub) -> None:
         help="cap IPOPT iterations (a solver that then fails makes its gate "
         "unverified, and the run fails)",
     )
+    _add_junit(p)
     p.set_defaults(handler=_cmd_check)
 
 
@@ -364,8 +453,13 @@ def _cmd_check(args: argparse.Namespace) -> int:
         unknown = [g for g in args.gate if g not in GATES]
         if unknown:
             raise InputError(f"unknown gate '{unknown[0]}' (choose from {', '.join(GATES)})")
+    _check_junit(args)
     results = run_checks(cfg, args.gate, max_iter=args.max_iter)
     summary = summarize(results)
+    if args.junit:
+        from ptoverify.junit import junit_xml
+
+        write_atomic(args.junit, junit_xml(results, "ptoverify.check", None, {"config": cfg.name}))
     if args.json:
         print_json(
             {"config": cfg.name, "checks": [r.to_json() for r in results], "summary": summary}
@@ -404,39 +498,26 @@ def _add_sweep(sub) -> None:
     p.add_argument(
         "--grid",
         type=positive_int,
-        default=50,
-        help="grid points per axis (default 50: 2,500 states)",
+        default=200,
+        help="grid points per axis (default 200: 40,000 states; at most 1000)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     p.set_defaults(handler=_cmd_sweep)
-
-
-def _progress_bar(enabled: bool):
-    """Return a progress callback drawing on stderr, or None."""
-    if not enabled:
-        return None
-
-    def show(stage: str, frac: float) -> None:
-        n = int(round(30 * frac))
-        sys.stderr.write(f"\r[{'#' * n}{'.' * (30 - n)}] {stage:<24}")
-        if frac >= 1.0:
-            sys.stderr.write("\n")
-        sys.stderr.flush()
-
-    return show
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from ptoverify.sweep import SweepSettings, run_sweep
 
     cfg = _config(args)
-    if args.grid < 2 or args.grid > 400:
-        raise InputError(f"--grid must be in [2, 400], got {args.grid}")
+    if args.grid < 2 or args.grid > 1000:
+        raise InputError(f"--grid must be in [2, 1000], got {args.grid}")
     target = tmp = None
     if args.out is not None:
-        target = check_target(args.out)
+        target = check_target(args.out, config_hash=cfg.digest())
     try:
-        bar = _progress_bar(sys.stderr.isatty() and not args.quiet)
+        from ptoverify.progress import stderr_bar
+
+        bar = stderr_bar(args.quiet)
         res = run_sweep(cfg, SweepSettings(n1=args.grid, n2=args.grid), progress=bar)
         result = res.to_json()
         if args.out is not None:
@@ -446,7 +527,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
             files = save_sweep(res, tmp)
             (tmp / "sweep.json").write_text(json.dumps(to_jsonable(result), indent=2) + "\n")
             result["files"] = [str(target / f.name) for f in files] + [str(target / "sweep.json")]
-            publish(tmp, target)
+            publish(tmp, target, config_hash=cfg.digest(), name=cfg.name)
             tmp = None
     finally:
         discard(tmp)
@@ -636,6 +717,7 @@ def _add_conform(sub) -> None:
         metavar="TOL",
         help="agreement tolerance relative to w_max (default 1e-6)",
     )
+    _add_junit(p)
     p.set_defaults(handler=_cmd_conform)
 
 
@@ -646,6 +728,7 @@ def _cmd_conform(args: argparse.Namespace) -> int:
     rtol = conform.DEFAULT_RTOL if args.tolerance is None else args.tolerance
     if not 0 < rtol < 1:
         raise InputError(f"--tolerance must be in (0, 1), got {rtol:g}")
+    _check_junit(args)
     if args.emit_grid:
         text = conform.grid_csv(cfg)
         write_atomic(args.emit_grid, text)
@@ -665,6 +748,13 @@ def _cmd_conform(args: argparse.Namespace) -> int:
         with contextlib.redirect_stdout(sys.stderr):
             fn = conform.load_callable(args.law)
             result = conform.conform_callable(fn, cfg, target=args.law, rtol=rtol)
+    if args.junit:
+        from ptoverify.junit import conform_verdicts, junit_xml
+
+        verdicts, states = conform_verdicts(result)
+        props = {"config": cfg.name, "target": result.target, "mode": result.mode}
+        xml = junit_xml(verdicts, "ptoverify.conform", states, props, result.conforms)
+        write_atomic(args.junit, xml)
     if args.json:
         print_json(result.to_json())
     else:
@@ -724,7 +814,14 @@ def main(argv: list[str] | None = None) -> int:
             # numeric caveats belong in the results, not on stderr (one line on error)
             warnings.simplefilter("ignore")
             args = build_parser().parse_args(argv)
-            return int(args.handler(args))
+            with sigterm_raises():
+                return int(args.handler(args))
+    except Terminated:
+        print("ptoverify: error: terminated (SIGTERM); nothing written", file=sys.stderr)
+        return 143
+    except OutputBusy as exc:
+        print(f"ptoverify: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 1
     except SolverError as exc:
         print(f"ptoverify: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 1

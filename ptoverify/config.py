@@ -17,11 +17,16 @@ The configuration format is the one in ``shared/DESIGN.md``::
     k2 = 3.6
 
 Every rejection is a :class:`~ptoverify.errors.ConfigError` whose message
-names the key and the value.
+names the key and the value.  Ranges: a, w_max, position_range <= 1e6;
+1e-7 <= sample_time <= 1 s and 1e-6 <= a T <= 20; 0 <= d <= position_range;
+gains 0 <= kp T, k1 T <= 1e4 and 0 <= kd, k2 <= 1e4 (far beyond the sampled
+stability limits, so unstable gains reach the gates; see ``_check_gains``).
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
 import tomllib
 from dataclasses import dataclass, field, replace
@@ -188,6 +193,20 @@ class Config:
             bandwidth_hz=None if "a" in changes else self.bandwidth_hz,
         )
 
+    def digest(self) -> str:
+        """Return a SHA-256 hex digest of the configuration (its TOML layout).
+
+        Output folders record it, so a default folder is never replaced by the
+        output of another configuration.
+
+        Examples
+        --------
+        >>> paper_config().digest() == paper_config().digest()
+        True
+        """
+        text = json.dumps(self.to_mapping(), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()
+
     def to_mapping(self) -> dict[str, Any]:
         """Return the configuration as a plain dict (the TOML layout)."""
         p = self.plant
@@ -272,7 +291,38 @@ LIMITS = {
     "sample_time": (1e-7, 1.0),
     "aT": (1e-6, 20.0),
     "samples_across_range": 1e6,
+    "gain_T": 1e4,
+    "gain": 1e4,
 }
+
+
+def _check_gains(pd: dict[str, float], pto: dict[str, float], T: float) -> None:  # noqa: N803
+    """Reject gains outside their documented ranges (the key is named).
+
+    Position gains kp, k1 [1/s]: 0 <= k T <= 1e4.  Velocity gains kd, k2 [-]:
+    0 <= k <= 1e4.  The sampled loops become unstable far inside these
+    ranges (with a fast velocity loop, u = -kp x1 - kd x2 is unstable for
+    kp T > 2 (1 + kd); the velocity loop alone for kd > coth(a T / 2)), so
+    unstable gains stay reachable and fail their gates, while every product
+    the checks form (gain x range x samples) stays finite.  Negative gains
+    make the law push away from the target; they are rejected.
+    """
+    for section, values in (("pd", pd), ("pto", pto)):
+        for key, scaled in (("kp", True), ("kd", False), ("k1", True), ("k2", False)):
+            if key not in values:
+                continue
+            value = values[key]
+            if value < 0:
+                raise ConfigError(f"config key '{section}.{key}' must be >= 0, got {value!r}")
+            if scaled and value * T > LIMITS["gain_T"]:
+                raise ConfigError(
+                    f"config key '{section}.{key}' must be <= {LIMITS['gain_T']:g} / sample_time "
+                    f"= {LIMITS['gain_T'] / T:g} 1/s, got {value!r}"
+                )
+            if not scaled and value > LIMITS["gain"]:
+                raise ConfigError(
+                    f"config key '{section}.{key}' must be <= {LIMITS['gain']:g}, got {value!r}"
+                )
 
 
 def _check_scales(a: float, plant: dict[str, float], a_key: str) -> None:
@@ -357,6 +407,7 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
     for key in ("w_max", "sample_time", "position_range"):
         _positive("plant", key, plant[key])
     _check_scales(a, plant, "plant.bandwidth_hz" if has_hz else "plant.a")
+    _check_gains(pd, pto, plant["sample_time"])
     if pto["d"] < 0:
         raise ConfigError(f"config key 'pto.d' must be >= 0, got {pto['d']!r}")
     if pto["d"] > plant["position_range"]:

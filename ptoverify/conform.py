@@ -217,13 +217,13 @@ def _settling_reference(cfg: Config) -> dict:
 
     x1, x2, _ = initial_grid(cfg, 11, 11, 20)
     dm = discrete_min_steps_batch(x1, x2, cfg.plant)
-    n_star = np.array([m.steps if m.success else -1 for m in dm], dtype=float)
+    n_star = dm.steps.astype(float)  # -1 where N* > n_max
     steps = default_steps(cfg)
     res = simulate_batch(reference(cfg), cfg.plant, x1, x2, steps)
     s_ref = _settle_steps(res.x1, _BAND_MM)
     ok = n_star >= 0
     e_ref = float(np.max(s_ref[ok] - n_star[ok])) if ok.any() else math.inf
-    failed = [(float(x1[i]), float(x2[i]), dm[i].status) for i in np.flatnonzero(~ok)]
+    failed = [(float(x1[i]), float(x2[i]), "not_found") for i in np.flatnonzero(~ok)]
     return {
         "x1": x1,
         "x2": x2,

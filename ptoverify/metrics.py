@@ -35,6 +35,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ptoverify.errors import InputError
+
 if TYPE_CHECKING:  # pragma: no cover
     from ptoverify.simulate import SimResult
 
@@ -417,13 +419,14 @@ def summarize(
 ) -> dict[str, float]:
     """All metrics of one simulated response, by name (units in the names).
 
-    The steady part is the last half of the record.  For the sine, the fit
-    starts after the first period.
+    The steady part is the last half of the record.  The signal, its final
+    value and the sine's frequency are read from ``res.reference``.  For the
+    sine, the fit starts after the first period.
 
     Parameters
     ----------
     res : SimResult
-        A Section 6 response.
+        A simulated response (any step, ramp or sine).
     band : float
         Tight band [mm].
     step_fraction : float
@@ -433,10 +436,14 @@ def summarize(
     -------
     dict
         Metric name -> value (NaN where undefined for this signal).
+
+    Raises
+    ------
+    InputError
+        For a sine whose period is not a whole number of samples.
     """
-    t, e = res.t, res.e
+    t, e, ref = res.t, res.e, res.reference
     half = t.size // 2
-    final = float(res.r[-1])
     out = {
         "settling_tight_s": settling_time(t, e, band),
         "steady_amplitude_mm": oscillation_amplitude(e[half:]),
@@ -445,24 +452,25 @@ def summarize(
         "input_switches": float(input_switches(res.u)),
         "linear_zone_s": time_to_linear_zone(t, res.region),
     }
-    if res.signal in ("step", "ramp"):
+    if ref.name in ("step", "ramp"):
+        final = float(ref.target)
         out["settling_2pct_s"] = settling_time(t, e, step_fraction * abs(final))
         out["overshoot_mm"] = overshoot(res.x1, final)
-    if res.signal == "step":
+    if ref.name == "step":
         out["rise_time_s"] = rise_time(t, res.x1, final)
-    if res.signal == "ramp":
+    if ref.name == "ramp":
         out["ramp_lag_mm"] = ramp_lag(t, e, res.r_dot)
-    if res.signal == "sine":
-        freq = _sine_freq(res)
-        ref = sine_fit(t, res.r, freq, t_from=1.0 / freq)
+    if ref.name == "sine":
+        freq = ref.frequency  # the simulated sine's, never a global table's
+        per = 1.0 / (freq * (t[1] - t[0]))
+        if abs(per - round(per)) > 1e-9 * per:
+            raise InputError(
+                f"the phase of a {freq:g} Hz sine is fitted over whole periods: its period must "
+                f"be a whole number of samples, got {per:.6g} (T = {t[1] - t[0]:g} s)"
+            )
+        fit_r = sine_fit(t, res.r, freq, t_from=1.0 / freq)
         pos = sine_fit(t, res.x1, freq, t_from=1.0 / freq)
-        out["phase_delay_deg"] = phase_delay(ref, pos)
-        out["amplitude_ratio"] = pos.amplitude / ref.amplitude
+        out["phase_delay_deg"] = phase_delay(fit_r, pos)
+        out["amplitude_ratio"] = pos.amplitude / fit_r.amplitude
         out["fit_residual_rms_mm"] = pos.residual_rms
     return out
-
-
-def _sine_freq(res: SimResult) -> float:
-    from ptoverify.simulate import SIGNALS
-
-    return SIGNALS["sine"].rate

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -31,6 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from ptoverify.config import Plant
 from ptoverify.curves import blockwise, h
 from ptoverify.errors import InputError
+from ptoverify.reach import DiscreteLimit
 
 __all__ = [
     "MinTime",
@@ -39,6 +41,10 @@ __all__ = [
     "ZOHReach",
     "discrete_min_steps",
     "discrete_min_steps_batch",
+    "DiscreteLimit",
+    "TABLE_COLUMNS",
+    "read_states",
+    "batch_table",
 ]
 
 
@@ -366,29 +372,203 @@ def discrete_min_steps(
 
 
 def discrete_min_steps_batch(
-    x1: ArrayLike, x2: ArrayLike, plant: Plant, n_max: int = 20000, confirm: bool = True
-) -> list[DiscreteMinTime]:
-    """:func:`discrete_min_steps` for many states, sharing the generators.
+    x1: ArrayLike, x2: ArrayLike, plant: Plant, n_max: int = 20000
+) -> DiscreteLimit:
+    """N* for many states at once: exact 2-D zonotope membership, vectorized.
+
+    The production path for many states (:mod:`ptoverify.reach`: the states
+    that reach the origin in N ZOH samples with |u_k| <= w_max form a 2-D
+    zonotope, tested facet by facet; N* by exponential search and bisection on
+    N from ceil(t_f* / T), per state).  No LP and no input sequence:
+    :func:`discrete_min_steps` (linear programs) is its independent reference.
+    A state counts as reaching the origin in N samples if it does so with
+    |u_k| <= (1 + 1e-9) w_max (:data:`ptoverify.reach.MARGIN`, the LP's own
+    acceptance rule), so states on a boundary in exact arithmetic are inside.
 
     Parameters
     ----------
     x1, x2 : array_like
-        Initial positions [mm] and velocities [mm/s]; broadcast, flattened.
+        Initial positions [mm] and velocities [mm/s], finite; broadcast.
     plant : Plant
         The plant (a [rad/s], w_max [mm/s], sample_time T [s]).
     n_max : int
-        Largest N tried.
-    confirm : bool
-        Check N* - 1 by LP where it was not solved during the search.
+        Largest N tried [samples]; N* = -1 beyond.
 
     Returns
     -------
-    list of DiscreteMinTime
-        One per state, in flattened order.
+    DiscreteLimit
+        ``steps`` (N*, int64, -1 where > n_max) and ``time_s`` (N* T [s], NaN
+        where not found), of the broadcast shape.
+
+    Raises
+    ------
+    InputError
+        A state that is not finite.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> plant = paper_config().plant
+    >>> d = discrete_min_steps_batch([5.0, 0.0], [0.0, 0.0], plant)
+    >>> d.steps.tolist() == [discrete_min_steps(5.0, 0.0, plant).steps, 0]
+    True
     """
+    from dataclasses import replace
+
+    from ptoverify.reach import zonotope_steps
+
     x1, x2 = np.broadcast_arrays(np.asarray(x1, dtype=float), np.asarray(x2, dtype=float))
-    reach = ZOHReach(plant)
-    return [
-        discrete_min_steps(a, b, plant, n_max=n_max, reach=reach, confirm=confirm)
-        for a, b in zip(x1.ravel(), x2.ravel(), strict=True)
-    ]
+    if not (np.isfinite(x1).all() and np.isfinite(x2).all()):
+        raise InputError("a state is not finite")
+    shape = x1.shape
+    t_f = min_time(x1, x2, plant).t_f
+    n0 = np.maximum(np.ceil(t_f.ravel() / plant.sample_time - 1e-9), 1.0)
+    n0 = np.minimum(n0, n_max + 1.0).astype(np.int64)  # beyond n_max: not found
+    d = zonotope_steps(x1.ravel(), x2.ravel(), n0, plant, n_max)
+    return replace(
+        d,
+        steps=d.steps.reshape(shape),
+        time_s=d.time_s.reshape(shape),
+        below_bound=d.below_bound.reshape(shape),
+    )
+
+
+# ---------------------------------------------------------------- batch queries
+TABLE_COLUMNS = ("x1", "x2", "analytic_s", "switch_time_s", "discrete_steps", "discrete_s")
+FAR_FACTOR = 1e3  # states beyond 1000 x the envelope are rejected (as `mintime X1 X2`)
+
+
+def read_states(path: str | Path) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Read initial states from a CSV file whose header names columns x1, x2.
+
+    Other columns are ignored; blank lines are skipped.
+
+    Parameters
+    ----------
+    path : str or Path
+        A regular file.
+
+    Returns
+    -------
+    x1, x2 : ndarray
+        Positions [mm] and velocities [mm/s], one per data row.
+
+    Raises
+    ------
+    InputError
+        Not a regular file, unreadable, empty, no x1/x2 column, no rows, or a
+        row with a missing field or a field that is not a finite number (its
+        line named).
+    """
+    import csv
+
+    p = Path(path)
+    if not p.is_file():
+        why = "does not exist" if not p.exists() else "is not a regular file"
+        raise InputError(f"states file '{path}' {why}")
+    try:
+        with open(p, newline="") as fh:
+            rows = list(csv.reader(fh))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read states file '{path}': {exc}") from None
+    except csv.Error as exc:
+        raise InputError(f"states file '{path}': malformed CSV: {exc}") from None
+    if not rows:
+        raise InputError(f"states file '{path}' is empty")
+    header = [h.strip() for h in rows[0]]
+    missing = [c for c in ("x1", "x2") if c not in header]
+    if missing:
+        raise InputError(
+            f"states file '{path}': no column {', '.join(missing)} in header "
+            f"'{','.join(header)}' (need x1, x2)"
+        )
+    j1, j2 = header.index("x1"), header.index("x2")
+    width = max(j1, j2) + 1
+    lines = [i for i, r in enumerate(rows[1:], start=2) if any(f.strip() for f in r)]
+    if not lines:
+        raise InputError(f"states file '{path}' has a header but no rows")
+    for i in lines:
+        if len(rows[i - 1]) < width:
+            raise InputError(f"states file '{path}' line {i}: missing field (need x1, x2)")
+    cols = []
+    for name, j in (("x1", j1), ("x2", j2)):
+        text = [rows[i - 1][j] for i in lines]
+        try:
+            v = np.array(text, dtype=float)
+        except ValueError:
+            v = np.array([_to_float(t) for t in text])
+        bad = np.flatnonzero(~np.isfinite(v))
+        if bad.size:
+            k = int(bad[0])
+            raise InputError(
+                f"states file '{path}' line {lines[k]}: {name} = {text[k].strip()!r} "
+                "is not a finite number"
+            )
+        cols.append(v)
+    return cols[0], cols[1]
+
+
+def _to_float(text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        return math.nan
+
+
+def batch_table(path: str | Path, cfg) -> dict[str, NDArray]:
+    """``mintime --states``: closed form and exact N* for every state of a CSV.
+
+    No solver: t_f* and the switch time by :func:`min_time`, N* by
+    :func:`discrete_min_steps_batch` (zonotopes; N* searched up to 20000
+    samples, as the single-state command).
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV with a header naming columns x1 [mm], x2 [mm/s] (:func:`read_states`).
+    cfg : Config
+        Configuration (its plant).
+
+    Returns
+    -------
+    dict of str to ndarray
+        The columns :data:`TABLE_COLUMNS`: x1 [mm], x2 [mm/s], analytic_s [s],
+        switch_time_s [s], discrete_steps (int, -1 where N* > 20000) and
+        discrete_s [s] (NaN there).
+
+    Raises
+    ------
+    InputError
+        A bad file or row (:func:`read_states`), or a state beyond 1000 x the
+        envelope (|x1| > 1000 position_range or |x2| > 1000 w_max), its line named.
+    """
+    plant = cfg.plant
+    x1, x2 = read_states(path)
+    far = np.flatnonzero(
+        (np.abs(x1) > FAR_FACTOR * plant.position_range) | (np.abs(x2) > FAR_FACTOR * plant.w_max)
+    )
+    if far.size:
+        k = int(far[0])
+        line = _data_line(path, k)
+        raise InputError(
+            f"states file '{path}' line {line}: state ({x1[k]:g}, {x2[k]:g}) is far outside the "
+            f"envelope (|x1| <= {FAR_FACTOR * plant.position_range:g} mm, "
+            f"|x2| <= {FAR_FACTOR * plant.w_max:g} mm/s accepted)"
+        )
+    mt = min_time(x1, x2, plant)
+    dm = discrete_min_steps_batch(x1, x2, plant)
+    return dict(zip(TABLE_COLUMNS, (x1, x2, mt.t_f, mt.t_switch, dm.steps, dm.time_s), strict=True))
+
+
+def _data_line(path: str | Path, k: int) -> int:
+    """File line number of the k-th data row (blank lines skipped), for messages."""
+    import csv
+
+    with open(path, newline="") as fh:
+        n = -1
+        for line, row in enumerate(csv.reader(fh), start=1):
+            if line > 1 and any(f.strip() for f in row):
+                n += 1
+                if n == k:
+                    return line
+    return -1

@@ -22,7 +22,6 @@ import json
 import math
 import platform
 import subprocess
-import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -458,7 +457,8 @@ def write_report(
     cfg : Config
         Configuration.
     out : str or Path, optional
-        Folder; default ``reports/<config name>``.
+        Folder; default ``reports/<config name>``, which is never replaced by
+        the report of another configuration (see :mod:`ptoverify.outdir`).
     progress : callable, optional
         Called with each stage's name.
 
@@ -475,7 +475,10 @@ def write_report(
     """
     from ptoverify.outdir import check_target, discard, make_temp, publish
 
-    out = check_target(out if out is not None else Path("reports") / cfg.name)
+    default = out is None
+    out = check_target(
+        Path("reports") / cfg.name if default else out, config_hash=cfg.digest(), default=default
+    )
     res = collect(cfg, progress)  # nothing is written before this ends
     tmp = make_temp(out)
     try:
@@ -498,35 +501,29 @@ def write_report(
         )
         (tmp / "index.html").write_text(render_html(sections, title))
         (tmp / "report.md").write_text(render_markdown(sections, title))
-        publish(tmp, out)
+        publish(tmp, out, config_hash=cfg.digest(), name=cfg.name, default=default)
         tmp = None
     finally:
         discard(tmp)
     return out
 
 
+#: The stages ``collect`` and ``write_report`` announce, in order.
+STAGES = (
+    "derivations",
+    "ground truth",
+    "switching zone",
+    "poles",
+    "closed-loop properties",
+    "Section 6 claims",
+    "suboptimality sweep",
+    "gates",
+    "figures",
+)
+
+
 def stderr_progress(quiet: bool) -> Progress | None:
-    """Progress on stderr when it is a terminal and not ``quiet``; else None."""
-    if quiet or not sys.stderr.isatty():
-        return None
-    stages = [
-        "derivations",
-        "ground truth",
-        "switching zone",
-        "poles",
-        "closed-loop properties",
-        "Section 6 claims",
-        "suboptimality sweep",
-        "gates",
-        "figures",
-    ]
+    """Progress bar on stderr (:mod:`ptoverify.progress`) over :data:`STAGES`, or None."""
+    from ptoverify.progress import stderr_bar
 
-    def show(stage: str) -> None:
-        i = stages.index(stage) + 1 if stage in stages else 0
-        bar = "#" * i + "." * (len(stages) - i)
-        sys.stderr.write(f"\r[{bar}] {i}/{len(stages)} {stage:<24}")
-        if i == len(stages):
-            sys.stderr.write("\n")
-        sys.stderr.flush()
-
-    return show
+    return stderr_bar(quiet, STAGES)

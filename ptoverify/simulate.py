@@ -1,22 +1,35 @@
 """Sampled-data closed loop, exact between samples (ZOH flow, no Euler).
 
-At each sample t_k = k T the law sees the error state and its input is held
+At each sample t_k = k T the law sees an error state and its input is held
 for one period; the plant moves by its exact flow (eq. 7)::
 
-    e1_k = x1_k - r_k,   e2_k = x2_k - f * r'_k          (f = 1 with feed-forward)
-    u_k  = sat(f * r'_k + law(e1_k, e2_k))
+    e1_k = x1_k - r_k,   e2_k = x2_k - f_e * r'_k
+    u_k  = sat(f_u * r'_k + law(e1_k, e2_k))
     x_{k+1} = flow(x_k, u_k, T)
 
-The Section 6 references are a 5 mm step, a ramp from 0 to 30 mm at
-200 mm/s, and a 5 mm, 5 Hz sine.  The paper does not say how its laws track
-a moving reference; ``feedforward`` selects the reading (with reference
-velocity feed-forward, the error obeys the plant's own dynamics for a ramp).
+The paper does not say how its laws, written for regulation to the origin,
+track a moving reference; ``tracking`` selects the reading:
+
+* ``feedforward`` (f_e = f_u = 1): the law sees the error state and the
+  reference velocity is fed forward (for a ramp the error then obeys the
+  plant's own dynamics);
+* ``none`` (f_e = f_u = 0): the law sees (x1 - r, x2), nothing is added: a
+  moving set-point;
+* ``error`` (f_e = 1, f_u = 0): the law sees the error state, nothing is
+  added: the textbook PD on the error e and its derivative.
+
+For a step (r' = 0) the three coincide.  The Section 6 references
+(:data:`SIGNALS`) are a 5 mm step, a ramp from 0 to 30 mm at 200 mm/s and a
+5 mm, 5 Hz sine; :class:`Reference` builds any other step, ramp or sine.
+Every :class:`SimResult` carries the :class:`Reference` it tracked and its
+tracking mode, so nothing downstream reads a global to learn what was
+simulated.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -26,6 +39,7 @@ from ptoverify.errors import InputError
 from ptoverify.laws import Law
 
 __all__ = [
+    "TRACKING",
     "Reference",
     "reference",
     "SIGNALS",
@@ -37,58 +51,256 @@ __all__ = [
 ]
 
 
+TRACKING = ("feedforward", "none", "error")
+"""Tracking modes of :func:`simulate` (see the module docstring)."""
+
+
 @dataclass(frozen=True)
 class Reference:
-    """A reference signal r(t) with its derivative.
+    """A reference signal r(t) with its derivative: a step, a ramp or a sine.
+
+    Build one with :meth:`step`, :meth:`ramp` or :meth:`sine`; the Section 6
+    ones are in :data:`SIGNALS`.  Bad values raise
+    :class:`~ptoverify.errors.InputError`.
 
     Attributes
     ----------
     name : str
         ``step``, ``ramp`` or ``sine``.
     amplitude : float
-        Step height, ramp end value or sine amplitude [mm].
-    rate : float
-        Ramp slope [mm/s] or sine frequency [Hz] (unused for the step).
+        Step height, ramp end value (its target) or sine amplitude [mm], finite, nonzero.
+    frequency : float or None
+        Sine frequency [Hz], > 0 (None for a step or a ramp).
+    speed : float or None
+        Ramp speed [mm/s], > 0; the ramp moves toward its target at this speed
+        and then holds it (None for a step or a sine).
     duration : float
-        Default simulated time [s].
+        Simulated time [s], > 0: the default of :func:`simulate`, and in a
+        :class:`SimResult` the time actually simulated.
+
+    Examples
+    --------
+    >>> ref = Reference.ramp(speed=100.0, target=-20.0)
+    >>> ref.target, ref.duration
+    (-20.0, 0.45)
+    >>> [float(v) for v in ref.r(np.array([0.0, 0.1, 0.3]))]
+    [0.0, -10.0, -20.0]
     """
 
     name: str
     amplitude: float
-    rate: float
-    duration: float
+    frequency: float | None = None
+    speed: float | None = None
+    duration: float = 0.2
+
+    def __post_init__(self) -> None:
+        """Validate the signal; raise InputError on bad values."""
+        if self.name not in ("step", "ramp", "sine"):
+            raise InputError(f"unknown signal '{self.name}' (choose from step, ramp, sine)")
+        if not (math.isfinite(self.amplitude) and self.amplitude != 0.0):
+            raise InputError(
+                f"{self.name} amplitude must be finite and nonzero, got {self.amplitude!r} mm"
+            )
+        need = {"sine": ("frequency", "Hz"), "ramp": ("speed", "mm/s")}.get(self.name)
+        for field, unit in (("frequency", "Hz"), ("speed", "mm/s")):
+            value = getattr(self, field)
+            if need is not None and field == need[0]:
+                if value is None or not (math.isfinite(value) and value > 0.0):
+                    raise InputError(
+                        f"{self.name} {field} must be finite and > 0, got {value!r} {unit}"
+                    )
+            elif value is not None:
+                raise InputError(f"a {self.name} has no {field}")
+        if not (math.isfinite(self.duration) and self.duration > 0.0):
+            raise InputError(f"duration must be finite and > 0, got {self.duration!r} s")
+
+    @classmethod
+    def step(cls, height: float = 5.0, *, duration: float = 0.2) -> Reference:
+        """Step of ``height`` [mm] at t = 0, simulated for ``duration`` [s].
+
+        Parameters
+        ----------
+        height : float
+            Step height [mm], nonzero.
+        duration : float
+            Simulated time [s] (Section 6: 0.2 s; give more for steps much
+            longer than w_max * 0.1 s).
+
+        Returns
+        -------
+        Reference
+            The step.
+        """
+        return cls("step", float(height), duration=float(duration))
+
+    @classmethod
+    def ramp(
+        cls, speed: float = 200.0, target: float = 30.0, *, duration: float | None = None
+    ) -> Reference:
+        """Ramp from 0 toward ``target`` [mm] at ``speed`` [mm/s], then held.
+
+        Parameters
+        ----------
+        speed : float
+            Ramp speed [mm/s], > 0.
+        target : float
+            End value [mm], nonzero (negative: the ramp goes down).
+        duration : float, optional
+            Simulated time [s]; default the ramp's time |target| / speed plus
+            0.25 s (Section 6: 0.15 + 0.25 = 0.4 s).
+
+        Returns
+        -------
+        Reference
+            The ramp.
+        """
+        if duration is None and speed > 0.0 and math.isfinite(target / speed):
+            duration = abs(target) / speed + 0.25
+        return cls("ramp", float(target), speed=float(speed), duration=_num(duration))
+
+    @classmethod
+    def sine(
+        cls, amplitude: float = 5.0, frequency: float = 5.0, *, duration: float | None = None
+    ) -> Reference:
+        """Sine r = amplitude sin(2 pi frequency t).
+
+        Parameters
+        ----------
+        amplitude : float
+            Amplitude [mm], nonzero.
+        frequency : float
+            Frequency [Hz], > 0.  The phase metrics fit whole periods, so
+            1 / (frequency T) should be a whole number of samples.
+        duration : float, optional
+            Simulated time [s]; default five periods (Section 6: 1 s).
+
+        Returns
+        -------
+        Reference
+            The sine.
+        """
+        if duration is None and frequency > 0.0:
+            duration = 5.0 / frequency
+        return cls("sine", float(amplitude), frequency=float(frequency), duration=_num(duration))
+
+    @property
+    def target(self) -> float | None:
+        """Final value of a step or ramp [mm]; None for a sine."""
+        return None if self.name == "sine" else self.amplitude
 
     def r(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
         """Return the reference position [mm] at times t [s]."""
         if self.name == "step":
             return np.full_like(t, self.amplitude)
         if self.name == "ramp":
-            return np.minimum(self.rate * t, self.amplitude)
-        return self.amplitude * np.sin(2.0 * math.pi * self.rate * t)
+            s = math.copysign(1.0, self.amplitude)
+            return s * np.minimum(self.speed * t, abs(self.amplitude)) + 0.0  # no -0.0
+        return self.amplitude * np.sin(2.0 * math.pi * self.frequency * t)
 
     def r_dot(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
         """Return the reference velocity [mm/s] at times t [s] (0 for the step)."""
         if self.name == "step":
             return np.zeros_like(t)
         if self.name == "ramp":
-            return np.where(self.rate * t < self.amplitude, self.rate, 0.0)
-        omega = 2.0 * math.pi * self.rate
+            v = math.copysign(self.speed, self.amplitude)
+            return np.where(self.speed * t < abs(self.amplitude), v, 0.0)
+        omega = 2.0 * math.pi * self.frequency
         return self.amplitude * omega * np.cos(omega * t)
+
+    def to_json(self) -> dict:
+        """Return the reference as a dict (units in the keys)."""
+        return {
+            "signal": self.name,
+            "amplitude_mm": self.amplitude,
+            "frequency_hz": self.frequency,
+            "speed_mm_s": self.speed,
+            "target_mm": self.target,
+            "duration_s": self.duration,
+        }
+
+
+def _num(x: float | None) -> float:
+    return math.nan if x is None else float(x)
 
 
 SIGNALS: dict[str, Reference] = {
-    "step": Reference("step", 5.0, 0.0, 0.2),
-    "ramp": Reference("ramp", 30.0, 200.0, 0.4),
-    "sine": Reference("sine", 5.0, 5.0, 1.0),
+    "step": Reference.step(5.0, duration=0.2),
+    "ramp": Reference.ramp(200.0, 30.0, duration=0.4),
+    "sine": Reference.sine(5.0, 5.0, duration=1.0),
+}
+"""The Section 6 references: 5 mm step, ramp to 30 mm at 200 mm/s, 5 mm 5 Hz sine."""
+
+
+_OPTIONS = {
+    "step": ("step",),
+    "ramp": ("ramp_speed", "ramp_to"),
+    "sine": ("amplitude", "frequency"),
 }
 
 
-def reference(name: str) -> Reference:
-    """Return the Section 6 reference called ``name`` (step, ramp, sine)."""
-    try:
-        return SIGNALS[name]
-    except KeyError:
-        raise InputError(f"unknown signal '{name}' (choose from step, ramp, sine)") from None
+def reference(
+    name: str,
+    *,
+    step: float | None = None,
+    ramp_speed: float | None = None,
+    ramp_to: float | None = None,
+    amplitude: float | None = None,
+    frequency: float | None = None,
+) -> Reference:
+    """Return the Section 6 reference ``name``, with any of its parameters changed.
+
+    The keywords are those of ``ptoverify simulate`` (``--step``, ``--ramp-speed``,
+    ``--ramp-to``, ``--amplitude``, ``--frequency``); one that does not belong to
+    ``name`` raises :class:`~ptoverify.errors.InputError`.  With none given this is
+    the Section 6 reference of :data:`SIGNALS`.
+
+    Parameters
+    ----------
+    name : str
+        ``step``, ``ramp`` or ``sine``.
+    step : float, optional
+        Step height [mm] (Section 6: 5).
+    ramp_speed, ramp_to : float, optional
+        Ramp speed [mm/s] and end value [mm] (Section 6: 200, 30).
+    amplitude, frequency : float, optional
+        Sine amplitude [mm] and frequency [Hz] (Section 6: 5, 5).
+
+    Returns
+    -------
+    Reference
+        The reference; its duration is the default of its constructor.
+
+    Examples
+    --------
+    >>> reference("sine", frequency=2.0)
+    Reference(name='sine', amplitude=5.0, frequency=2.0, speed=None, duration=2.5)
+    """
+    if name not in SIGNALS:
+        raise InputError(f"unknown signal '{name}' (choose from step, ramp, sine)")
+    given = {
+        "step": step,
+        "ramp_speed": ramp_speed,
+        "ramp_to": ramp_to,
+        "amplitude": amplitude,
+        "frequency": frequency,
+    }
+    for key, value in given.items():
+        if value is not None and key not in _OPTIONS[name]:
+            raise InputError(f"--{key.replace('_', '-')} does not apply to the {name}")
+    base = SIGNALS[name]
+    if all(given[k] is None for k in _OPTIONS[name]):
+        return base
+    if name == "step":
+        return Reference.step(step)
+    if name == "ramp":
+        return Reference.ramp(
+            base.speed if ramp_speed is None else ramp_speed,
+            base.amplitude if ramp_to is None else ramp_to,
+        )
+    return Reference.sine(
+        base.amplitude if amplitude is None else amplitude,
+        base.frequency if frequency is None else frequency,
+    )
 
 
 @dataclass(frozen=True)
@@ -97,10 +309,13 @@ class SimResult:
 
     Attributes
     ----------
-    law, signal : str
-        What was simulated.
-    feedforward : bool
-        Whether the reference velocity was fed forward.
+    law : str
+        Name of the law simulated.
+    reference : Reference
+        The reference tracked (signal, amplitude [mm], frequency [Hz], ramp
+        speed [mm/s], target [mm]); its ``duration`` is the time simulated [s].
+    tracking : str
+        Tracking mode, one of :data:`TRACKING`.
     t : ndarray
         Sample times [s].
     r, r_dot : ndarray
@@ -116,8 +331,8 @@ class SimResult:
     """
 
     law: str
-    signal: str
-    feedforward: bool
+    reference: Reference
+    tracking: str
     t: NDArray[np.float64]
     r: NDArray[np.float64]
     r_dot: NDArray[np.float64]
@@ -126,6 +341,16 @@ class SimResult:
     e: NDArray[np.float64]
     u: NDArray[np.float64]
     region: NDArray[np.int8]
+
+    @property
+    def signal(self) -> str:
+        """Name of the reference signal (``step``, ``ramp``, ``sine``)."""
+        return self.reference.name
+
+    @property
+    def feedforward(self) -> bool:
+        """Whether the reference velocity was added to the input."""
+        return self.tracking == "feedforward"
 
     def columns(self) -> dict[str, NDArray]:
         """Return the time series as named columns (for CSV and JSON)."""
@@ -146,7 +371,8 @@ def simulate(
     signal: str | Reference = "step",
     *,
     duration: float | None = None,
-    feedforward: bool = True,
+    tracking: str | None = None,
+    feedforward: bool | None = None,
 ) -> SimResult:
     """Simulate the sampled closed loop tracking a reference from rest at 0.
 
@@ -157,16 +383,19 @@ def simulate(
     plant : Plant
         Plant and sample time.
     signal : str or Reference
-        ``step``, ``ramp``, ``sine`` or a :class:`Reference`.
+        ``step``, ``ramp``, ``sine`` (Section 6) or any :class:`Reference`.
     duration : float, optional
-        Simulated time [s]; default the signal's.
-    feedforward : bool
-        Feed the reference velocity forward (see module docstring).
+        Simulated time [s]; default the reference's.
+    tracking : str, optional
+        ``feedforward`` (default), ``none`` or ``error`` (module docstring).
+    feedforward : bool, optional
+        Older spelling: True is ``tracking="feedforward"``, False is
+        ``tracking="none"``.  Give ``tracking`` or ``feedforward``, not both.
 
     Returns
     -------
     SimResult
-        The response at the samples.
+        The response at the samples, with its reference and tracking mode.
 
     Examples
     --------
@@ -174,29 +403,42 @@ def simulate(
     >>> from ptoverify.laws import pd_law
     >>> cfg = paper_config()
     >>> res = simulate(pd_law(cfg), cfg.plant, "step")
-    >>> bool(abs(res.e[-1]) < 1e-6)
-    True
+    >>> bool(abs(res.e[-1]) < 1e-6), res.tracking
+    (True, 'feedforward')
+    >>> res = simulate(pd_law(cfg), cfg.plant, Reference.sine(2.0, 2.0), tracking="error")
+    >>> res.reference.frequency, res.reference.duration
+    (2.0, 2.5)
     """
+    if feedforward is not None:
+        if tracking is not None:
+            raise TypeError("give tracking or feedforward, not both")
+        tracking = "feedforward" if feedforward else "none"
+    tracking = "feedforward" if tracking is None else tracking
+    if tracking not in TRACKING:
+        raise InputError(f"unknown tracking '{tracking}' (choose from {', '.join(TRACKING)})")
     ref = reference(signal) if isinstance(signal, str) else signal
-    duration = ref.duration if duration is None else duration
-    n = int(round(duration / plant.sample_time))
+    if duration is not None:
+        ref = replace(ref, duration=float(duration))
+    n = int(round(ref.duration / plant.sample_time))
     t = np.arange(n + 1) * plant.sample_time
     r, r_dot = ref.r(t), ref.r_dot(t)
-    ff = r_dot if feedforward else np.zeros_like(r_dot)
+    zero = np.zeros_like(r_dot)
+    e2_off = zero if tracking == "none" else r_dot  # what the law subtracts from x2
+    u_add = r_dot if tracking == "feedforward" else zero  # what is added to the law's output
     x1, x2 = np.zeros(n + 1), np.zeros(n + 1)
     u, region = np.zeros(n + 1), np.zeros(n + 1, dtype=np.int8)
     w, a, T = plant.w_max, plant.a, plant.sample_time
     g = -math.expm1(-a * T)
     law_scalar = law.scalar
     for k in range(n + 1):
-        v, region[k] = law_scalar(float(x1[k] - r[k]), float(x2[k] - ff[k]))
-        uk = min(max(v + ff[k], -w), w)
+        v, region[k] = law_scalar(float(x1[k] - r[k]), float(x2[k] - e2_off[k]))
+        uk = min(max(v + u_add[k], -w), w)
         u[k] = uk
         if k < n:
             dv = x2[k] - uk
             x1[k + 1] = x1[k] + uk * T + dv * g / a
             x2[k + 1] = x2[k] - dv * g
-    return SimResult(law.name, ref.name, feedforward, t, r, r_dot, x1, x2, r - x1, u, region)
+    return SimResult(law.name, ref, tracking, t, r, r_dot, x1, x2, r - x1, u, region)
 
 
 @dataclass(frozen=True)

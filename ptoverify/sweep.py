@@ -8,12 +8,15 @@ divided by two lower bounds:
 * t_f*, the continuous minimum time (closed form, :func:`~ptoverify.mintime.min_time`);
 * N* T, the discrete-time limit: the fewest ZOH samples from which the origin
   can be reached exactly with |u_k| <= w_max
-  (:func:`~ptoverify.mintime.discrete_min_steps`, an LP per N).
+  (:func:`~ptoverify.mintime.discrete_min_steps_batch`: exact 2-D zonotope
+  membership, about 10^6 states/s; the LP search is its reference in the tests).
 
 Decisions (the issue is silent on them):
 
-* Grid: 50 x 50 = 2,500 states, evenly spaced and including the envelope's
+* Grid: 200 x 200 = 40,000 states, evenly spaced and including the envelope's
   corners.  An even count per axis keeps the origin (t_f* = 0) off the grid.
+  States are simulated in chunks of 4,096 (the trajectories of one chunk are
+  held in memory, never the whole grid's).
 * Settled: |x1| <= ``band`` (0.01 mm, :data:`~ptoverify.metrics.TIGHT_BAND`)
   and |x2| <= ``velocity_band`` (default a * band: a state coasting with
   u = 0 from the velocity band moves at most x2 / a = band further), from a
@@ -23,12 +26,14 @@ Decisions (the issue is silent on them):
 * A state counts as settled only if it stays settled for at least ``hold``
   (default 0.05 s = 25 samples at T = 2 ms) before the horizon ends; the
   horizon is 4 max t_f* + hold over the grid, rounded up to whole samples.
-* N* is computed only for states that some law settles from (the ratio is
-  undefined elsewhere), once per (plant, grid), and cached in memory.
+* N* is computed for every grid state (a fraction of a second at 40,000).
 * Statistics per law: the fraction of states that settle, the median of the
-  ratio over the settled states, the worst (largest) ratio with its state, and
-  the 95th percentile (the worst states lie next to the origin, where t_f* is
-  a few samples and a fixed settling tail weighs most).
+  ratio over the settled states, the worst (largest) ratio with its state, the
+  percentiles 50/95/99/max of both ratios, and the five worst states of each
+  (the worst states lie next to the origin, where t_f* is a few samples and a
+  fixed settling tail weighs most).
+* The settling times come from one call, :func:`settling_times` (sample-grid
+  reading); an exact between-sample reading replaces that one function.
 """
 
 from __future__ import annotations
@@ -37,7 +42,6 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
@@ -55,6 +59,7 @@ __all__ = [
     "SweepResult",
     "run_sweep",
     "settle_steps",
+    "settling_times",
     "grid_states",
     "discrete_limit",
 ]
@@ -82,8 +87,8 @@ class SweepSettings:
         Laws to sweep.
     """
 
-    n1: int = 50
-    n2: int = 50
+    n1: int = 200
+    n2: int = 200
     band: float = TIGHT_BAND
     velocity_band: float | None = None
     hold: float = 0.05
@@ -116,6 +121,10 @@ class LawSweep:
     p95_ratio_tf : float
         95th percentile of settle_time / t_f* over the settled states [-]; the
         worst ratio sits next to the origin, where t_f* is a few samples.
+    percentiles_tf, percentiles_nt : dict
+        ``p50``, ``p95``, ``p99``, ``max`` of each ratio over the settled states [-].
+    worst_states_tf, worst_states_nt : list
+        The five largest ratios, worst first, as [x1 [mm], x2 [mm/s], ratio].
     seconds : float
         Wall time of this law's simulation [s].
     """
@@ -133,6 +142,10 @@ class LawSweep:
     worst_state_nt: tuple[float, float]
     seconds: float
     p95_ratio_tf: float = math.nan
+    percentiles_tf: dict = field(default_factory=dict)
+    percentiles_nt: dict = field(default_factory=dict)
+    worst_states_tf: list = field(default_factory=list)
+    worst_states_nt: list = field(default_factory=list)
 
     def to_json(self) -> dict:
         """Return the statistics (not the arrays) as a JSON-able dict."""
@@ -146,6 +159,10 @@ class LawSweep:
             "worst_ratio_nt": self.worst_ratio_nt,
             "worst_state_nt": list(self.worst_state_nt),
             "p95_ratio_tf": self.p95_ratio_tf,
+            "percentiles_ratio_tf": self.percentiles_tf,
+            "percentiles_ratio_nt": self.percentiles_nt,
+            "worst_states_tf": self.worst_states_tf,
+            "worst_states_nt": self.worst_states_nt,
             "seconds": self.seconds,
         }
 
@@ -246,16 +263,51 @@ def settle_steps(
     return np.where(last - k >= hold_steps, k, -1)
 
 
-@lru_cache(maxsize=8)
-def _n_star_cached(plant: Plant, x1: tuple[float, ...], x2: tuple[float, ...]) -> tuple[int, ...]:
-    res = discrete_min_steps_batch(np.array(x1), np.array(x2), plant, confirm=False)
-    return tuple(r.steps if r.success else -1 for r in res)
+def settling_times(
+    law,
+    plant: Plant,
+    x1: NDArray,
+    x2: NDArray,
+    steps: int,
+    band: float,
+    velocity_band: float,
+    hold_steps: int,
+    chunk: int = 4096,
+) -> NDArray[np.float64]:
+    """Settling time of ``law`` from each state, read on the sample grid.
+
+    Parameters
+    ----------
+    law : Law
+        Feedback law (vectorized path).
+    plant : Plant
+        The plant (a [rad/s], w_max [mm/s], sample_time T [s]).
+    x1, x2 : ndarray, shape (n,)
+        Initial states [mm], [mm/s].
+    steps : int
+        Horizon [samples].
+    band, velocity_band : float
+        Half-widths of the settled box [mm], [mm/s].
+    hold_steps : int
+        Shortest settled tail [samples].
+    chunk : int
+        States simulated at once (memory: about 25 bytes x chunk x steps).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Settling time [s] (:func:`settle_steps` times T); NaN where not settled.
+    """
+    k = np.empty(x1.size, dtype=np.int64)
+    for i in range(0, x1.size, chunk):
+        b = simulate_batch(law, plant, x1[i : i + chunk], x2[i : i + chunk], steps)
+        k[i : i + chunk] = settle_steps(b.x1, b.x2, band, velocity_band, hold_steps)
+    return np.where(k >= 0, k * plant.sample_time, np.nan)
 
 
 def discrete_limit(plant: Plant, x1: NDArray, x2: NDArray) -> NDArray[np.int64]:
-    """N* for each state (-1 where the LP search failed), cached per plant and states."""
-    x1, x2 = np.ravel(x1), np.ravel(x2)
-    return np.array(_n_star_cached(plant, tuple(x1.tolist()), tuple(x2.tolist())), dtype=np.int64)
+    """N* for each state (-1 where N* > 20000), by zonotope membership."""
+    return discrete_min_steps_batch(np.ravel(x1), np.ravel(x2), plant).steps
 
 
 def _stats(ratio: NDArray, x1: NDArray, x2: NDArray) -> tuple[float, float, tuple[float, float]]:
@@ -264,6 +316,20 @@ def _stats(ratio: NDArray, x1: NDArray, x2: NDArray) -> tuple[float, float, tupl
         return math.nan, math.nan, (math.nan, math.nan)
     k = int(np.nanargmax(np.where(ok, ratio, -np.inf)))
     return float(np.median(ratio[ok])), float(ratio.flat[k]), (float(x1.flat[k]), float(x2.flat[k]))
+
+
+def _percentiles(ratio: NDArray) -> dict:
+    r = ratio[np.isfinite(ratio)]
+    if not r.size:
+        return {k: math.nan for k in ("p50", "p95", "p99", "max")}
+    p50, p95, p99 = np.percentile(r, [50, 95, 99])
+    return {"p50": float(p50), "p95": float(p95), "p99": float(p99), "max": float(r.max())}
+
+
+def _worst(ratio: NDArray, x1: NDArray, x2: NDArray, count: int = 5) -> list:
+    r = np.where(np.isfinite(ratio), ratio, -np.inf).ravel()
+    top = np.argsort(-r, kind="stable")[:count]
+    return [[float(x1.flat[i]), float(x2.flat[i]), float(r[i])] for i in top if np.isfinite(r[i])]
 
 
 def run_sweep(
@@ -305,31 +371,25 @@ def run_sweep(
     hold_steps = math.ceil(s.hold / T - 1e-9)
     steps = math.ceil(s.horizon_factor * float(t_f.max()) / T) + hold_steps
     timings["min_time"] = time.perf_counter() - t0
+    report("discrete limit N*", 0.0)
+    t1 = time.perf_counter()
+    n_star = discrete_limit(plant, X1, X2).reshape(X1.shape)
+    timings["discrete_limit"] = time.perf_counter() - t1
     settle: dict[str, NDArray] = {}
     secs: dict[str, float] = {}
     skipped: dict[str, str] = {}
     for i, name in enumerate(s.laws):
-        report(f"simulate {name}", i / (len(s.laws) + 1))
+        report(f"simulate {name}", (i + 1) / (len(s.laws) + 1))
         try:
             law = make_law(name, cfg)
         except InputError as exc:
             skipped[name] = str(exc)
             continue
         t1 = time.perf_counter()
-        b = simulate_batch(law, plant, X1.ravel(), X2.ravel(), steps)
-        k = settle_steps(b.x1, b.x2, s.band, vband, hold_steps)
-        settle[name] = np.where(k >= 0, k * T, np.nan).reshape(X1.shape)
+        st = settling_times(law, plant, X1.ravel(), X2.ravel(), steps, s.band, vband, hold_steps)
+        settle[name] = st.reshape(X1.shape)
         secs[name] = time.perf_counter() - t1
         timings[f"simulate_{name}"] = secs[name]
-    report("discrete limit N*", len(s.laws) / (len(s.laws) + 1))
-    t1 = time.perf_counter()
-    need = np.zeros(X1.shape, dtype=bool)
-    for st in settle.values():
-        need |= np.isfinite(st)
-    n_star = np.full(X1.shape, -1, dtype=np.int64)
-    if need.any():
-        n_star[need] = discrete_limit(plant, X1[need], X2[need])
-    timings["discrete_limit"] = time.perf_counter() - t1
     nt = np.where(n_star > 0, n_star * T, np.nan)
     laws = {}
     for name, st in settle.items():
@@ -337,6 +397,7 @@ def run_sweep(
             r_tf, r_nt = st / t_f, st / nt
         med_tf, worst_tf, at_tf = _stats(r_tf, X1, X2)
         med_nt, worst_nt, at_nt = _stats(r_nt, X1, X2)
+        pct_tf = _percentiles(r_tf)
         laws[name] = LawSweep(
             name,
             st,
@@ -350,9 +411,11 @@ def run_sweep(
             at_tf,
             at_nt,
             secs[name],
-            float(np.percentile(r_tf[np.isfinite(r_tf)], 95))
-            if np.isfinite(r_tf).any()
-            else math.nan,
+            pct_tf["p95"],
+            pct_tf,
+            _percentiles(r_nt),
+            _worst(r_tf, X1, X2),
+            _worst(r_nt, X1, X2),
         )
     timings["total"] = time.perf_counter() - t0
     report("done", 1.0)

@@ -30,6 +30,9 @@ KEYS = {
     "collocation_ms",
     "collocation_vs_two_phase_error_ratio",
     "discrete_ms",
+    "discrete_batch_states_per_s",
+    "discrete_lp_states_per_s",
+    "discrete_batch_vs_lp_ratio",
     "check_s",
     "report_s",
 }

@@ -1,14 +1,18 @@
 """Claims registry: every claim present, verdicts computed, measured values not typed in."""
 
+import dataclasses
 import json
 import math
 
+import numpy as np
 import pytest
 
 from ptoverify import claims as cl
+from ptoverify import metrics as mt
 from ptoverify.config import paper_config
 from ptoverify.laws import make_law
 from ptoverify.metrics import settling_time
+from ptoverify.plant import step as plant_step
 from ptoverify.simulate import simulate
 
 REQUIRED = {
@@ -47,12 +51,42 @@ def test_every_issue_claim_present_with_a_verdict(results):
         json.dumps(r.to_json(), allow_nan=True)
 
 
-def test_paper_numbers_are_claims(results):
+NUMERIC = ("step-pd-31-percent", "sine-pto-delay", "sine-pd-delay", "sine-pto-vs-pd")
+
+
+def test_paper_numbers_live_in_the_registry(results):
+    """Each numeric claim's paper value is the number its quoted wording gives, and its rule."""
     by = {r.id: r for r in results}
-    assert by["sine-pto-delay"].paper_value == 4.5
-    assert by["sine-pd-delay"].paper_value == 8.1
-    assert by["sine-pto-vs-pd"].paper_value == 55.5
-    assert by["step-pd-31-percent"].paper_value == 31.0
+    for i in NUMERIC:
+        p = by[i].paper_value
+        assert p is not None and f"{p:g}" in by[i].claim, f"{i}: value and quote agree"
+        assert by[i].rule.startswith(f"|measured - {p:g}| <= "), f"{i}: rule reads the value"
+
+
+@pytest.mark.parametrize("claim_id", NUMERIC)
+def test_changing_the_registry_value_flips_the_verdict(claim_id):
+    """The verdict reads the registry: set the paper value to the measurement, then far off."""
+    cfg = paper_config()
+    entry = next(c for c in cl.CLAIMS if c.id == claim_id)
+    measured = cl.evaluate_claims(cfg, (entry,))[0].readings[0].measured
+    assert measured is not None and math.isfinite(measured), claim_id
+    near = cl.evaluate_claims(cfg, (dataclasses.replace(entry, paper_value=measured),))[0]
+    far_value = -(abs(measured) + 100.0)  # |measured - far| > 20 % of |far| and any floor
+    far = cl.evaluate_claims(cfg, (dataclasses.replace(entry, paper_value=far_value),))[0]
+    assert near.readings[0].verdict == "reproduced", f"{claim_id}: paper value = measured"
+    assert far.readings[0].verdict == "not reproduced", f"{claim_id}: paper value far off"
+    assert (near.paper_value, far.paper_value) == (measured, far_value), "reported value follows"
+    assert f"{far_value:g}" in far.rule, "the rule text follows the registry"
+
+
+def test_ratio_detail_reads_the_other_claims_paper_values():
+    """'the paper's own numbers give X %' is computed from the two delay claims' entries."""
+    cfg = paper_config()
+    by = {c.id: c for c in cl.CLAIMS}
+    pto = dataclasses.replace(by["sine-pto-delay"], paper_value=2.0)
+    pd = dataclasses.replace(by["sine-pd-delay"], paper_value=8.0)
+    ratio = cl.evaluate_claims(cfg, (pto, pd, by["sine-pto-vs-pd"]))[2]
+    assert "the paper's own numbers give 25.0 %" in ratio.detail, ratio.detail
 
 
 def test_readings_cover_the_ambiguities(results):
@@ -109,12 +143,54 @@ def test_cached():
     assert all(a is b for a, b in zip(first, again, strict=True)), "cache"
 
 
-def test_error_tracking_reading_matches_simulate_for_a_step(paper_cfg):
-    """With r' = 0 the local 'error' loop is the feed-forward loop of simulate (same flow)."""
-    from ptoverify.claims import _simulate_error_tracking
+def _hand_loop_error_tracking(law, plant, r, r_dot):
+    """u_k = sat(law(x1_k - r_k, x2_k - r'_k)), nothing added; x_{k+1} = plant.step(x_k, u_k)."""
+    x1, x2, X1 = 0.0, 0.0, np.empty(r.size)
+    for k in range(r.size):
+        v, _ = law.scalar(x1 - r[k], x2 - r_dot[k])
+        u = min(max(v, -plant.w_max), plant.w_max)
+        X1[k] = x1
+        x1, x2 = (float(z) for z in plant_step(x1, x2, u, plant))
+    return X1
 
-    for name in ("pd", "pto"):
-        law = make_law(name, paper_cfg)
-        ref = simulate(law, paper_cfg.plant, "step")
-        loc = _simulate_error_tracking(law, paper_cfg.plant, "step")
-        assert (loc.x1 == ref.x1).all() and (loc.u == ref.u).all(), name
+
+@pytest.mark.parametrize("a_reading", ["2pi*f", "f"])
+def test_error_tracking_reading_against_a_hand_built_loop(results, a_reading):
+    """The 'error' reading of the ramp and sine claims equals a loop built by hand.
+
+    The loop is assembled here from plant.step with the references written out (ramp
+    0-30 mm at 200 mm/s, 5 mm 5 Hz sine); the claims' numbers under that reading must be the
+    metrics of this loop.  The readings must differ from feed-forward (else the test is void).
+    """
+    cfg = paper_config()
+    if a_reading == "f":
+        cfg = cfg.with_plant(a=cfg.bandwidth_hz)
+    T = cfg.plant.sample_time
+
+    def reading(claim_id, tracking, pto=None):
+        by = {r.id: r for r in results}
+        return next(
+            x
+            for x in by[claim_id].readings
+            if (x.reading.a, x.reading.tracking, x.reading.pto) == (a_reading, tracking, pto)
+        )
+
+    t = np.arange(201) * T  # the ramp record, 0.4 s
+    r, r_dot = np.minimum(200.0 * t, 30.0), np.where(200.0 * t < 30.0, 200.0, 0.0)
+    x1 = _hand_loop_error_tracking(make_law("pd", cfg), cfg.plant, r, r_dot)
+    lag = reading("ramp-pd-lag", "error").values["lag_mm"]
+    assert lag == pytest.approx(mt.ramp_lag(t, r - x1, r_dot), rel=1e-9), "ramp lag, error"
+    assert abs(lag - reading("ramp-pd-lag", "feed-forward").values["lag_mm"]) > 0.1
+    t = np.arange(501) * T  # the sine record, 1 s
+    w = 2 * np.pi * 5.0
+    r, r_dot = 5.0 * np.sin(w * t), 5.0 * w * np.cos(w * t)
+    for law, cid, pto in (("pd", "sine-pd-delay", None), ("pto", "sine-pto-delay", "corrected")):
+        x1 = _hand_loop_error_tracking(make_law(law, cfg), cfg.plant, r, r_dot)
+        fit_r, fit_x = mt.sine_fit(t, r, 5.0, t_from=0.2), mt.sine_fit(t, x1, 5.0, t_from=0.2)
+        got = reading(cid, "error", pto).values
+        assert got["phase_delay_deg"] == pytest.approx(
+            mt.phase_delay(fit_r, fit_x), rel=1e-9, abs=1e-9
+        ), f"{law} sine phase delay, error tracking"
+        assert got["residual_rms_mm"] == pytest.approx(fit_x.residual_rms, rel=1e-6, abs=1e-12)
+        ff = reading(cid, "feed-forward", pto).values["phase_delay_deg"]
+        assert abs(got["phase_delay_deg"] - ff) > 0.1, f"{law}: error reading is not feed-forward"

@@ -92,3 +92,69 @@ def test_missing_file_and_not_toml(tmp_path):
 def test_roundtrip_mapping():
     cfg = paper_config()
     assert config_from_mapping(cfg.to_mapping()) == cfg
+
+
+@pytest.mark.parametrize(
+    "old,new,key",
+    [
+        ("k1 = 323.0", "k1 = 1e300", "pto.k1"),
+        ("k2 = 3.6", "k2 = 1e300", "pto.k2"),
+        ("kp = 356.0", "kp = 1e300", "pd.kp"),
+        ("kd = 1.15", "kd = 1e300", "pd.kd"),
+        ("kp = 356.0", "kp = -1.0", "pd.kp"),
+        ("k2 = 3.6", "k2 = -0.1", "pto.k2"),
+        ("k1 = 323.0", "k1 = 5000001.0", "pto.k1"),  # k1 T just above 1e4
+        ("kd = 1.15", "kd = 10001.0", "pd.kd"),
+    ],
+)
+def test_gains_out_of_range_name_the_key(tmp_path, old, new, key):
+    f = tmp_path / "c.toml"
+    f.write_text(GOOD.replace(old, new))
+    with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
+        load_config(f)
+
+
+def test_gain_range_reaches_the_sampled_instability():
+    """The ranges reject nonsense, not unstable gains: at the top of the kp range the
+    ZOH-sampled PD loop (computed here independently with scipy's expm) is unstable."""
+    import numpy as np
+    from scipy.linalg import expm
+
+    from ptoverify.config import LIMITS
+
+    cfg = paper_config()
+    a, T = cfg.plant.a, cfg.plant.sample_time
+    A = np.array([[0.0, 1.0], [0.0, -a]])
+    B = np.array([[0.0], [a]])
+    M = expm(np.block([[A, B], [np.zeros((1, 3))]]) * T)
+    Ad, Bd = M[:2, :2], M[:2, 2:]
+
+    def radius(kp, kd):
+        return max(abs(np.linalg.eigvals(Ad - Bd @ np.array([[kp, kd]]))))
+
+    assert radius(cfg.pd.kp, cfg.pd.kd) < 1, "the paper's PD is stable"
+    kp_max = LIMITS["gain_T"] / T
+    for kd in (0.0, 1.0, LIMITS["gain"]):
+        assert radius(kp_max, kd) > 1, f"kp at its bound with kd = {kd} should be unstable"
+    config_from_mapping(
+        {**cfg.to_mapping(), "pd": {"kp": kp_max, "kd": LIMITS["gain"]}}
+    )  # accepted: the gates, not the loader, judge it
+
+
+def test_cli_rejects_huge_gain(tmp_path, capsys):
+    from ptoverify.cli import main
+
+    f = tmp_path / "c.toml"
+    f.write_text(GOOD.replace("k1 = 323.0", "k1 = 1e300"))
+    assert main(["check", "--config", str(f), "--gate", "odd-symmetry"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "pto.k1" in err[0]
+
+
+def test_digest_changes_with_every_value():
+    cfg = paper_config()
+    base = cfg.digest()
+    m = cfg.to_mapping()
+    m["pto"]["k1"] = 324.0
+    assert config_from_mapping(m).digest() != base
+    assert config_from_mapping(cfg.to_mapping()).digest() == base

@@ -5,10 +5,12 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
+from scipy.signal import cont2discrete
 
 from ptoverify import metrics as m
+from ptoverify.errors import InputError
 from ptoverify.laws import Region, make_law
-from ptoverify.simulate import simulate
+from ptoverify.simulate import Reference, simulate
 
 T = 0.002
 t = np.arange(0, 1.0 + T / 2, T)
@@ -111,14 +113,78 @@ def test_summarize_on_simulations(paper_cfg):
     assert to["steady_amplitude_mm"] > m.TIGHT_BAND > pd["steady_amplitude_mm"]
     sine = m.summarize(simulate(make_law("pd", paper_cfg), paper_cfg.plant, "sine"))
     assert 0 < sine["phase_delay_deg"] < 45 and 0.5 < sine["amplitude_ratio"] < 2
-    ramp = m.summarize(
-        simulate(make_law("pd", paper_cfg), paper_cfg.plant, "ramp", feedforward=False)
+
+
+def _closed_loop_pd(cfg):
+    """Sampled PD loop x+ = Acl x + Bd v, ZOH by scipy's cont2discrete (independent of plant.py)."""
+    a, T = cfg.plant.a, cfg.plant.sample_time
+    Ad, Bd, *_ = cont2discrete(
+        (np.array([[0.0, 1.0], [0.0, -a]]), np.array([[0.0], [a]]), np.eye(2), np.zeros((2, 1))),
+        T,
+        method="zoh",
     )
-    kp, kd, v = paper_cfg.pd.kp, paper_cfg.pd.kd, 200.0
-    # steady ramp without feed-forward: kp e = (1 + kd) v  =>  e = (1 + kd) v / kp
-    assert_allclose(
-        ramp["ramp_lag_mm"],
-        (1 + kd) * v / kp,
-        rtol=0.02,
-        err_msg="PD ramp lag vs its steady-state value (2 %: transient tail)",
+    K = np.array([[cfg.pd.kp, cfg.pd.kd]])
+    return Ad - Bd @ K, Bd
+
+
+def test_pd_ramp_lag_without_feedforward(paper_cfg):
+    """Steady ramp, no feed-forward: u = kp e - kd x2 = v, x2 = v  =>  e = (1 + kd) v / kp.
+
+    The sampled loop reaches this exactly (x_ss(k) = (v k T - e_ss, v) solves the ZOH
+    recursion while the ramp moves), and the start-up transient is exact too: z_k = x_k -
+    x_ss(k) = Acl^k z_0, so e_k = e_ss - (Acl^k z_0)_1 (linear loop, scipy's ZOH).  The
+    metric must equal the mean of that over its window to round-off; and the closed form
+    e_ss must hold within the largest transient left in the window, a tolerance derived
+    from the loop (~1e-8 mm here), not a 2 % guess.  Valid while the PD does not saturate,
+    which is asserted.
+    """
+    res = simulate(make_law("pd", paper_cfg), paper_cfg.plant, "ramp", tracking="none")
+    assert np.max(np.abs(res.u)) < paper_cfg.plant.w_max, "linear range"
+    kp, kd, v = paper_cfg.pd.kp, paper_cfg.pd.kd, res.reference.speed
+    e_ss = (1 + kd) * v / kp
+    Acl, _ = _closed_loop_pd(paper_cfg)
+    moving = np.flatnonzero(res.r_dot > 0)
+    k0 = moving[0] + int(np.ceil(0.5 * (moving[-1] - moving[0])))  # ramp_lag's default skip
+    window = range(k0, moving[-1] + 1)
+    z0 = np.array([e_ss, -v])  # x(0) = 0 minus x_ss(0) = (-e_ss, v)
+    transient = np.array([(np.linalg.matrix_power(Acl, k) @ z0)[0] for k in window])
+    lag = m.summarize(res)["ramp_lag_mm"]
+    assert_allclose(lag, e_ss - transient.mean(), rtol=1e-12, atol=1e-12, err_msg="lag [mm]")
+    bound = np.max(np.abs(transient))
+    assert bound < 1e-6 * e_ss, "the window starts late enough for e_ss to be a sharp check"
+    assert abs(lag - e_ss) <= bound + 1e-12 * e_ss, f"lag {lag} vs {e_ss} (bound {bound:.2e})"
+
+
+@pytest.mark.parametrize("tracking", ["feedforward", "none", "error"])
+def test_phase_delay_of_a_2hz_sine_is_the_sampled_frequency_response(paper_cfg, tracking):
+    """A 3 mm, 2 Hz sine: summarize's phase delay is the loop's exact frequency response.
+
+    In its linear range the sampled PD loop is x+ = Acl x + Bd (kp r + c r'), with c = 1 + kd
+    (feed-forward), kd (law on the error) or 0 (no feed-forward; then the law sees x2 itself).
+    For r = A sin(w k T) the steady output is Im(X1 e^{j w k T}), X1 = C (zI - Acl)^-1 Bd A
+    (kp + j w c), z = e^{j w T}; after one period the transient is below round-off (asserted),
+    so the fit over whole periods returns arg X1 to round-off.  A reading of the frequency
+    from anywhere but the simulated reference (5 Hz, Section 6) fails this.
+    """
+    A, f = 3.0, 2.0
+    res = simulate(
+        make_law("pd", paper_cfg), paper_cfg.plant, Reference.sine(A, f), tracking=tracking
     )
+    assert np.max(np.abs(res.u)) < paper_cfg.plant.w_max, "linear range"
+    Acl, Bd = _closed_loop_pd(paper_cfg)
+    assert np.max(np.abs(np.linalg.eigvals(Acl))) ** (1 / (f * paper_cfg.plant.T)) < 1e-30
+    kp, kd, w = paper_cfg.pd.kp, paper_cfg.pd.kd, 2 * np.pi * f
+    c = {"feedforward": 1 + kd, "error": kd, "none": 0.0}[tracking]
+    z = np.exp(1j * w * paper_cfg.plant.T)
+    X = np.linalg.solve(z * np.eye(2) - Acl, Bd[:, 0]) * A * (kp + 1j * w * c)
+    expect = -math.degrees(np.angle(X[0]))
+    got = m.summarize(res)
+    assert_allclose(got["phase_delay_deg"], expect, atol=1e-7, err_msg="phase delay [deg]")
+    assert_allclose(got["amplitude_ratio"], abs(X[0]) / A, rtol=1e-9, err_msg="gain")
+
+
+def test_summarize_rejects_a_sine_of_fractional_period(paper_cfg):
+    """7 Hz at T = 2 ms is 71.4 samples a period: no whole-period fit, a clear input error."""
+    res = simulate(make_law("pd", paper_cfg), paper_cfg.plant, Reference.sine(1.0, 7.0))
+    with pytest.raises(InputError, match="whole number of samples"):
+        m.summarize(res)

@@ -1,9 +1,23 @@
+import dataclasses
+import json
+
 import numpy as np
+import pytest
 from numpy.testing import assert_allclose
 
+from ptoverify.cli import main
+from ptoverify.errors import InputError
 from ptoverify.laws import make_law
+from ptoverify.plant import step as plant_step
 from ptoverify.plant import zoh_matrices
-from ptoverify.simulate import SIGNALS, simulate, simulate_batch
+from ptoverify.simulate import (
+    SIGNALS,
+    TRACKING,
+    Reference,
+    reference,
+    simulate,
+    simulate_batch,
+)
 
 
 def test_simulate_matches_zoh_matrices(paper_cfg):
@@ -55,3 +69,145 @@ def test_pd_step_settles_and_to_keeps_oscillating(paper_cfg):
     assert abs(pd.e[-1]) < 1e-6
     tail = to.e[-50:]
     assert np.ptp(tail) > 1e-3 and np.sum(np.diff(np.sign(tail)) != 0) > 5
+
+
+# ------------------------------------------------------------------ references and tracking
+def _hand_loop(law, plant, r, r_dot, tracking):
+    """The closed loop assembled by hand from plant.step, one sample at a time."""
+    w = plant.w_max
+    x1, x2 = 0.0, 0.0
+    X1, U = [], []
+    for k in range(r.size):
+        e2 = x2 if tracking == "none" else x2 - r_dot[k]
+        v, _ = law.scalar(x1 - r[k], e2)
+        u = min(max(v + (r_dot[k] if tracking == "feedforward" else 0.0), -w), w)
+        X1.append(x1)
+        U.append(u)
+        x1, x2 = (float(z) for z in plant_step(x1, x2, u, plant))
+    return np.array(X1), np.array(U)
+
+
+def _by_hand_reference(name, t):
+    """Section 6 references written out here (not through Reference)."""
+    if name == "ramp":
+        return np.minimum(200.0 * t, 30.0), np.where(200.0 * t < 30.0, 200.0, 0.0)
+    w = 2 * np.pi * 5.0
+    return 5.0 * np.sin(w * t), 5.0 * w * np.cos(w * t)
+
+
+@pytest.mark.parametrize("tracking", TRACKING)
+@pytest.mark.parametrize("signal", ["ramp", "sine"])
+@pytest.mark.parametrize("name", ["pd", "pto", "to"])
+def test_tracking_modes_match_a_hand_assembled_loop(paper_cfg, name, signal, tracking):
+    """Each tracking mode is the loop of the module docstring, built from plant.step."""
+    law, p = make_law(name, paper_cfg), paper_cfg.plant
+    res = simulate(law, p, signal, tracking=tracking, duration=0.1)
+    r, r_dot = _by_hand_reference(signal, res.t)
+    x1, u = _hand_loop(law, p, r, r_dot, tracking)
+    # same flow formula in the same order: equal to round-off (TO/PTO switch on signs, so a
+    # round-off difference could flip an input; none does over these 50 samples)
+    assert_allclose(res.x1, x1, rtol=1e-12, atol=1e-12, err_msg=f"{name} {signal} {tracking}: x1")
+    assert_allclose(res.u, u, rtol=1e-12, atol=1e-12, err_msg=f"{name} {signal} {tracking}: u")
+    assert res.tracking == tracking
+    assert res.reference == dataclasses.replace(SIGNALS[signal], duration=0.1), "reference carried"
+
+
+def test_tracking_modes_differ_on_a_ramp_and_coincide_on_a_step(paper_cfg):
+    """r' = 0 makes the three modes one loop; a ramp tells them apart (else the test is void)."""
+    law, p = make_law("pd", paper_cfg), paper_cfg.plant
+    step = [simulate(law, p, "step", tracking=m) for m in TRACKING]
+    ramp = [simulate(law, p, "ramp", tracking=m) for m in TRACKING]
+    assert all((s.x1 == step[0].x1).all() for s in step), "step: modes coincide"
+    for i in range(3):
+        for j in range(i):
+            assert np.max(np.abs(ramp[i].x1 - ramp[j].x1)) > 0.1, (TRACKING[i], TRACKING[j])
+    assert (simulate(law, p, "ramp", feedforward=False).x1 == ramp[1].x1).all(), "alias"
+    with pytest.raises(TypeError):
+        simulate(law, p, "ramp", feedforward=True, tracking="none")
+    with pytest.raises(InputError):
+        simulate(law, p, "ramp", tracking="feed forward")
+
+
+def test_custom_references_closed_form():
+    t = np.array([0.0, 0.05, 0.1, 0.3])
+    s = Reference.step(-2.5)
+    assert_allclose(s.r(t), -2.5, err_msg="step height")
+    assert_allclose(s.r_dot(t), 0.0, err_msg="step velocity")
+    ramp = Reference.ramp(speed=50.0, target=-4.0)
+    assert_allclose(ramp.r(t), [0.0, -2.5, -4.0, -4.0], err_msg="ramp down to -4 mm at 50 mm/s")
+    assert_allclose(ramp.r_dot(t), [-50.0, -50.0, 0.0, 0.0], err_msg="ramp velocity")
+    assert ramp.target == -4.0 and ramp.duration == pytest.approx(0.08 + 0.25)
+    sine = Reference.sine(amplitude=3.0, frequency=2.0)
+    assert_allclose(sine.r(np.array([0.125])), [3.0], err_msg="2 Hz sine peaks at T/4")
+    assert_allclose(sine.r_dot(np.array([0.0])), [3.0 * 4 * np.pi], err_msg="sine slope at 0")
+    assert sine.target is None and sine.duration == 2.5, "default: five periods"
+    json = sine.to_json()
+    assert (json["signal"], json["amplitude_mm"], json["frequency_hz"]) == ("sine", 3.0, 2.0)
+    tt = np.linspace(0.01, 0.5, 50)
+    for ref in (ramp, sine):  # r_dot is the derivative of r (central differences, h = 1e-6 s)
+        fd = (ref.r(tt + 1e-6) - ref.r(tt - 1e-6)) / 2e-6
+        keep = np.abs(tt - 0.08) > 1e-5  # the ramp's corner
+        assert_allclose(ref.r_dot(tt)[keep], fd[keep], rtol=1e-6, atol=1e-4, err_msg=ref.name)
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: Reference.step(0.0),
+        lambda: Reference.step(float("nan")),
+        lambda: Reference.ramp(speed=0.0, target=5.0),
+        lambda: Reference.ramp(speed=-1.0, target=5.0),
+        lambda: Reference.ramp(speed=100.0, target=0.0),
+        lambda: Reference.sine(amplitude=1.0, frequency=0.0),
+        lambda: Reference.sine(amplitude=1.0, frequency=float("inf")),
+        lambda: Reference.sine(amplitude=1.0, frequency=2.0, duration=-1.0),
+        lambda: Reference("square", 1.0),
+        lambda: Reference("step", 1.0, frequency=2.0),
+    ],
+)
+def test_bad_references_are_input_errors(make):
+    with pytest.raises(InputError):
+        make()
+
+
+def test_result_carries_its_reference(paper_cfg):
+    ref = Reference.sine(amplitude=3.0, frequency=2.0)
+    res = simulate(make_law("pd", paper_cfg), paper_cfg.plant, ref, duration=1.0, tracking="error")
+    assert res.reference.frequency == 2.0 and res.reference.amplitude == 3.0
+    assert res.reference.duration == 1.0 and res.t[-1] == pytest.approx(1.0), "time simulated"
+    assert (res.signal, res.tracking, res.feedforward) == ("sine", "error", False)
+    assert_allclose(res.r, ref.r(res.t), rtol=0, atol=0, err_msg="r from the reference carried")
+
+
+def test_reference_overrides_section6_values():
+    assert reference("step") is SIGNALS["step"], "no override: the Section 6 reference"
+    assert reference("ramp", ramp_to=-12.0) == Reference.ramp(200.0, -12.0), "speed kept"
+    assert reference("sine", amplitude=3.0) == Reference.sine(3.0, 5.0), "frequency kept"
+    with pytest.raises(InputError, match="--frequency does not apply to the step"):
+        reference("step", frequency=2.0)
+    with pytest.raises(InputError):
+        reference("square")
+
+
+def test_cli_simulate_custom_sine(capsys):
+    """--amplitude/--frequency reach the simulation: r is 3 sin(2 pi 2 t) over five periods."""
+    argv = ["simulate", "--law", "pd", "--signal", "sine", "--amplitude", "3", "--frequency", "2"]
+    assert main([*argv, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    t, r = np.array(out["series"]["t"]), np.array(out["series"]["r"])
+    assert_allclose(t[-1], 2.5, rtol=1e-12, err_msg="default duration: five periods [s]")
+    assert_allclose(r, 3.0 * np.sin(4 * np.pi * t), rtol=0, atol=1e-12, err_msg="r [mm]")
+    assert sorted(out) == sorted(
+        [
+            "law",
+            "signal",
+            "feedforward",
+            "note",
+            "samples",
+            "final_error_mm",
+            "max_abs_error_second_half_mm",
+            "series",
+        ]
+    ), "JSON keys unchanged"
+    assert main(["simulate", "--signal", "ramp", "--step", "3"]) == 2
+    assert "does not apply" in capsys.readouterr().err

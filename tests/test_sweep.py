@@ -14,7 +14,7 @@ from ptoverify.config import paper_config
 from ptoverify.laws import make_law
 from ptoverify.mintime import discrete_min_steps, min_time
 from ptoverify.simulate import simulate_batch
-from ptoverify.sweep import SweepSettings, run_sweep, settle_steps
+from ptoverify.sweep import SweepSettings, run_sweep, settle_steps, settling_times
 
 SMALL = SweepSettings(n1=6, n2=5)
 
@@ -56,7 +56,7 @@ def test_small_sweep_agrees_with_single_state_runs(small):
                 err_msg=f"{law}: ratio to t_f*",
             )
             ns = discrete_min_steps(x1, x2, p).steps
-            assert small.n_star.flat[j] == ns, "N* from the LP reference"
+            assert small.n_star.flat[j] == ns, "N* (zonotope) equals the LP reference"
             assert_allclose(
                 small.laws[law].ratio_nt.flat[j],
                 ts / (ns * p.T),
@@ -103,7 +103,46 @@ def test_sweep_json_keys(capsys):
             "worst_state_tf",
             "worst_ratio_nt",
             "worst_state_nt",
+            "percentiles_ratio_tf",
+            "percentiles_ratio_nt",
+            "worst_states_tf",
+            "worst_states_nt",
         } <= set(r)
+        assert set(r["percentiles_ratio_nt"]) == {"p50", "p95", "p99", "max"}
+
+
+def test_percentiles_and_worst_states(small):
+    """p50 <= p95 <= p99 <= max = the worst ratio; worst states listed worst first."""
+    for r in small.laws.values():
+        for pct, worst, states, ratio in (
+            (r.percentiles_tf, r.worst_ratio_tf, r.worst_states_tf, r.ratio_tf),
+            (r.percentiles_nt, r.worst_ratio_nt, r.worst_states_nt, r.ratio_nt),
+        ):
+            ok = np.isfinite(ratio)
+            if not ok.any():
+                continue
+            assert pct["p50"] <= pct["p95"] <= pct["p99"] <= pct["max"] == worst
+            assert pct["p50"] == pytest.approx(np.median(ratio[ok]), rel=1e-12)
+            assert [w[2] for w in states] == sorted(ratio[ok], reverse=True)[: len(states)]
+            x1, x2, v = states[0]
+            j = np.flatnonzero((small.x1 == x1) & (small.x2 == x2))
+            assert ratio.flat[j[0]] == v, "worst state's ratio at that grid state"
+
+
+def test_settling_chunks_do_not_change_results():
+    cfg = paper_config()
+    p = cfg.plant
+    x1, x2 = np.linspace(-20, 20, 11), np.linspace(300, -300, 11)
+    law = make_law("pto", cfg)
+    a = settling_times(law, p, x1, x2, 200, 0.01, p.a * 0.01, 25, chunk=3)
+    b = settling_times(law, p, x1, x2, 200, 0.01, p.a * 0.01, 25)
+    assert np.array_equal(a, b, equal_nan=True)
+
+
+def test_grid_limit(capsys):
+    assert main(["sweep", "--json", "--grid", "1001", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("ptoverify: error:") and "1000" in err
 
 
 def test_sweep_out_writes_atomically(tmp_path, capsys):
@@ -149,7 +188,7 @@ def test_sweep_out_is_a_file(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_full_sweep_runs_every_law():
-    """2,500 states, all laws (its time is measured in benchmarks/, not asserted here)."""
+    """40,000 states, all laws (its time is measured in benchmarks/, not asserted here)."""
     res = run_sweep(paper_config())
-    assert res.x1.size >= 2500
+    assert res.x1.size >= 40000
     assert set(res.laws) == {"to", "pd", "pto", "pto-printed"}

@@ -1,0 +1,62 @@
+"""The firmware example: the PTO law in C99, built by the system compiler, gated by
+``conform --law`` in double precision (conforms) and single precision (does not, and why)."""
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from ptoverify.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+SPEC = ROOT / "examples" / "c_law" / "c_pto.py"
+
+pytestmark = pytest.mark.skipif(
+    not any(shutil.which(c) for c in ("cc", "gcc", "clang")),
+    reason="no C compiler (cc, gcc or clang) on PATH: the C firmware example is not gated",
+)
+
+
+def _conform(capsys, func, tmp_path):
+    junit = tmp_path / f"{func}.xml"
+    code = main(["conform", "--law", f"{SPEC}:{func}", "--json", "--junit", str(junit)])
+    return code, json.loads(capsys.readouterr().out), junit
+
+
+@pytest.mark.slow
+def test_c_double_build_conforms(capsys, tmp_path):
+    code, res, junit = _conform(capsys, "pto", tmp_path)
+    assert code == 0 and res["conforms"], res["failures"]
+    assert res["agreement"]["max_abs_du"] <= 1e-9 * 300.0, "double C port differs beyond round-off"
+    assert junit.read_text().count("<testcase") == len(res["properties"]) + len(
+        res["agreement"]["regions"]
+    )
+
+
+@pytest.mark.slow
+def test_c_single_build_fails_only_agreement(capsys, tmp_path):
+    """float32 rounds the state: near |x1| = d and near the curves the region flips, so
+    agreement at 1e-6 w_max fails there, while the closed loop keeps every property."""
+    code, res, _ = _conform(capsys, "pto_single", tmp_path)
+    assert code == 1 and not res["conforms"]
+    failing = {f["property"] for f in res["failures"]}
+    assert failing == {"agreement"}, failing
+    bad_regions = {k for k, e in res["agreement"]["regions"].items() if not e["pass"]}
+    assert bad_regions and bad_regions <= {"LINEAR", "SATURATED", "BANG_P", "BANG_N"}
+    for name in bad_regions:  # the worst disagreement sits where float32 moves |x1| across d
+        x1 = res["agreement"]["regions"][name]["state"][0]
+        assert abs(abs(x1) - 0.5) <= 1e-6, (name, x1)
+    assert all(p["status"] == "pass" for p in res["properties"].values()), res["properties"]
+
+
+def test_c_source_is_c99_without_allocation_or_state():
+    import re
+
+    src = (ROOT / "examples" / "c_law" / "pto_law.c").read_text()
+    for banned in ("malloc", "calloc", "realloc", "free(", "alloca("):
+        assert banned not in src, banned
+    file_scope_vars = re.findall(
+        r"^(?:static\s+)?(?:const\s+)?(?:double|float|real|int)\s+\w+\s*(?:=|;|\[)", src, re.M
+    )
+    assert file_scope_vars == [], f"state between calls: {file_scope_vars}"
