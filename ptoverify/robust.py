@@ -146,8 +146,8 @@ def _n_star(x1: NDArray, x2: NDArray, plant: Plant) -> NDArray[np.float64]:
 @functools.lru_cache(maxsize=256)
 def _n_star_memo(plant: Plant, b1: bytes, b2: bytes) -> NDArray[np.float64]:
     x1, x2 = np.frombuffer(b1), np.frombuffer(b2)
-    res = discrete_min_steps_batch(x1, x2, plant, confirm=False)
-    out = np.array([r.steps if r.success else np.nan for r in res], dtype=float)
+    steps = discrete_min_steps_batch(x1, x2, plant).steps
+    out = np.where(steps >= 0, steps, np.nan).astype(float)
     out.setflags(write=False)
     return out
 
