@@ -37,8 +37,8 @@ from scipy.optimize import differential_evolution
 
 from ptoverify.config import Config, PDGains, PTOSettings
 from ptoverify.errors import InputError
+from ptoverify.exact import exact_metrics
 from ptoverify.laws import make_law
-from ptoverify.metrics import overshoot, settling_time
 from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import law_properties
 from ptoverify.simulate import reference, simulate
@@ -139,7 +139,10 @@ def _linear_gains(law: str, gains: dict[str, float]) -> tuple[float, float]:
 
 
 def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:
-    """Settling (2 % and 0.01 mm) and overshoot of ``law`` on ``signal`` under ``cfg``.
+    """Settling (2 % and 0.01 mm), overshoot and rise time of ``law`` on ``signal``.
+
+    Measured between samples, on the exact trajectory (:mod:`ptoverify.exact`),
+    exactly as ``ptoverify simulate --json`` reports them in ``metrics``.
 
     Parameters
     ----------
@@ -154,16 +157,11 @@ def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:
     -------
     dict
         ``settling_2pct_s`` [s], ``settling_0p01mm_s`` [s], ``overshoot_mm`` [mm],
-        ``omega0`` [mm/s] (PTO) as ``simulate`` reports them.
+        ``rise_time_s`` [s]; NaN where undefined (never settles).
     """
-    lw = make_law(law, cfg)
-    res = simulate(lw, cfg.plant, signal)
-    ref = reference(signal)
-    return {
-        "settling_2pct_s": settling_time(res.t, res.e, 0.02 * abs(ref.amplitude)),
-        "settling_0p01mm_s": settling_time(res.t, res.e, 0.01),
-        "overshoot_mm": overshoot(res.x1, float(res.r[-1])),
-    }
+    res = simulate(make_law(law, cfg), cfg.plant, signal)
+    m = exact_metrics(res, cfg.plant).json_metrics()
+    return {k: math.nan if v is None else float(v) for k, v in m.items()}
 
 
 def evaluate(
@@ -204,7 +202,9 @@ def evaluate(
     p = cfg.plant
     nan = math.nan
     if sampled_spectral_radius(p.a, p.sample_time, *_linear_gains(law, gains)) >= 1.0:
-        return Candidate(gains, math.inf, nan, nan, nan, False, reason="sampled linear loop unstable")
+        return Candidate(
+            gains, math.inf, nan, nan, nan, False, reason="sampled linear loop unstable"
+        )
     omega0 = None
     try:
         if law == "pto":
@@ -271,9 +271,7 @@ def pareto_front(cands: list[Candidate]) -> list[Candidate]:
     >>> [x.overshoot_mm for x in pareto_front([c(0, 3), c(1, 2), c(2, 2.5), c(3, 1)])]
     [0, 1, 3]
     """
-    ok = [
-        c for c in cands if math.isfinite(c.overshoot_mm) and math.isfinite(c.settling_2pct_s)
-    ]
+    ok = [c for c in cands if math.isfinite(c.overshoot_mm) and math.isfinite(c.settling_2pct_s)]
     ok.sort(key=lambda c: (c.overshoot_mm, c.settling_2pct_s))
     front, best = [], math.inf
     for c in ok:
@@ -432,7 +430,9 @@ def tune(
     if law not in BOUNDS:
         raise InputError(f"tune: unknown law '{law}' (choose from pd, pto)")
     if objective not in OBJECTIVES:
-        raise InputError(f"tune: unknown objective '{objective}' (choose from {', '.join(OBJECTIVES)})")
+        raise InputError(
+            f"tune: unknown objective '{objective}' (choose from {', '.join(OBJECTIVES)})"
+        )
     if max_overshoot is not None and not (max_overshoot >= 0 and math.isfinite(max_overshoot)):
         raise InputError(f"tune: --max-overshoot must be a finite number >= 0, got {max_overshoot}")
     if objective == "worst_ratio_nt" and worst_ratio is None:
@@ -514,5 +514,7 @@ def tune(
         front=front,
         evaluations=len(seen),
         seconds=time.perf_counter() - t0,
-        config=dataclasses.replace(tuned_config(cfg, law, best.gains), name=f"{cfg.name}-tuned-{law}"),
+        config=dataclasses.replace(
+            tuned_config(cfg, law, best.gains), name=f"{cfg.name}-tuned-{law}"
+        ),
     )
