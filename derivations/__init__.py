@@ -7,20 +7,22 @@ every checked record is computed by :func:`derivations.record.judge`.
 
 Catalogue
 ---------
-all_records      -- every record, ordered by equation number (cached)
+all_records      -- every record, ordered by equation number (cached per plant)
+PlantNumbers     -- the plant at which records quote numeric examples
 render_markdown  -- Markdown table: id, verdict, printed, derived, note
 render_html      -- HTML fragment: MathML printed vs derived, verdict, note
 record           -- EquationRecord, judge (the verdict machinery)
 printed          -- the printed transcriptions, as data, in one file
-common           -- the flow of eq. (1) by dsolve, shared helpers
+common           -- the flow of eq. (1) by dsolve, PlantNumbers, shared helpers
 section3         -- eqs. (3)-(12); minimum time and switch time (``mintime``)
 section4         -- eqs. (13)-(35); 15inv, 19c, 22c, 22W, 26W, 31W
 section5         -- eqs. (36)-(39); the stability claim (``39L``)
 
 Examples
 --------
->>> from derivations import all_records
->>> ids = [r.id for r in all_records()]
+>>> from derivations import PlantNumbers, all_records
+>>> plant = PlantNumbers(a=100.0, w_max=200.0, T=0.001, d=0.2, k1=150.0, k2=1.0)
+>>> ids = [r.id for r in all_records(plant)]
 >>> all(str(i) in ids for i in range(1, 40))
 True
 """
@@ -31,9 +33,10 @@ import html
 import re
 from functools import lru_cache
 
+from derivations.common import PlantNumbers
 from derivations.record import EquationRecord, definition
 
-__all__ = ["all_records", "render_markdown", "render_html", "EquationRecord"]
+__all__ = ["all_records", "render_markdown", "render_html", "EquationRecord", "PlantNumbers"]
 
 
 def _order(rec: EquationRecord) -> tuple[float, str]:
@@ -43,8 +46,8 @@ def _order(rec: EquationRecord) -> tuple[float, str]:
     return (float(m.group(1)), m.group(2)) if m else (1e9, rec.id)
 
 
-@lru_cache(maxsize=None)
-def _records() -> tuple[EquationRecord, ...]:
+@lru_cache(maxsize=8)
+def _records(numbers: PlantNumbers) -> tuple[EquationRecord, ...]:
     from derivations import section3, section4, section5
     from derivations.printed import printed_text
 
@@ -57,22 +60,33 @@ def _records() -> tuple[EquationRecord, ...]:
         ),
         definition("2", printed_text("2"), "The cost: minimum final time."),
     ]
-    recs += list(section3.records()) + list(section4.records()) + list(section5.records())
+    recs += list(section3.records())
+    recs += list(section4.records(numbers)) + list(section5.records(numbers))
     return tuple(sorted(recs, key=_order))
 
 
-def all_records() -> list[EquationRecord]:
+def all_records(numbers: PlantNumbers) -> list[EquationRecord]:
     """Every equation record, ordered by equation number.
 
     Ids "1" to "39" are all present; extras ("mintime", "15inv", "19c", "22c",
-    "22W", "26W", "31W", "39L") follow the equation they extend.  The first
-    call derives everything (a few seconds); later calls hit a cache.
+    "22W", "26W", "31W", "36Z", "39L") follow the equation they extend.  The
+    first call derives everything (about ten seconds); the symbolic part is
+    cached, so a call for another plant only redoes the numeric examples.
+
+    Parameters
+    ----------
+    numbers : PlantNumbers
+        Plant at which records 16, 27, 36Z and 39L quote numeric examples
+        (a [rad/s], w_max [mm/s], T [s], d [mm], k1 [1/s], k2 [-]).  The
+        derivations themselves are symbolic and do not depend on it.
 
     Returns
     -------
     list of EquationRecord
     """
-    return list(_records())
+    if not isinstance(numbers, PlantNumbers):
+        raise TypeError(f"numbers must be a PlantNumbers, got {type(numbers).__name__}")
+    return list(_records(numbers))
 
 
 def _md_cell(text: str) -> str:

@@ -6,7 +6,9 @@ of eq. (1); every later section uses it.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
@@ -16,9 +18,67 @@ import sympy as sp
 from derivations.printed import SYMBOLS, printed, printed_text
 from derivations.record import EquationRecord, Judgement
 
-__all__ = ["S", "flow", "flow_T", "switch_curve_x1", "uniform", "record_from", "rhs", "combine"]
+__all__ = [
+    "PlantNumbers",
+    "S",
+    "flow",
+    "flow_T",
+    "switch_curve_x1",
+    "uniform",
+    "record_from",
+    "rhs",
+    "combine",
+]
 
 S = SYMBOLS
+
+
+@dataclass(frozen=True)
+class PlantNumbers:
+    """Plant and law numbers at which the records quote numeric examples.
+
+    The derivations are symbolic; a few records (16, 27, 36Z, 39L) also evaluate
+    their result at one plant, to say what the printed chain gives there.  The
+    caller passes that plant (``ptoverify`` passes its configuration's numbers);
+    the derivations import nothing from ``ptoverify``.
+
+    Attributes
+    ----------
+    a : float
+        Velocity-loop bandwidth [rad/s].
+    w_max : float
+        Velocity saturation omega_m [mm/s].
+    T : float
+        Sampling period [s].
+    d : float
+        Half-width of the linear zone [mm].
+    k1 : float
+        Linear-zone position gain of eq. (34) [1/s].
+    k2 : float
+        Linear-zone velocity gain of eq. (34) [-].
+
+    Examples
+    --------
+    >>> PlantNumbers(a=100.0, w_max=200.0, T=0.001, d=0.2, k1=150.0, k2=1.0).w_max
+    200.0
+    """
+
+    a: float
+    w_max: float
+    T: float  # noqa: N815 - the paper's symbol
+    d: float
+    k1: float
+    k2: float
+
+    def __post_init__(self) -> None:
+        for name in ("a", "w_max", "T"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"PlantNumbers.{name} must be a finite number > 0, got {v!r}")
+        for name in ("d", "k1", "k2"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v)):
+                raise ValueError(f"PlantNumbers.{name} must be a finite number, got {v!r}")
 
 
 @lru_cache(maxsize=None)

@@ -110,6 +110,21 @@ class EquationRecord:
             "inherits": list(self.inherits),
         }
 
+    @classmethod
+    def from_json(cls, data: dict[str, Any]) -> EquationRecord:
+        """Rebuild a record from :meth:`to_json` output.
+
+        Parameters
+        ----------
+        data : dict
+            The keys of :meth:`to_json`.
+
+        Returns
+        -------
+        EquationRecord
+        """
+        return cls(**{f: data[f] for f in cls.__dataclass_fields__ if f in data})
+
     def to_mathml(self) -> dict[str, str]:
         """Return the printed and derived forms as presentation MathML.
 

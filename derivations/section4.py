@@ -16,19 +16,21 @@ equation, and the Lambert-W roots.
 
 from __future__ import annotations
 
+import dataclasses
 from functools import lru_cache
 
 import mpmath
 import numpy as np
 import sympy as sp
 
-from derivations.common import S, combine, flow_T, parsed, record_from, rhs
+from derivations.common import PlantNumbers, S, combine, flow_T, parsed, record_from, rhs
 from derivations.printed import printed_text
 from derivations.record import EquationRecord, definition, judge
 from derivations.section3 import trajectory_residual
 
 __all__ = [
     "records",
+    "l1_x1",
     "one_step",
     "one_step_inverse",
     "preimage_l1",
@@ -286,23 +288,10 @@ def _rec_13_17() -> list[EquationRecord]:
         "b0 = a*d/omega_m + 2*(exp(a*T) - 1 - a*T) (record 22c)",
         "23: x~20 = -(Y* - 2*(exp(a*T) - 1))*omega_m",
         "24-27: same algebra, but the intersection point, k, z* and omega0 change (values "
-        "at the paper defaults in the note of 27)",
+        "at the plant in the note of 27)",
         "36, 35: the zone S~_P and the law use the omega0 of the corrected chain",
     ]
     jj = combine([j1, j2])
-
-    def at_defaults(ce):
-        av, wv, Tv, _ = _paper()
-        num = {a: av, wm: wv, T: Tv, x2: -wv / 2}
-        num[x1] = float(l1_x1(x2).subs(num))
-        return {
-            "at_paper_defaults": {
-                "point": {str(k_): float(v_) for k_, v_ in num.items()},
-                "printed": float(p16[1].subs(num)),
-                "derived": float(lhs_plus.subs(num)),
-            }
-        }
-
     out.append(
         record_from(
             "16",
@@ -323,7 +312,6 @@ def _rec_13_17() -> list[EquationRecord]:
             ),
             corrected=corrected,
             inherits=inherits,
-            extra=at_defaults,
         )
     )
     p17 = parsed("17")
@@ -599,34 +587,16 @@ def _rec_20_27() -> list[EquationRecord]:
         pts[z] = rng.uniform(0.01, 10.0, n)
         return pts
 
-    pr = intersection(*_paper(), corrected=False)
-    co = intersection(*_paper(), corrected=True)
-    av, wv, _, dv = _paper()
-    nums = (
-        f" At the paper defaults (a = {av:.6g} rad/s, omega_m = {wv:.6g} mm/s, T, d) the "
-        f"printed chain gives x~20 = {pr['x20']:.6g} mm/s "
-        + ("(|x~20| > omega_m: outside the saturation band) " if abs(pr["x20"]) > wv else "")
-        + f"and omega0 = {pr['omega0']:.6g} mm/s "
-        f"({'>' if pr['omega0'] > wv else '<='} omega_m); the corrected chain (19c, 22c) "
-        f"gives x~20 = {co['x20']:.6g} mm/s and omega0 = {co['omega0']:.6g} mm/s."
-    )
     out.append(
         record_from(
             "27",
             d27,
             ["solve z = -x~20/omega0 for omega0"],
             judge(rhs(p27, w0), d27, s27),
-            "Inverse of the definition of z." + inh + nums,
+            "Inverse of the definition of z." + inh,
         )
     )
     return out
-
-
-def _paper() -> tuple[float, float, float, float]:
-    from ptoverify.config import paper_config
-
-    c = paper_config()
-    return c.plant.a, c.plant.w_max, c.plant.sample_time, c.pto.d
 
 
 def _rec_28_35() -> list[EquationRecord]:
@@ -816,11 +786,58 @@ def _rec_lambert() -> list[EquationRecord]:
 
 
 @lru_cache(maxsize=None)
-def records() -> tuple[EquationRecord, ...]:
+def _symbolic_records() -> tuple[EquationRecord, ...]:
+    """Build the records of eqs. (13)-(35) and extras without numbers (the costly part)."""
+    return tuple(_rec_13_17() + _rec_18_19() + _rec_20_27() + _rec_28_35() + _rec_lambert())
+
+
+def _at_plant_16(rec: EquationRecord, num: PlantNumbers) -> EquationRecord:
+    """Add to the (16) erratum's counterexample the values at the given plant."""
+    if rec.counterexample is None:
+        return rec
+    p16 = parsed("16")
+    m1, m2 = one_step(+1)
+    lhs_plus = sp.expand(a * m1 + m2)
+    at = {a: num.a, wm: num.w_max, T: num.T, x2: -num.w_max / 2}
+    at[x1] = float(l1_x1(x2).subs(at))
+    ce = dict(rec.counterexample)
+    ce["at_plant"] = {
+        "point": {str(k_): float(v_) for k_, v_ in at.items()},
+        "printed": float(p16[1].subs(at)),
+        "derived": float(lhs_plus.subs(at)),
+    }
+    return dataclasses.replace(rec, counterexample=ce)
+
+
+def _at_plant_27(rec: EquationRecord, num: PlantNumbers) -> EquationRecord:
+    """Append to the note of (27) what both chains give at the given plant."""
+    pr = intersection(num.a, num.w_max, num.T, num.d, corrected=False)
+    co = intersection(num.a, num.w_max, num.T, num.d, corrected=True)
+    wv = num.w_max
+    nums = (
+        f" At the plant (a = {num.a:.6g} rad/s, omega_m = {wv:.6g} mm/s, T = {num.T:.6g} s, "
+        f"d = {num.d:.6g} mm) the printed chain gives x~20 = {pr['x20']:.6g} mm/s "
+        + ("(|x~20| > omega_m: outside the saturation band) " if abs(pr["x20"]) > wv else "")
+        + f"and omega0 = {pr['omega0']:.6g} mm/s "
+        f"({'>' if pr['omega0'] > wv else '<='} omega_m); the corrected chain (19c, 22c) "
+        f"gives x~20 = {co['x20']:.6g} mm/s and omega0 = {co['omega0']:.6g} mm/s."
+    )
+    return dataclasses.replace(rec, note=rec.note + nums)
+
+
+@lru_cache(maxsize=8)
+def records(numbers: PlantNumbers) -> tuple[EquationRecord, ...]:
     """Build the records of eqs. (13)-(35) and 15inv, 19c, 22c, 22W, 26W, 31W.
+
+    Parameters
+    ----------
+    numbers : PlantNumbers
+        Plant at which records 16 and 27 quote numeric examples (a [rad/s],
+        w_max [mm/s], T [s], d [mm]).
 
     Returns
     -------
     tuple of EquationRecord
     """
-    return tuple(_rec_13_17() + _rec_18_19() + _rec_20_27() + _rec_28_35() + _rec_lambert())
+    at = {"16": _at_plant_16, "27": _at_plant_27}
+    return tuple(at[r.id](r, numbers) if r.id in at else r for r in _symbolic_records())

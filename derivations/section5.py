@@ -9,12 +9,13 @@ continuous-time statement without saturation.
 
 from __future__ import annotations
 
+import dataclasses
 from functools import lru_cache
 
 import numpy as np
 import sympy as sp
 
-from derivations.common import S, combine, parsed, record_from, rhs
+from derivations.common import PlantNumbers, S, combine, parsed, record_from, rhs
 from derivations.record import EquationRecord, definition, judge
 
 __all__ = ["records", "closed_loop_matrix", "lyapunov_derivative", "zoh_spectral_radius"]
@@ -110,8 +111,8 @@ def _rec_36() -> EquationRecord:
             "x_l1(x2) = -(x2 + omega_m ln(1 - x2/omega_m))/a and x_l1*(x2) likewise with omega0",
             "for omega0 < omega_m: l1* lies right of l1; indicator of (36) equals the indicator "
             f"of the band between them: {j_lo.verdict}",
-            "for omega0 > omega_m (what the printed chain (20)-(27) yields at the paper defaults, "
-            f"see 27): the set (36) is empty in the fourth quadrant: {j_hi.verdict}",
+            "for omega0 > omega_m (what the printed chain (20)-(27) can yield; see 27 for "
+            f"the plant's value): the set (36) is empty in the fourth quadrant: {j_hi.verdict}",
         ],
         combine([j_lo, j_hi]),
         "The first inequality selects the side right of (above) l1, the second the side left "
@@ -120,15 +121,15 @@ def _rec_36() -> EquationRecord:
     )
 
 
-def _rec_36_claim() -> EquationRecord:
+def _rec_36_claim(num: PlantNumbers) -> EquationRecord:
     """Judge the claim that one -omega_m sample from l1* (x1 > d) stays above l1."""
-    from derivations.section4 import _paper, intersection, l1_x1, one_step
+    from derivations.section4 import intersection, l1_x1, one_step
 
     x1_star = l1_x1(x2, w0)
     n1, n2 = one_step(-1)
     img = {x1: n1.subs(x1, x1_star), x2: n2.subs(x1, x1_star)}
     resid = (a * x1 + x2 + wm * sp.log(1 - x2 / wm)).subs(img, simultaneous=True)
-    av, wv, Tv, dv = _paper()
+    av, wv, Tv, dv = num.a, num.w_max, num.T, num.d
     f_x1 = sp.lambdify((x2, a, w0), x1_star, "numpy")
 
     def sampler(om0):
@@ -160,7 +161,8 @@ def _rec_36_claim() -> EquationRecord:
         j_pr,
         "Claim of rule (1) and of Section 5 ('l1* lies above l~1 when |x1| > d'"
         "): from l1*, one -omega_m sample does not stride over l1. Judged at "
-        "the paper defaults for the omega0 of the printed chain. "
+        f"the plant (a = {av:.6g} rad/s, omega_m = {wv:.6g} mm/s, T = {Tv:.6g} s, "
+        f"d = {dv:.6g} mm) for the omega0 of the printed chain. "
         + (
             f"With it, no state of l1* with x1 > d has |x2| < omega_m (l1* "
             f"reaches x1 = d at x2 = {pr['x20']:.6g} mm/s), so the claim has no "
@@ -216,11 +218,12 @@ def _rec_37_39() -> list[EquationRecord]:
             "Both lines of (39) compared with the derived derivative.",
         )
     )
-    out.append(_rec_39_lasalle(Acl))
     return out
 
 
-def _rec_39_lasalle(Acl: sp.Matrix) -> EquationRecord:
+@lru_cache(maxsize=None)
+def _rec_39_lasalle() -> EquationRecord:
+    Acl = closed_loop_matrix()
     s = sp.Symbol("s")
     charpoly = sp.expand((s * sp.eye(2) - Acl).det())
     # LaSalle: largest invariant set in {dV/dt = 0} = {x2 = 0} (1 + k2 > 0)
@@ -246,11 +249,6 @@ def _rec_39_lasalle(Acl: sp.Matrix) -> EquationRecord:
         return pts
 
     j_v = judge(sp.sign(V), sp.Integer(1), samp_x, symbolic=False)
-    from ptoverify.config import paper_config
-
-    c = paper_config()
-    rho = zoh_spectral_radius(c.plant.a, c.plant.sample_time, c.pto.k1, c.pto.k2)
-    u_peak = c.pto.k1 * c.pto.d + abs(c.pto.k2) * c.plant.w_max
     j = combine([j_h, j_v]) if inv_ok else judge(sp.Integer(1), sp.Integer(0), samp)
     return record_from(
         "39L",
@@ -268,21 +266,49 @@ def _rec_39_lasalle(Acl: sp.Matrix) -> EquationRecord:
         "is not true pointwise (any (x1, 0) has x2 = 0); what holds is LaSalle: "
         "the only trajectory staying in {x2 = 0} is the origin, since there "
         "dx2/dt = -a k1 x1. This is a continuous-time statement for the "
-        "unsaturated loop: it says nothing about the ZOH-sampled loop (spectral "
-        f"radius of Ad - Bd K at the paper defaults: {rho:.6g}) nor about "
-        f"saturation (|u| reaches k1 d + k2 omega_m = {u_peak:.6g} mm/s inside "
-        "|x1| < d, above omega_m), so it is local and not a proof for the "
-        "implemented law.",
+        "unsaturated loop: it says nothing about the ZOH-sampled loop nor about "
+        "saturation, so it is local and not a proof for the implemented law.",
         printed_str="(claim after eq. 39)",
     )
 
 
+def _at_plant_39L(rec: EquationRecord, num: PlantNumbers) -> EquationRecord:
+    """Append to the note of 39L the sampled-loop and saturation numbers at the plant."""
+    rho = zoh_spectral_radius(num.a, num.T, num.k1, num.k2)
+    u_peak = num.k1 * num.d + abs(num.k2) * num.w_max
+    note = (
+        f" At the plant (a = {num.a:.6g} rad/s, T = {num.T:.6g} s, k1 = {num.k1:.6g} 1/s, "
+        f"k2 = {num.k2:.6g}): spectral radius of Ad - Bd K = {rho:.6g} "
+        f"({'<' if rho < 1 else '>='} 1); |u| reaches k1 d + |k2| omega_m = {u_peak:.6g} "
+        f"mm/s inside |x1| < d ({'above' if u_peak > num.w_max else 'within'} omega_m = "
+        f"{num.w_max:.6g} mm/s)."
+    )
+    return dataclasses.replace(rec, note=rec.note + note)
+
+
 @lru_cache(maxsize=None)
-def records() -> tuple[EquationRecord, ...]:
-    """Build the records of eqs. (36)-(39) and the stability claim 39L.
+def _symbolic_records() -> tuple[EquationRecord, ...]:
+    return tuple([_rec_36()] + _rec_37_39())
+
+
+@lru_cache(maxsize=8)
+def records(numbers: PlantNumbers) -> tuple[EquationRecord, ...]:
+    """Build the records of eqs. (36)-(39) and the stability claims 36Z, 39L.
+
+    Parameters
+    ----------
+    numbers : PlantNumbers
+        Plant at which 36Z is judged and 39L quotes the sampled loop (a [rad/s],
+        w_max [mm/s], T [s], d [mm], k1 [1/s], k2 [-]).
 
     Returns
     -------
     tuple of EquationRecord
     """
-    return tuple([_rec_36(), _rec_36_claim()] + _rec_37_39())
+    sym = _symbolic_records()
+    return (
+        sym[0],
+        _rec_36_claim(numbers),
+        *sym[1:],
+        _at_plant_39L(_rec_39_lasalle(), numbers),
+    )

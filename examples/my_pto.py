@@ -37,6 +37,8 @@ def _residual(x1: float, x2: float, a: float, omega: float) -> float:
 def _omega_c(x1: float, x2: float, a: float, lo: float, hi: float) -> float:
     """Level omega in [lo, hi] of the curve through (x1, x2), eq. (28)/(33), by bisection."""
     f_lo = _residual(x1, x2, a, lo)
+    if f_lo == 0.0:  # exactly on l1* / l2*: the same branch on both sides (odd symmetry)
+        return lo
     for _ in range(200):
         mid = 0.5 * (lo + hi)
         if not lo < mid < hi:

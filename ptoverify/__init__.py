@@ -13,6 +13,9 @@ mintime     min_time: closed-form minimum time and switch time from any state;
             discrete_min_steps_batch (N* for many states by zonotopes, see reach)
 reach       ZonotopeTable, zonotope_steps: N-step null-controllable sets as 2-D zonotopes
 ocp         TwoPhaseOCP, CollocationOCP (CasADi + IPOPT), convergence_study
+groundtruth verified_mintime -> GroundTruth: closed form, both OCPs and N* from one state, each
+            OCP answer checked a posteriori (exact-flow arcs, re-simulated collocation) or
+            null; verify_two_phase, verify_collocation (used by mintime, report and check)
 zones       PTOZone; printed_zone (eqs. 19-27 as printed, judged), corrected_zone (largest
             omega0 meeting the no-stride-over principle, verified on a grid), zone_summary
 laws        Law, Region; to_law (eq. 12), pd_law, pto_law (eq. 35: pto, pto-printed); make_law
@@ -30,13 +33,17 @@ claims      Section 6 and conclusion claims, each measured under every reading
 sweep       run_sweep: settling time / t_f* and / N* T over a 200 x 200 grid of initial states
 plots       Figs. 2-14 for TO, PD, PTO (both), sweep heat maps, zone geometry, collocation
             convergence (the only module importing matplotlib)
-checks      the gates of ``ptoverify check``: CheckResult, GATES, run_checks
+checks      the gates of ``ptoverify check``: GATES (each a Verdict with a unit), GateContext
+            (the run's options, e.g. the IPOPT cap), run_checks, summarize
 report      collect, render_html / render_markdown, write_report (atomic);
             report_sections builds the nine sections
 conform     conform: gate a third-party PTO law (callable or table) against the reference
 agreement   conformance grid (--emit-grid), CSV tables, per-region agreement with the reference
 userlaw     loading a user law (MODULE:FUNCTION or file.py:FUNCTION), vectorized/scalar detection
-cli         the ``ptoverify`` command line
+commands    the numeric side of commands that compose several steps: run_simulation
+            (simulate), run_zone (zone)
+cli         the ``ptoverify`` command line: parses, calls one function per command, formats
+verdict     Verdict (PASS, FAIL, UNVERIFIED, NOT_RUN), at_most, tie_band
 errors      InputError (exit 2), ConfigError, SolverError
 """
 

@@ -6,7 +6,7 @@ decisions).  Here:
 * :func:`conformance_grid`: the states ``--emit-grid`` writes, dense near l1,
   l2, l1*, l2* (the zone boundary), the switching zone, |x1| = d, the origin
   and |x2| = w_max;
-* :func:`read_table`: a CSV with columns x1, x2, u;
+* :func:`read_table`: a CSV with columns x1, x2, u (regular files, in chunks);
 * :func:`agreement`: |u - u_ref| <= rtol w_max per reference region (default
   rtol = 1e-6), with the largest |du| and its state.  Points outside |x1| < d
   within ``tie_band`` = 1e-9 (w_max + a position_range) mm/s of a computed
@@ -31,7 +31,6 @@ from ptoverify.config import Config
 from ptoverify.curves import level_curve_x1, level_residual, root_22, switching_function
 from ptoverify.errors import InputError
 from ptoverify.laws import Law, Region, make_law
-from ptoverify.verdict import FAIL, NOT_RUN, PASS, UNVERIFIED  # noqa: F401 - re-exported
 
 __all__ = [
     "DEFAULT_RTOL",
@@ -43,7 +42,8 @@ __all__ = [
     "read_table",
     "ties",
     "agreement",
-    "input_bound",
+    "region_counts",
+    "largest_gap",
 ]
 
 DEFAULT_RTOL = 1e-6  #: agreement tolerance relative to w_max
@@ -173,13 +173,55 @@ def grid_csv(cfg: Config) -> str:
     return "\n".join(lines) + "\n"
 
 
-def read_table(path: str | Path) -> tuple[NDArray, NDArray, NDArray]:
-    """Read a CSV with a header naming columns x1, x2, u (others ignored).
+def _chunk_error(path, lines, first_line: int, cols: dict, cfg: Config | None) -> InputError:
+    """Locate the first bad line of a chunk that numpy rejected (slow path, one chunk)."""
+    for line, row in enumerate(csv.reader(lines), start=first_line):
+        if not any(f.strip() for f in row):
+            continue
+        vals = {}
+        for name, j in cols.items():
+            text = row[j].strip() if j < len(row) else ""
+            try:
+                v = float(text)
+            except ValueError:
+                v = math.nan
+            if not math.isfinite(v):
+                return InputError(
+                    f"table '{path}' line {line}: column {name} = {text!r} is not a finite number"
+                )
+            vals[name] = v
+        if cfg is not None and _far(vals["x1"], vals["x2"], cfg):
+            return InputError(
+                f"table '{path}' line {line}: state ({vals['x1']:g}, {vals['x2']:g}) is far "
+                f"outside the envelope (|x1| <= {1e3 * cfg.plant.position_range:g} mm, "
+                f"|x2| <= {1e3 * cfg.plant.w_max:g} mm/s accepted)"
+            )
+    return InputError(f"table '{path}' near line {first_line}: malformed row")
+
+
+def _far(x1, x2, cfg: Config):
+    """States beyond 1000 x the envelope (as ``mintime`` rejects them)."""
+    p = cfg.plant
+    return (np.abs(x1) > 1e3 * p.position_range) | (np.abs(x2) > 1e3 * p.w_max)
+
+
+_CHUNK_LINES = 500_000  #: table lines parsed per numpy call
+
+
+def read_table(path: str | Path, cfg: Config | None = None) -> tuple[NDArray, NDArray, NDArray]:
+    """Read a CSV with a header naming columns x1, x2, u (others ignored), in chunks.
+
+    Only regular files are read (a device or a FIFO is bad input at once).
+    Chunks of 500000 lines are parsed by numpy, so memory stays about twice
+    the table's numeric size.
 
     Parameters
     ----------
     path : str or Path
         CSV file.
+    cfg : Config, optional
+        When given, states beyond 1000 x the envelope (|x1| > 1000
+        position_range or |x2| > 1000 w_max, as ``mintime``) are bad input.
 
     Returns
     -------
@@ -189,49 +231,66 @@ def read_table(path: str | Path) -> tuple[NDArray, NDArray, NDArray]:
     Raises
     ------
     InputError
-        Unreadable file, missing column, empty table, a field that is not a
-        finite number (line and column named).
+        Not a regular file, unreadable, missing column, empty table, a field
+        that is not a finite number or a state far outside the envelope (line
+        and column named).
     """
+    import itertools
+    import os
+    import stat
+
     try:
-        with open(path, newline="") as fh:
-            rows = list(csv.reader(fh))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(
-            f"cannot read table '{path}': {getattr(exc, 'strerror', None) or exc}"
-        ) from None
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            raise InputError(f"table '{path}' is not a regular file")
+        fh = open(path, newline="", encoding="utf-8")
+    except OSError as exc:
+        raise InputError(f"cannot read table '{path}': {exc.strerror or exc}") from None
+    chunks = []
+    try:
+        with fh:
+            head = fh.readline()
+            if not head.strip():
+                raise InputError(f"table '{path}' is empty")
+            header = [h.strip() for h in next(csv.reader([head]))]
+            cols = {}
+            for name in ("x1", "x2", "u"):
+                if name not in header:
+                    raise InputError(
+                        f"table '{path}': no column '{name}' in header {','.join(header)} "
+                        "(need x1, x2, u)"
+                    )
+                cols[name] = header.index(name)
+            line = 2
+            while True:
+                lines = list(itertools.islice(fh, _CHUNK_LINES))
+                if not lines:
+                    break
+                try:
+                    arr = np.loadtxt(
+                        lines,
+                        delimiter=",",
+                        usecols=tuple(cols.values()),
+                        ndmin=2,
+                        comments=None,
+                        quotechar='"',
+                    )
+                except ValueError:
+                    raise _chunk_error(path, lines, line, cols, cfg) from None
+                bad = not np.isfinite(arr).all()
+                if cfg is not None and arr.size:
+                    bad = bad or bool(_far(arr[:, 0], arr[:, 1], cfg).any())
+                if bad:
+                    raise _chunk_error(path, lines, line, cols, cfg)
+                chunks.append(arr)
+                line += len(lines)
+    except UnicodeDecodeError as exc:
+        raise InputError(f"cannot read table '{path}': not UTF-8 text ({exc.reason})") from None
     except csv.Error as exc:
         raise InputError(f"table '{path}': malformed CSV: {exc}") from None
-    if not rows:
-        raise InputError(f"table '{path}' is empty")
-    header = [h.strip() for h in rows[0]]
-    cols = {}
-    for name in ("x1", "x2", "u"):
-        if name not in header:
-            raise InputError(
-                f"table '{path}': no column '{name}' in header {','.join(header)} (need x1, x2, u)"
-            )
-        cols[name] = header.index(name)
-    data = []
-    for line, row in enumerate(rows[1:], start=2):
-        if not any(f.strip() for f in row):
-            continue
-        vals = []
-        for name, j in cols.items():
-            text = row[j].strip() if j < len(row) else ""
-            try:
-                v = float(text)
-            except ValueError:
-                v = math.nan
-            if not math.isfinite(v):
-                raise InputError(
-                    f"table '{path}' line {line}: column {name} = {text!r} is not a finite number"
-                )
-            vals.append(v)
-        data.append(vals)
-    if not data:
+    if not sum(c.shape[0] for c in chunks):
         raise InputError(f"table '{path}' has a header but no rows")
-    arr = np.array(data, dtype=float)
-    return arr[:, 0].copy(), arr[:, 1].copy(), arr[:, 2].copy()
+    out = tuple(np.concatenate([c[:, k] for c in chunks]) for k in range(3))
+    return out[0], out[1], out[2]
 
 
 # ------------------------------------------------------------------ agreement
@@ -244,6 +303,66 @@ def ties(x1: NDArray, x2: NDArray, cfg: Config) -> NDArray[np.bool_]:
     if om is not None:
         near |= np.abs(level_residual(x1, x2, a, om)) <= band
     return near & (np.abs(x1) >= cfg.pto.d)
+
+
+def _reference_chunked(x1, x2, cfg: Config, chunk: int = 1_000_000):
+    """Return u_ref, region codes and the tie mask, computed a million states at a time."""
+    u_ref, reg = np.empty(x1.size), np.empty(x1.size, dtype=np.int8)
+    tie = np.empty(x1.size, dtype=bool)
+    for i in range(0, x1.size, chunk):
+        s = slice(i, i + chunk)
+        u_ref[s], reg[s] = reference(cfg)(x1[s], x2[s])
+        tie[s] = ties(x1[s], x2[s], cfg)
+    return u_ref, reg, tie
+
+
+def region_counts(x1: NDArray, x2: NDArray, cfg: Config) -> dict[str, int]:
+    """Count states per reference region (regions with none left out)."""
+    _, reg, _ = _reference_chunked(np.asarray(x1, float), np.asarray(x2, float), cfg)
+    counts = np.bincount(reg, minlength=len(Region))
+    return {code.name: int(counts[code]) for code in Region if counts[code]}
+
+
+def largest_gap(x1: NDArray, x2: NDArray, cfg: Config, n: int = 201) -> dict:
+    """Find the largest disc of the envelope with no probed state (on an n x n lattice).
+
+    Probed states are binned to the lattice and the distance to the nearest
+    occupied node is measured in the scaled state (x1 / position_range,
+    x2 / w_max), so the gap is an ellipse with the reported half-widths.
+
+    Parameters
+    ----------
+    x1, x2 : ndarray
+        Probed states [mm], [mm/s].
+    cfg : Config
+        Configuration.
+    n : int
+        Lattice resolution per axis.
+
+    Returns
+    -------
+    dict
+        ``center`` [x1, x2], ``radius`` (scaled), ``half_width_mm``, ``half_width_mm_s``.
+    """
+    from scipy.ndimage import distance_transform_edt
+
+    R, w = cfg.plant.position_range, cfg.plant.w_max
+    inside = (np.abs(x1) <= R) & (np.abs(x2) <= w)
+    i1 = np.rint((x1[inside] / R + 1.0) * 0.5 * (n - 1)).astype(np.intp)
+    i2 = np.rint((x2[inside] / w + 1.0) * 0.5 * (n - 1)).astype(np.intp)
+    empty = np.ones((n, n), dtype=bool)
+    empty[i2, i1] = False
+    dist = distance_transform_edt(empty) if not empty.all() else np.full((n, n), np.inf)
+    k2, k1 = np.unravel_index(int(np.argmax(dist)), dist.shape)
+    r = float(dist[k2, k1]) * 2.0 / (n - 1)
+    q = np.array([[k1, k2]]) * 2.0 / (n - 1) - 1.0
+    i = 0
+    return {
+        "center": [float(q[i, 0] * R), float(q[i, 1] * w)],
+        "radius": r,
+        "half_width_mm": r * R,
+        "half_width_mm_s": r * w,
+    }
 
 
 def agreement(
@@ -273,9 +392,8 @@ def agreement(
     """
     w = cfg.plant.w_max
     tol = rtol * w
-    u_ref, reg = reference(cfg)(x1, x2)
+    u_ref, reg, tie = _reference_chunked(x1, x2, cfg)
     du = np.abs(u - u_ref)
-    tie = ties(x1, x2, cfg)
     judged = ~tie
     bad = judged & (du > tol)
     regions = {}
@@ -335,26 +453,3 @@ def agreement(
             )
         )
     return summary, failures
-
-
-def input_bound(x1: NDArray, x2: NDArray, u: NDArray, cfg: Config, where: str):
-    """Judge |u| <= w_max at the given states; returns (property, failures)."""
-    w = cfg.plant.w_max
-    over = np.abs(u) > w
-    prop = {
-        "status": FAIL if over.any() else PASS,
-        "measured": float(np.abs(u).max()),
-        "limit": w,
-        "detail": f"max |u| [mm/s] {where}; limit w_max",
-    }
-    fails = []
-    if over.any():
-        i = int(np.argmax(over))
-        fails.append(
-            failure(
-                "input-bound-grid",
-                (x1[i], x2[i]),
-                f"|u| = {abs(u[i]):.10g} mm/s > w_max = {w:g} mm/s {where}",
-            )
-        )
-    return prop, fails

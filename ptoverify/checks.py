@@ -1,8 +1,11 @@
 """The gates of ``ptoverify check``: each verification as pass / fail / unverified.
 
-A gate is a function ``gate(ctx) -> CheckResult``.  It measures one number,
-compares it with a limit derived from the method (round-off, sampling, the
-paper's own principle), and says why in ``detail``.  A gate whose reference
+A gate is a function ``gate(ctx) -> Verdict`` of a :class:`GateContext` (the
+configuration and the run's options, e.g. an IPOPT iteration cap); calling a
+registered gate with a bare :class:`~ptoverify.config.Config` runs it with the
+default options.  It measures one number in a stated unit, compares it with a
+limit derived from the method (round-off, sampling, the paper's own principle),
+and says why in ``detail``.  A gate whose reference
 cannot be computed (a solver that does not converge, an exception) is
 ``unverified``, and ``unverified`` fails the run: the gate fails closed.
 
@@ -13,6 +16,7 @@ sampled, or whose zone cannot be built, fails its gates.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from collections.abc import Callable
@@ -21,43 +25,89 @@ from typing import Any
 import numpy as np
 
 from ptoverify.config import Config
-from ptoverify.errors import SolverError
+from ptoverify.errors import InputError, SolverError
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED, Verdict, at_most
 
-__all__ = ["CheckResult", "GATES", "run_checks", "summarize"]
+__all__ = ["CheckResult", "GATES", "GATE_UNITS", "GateContext", "run_checks", "summarize"]
 
-#: A gate's outcome is the suite's one verdict type.
+#: Former name of the gates' result type, kept for compatibility: it *is* :class:`Verdict`.
 CheckResult = Verdict
 
 
-def _at_most(name: str, measured: float, limit: float, detail: str) -> CheckResult:
-    return at_most(name, measured, limit, detail)
+@dataclasses.dataclass
+class GateContext:
+    """What a gate sees: the configuration and the options of this run.
+
+    Results shared by several gates (the corrected PTO's closed-loop properties)
+    are computed once per context, so one ``run_checks`` call simulates them once.
+
+    Attributes
+    ----------
+    cfg : Config
+        Configuration under test.
+    max_iter : int or None
+        Cap on IPOPT iterations (None: the solvers' own caps).
+    """
+
+    cfg: Config
+    max_iter: int | None = None
+
+    def solver_caps(self) -> dict[str, int]:
+        """Return keyword arguments capping IPOPT (empty without a cap)."""
+        return {} if self.max_iter is None else {"max_iter": self.max_iter}
+
+    @functools.cached_property
+    def pto_properties(self):
+        """Closed-loop properties of the corrected PTO law over the default grid."""
+        from ptoverify.laws import make_law
+        from ptoverify.properties import law_properties
+
+        return law_properties(make_law("pto", self.cfg), self.cfg)
 
 
-Gate = Callable[[Config], CheckResult]
+Gate = Callable[[Config | GateContext], Verdict]
 GATES: dict[str, Gate] = {}
+#: Unit of each gate's measured figure and limit (``"1"``: dimensionless).
+GATE_UNITS: dict[str, str] = {}
 
 
-def gate(name: str) -> Callable[[Callable[[Config], CheckResult]], Gate]:
-    """Register a gate under ``name``; exceptions make it ``unverified``."""
+def gate(name: str, unit: str) -> Callable[[Callable[[GateContext], Verdict]], Gate]:
+    """Register a gate under ``name`` measuring in ``unit``; exceptions make it ``unverified``.
 
-    def wrap(fn: Callable[[Config], CheckResult]) -> Gate:
+    Parameters
+    ----------
+    name : str
+        Stable gate name.
+    unit : str
+        Unit of the measured figure and its limit (``"1"`` when dimensionless).
+
+    Returns
+    -------
+    callable
+        Decorator registering ``fn(ctx) -> Verdict`` in :data:`GATES`.
+    """
+
+    def wrap(fn: Callable[[GateContext], Verdict]) -> Gate:
         @functools.wraps(fn)
-        def safe(cfg: Config) -> CheckResult:
+        def safe(ctx: Config | GateContext) -> Verdict:
+            if isinstance(ctx, Config):
+                ctx = GateContext(ctx)
             try:
-                return fn(cfg)
+                res = fn(ctx)
             except SolverError as exc:
-                return CheckResult(name, UNVERIFIED, None, None, f"solver failed: {exc}")
+                res = Verdict(name, UNVERIFIED, None, None, f"solver failed: {exc}")
             except Exception as exc:  # noqa: BLE001 - a gate fails closed on any fault
-                return CheckResult(
+                res = Verdict(
                     name,
                     UNVERIFIED,
                     None,
                     None,
                     f"could not be computed: {type(exc).__name__}: {exc}",
                 )
+            return dataclasses.replace(res, unit=unit)
 
         GATES[name] = safe
+        GATE_UNITS[name] = unit
         return safe
 
     return wrap
@@ -73,13 +123,14 @@ def _random_states(cfg: Config, n: int, seed: int, vmax: float = 1.0) -> tuple[n
 
 
 # ------------------------------------------------------------------ core gates
-@gate("zoh-vs-integrator")
-def _zoh_vs_integrator(cfg: Config) -> CheckResult:
+@gate("zoh-vs-integrator", "1")
+def _zoh_vs_integrator(ctx: GateContext) -> Verdict:
     """Exact one-sample map against an adaptive ODE integrator at rtol 1e-12."""
     from scipy.integrate import solve_ivp
 
     from ptoverify.plant import step
 
+    cfg = ctx.cfg
     p = cfg.plant
     x1, x2 = _random_states(cfg, 40, 11, 1.5)
     u = np.random.default_rng(12).uniform(-p.w_max, p.w_max, 40)
@@ -98,7 +149,7 @@ def _zoh_vs_integrator(cfg: Config) -> CheckResult:
         err = max(
             err, abs(sol.y[0, -1] - y1[i]) / scale, abs(sol.y[1, -1] - y2[i]) / (1.0 + abs(x2[i]))
         )
-    return _at_most(
+    return at_most(
         "zoh-vs-integrator",
         err,
         1e-9,
@@ -108,8 +159,8 @@ def _zoh_vs_integrator(cfg: Config) -> CheckResult:
     )
 
 
-@gate("roots-closed-form-vs-bisection")
-def _roots(cfg: Config) -> CheckResult:
+@gate("roots-closed-form-vs-bisection", "1")
+def _roots(ctx: GateContext) -> Verdict:
     """Lambert-W closed forms of eqs. (22), (26)/(31) against bisection to the last bit."""
     from ptoverify.curves import root_22, root_22_bisect, root_k, root_k_bisect
 
@@ -118,7 +169,7 @@ def _roots(cfg: Config) -> CheckResult:
     m = np.concatenate([rng.uniform(0, 0.999, 2000), 10 ** rng.uniform(-12, -0.01, 2000)])
     e22 = np.max(np.abs(root_22(b0) - root_22_bisect(b0)) / root_22_bisect(b0))
     ek = np.max(np.abs(root_k(m) - root_k_bisect(m)) / root_k_bisect(m))
-    return _at_most(
+    return at_most(
         "roots-closed-form-vs-bisection",
         max(e22, ek),
         1e-13,
@@ -127,12 +178,13 @@ def _roots(cfg: Config) -> CheckResult:
     )
 
 
-@gate("mintime-closed-form-vs-propagation")
-def _mintime_propagation(cfg: Config) -> CheckResult:
+@gate("mintime-closed-form-vs-propagation", "1")
+def _mintime_propagation(ctx: GateContext) -> Verdict:
     """Closed-form t_f and switch: the two arcs of the exact flow end at the origin."""
     from ptoverify.mintime import min_time
     from ptoverify.plant import flow
 
+    cfg = ctx.cfg
     p = cfg.plant
     x1, x2 = _random_states(cfg, 20000, 14, 1.5)
     mt = min_time(x1, x2, p)
@@ -141,7 +193,7 @@ def _mintime_propagation(cfg: Config) -> CheckResult:
     # a miss of dz in position is a time error of about dz / |x2 near the end|; normalise by
     # the state's scale: round-off of eq. (7) over the two arcs
     miss = np.max(np.abs(z1) / (1 + np.abs(x1)) + np.abs(z2) / (p.w_max + np.abs(x2)))
-    return _at_most(
+    return at_most(
         "mintime-closed-form-vs-propagation",
         miss,
         1e-11,
@@ -150,11 +202,12 @@ def _mintime_propagation(cfg: Config) -> CheckResult:
     )
 
 
-@gate("input-bound")
-def _input_bound(cfg: Config) -> CheckResult:
+@gate("input-bound", "mm/s")
+def _input_bound(ctx: GateContext) -> Verdict:
     """|u| <= w_max for every law over a dense random cloud of states."""
     from ptoverify.laws import LAW_NAMES, make_law
 
+    cfg = ctx.cfg
     x1, x2 = _random_states(cfg, 200000, 15, 2.0)
     x1 = np.concatenate([x1, x1 * 1e-3])
     x2 = np.concatenate([x2, x2 * 1e-3])
@@ -162,7 +215,7 @@ def _input_bound(cfg: Config) -> CheckResult:
     for name in LAW_NAMES:
         u, _ = make_law(name, cfg)(x1, x2)
         if not np.all(np.isfinite(u)):
-            return CheckResult(
+            return Verdict(
                 "input-bound",
                 FAIL,
                 math.inf,
@@ -171,7 +224,7 @@ def _input_bound(cfg: Config) -> CheckResult:
             )
         worst = max(worst, float(np.max(np.abs(u))))
         names.append(name)
-    return _at_most(
+    return at_most(
         "input-bound",
         worst,
         cfg.plant.w_max,
@@ -180,17 +233,18 @@ def _input_bound(cfg: Config) -> CheckResult:
     )
 
 
-@gate("odd-symmetry")
-def _odd_symmetry(cfg: Config) -> CheckResult:
+@gate("odd-symmetry", "mm/s")
+def _odd_symmetry(ctx: GateContext) -> Verdict:
     """u(-x) = -u(x) for every law (the plant is odd, so the laws must be)."""
     from ptoverify.laws import LAW_NAMES, make_law
 
+    cfg = ctx.cfg
     x1, x2 = _random_states(cfg, 100000, 16, 1.5)
     worst = 0.0
     for name in LAW_NAMES:
         law = make_law(name, cfg)
         worst = max(worst, float(np.max(np.abs(law(x1, x2)[0] + law(-x1, -x2)[0]))))
-    return _at_most(
+    return at_most(
         "odd-symmetry",
         worst,
         1e-9 * cfg.plant.w_max,
@@ -199,50 +253,50 @@ def _odd_symmetry(cfg: Config) -> CheckResult:
 
 
 # ------------------------------------------------------------ ground-truth gates
-_OPTIONS: dict[str, Any] = {"max_iter": None}
-
-
-def _solver_caps() -> dict[str, int]:
-    """IPOPT iteration cap set by ``run_checks(max_iter=...)`` (none by default)."""
-    return {} if _OPTIONS["max_iter"] is None else {"max_iter": _OPTIONS["max_iter"]}
-
-
 def _gt_states(cfg: Config, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     return _random_states(cfg, n, seed, 0.95)
 
 
 def _ocp_vs_closed_form(
-    name: str, cfg: Config, ocp, n: int, seed: int, limit: float, detail: str
-) -> CheckResult:
-    """Worst relative t_f difference of an OCP solver from the closed form over n states."""
+    name: str, cfg: Config, ocp, verify, n: int, seed: int, limit: float, detail: str
+) -> Verdict:
+    """Worst relative t_f difference of a verified OCP answer from the closed form.
+
+    ``verify`` is the a-posteriori check of :mod:`ptoverify.groundtruth` (the one
+    definition of a verified answer): an answer that did not converge, or converged
+    but fails its check, makes the gate ``unverified``.
+    """
     from ptoverify.mintime import min_time
 
     x1, x2 = _gt_states(cfg, n, seed)
     mt = min_time(x1, x2, cfg.plant)
     worst = 0.0
     for i in range(n):
-        res = ocp.solve(float(x1[i]), float(x2[i]))
+        res = verify(ocp.solve(float(x1[i]), float(x2[i])), float(x1[i]), float(x2[i]), cfg.plant)
         if not res.success:
-            return CheckResult(
+            return Verdict(
                 name,
                 UNVERIFIED,
                 None,
                 limit,
-                f"IPOPT did not converge at ({x1[i]:.4g}, {x2[i]:.4g}): {res.status}",
+                f"no verified answer at ({x1[i]:.4g}, {x2[i]:.4g}): {res.status}",
             )
         worst = max(worst, abs(res.t_f - mt.t_f[i]) / mt.t_f[i])
-    return _at_most(name, worst, limit, detail)
+    return at_most(name, worst, limit, detail)
 
 
-@gate("mintime-closed-form-vs-two-phase")
-def _two_phase(cfg: Config) -> CheckResult:
+@gate("mintime-closed-form-vs-two-phase", "1")
+def _two_phase(ctx: GateContext) -> Verdict:
     """CasADi two-phase OCP (IPOPT) against the closed-form minimum time."""
+    from ptoverify.groundtruth import verify_two_phase
     from ptoverify.ocp import TwoPhaseOCP
 
+    cfg = ctx.cfg
     return _ocp_vs_closed_form(
         "mintime-closed-form-vs-two-phase",
         cfg,
-        TwoPhaseOCP(cfg.plant, **_solver_caps()),
+        TwoPhaseOCP(cfg.plant, **ctx.solver_caps()),
+        verify_two_phase,
         30,
         21,
         1e-9,
@@ -251,15 +305,18 @@ def _two_phase(cfg: Config) -> CheckResult:
     )
 
 
-@gate("mintime-closed-form-vs-collocation")
-def _collocation(cfg: Config) -> CheckResult:
+@gate("mintime-closed-form-vs-collocation", "1")
+def _collocation(ctx: GateContext) -> Verdict:
     """CasADi Radau collocation (N = 100) against the closed-form minimum time."""
+    from ptoverify.groundtruth import verify_collocation
     from ptoverify.ocp import CollocationOCP
 
+    cfg = ctx.cfg
     return _ocp_vs_closed_form(
         "mintime-closed-form-vs-collocation",
         cfg,
-        CollocationOCP(cfg.plant, intervals=100, **_solver_caps()),
+        CollocationOCP(cfg.plant, intervals=100, **ctx.solver_caps()),
+        verify_collocation,
         8,
         22,
         5e-4,
@@ -269,18 +326,19 @@ def _collocation(cfg: Config) -> CheckResult:
     )
 
 
-@gate("discrete-limit-consistency")
-def _discrete(cfg: Config) -> CheckResult:
+@gate("discrete-limit-consistency", "1")
+def _discrete(ctx: GateContext) -> Verdict:
     """N*: N* T >= t_f*, the sequence reaches the origin, N* - 1 infeasible, zonotope = LP."""
     from ptoverify.mintime import ZOHReach, discrete_min_steps, discrete_min_steps_batch, min_time
 
+    cfg = ctx.cfg
     x1, x2 = _gt_states(cfg, 25, 23)
     reach = ZOHReach(cfg.plant)
     worst_gap, lp_steps = math.inf, []
     for i in range(len(x1)):
         dm = discrete_min_steps(float(x1[i]), float(x2[i]), cfg.plant)
         if not dm.success:
-            return CheckResult(
+            return Verdict(
                 "discrete-limit-consistency",
                 UNVERIFIED,
                 None,
@@ -291,7 +349,7 @@ def _discrete(cfg: Config) -> CheckResult:
         t_f = float(min_time(x1[i], x2[i], cfg.plant).t_f)
         ok_prev, _, why = reach.feasible(float(x1[i]), float(x2[i]), dm.steps - 1)
         if ok_prev:
-            return CheckResult(
+            return Verdict(
                 "discrete-limit-consistency",
                 FAIL,
                 None,
@@ -300,7 +358,7 @@ def _discrete(cfg: Config) -> CheckResult:
                 ">=",
             )
         if why != "infeasible":
-            return CheckResult(
+            return Verdict(
                 "discrete-limit-consistency",
                 UNVERIFIED,
                 None,
@@ -310,7 +368,7 @@ def _discrete(cfg: Config) -> CheckResult:
                 ">=",
             )
         if abs(dm.end[0]) > 1e-9 or abs(dm.end[1]) > 1e-6:
-            return CheckResult(
+            return Verdict(
                 "discrete-limit-consistency",
                 FAIL,
                 None,
@@ -324,7 +382,7 @@ def _discrete(cfg: Config) -> CheckResult:
     off = np.flatnonzero(zono != np.array(lp_steps))
     if off.size:
         i = int(off[0])
-        return CheckResult(
+        return Verdict(
             "discrete-limit-consistency",
             FAIL,
             None,
@@ -333,7 +391,7 @@ def _discrete(cfg: Config) -> CheckResult:
             f"({off.size} of {len(x1)} states disagree)",
             ">=",
         )
-    res = CheckResult(
+    res = Verdict(
         "discrete-limit-consistency",
         PASS if worst_gap >= 0 else FAIL,
         worst_gap,
@@ -348,8 +406,8 @@ def _discrete(cfg: Config) -> CheckResult:
 
 
 # ------------------------------------------------------------ derivation gate
-@gate("derivation-identities-vs-numerics")
-def _derivations(cfg: Config) -> CheckResult:
+@gate("derivation-identities-vs-numerics", "1")
+def _derivations(ctx: GateContext) -> Verdict:
     """SymPy results (flow by dsolve, min-time closed form) lambdified against the numerics."""
     import sympy as sp
 
@@ -358,6 +416,7 @@ def _derivations(cfg: Config) -> CheckResult:
     from ptoverify.mintime import min_time
     from ptoverify.plant import flow as flow_num
 
+    cfg = ctx.cfg
     p = cfg.plant
     a, w, t, u, x10, x20 = (S[n] for n in ("a", "omega_m", "t", "u", "x10", "x20"))
     fx1, fx2 = (sp.lambdify((x10, x20, u, t, a), e, "numpy") for e in flow(u))
@@ -384,7 +443,7 @@ def _derivations(cfg: Config) -> CheckResult:
             ref = f_tf(mpmath.mpf(r1[i]), mpmath.mpf(r2[i]), mpmath.mpf(p.a), mpmath.mpf(p.w_max))
             e_tf = max(e_tf, abs(float(mpmath.re(ref)) - mt.t_f[i]) / mt.t_f[i])
     worst = max(e_flow, e_tf)
-    return _at_most(
+    return at_most(
         "derivation-identities-vs-numerics",
         worst,
         1e-12,
@@ -396,18 +455,19 @@ def _derivations(cfg: Config) -> CheckResult:
 
 
 # ------------------------------------------------------------ PTO / zone / pole gates
-@gate("zone-corrected-valid")
-def _zone_valid(cfg: Config) -> CheckResult:
+@gate("zone-corrected-valid", "1")
+def _zone_valid(ctx: GateContext) -> Verdict:
     """Check that the corrected zone exists, acts, and holds on the grid."""
     from ptoverify.zones import corrected_zone
 
+    cfg = ctx.cfg
     z = corrected_zone(cfg)
     if not z.valid:
-        measured = float(z.grid_violations) if z.grid_violations > 0 else None
-        return CheckResult(
+        measured = float(z.grid_violations) if (z.grid_violations or 0) > 0 else None
+        return Verdict(
             "zone-corrected-valid", FAIL, measured, 0.0, f"no valid corrected zone: {z.reason}"
         )
-    return CheckResult(
+    return Verdict(
         "zone-corrected-valid",
         PASS if z.grid_violations == 0 else FAIL,
         float(z.grid_violations),
@@ -417,19 +477,11 @@ def _zone_valid(cfg: Config) -> CheckResult:
     )
 
 
-@functools.lru_cache(maxsize=4)
-def _pto_properties(cfg: Config):
-    from ptoverify.laws import make_law
-    from ptoverify.properties import law_properties
-
-    return law_properties(make_law("pto", cfg), cfg)
-
-
-@gate("no-stride-over")
-def _no_stride(cfg: Config) -> CheckResult:
+@gate("no-stride-over", "1")
+def _no_stride(ctx: GateContext) -> Verdict:
     """Corrected PTO: no sampled state strides over the switching zone."""
-    pr = _pto_properties(cfg)
-    return _at_most(
+    pr = ctx.pto_properties
+    return at_most(
         "no-stride-over",
         float(pr.stride_overs),
         0.0,
@@ -439,11 +491,11 @@ def _no_stride(cfg: Config) -> CheckResult:
     )
 
 
-@gate("no-limit-cycle")
-def _no_limit_cycle(cfg: Config) -> CheckResult:
+@gate("no-limit-cycle", "1")
+def _no_limit_cycle(ctx: GateContext) -> Verdict:
     """Corrected PTO: no sustained oscillation at the end of the horizon."""
-    pr = _pto_properties(cfg)
-    return _at_most(
+    pr = ctx.pto_properties
+    return at_most(
         "no-limit-cycle",
         float(pr.limit_cycles + pr.not_settled),
         0.0,
@@ -453,13 +505,13 @@ def _no_limit_cycle(cfg: Config) -> CheckResult:
     )
 
 
-def _loop_gate(name: str, which: str, cfg: Config) -> CheckResult:
+def _loop_gate(name: str, which: str, cfg: Config) -> Verdict:
     from ptoverify.poles import all_loop_poles
 
     lp = all_loop_poles(cfg)[which]
     radius = max(lp.sampled_moduli)
     if lp.pole_mismatch > 1e-9:
-        return CheckResult(
+        return Verdict(
             name,
             UNVERIFIED,
             radius,
@@ -467,7 +519,7 @@ def _loop_gate(name: str, which: str, cfg: Config) -> CheckResult:
             f"python-control and numpy disagree on the sampled poles by {lp.pole_mismatch:.2e}",
         )
     status = PASS if radius < 1.0 else FAIL
-    return CheckResult(
+    return Verdict(
         name,
         status,
         radius,
@@ -480,21 +532,23 @@ def _loop_gate(name: str, which: str, cfg: Config) -> CheckResult:
     )
 
 
-@gate("pd-sampled-stable")
-def _pd_stable(cfg: Config) -> CheckResult:
+@gate("pd-sampled-stable", "1")
+def _pd_stable(ctx: GateContext) -> Verdict:
     """Check that the PD loop sampled with ZOH at T is stable."""
+    cfg = ctx.cfg
     return _loop_gate("pd-sampled-stable", "pd", cfg)
 
 
-@gate("linear-zone-sampled-stable")
-def _linear_stable(cfg: Config) -> CheckResult:
+@gate("linear-zone-sampled-stable", "1")
+def _linear_stable(ctx: GateContext) -> Verdict:
     """Check that the linear-zone loop (eq. 37) sampled with ZOH at T is stable."""
+    cfg = ctx.cfg
     return _loop_gate("linear-zone-sampled-stable", "linear", cfg)
 
 
 # ------------------------------------------------------------ Section 6 gate
-@gate("claims-computed")
-def _claims_computed(cfg: Config) -> CheckResult:
+@gate("claims-computed", "1")
+def _claims_computed(ctx: GateContext) -> Verdict:
     """Every Section 6 claim has a verdict computed from simulation under every reading.
 
     The verdicts themselves (reproduced or not) are findings of the report, not
@@ -502,6 +556,7 @@ def _claims_computed(cfg: Config) -> CheckResult:
     """
     from ptoverify.claims import evaluate_claims
 
+    cfg = ctx.cfg
     allowed = {"reproduced", "not reproduced", "ambiguous"}
     results = evaluate_claims(cfg)
 
@@ -519,7 +574,7 @@ def _claims_computed(cfg: Config) -> CheckResult:
         or any(not measured(r.values) or r.verdict not in allowed for r in c.readings)
     ]
     readings = sum(len(c.readings) for c in results)
-    return _at_most(
+    return at_most(
         "claims-computed",
         float(len(missing)),
         0.0,
@@ -529,8 +584,8 @@ def _claims_computed(cfg: Config) -> CheckResult:
 
 
 def run_checks(
-    cfg: Config, names: list[str] | None = None, max_iter: int | None = None
-) -> list[CheckResult]:
+    cfg: Config, names: list[str] | None = None, *, max_iter: int | None = None
+) -> list[Verdict]:
     """Run the gates (all, or the named ones) in registration order.
 
     Parameters
@@ -545,16 +600,23 @@ def run_checks(
 
     Returns
     -------
-    list of CheckResult
+    list of Verdict
+        One per gate run, each with its unit.
+
+    Raises
+    ------
+    InputError
+        A name that is not a gate.
     """
-    _OPTIONS["max_iter"] = max_iter
-    try:
-        return [fn(cfg) for name, fn in GATES.items() if names is None or name in names]
-    finally:
-        _OPTIONS["max_iter"] = None
+    if names is not None:
+        unknown = [g for g in names if g not in GATES]
+        if unknown:
+            raise InputError(f"unknown gate '{unknown[0]}' (choose from {', '.join(GATES)})")
+    ctx = GateContext(cfg, max_iter=max_iter)
+    return [fn(ctx) for name, fn in GATES.items() if names is None or name in names]
 
 
-def summarize(results: list[CheckResult]) -> dict[str, Any]:
+def summarize(results: list[Verdict]) -> dict[str, Any]:
     """Count statuses; ``ok`` is True only when every gate passed."""
     counts = {s: sum(r.status == s for r in results) for s in (PASS, FAIL, UNVERIFIED)}
     return {"total": len(results), **counts, "ok": counts[PASS] == len(results)}

@@ -49,6 +49,19 @@ verdicts and the rule texts read them from there.
 * "Lags by a large value": the mean ramp error exceeds d, the paper's linear
   zone (1 % of the position range, its own scale for "close to the target").
 * "Faster", "more stable", "quicker": strict inequalities of the metric.
+* Time metrics (settling, rise time), overshoots and phase delays are measured
+  between the samples, on the exact continuous trajectory
+  (:mod:`ptoverify.exact`), and every verdict is decided on those values.  Two
+  exact values closer than the sum of their accuracies (:attr:`Compared.accuracy
+  <ptoverify.exact.Compared.accuracy>`: brentq's tolerance and the round-off of
+  the flow over the crossed signal's slope, ~1e-15 s here) are a true tie: the
+  strict inequality does not hold, and the reading lists the tie in ``ties`` and
+  its detail.  The same rule is also applied to the sample-grid values (which
+  tie when equal, at one sample); each reading carries ``measured_grid``,
+  ``values_grid``, ``verdict_grid`` and ``verdict_differs_on_grid``, so a reader
+  sees where reading the samples would have decided otherwise.  Oscillation
+  amplitudes, sign reversals, ramp lag and the fit residual stay properties of
+  the sampled sequence.
 * A qualitative claim whose metric cannot be measured (a law never settles)
   is ``not reproduced`` under that reading, and the detail says why.
 
@@ -62,13 +75,14 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
 
 from ptoverify import metrics as mt
 from ptoverify.config import Config
+from ptoverify.exact import Compared, ExactMetrics, exact_metrics
 from ptoverify.laws import Law, make_law
 from ptoverify.simulate import SimResult, simulate
 
@@ -78,6 +92,7 @@ __all__ = [
     "ClaimResult",
     "CLAIMS",
     "evaluate_claims",
+    "response_metrics",
     "VERDICTS",
     "numeric_verdict",
 ]
@@ -157,6 +172,16 @@ class ReadingResult:
         ``reproduced`` or ``not reproduced``.
     detail : str
         The comparison, in words with the numbers.
+    measured_grid : float or None
+        The headline number with every time metric read on the sample grid.
+    values_grid : dict
+        ``values`` with every time metric read on the sample grid.
+    verdict_grid : str
+        The verdict the same rule gives on the grid values (grid values tie
+        only when equal).
+    ties : tuple of str
+        True ties between exact values met by a comparison (the claim's strict
+        inequality then does not hold), e.g. ``rise_time_pto_s = rise_time_pd_s``.
     """
 
     reading: Reading
@@ -165,6 +190,15 @@ class ReadingResult:
     values: dict
     verdict: str
     detail: str
+    measured_grid: float | None = None
+    values_grid: dict = field(default_factory=dict)
+    verdict_grid: str = ""
+    ties: tuple[str, ...] = ()
+
+    @property
+    def differs_on_grid(self) -> bool:
+        """Whether the verdict on the sample grid would differ from the exact one."""
+        return bool(self.verdict_grid) and self.verdict_grid != self.verdict
 
     def to_json(self) -> dict:
         """Return a JSON-able dict."""
@@ -175,6 +209,11 @@ class ReadingResult:
             "values": dict(self.values),
             "verdict": self.verdict,
             "detail": self.detail,
+            "measured_grid": self.measured_grid,
+            "values_grid": dict(self.values_grid),
+            "verdict_grid": self.verdict_grid,
+            "verdict_differs_on_grid": self.differs_on_grid,
+            "ties": list(self.ties),
         }
 
 
@@ -206,6 +245,10 @@ class ClaimResult:
         The primary reading's detail.
     readings : tuple of ReadingResult
         Every reading, the primary first.
+    measured_grid : float or None
+        Headline value under the primary reading, time metrics on the sample grid.
+    verdict_grid : str
+        Overall verdict from the readings' grid verdicts.
     """
 
     id: str
@@ -219,6 +262,13 @@ class ClaimResult:
     measured: float | None
     detail: str
     readings: tuple[ReadingResult, ...]
+    measured_grid: float | None = None
+    verdict_grid: str = ""
+
+    @property
+    def differs_on_grid(self) -> bool:
+        """Whether any reading's verdict, or the overall one, differs on the sample grid."""
+        return self.verdict_grid != self.verdict or any(r.differs_on_grid for r in self.readings)
 
     def to_json(self) -> dict:
         """Return a JSON-able dict."""
@@ -234,6 +284,9 @@ class ClaimResult:
             "measured": self.measured,
             "detail": self.detail,
             "readings": [r.to_json() for r in self.readings],
+            "measured_grid": self.measured_grid,
+            "verdict_grid": self.verdict_grid,
+            "verdict_differs_on_grid": self.differs_on_grid,
         }
 
 
@@ -258,16 +311,26 @@ def _sim(cfg: Config, law: str, signal: str, tracking: str) -> SimResult:
     return simulate(_law(law, cfg), cfg.plant, signal, tracking=_SIM_TRACKING[tracking])
 
 
+@lru_cache(maxsize=512)
+def _metrics(cfg: Config, law: str, signal: str, tracking: str, frac: float) -> ExactMetrics:
+    res = _sim(cfg, law, signal, tracking)
+    return exact_metrics(res, cfg.plant, res.reference, step_fraction=frac)
+
+
 class _Ctx:
     """Access to the responses under one reading."""
 
-    def __init__(self, cfg: Config, reading: Reading, paper: dict[str, float | None]):
+    def __init__(
+        self, cfg: Config, reading: Reading, paper: dict[str, float | None], grid: bool = False
+    ):
         self.cfg = _cfg_for(cfg, reading)
         self.reading = reading
         self.paper = paper  # claim id -> the registry's paper value
         self.tracking = reading.tracking or "feed-forward"
         self.pto = "pto-printed" if reading.pto == "printed" else "pto"
         self.vband = self.cfg.plant.a * mt.TIGHT_BAND
+        self.grid = grid  # decide on the sample-grid values instead of the exact ones
+        self.ties: list[str] = []  # true ties met by the comparisons of this pass
 
     def sim(self, law: str, signal: str) -> SimResult:
         name = self.pto if law == "pto" else law
@@ -284,21 +347,42 @@ class _Ctx:
         amp, rev = mt.oscillation_amplitude(y), mt.sign_reversals(y, band)
         return amp > band and rev >= 2, amp, rev
 
-    def settling(self, law: str) -> float:
-        r = self.sim(law, "step")
+    def metric(self, law: str, signal: str, key: str) -> Compared:
+        """Return a time metric of a response, exact and on the grid (:mod:`ptoverify.exact`)."""
+        name = self.pto if law == "pto" else law
+        tracking = self.tracking if signal != "step" else "feed-forward"
         frac = self.reading.band if self.reading.band is not None else mt.STEP_FRACTION
-        return mt.settling_time(r.t, r.e, frac * abs(float(r.r[-1])))
+        return _metrics(self.cfg, name, signal, tracking, frac).values[key]
+
+    def value(self, m: Compared) -> float:
+        """Return the value this pass decides on: exact, or the grid value in the grid pass."""
+        return m.grid if self.grid else m.exact
+
+    def settling(self, law: str, key: str = "settling_2pct_s") -> float:
+        return self.value(self.metric(law, "step", key))
 
     def overshoot(self, law: str, signal: str = "step") -> float:
-        r = self.sim(law, signal)
-        return mt.overshoot(r.x1, float(r.r[-1]))
+        return self.value(self.metric(law, signal, "overshoot_mm"))
 
     def sine(self, law: str) -> tuple[float, float]:
+        """Phase delay [deg] (between samples) and RMS of x1 minus its fundamental [mm]."""
         r = self.sim(law, "sine")
         f = r.reference.frequency  # the simulated sine's own frequency
-        ref = mt.sine_fit(r.t, r.r, f, t_from=1.0 / f)
         out = mt.sine_fit(r.t, r.x1, f, t_from=1.0 / f)
-        return mt.phase_delay(ref, out), out.residual_rms
+        return self.value(self.metric(law, "sine", "phase_delay_deg")), out.residual_rms
+
+    def less(self, law_a: str, law_b: str, signal: str, key: str, names: tuple[str, str]) -> bool:
+        """Whether law_a's metric is strictly below law_b's; a true tie is recorded and is not.
+
+        Exact values tie within the sum of their accuracies
+        (:meth:`ptoverify.exact.Compared.compare`), grid values only when equal.
+        """
+        a, b = self.metric(law_a, signal, key), self.metric(law_b, signal, key)
+        order = a.compare(b, grid=self.grid)
+        if order == 0:
+            tol = 0.0 if self.grid else a.accuracy + b.accuracy
+            self.ties.append(f"{names[0]} = {names[1]} (|difference| <= {tol:.3g})")
+        return order == -1
 
 
 Outcome = tuple[float | None, dict, bool, str]
@@ -315,7 +399,7 @@ def _near(measured: float, cl: _Claim) -> bool:
 
 
 def _ms(x: float) -> str:
-    return "never" if not math.isfinite(x) else f"{1e3 * x:.0f} ms"
+    return "never" if not math.isfinite(x) else f"{1e3 * x:.2f} ms"
 
 
 # ------------------------------------------------------------------ the claims
@@ -356,7 +440,8 @@ def _step_pto_between(c: _Ctx, cl: _Claim) -> Outcome:
     _, a_pto, _ = c.oscillates("pto", "step")
     _, a_to, _ = c.oscillates("to", "step")
     ts_pto, ts_pd = c.settling("pto"), c.settling("pd")
-    ok = a_pto < a_to and ts_pto < ts_pd
+    names = ("settling_pto_s", "settling_pd_s")
+    ok = a_pto < a_to and c.less("pto", "pd", "step", "settling_2pct_s", names)
     return (
         None,
         {
@@ -408,14 +493,14 @@ def _ramp_pd_lag(c: _Ctx, cl: _Claim) -> Outcome:
 def _ramp_pto_smooth(c: _Ctx, cl: _Claim) -> Outcome:
     r = c.sim("pto", "ramp")
     rev = mt.sign_reversals(r.e, mt.TIGHT_BAND)
-    ts = mt.settling_time(r.t, r.e, mt.TIGHT_BAND)
+    ts = c.value(c.metric("pto", "ramp", "settling_0p01mm_s"))
     ok = rev == 0 and math.isfinite(ts)
     return (
         float(rev),
         {
             "error_reversals": rev,
             "settling_tight_s": ts,
-            "overshoot_mm": mt.overshoot(r.x1, float(r.r[-1])),
+            "overshoot_mm": c.overshoot("pto", "ramp"),
         },
         ok,
         f"PTO ramp error: {rev} sign reversals outside 0.01 mm; settles to 0.01 mm at {_ms(ts)}",
@@ -482,7 +567,8 @@ def _conclusion(c: _Ctx, cl: _Claim) -> Outcome:
     osc_to, a_to, _ = c.oscillates("to", "step")
     os_pto, os_to = c.overshoot("pto"), c.overshoot("to")
     ts_pto, ts_pd = c.settling("pto"), c.settling("pd")
-    ok = (not osc_pto) and osc_to and os_pto <= mt.TIGHT_BAND < os_to and ts_pto < ts_pd
+    quicker = c.less("pto", "pd", "step", "settling_2pct_s", ("settling_pto_s", "settling_pd_s"))
+    ok = (not osc_pto) and osc_to and os_pto <= mt.TIGHT_BAND < os_to and quicker
     return (
         None,
         {
@@ -503,11 +589,8 @@ def _conclusion(c: _Ctx, cl: _Claim) -> Outcome:
 
 
 def _quicker(c: _Ctx, cl: _Claim) -> Outcome:
-    rt = {}
-    for law in ("pto", "pd"):
-        r = c.sim(law, "step")
-        rt[law] = mt.rise_time(r.t, r.x1, float(r.r[-1]))
-    ok = rt["pto"] < rt["pd"]
+    rt = {law: c.value(c.metric(law, "step", "rise_time_s")) for law in ("pto", "pd")}
+    ok = c.less("pto", "pd", "step", "rise_time_s", ("rise_time_pto_s", "rise_time_pd_s"))
     return (
         rt["pto"],
         {"rise_time_pto_s": rt["pto"], "rise_time_pd_s": rt["pd"]},
@@ -710,18 +793,37 @@ def _readings(cfg: Config, dims: tuple[str, ...]) -> list[Reading]:
     return [Reading(a, ff, pto, band) for a, ff, pto, band in itertools.product(*axes)]
 
 
+def _finite(x: float | None) -> float | None:
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
+def _overall(verdicts: set[str]) -> str:
+    return verdicts.pop() if len(verdicts) == 1 else "ambiguous"
+
+
 def _evaluate(cfg: Config, cl: _Claim, paper: dict[str, float | None]) -> ClaimResult:
     results = []
     for rd in _readings(cfg, cl.dims):
-        measured, values, ok, detail = cl.measure(_Ctx(cfg, rd, paper), cl)
-        m = None if measured is None or not math.isfinite(measured) else float(measured)
+        exact = _Ctx(cfg, rd, paper)
+        measured, values, ok, detail = cl.measure(exact, cl)
+        grid = _Ctx(cfg, rd, paper, grid=True)
+        measured_g, values_g, ok_g, _ = cl.measure(grid, cl)
+        if exact.ties:
+            detail += "; true tie between samples: " + ", ".join(exact.ties)
         results.append(
             ReadingResult(
-                rd, rd.label(cfg), m, values, "reproduced" if ok else "not reproduced", detail
+                rd,
+                rd.label(cfg),
+                _finite(measured),
+                values,
+                "reproduced" if ok else "not reproduced",
+                detail,
+                _finite(measured_g),
+                values_g,
+                "reproduced" if ok_g else "not reproduced",
+                tuple(exact.ties),
             )
         )
-    verdicts = {r.verdict for r in results}
-    overall = verdicts.pop() if len(verdicts) == 1 else "ambiguous"
     p = results[0]
     return ClaimResult(
         cl.id,
@@ -731,10 +833,12 @@ def _evaluate(cfg: Config, cl: _Claim, paper: dict[str, float | None]) -> ClaimR
         cl.paper_value,
         cl.unit,
         cl.rule,
-        overall,
+        _overall({r.verdict for r in results}),
         p.measured,
         p.detail,
         tuple(results),
+        p.measured_grid,
+        _overall({r.verdict_grid for r in results}),
     )
 
 
@@ -769,3 +873,48 @@ def evaluate_claims(cfg: Config, claims: tuple[_Claim, ...] | None = None) -> li
     True
     """
     return list(_evaluate_all(cfg, CLAIMS if claims is None else tuple(claims)))
+
+
+@lru_cache(maxsize=8)
+def _response_metrics(cfg: Config) -> dict[str, dict[str, dict[str, float]]]:
+    out: dict[str, dict[str, dict[str, float]]] = {}
+    for law in ("to", "pd", "pto", "pto-printed"):
+        d = {"to": None, "pd": math.inf}.get(law, cfg.pto.d)
+        out[law] = {
+            sig: mt.summarize(_sim(cfg, law, sig, "feed-forward"), cfg.plant, d=d)
+            for sig in ("step", "ramp", "sine")
+        }
+    return out
+
+
+def response_metrics(cfg: Config) -> dict[str, dict[str, dict[str, float]]]:
+    """Metrics of every Section 6 response under the primary reading, exact and on the grid.
+
+    The responses the claims are measured on (a as configured, feed-forward),
+    summarized by :func:`ptoverify.metrics.summarize`: each time metric between
+    samples with its sample-grid twin under ``<key>_grid``, and the linear-zone
+    entry with the law's zone (PTO: |r - x1| <= d; PD: linear everywhere, 0;
+    TO: none, NaN).  For a report to show both values where they differ.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    dict
+        law (``to``, ``pd``, ``pto``, ``pto-printed``) -> signal (``step``,
+        ``ramp``, ``sine``) -> metric name -> value (a new dict over cached values).
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> m = response_metrics(paper_config())["pd"]["step"]
+    >>> m["overshoot_mm"] >= m["overshoot_mm_grid"]
+    True
+    """
+    return {
+        law: {sig: dict(v) for sig, v in by_sig.items()}
+        for law, by_sig in _response_metrics(cfg).items()
+    }

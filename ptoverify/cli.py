@@ -1,14 +1,20 @@
 """Command line: ``ptoverify <command>``; the contract is in shared/DESIGN.md.
 
-Exit codes: 0 success (all gates pass), 1 a gate failed, 2 bad input (one
-line on stderr beginning ``ptoverify: error:``, no traceback, nothing written).
-``--json`` prints one JSON object on stdout and nothing else.
+This module parses arguments, calls one numeric function per command and
+formats its result; it computes nothing itself and imports no solver and no
+simulator.
+
+Exit codes: 0 success (all gates pass); 1 a gate failed, a reference could not
+be computed, or an internal error (a bug: one line ``ptoverify: internal error:
+...``; ``--debug`` shows the traceback); 2 bad input (one line on stderr
+beginning ``ptoverify: error:``, no traceback, nothing written).  ``--json``
+prints one JSON object on stdout and nothing else.  ``--version`` prints the
+version.
 """
 
 from __future__ import annotations
 
 import argparse
-import contextlib
 import csv
 import io
 import json
@@ -17,13 +23,13 @@ import os
 import re
 import sys
 import tempfile
-import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from ptoverify import __version__
 from ptoverify.config import Config, load_config
-from ptoverify.errors import InputError, PtoverifyError, SolverError
+from ptoverify.errors import InputError, SolverError
 from ptoverify.outdir import (
     OutputBusy,
     Terminated,
@@ -51,7 +57,9 @@ class _Parser(argparse.ArgumentParser):
         )
 
     def error(self, message: str):  # noqa: D102
-        raise InputError(f"{self.prog}: {message}")
+        # "ptoverify: error: mintime: ...", not "ptoverify: error: ptoverify mintime: ..."
+        where = self.prog.removeprefix("ptoverify").strip()
+        raise InputError(f"{where}: {message}" if where else message)
 
 
 def finite_float(text: str) -> float:
@@ -148,92 +156,14 @@ def _add_mintime(sub) -> None:
     p.set_defaults(handler=_cmd_mintime)
 
 
-def mintime_result(
-    cfg: Config, x1: float, x2: float, intervals: int, max_iter: int | None = None
-) -> dict[str, Any]:
-    """Compute the ``mintime`` JSON object (DESIGN.md keys plus status keys).
-
-    A reference whose solver did not converge (or an N* search that failed) is
-    reported as null with its status in ``<name>_status``: unverified, never truth.
-    ``max_iter`` caps IPOPT's iterations (default: the solvers' own caps).
-
-    States beyond 1000 x the envelope (|x1| > 1000 position_range or
-    |x2| > 1000 w_max) are rejected (InputError, exit 2).  Inside that, every
-    number is computed; N* is searched up to 20000 samples and is null with
-    ``discrete_status`` "not_found: ..." beyond.
-    """
-    from dataclasses import replace
-
-    import numpy as np
-
-    from ptoverify.mintime import discrete_min_steps, min_time
-    from ptoverify.ocp import CollocationOCP, TwoPhaseOCP
-
-    plant = cfg.plant
-    limit = 1e3 * plant.position_range
-    if abs(x1) > limit or abs(x2) > 1e3 * plant.w_max:
-        raise InputError(
-            f"state ({x1:g}, {x2:g}) is far outside the envelope "
-            f"(|x1| <= {limit:g} mm, |x2| <= {1e3 * plant.w_max:g} mm/s accepted)"
-        )
-    mt = min_time(x1, x2, plant)
-    caps = {} if max_iter is None else {"max_iter": max_iter}
-    tp = TwoPhaseOCP(plant, **caps).solve(x1, x2)
-    co = CollocationOCP(plant, intervals=intervals, **caps).solve(x1, x2)
-    dm = discrete_min_steps(x1, x2, plant)
-
-    from ptoverify.plant import flow
-
-    # a posteriori: IPOPT's "Solve_Succeeded" is not enough; the two-phase arcs, propagated by
-    # the exact flow, must end at the origin (relative to the state's scale), and the
-    # collocation input, re-simulated, must end near it
-    scale = abs(x1) + abs(x2) / plant.a
-    if tp.success and scale > 0:
-        y1, y2 = flow(x1, x2, -tp.side * plant.w_max, tp.t_switch, plant.a)
-        z1, z2 = flow(y1, y2, tp.side * plant.w_max, tp.t_f - tp.t_switch, plant.a)
-        miss = float(np.hypot(z1, z2 / plant.a))
-        if miss > 1e-6 * scale:
-            tp = replace(
-                tp, success=False, status=f"inaccurate: arcs end {miss:.3g} mm from the origin"
-            )
-    if co.success and scale > 0 and co.resim_error > 1e-2 * scale:
-        co = replace(
-            co,
-            success=False,
-            status=f"inaccurate: re-simulation ends {co.resim_error:.3g} mm from the origin",
-        )
-
-    def verified(value: float, ok: bool) -> float | None:
-        return float(value) if ok else None
-
-    return {
-        "x0": [x1, x2],
-        "analytic_s": float(mt.t_f),
-        "switch_time_s": float(mt.t_switch),
-        "two_phase_s": verified(tp.t_f, tp.success),
-        "collocation_s": verified(co.t_f, co.success),
-        "collocation_intervals": intervals,
-        "discrete_steps": dm.steps if dm.success else None,
-        "discrete_s": verified(dm.time_s, dm.success),
-        "two_phase_switch_time_s": verified(tp.t_switch, tp.success),
-        "two_phase_status": tp.status,
-        "two_phase_iterations": tp.iterations,
-        "collocation_status": co.status,
-        "collocation_iterations": co.iterations,
-        "collocation_resim_error_mm": verified(co.resim_error, co.success),
-        "discrete_status": dm.status,
-        "sample_time_s": plant.sample_time,
-    }
-
-
 def _mintime_states(args: argparse.Namespace, cfg: Config) -> int:
-    from ptoverify.mintime import batch_table
+    from ptoverify.commands import mintime_states
 
     if args.x1 is not None:
         raise InputError("give either X1 X2 or --states, not both")
     if args.out is not None and args.json:
         raise InputError("--out and --json are alternatives")
-    cols = batch_table(args.states, cfg)
+    cols = mintime_states(args.states, cfg)
     names = list(cols)
     # N* not found (-1, NaN): null in JSON, an empty field in CSV; floats as repr (round trip)
     rows = [
@@ -256,6 +186,8 @@ def _mintime_states(args: argparse.Namespace, cfg: Config) -> int:
 
 
 def _cmd_mintime(args: argparse.Namespace) -> int:
+    from ptoverify.groundtruth import verified_mintime
+
     cfg = _config(args)
     if args.states is not None:
         return _mintime_states(args, cfg)
@@ -265,7 +197,7 @@ def _cmd_mintime(args: argparse.Namespace) -> int:
         raise InputError("mintime needs X1 X2 or --states IN.csv")
     if args.intervals > 2000:
         raise InputError(f"--intervals must be at most 2000, got {args.intervals}")
-    result = mintime_result(cfg, args.x1, args.x2, args.intervals)
+    result = verified_mintime(args.x1, args.x2, cfg, intervals=args.intervals).to_json()
     if args.json:
         print_json(result)
     else:
@@ -314,33 +246,27 @@ def _add_simulate(sub) -> None:
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
-    from ptoverify.laws import make_law
-    from ptoverify.simulate import reference, simulate
+    from ptoverify.commands import run_simulation
 
     cfg = _config(args)
-    if args.duration is not None and not 0 < args.duration <= 100:
-        raise InputError(f"--duration must be in (0, 100] s, got {args.duration:g}")
     if args.csv is not None and args.json:
         raise InputError("--csv and --json are exclusive")
     if args.csv is not None and (args.csv.strip() == "" or Path(args.csv).is_dir()):
         raise InputError(f"--csv must name a file, got {args.csv!r}")
-    if args.duration is not None and args.duration < cfg.plant.sample_time:
-        raise InputError(
-            f"--duration {args.duration:g} s is shorter than one sample "
-            f"(T = {cfg.plant.sample_time:g} s)"
-        )
-    ref = reference(
+    run = run_simulation(
+        cfg,
+        args.law,
         args.signal,
+        duration=args.duration,
+        feedforward=not args.no_feedforward,
         step=args.step,
         ramp_speed=args.ramp_speed,
         ramp_to=args.ramp_to,
         amplitude=args.amplitude,
         frequency=args.frequency,
     )
-    law = make_law(args.law, cfg)
-    res = simulate(law, cfg.plant, ref, duration=args.duration, feedforward=not args.no_feedforward)
-    cols = res.columns()
     if args.csv is not None:
+        cols = run.result.columns()
         buf = io.StringIO()
         writer = csv.writer(buf, lineterminator="\n")
         writer.writerow(list(cols))
@@ -353,21 +279,14 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
             )
         write_atomic(args.csv, buf.getvalue())
         return 0
-    tail = res.e[len(res.e) // 2 :]
-    summary = {
-        "law": res.law,
-        "signal": res.signal,
-        "feedforward": res.feedforward,
-        "note": law.note,
-        "samples": len(res.t),
-        "final_error_mm": float(res.e[-1]),
-        "max_abs_error_second_half_mm": float(abs(tail).max()),
-    }
     if args.json:
-        print_json({**summary, "series": cols})
+        print_json(run.to_json())
     else:
-        for key, value in summary.items():
+        for key, value in run.summary().items():
             print(f"{key:>30}: {value}")
+        metrics, grid = run.metrics()
+        for key, value in metrics.items():
+            print(f"{key:>30}: {value} (sample grid: {grid[key]})")
     return 0
 
 
@@ -386,8 +305,13 @@ def _add_derive(sub) -> None:
 def _cmd_derive(args: argparse.Namespace) -> int:
     import derivations
 
-    _config(args)
-    records = derivations.all_records()
+    cfg = _config(args)
+    p = cfg.plant
+    records = derivations.all_records(
+        derivations.PlantNumbers(
+            a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
+        )
+    )
     if args.json:
         print_json({"equations": [r.to_json() for r in records]})
     else:
@@ -446,13 +370,9 @@ def _add_check(sub) -> None:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from ptoverify.checks import GATES, run_checks, summarize
+    from ptoverify.checks import run_checks, summarize
 
     cfg = _config(args)
-    if args.gate:
-        unknown = [g for g in args.gate if g not in GATES]
-        if unknown:
-            raise InputError(f"unknown gate '{unknown[0]}' (choose from {', '.join(GATES)})")
     _check_junit(args)
     results = run_checks(cfg, args.gate, max_iter=args.max_iter)
     summary = summarize(results)
@@ -586,14 +506,10 @@ def _add_zone(sub) -> None:
 
 
 def _cmd_zone(args: argparse.Namespace) -> int:
-    from ptoverify.zones import zone_summary
+    from ptoverify.commands import run_zone
 
     cfg = _config(args)
-    result = zone_summary(cfg, verify=not args.no_verify)
-    if not args.no_outcome:
-        from ptoverify.properties import zone_outcome
-
-        result["outcome"] = zone_outcome(cfg)
+    result = run_zone(cfg, verify=not args.no_verify, outcome=not args.no_outcome)
     if args.json:
         print_json(result)
         return 0
@@ -660,7 +576,10 @@ def _cmd_report(args: argparse.Namespace) -> int:
 # ---------------------------------------------------------------- conform
 _CONFORM_EPILOG = """\
 Loading a callable RUNS USER CODE: --law imports the named module (or executes the named
-.py file) in this process. Only the module or file you name is loaded; no path is searched
+.py file) in a child process (spawned; stdout/stderr captured and shown on stderr; memory
+limited to 4 GiB where the OS allows; --timeout for everything, 10 s + 1 ms per state per
+batch); a hang, crash or any exit of it is a finding (exit 1) and the properties it left
+unevaluated are "unverified". Only the module or file you name is loaded; no path is searched
 (MODULE must be importable from sys.path as it stands; give path/to/file.py:FUNCTION for a
 file). The callable is u = f(x1, x2, cfg) with x1 [mm], x2 [mm/s], cfg the ptoverify Config;
 it must accept Python floats and may accept numpy arrays (vectorized use is detected: an
@@ -717,6 +636,14 @@ def _add_conform(sub) -> None:
         metavar="TOL",
         help="agreement tolerance relative to w_max (default 1e-6)",
     )
+    p.add_argument(
+        "--timeout",
+        type=finite_float,
+        default=120.0,
+        metavar="S",
+        help="budget for the whole conformance of a --law [s] (default 120); the law runs "
+        "in a child process, and a hang, crash or exit of it is a finding",
+    )
     _add_junit(p)
     p.set_defaults(handler=_cmd_conform)
 
@@ -741,13 +668,14 @@ def _cmd_conform(args: argparse.Namespace) -> int:
                 }
             )
         return 0
+    if not 0 < args.timeout <= 86400:
+        raise InputError(f"--timeout must be in (0, 86400] s, got {args.timeout:g}")
     if args.table:
         result = conform.conform_table(args.table, cfg, rtol=rtol)
-    else:
-        # user code may print: keep stdout for the one JSON object / the report
-        with contextlib.redirect_stdout(sys.stderr):
-            fn = conform.load_callable(args.law)
-            result = conform.conform_callable(fn, cfg, target=args.law, rtol=rtol)
+    else:  # the law runs in a child process; what it prints goes to stderr afterwards
+        result = conform.conform_spec(args.law, cfg, rtol=rtol, timeout=args.timeout)
+        if result.law_output:
+            print(result.law_output, end="", file=sys.stderr)
     if args.junit:
         from ptoverify.junit import conform_verdicts, junit_xml
 
@@ -784,12 +712,26 @@ def build_parser() -> argparse.ArgumentParser:
         help="TOML configuration (default: the paper's Section 6 values)",
     )
     common.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    common.add_argument(
+        "--debug",
+        action="store_true",
+        default=argparse.SUPPRESS,
+        help="on an internal error, show the traceback",
+    )
     parser = _Parser(
         prog="ptoverify",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         description="Verification suite for the proximate time-optimal (PTO) "
         "control law with bandwidth and saturation.",
         epilog="example:\n  ptoverify report\n  ptoverify check --json",
+    )
+    parser.add_argument(
+        "--version", action="version", version=f"ptoverify {__version__}", help="print the version"
+    )
+    parser.add_argument(
+        "--debug",
+        action="store_true",
+        help="on an internal error (a bug), show the traceback instead of one line",
     )
     sub = parser.add_subparsers(
         dest="command", metavar="COMMAND", required=True, parser_class=_Parser
@@ -807,15 +749,31 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; return the exit code."""
+    """Run the command line; return the exit code.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Arguments (default: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        0 success; 1 a gate failed, a solver failed, or an internal error; 2 bad
+        input; 130 interrupted.
+    """
+    argv = sys.argv[1:] if argv is None else list(argv)
+    debug = "--debug" in argv  # known even if parsing fails
     try:
-        with warnings.catch_warnings():
-            # numeric caveats belong in the results, not on stderr (one line on error)
-            warnings.simplefilter("ignore")
-            args = build_parser().parse_args(argv)
-            with sigterm_raises():
-                return int(args.handler(args))
+        args = build_parser().parse_args(argv)
+        debug = bool(getattr(args, "debug", False))
+        with sigterm_raises():
+            return int(args.handler(args))
     except Terminated:
         print("ptoverify: error: terminated (SIGTERM); nothing written", file=sys.stderr)
         return 143
@@ -823,11 +781,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f"ptoverify: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 1
     except SolverError as exc:
-        print(f"ptoverify: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        print(f"ptoverify: error: {_one_line(exc)}", file=sys.stderr)
         return 1
-    except PtoverifyError as exc:
-        message = " ".join(str(exc).split())
-        print(f"ptoverify: error: {message}", file=sys.stderr)
+    except InputError as exc:
+        print(f"ptoverify: error: {_one_line(exc)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("ptoverify: error: interrupted", file=sys.stderr)
@@ -835,14 +792,15 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # e.g. `ptoverify ... | head`
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    except (MemoryError, OverflowError, ValueError, ZeroDivisionError) as exc:
-        # a configuration inside the validated ranges that still breaks a numeric step
+    except Exception as exc:  # noqa: BLE001 - anything else is a bug, never "bad input"
+        if debug:
+            raise
         print(
-            f"ptoverify: error: the computation failed for this input "
-            f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})",
+            f"ptoverify: internal error: {type(exc).__name__}: {_one_line(exc)[:300]} "
+            "(a bug; rerun with --debug for the traceback)",
             file=sys.stderr,
         )
-        return 2
+        return 1
 
 
 if __name__ == "__main__":

@@ -3,73 +3,64 @@
 ``ptoverify conform`` judges a user's law ``u = f(x1, x2, cfg)`` (a Python
 callable) or a table of its values (CSV, columns x1, x2, u) against the
 reference ``make_law("pto", cfg)`` (corrected omega0) and, for a callable, by
-the closed-loop properties that ``ptoverify check`` gates.
+the closed-loop properties that ``ptoverify check`` gates.  Every property is
+a :class:`ptoverify.verdict.Verdict`; the law conforms only when every one is
+``pass`` (``fail``, ``unverified`` and ``not_run`` fail closed).
 
 Decisions (also in ``ptoverify conform --help``):
 
-Loading
-    ``MODULE:FUNCTION`` imports exactly the named module with
-    :func:`importlib.import_module` (it must be importable from ``sys.path`` as
-    it stands; nothing is added to the path).  ``path/to/file.py:FUNCTION``
-    (the part before the last ``:`` ends in ``.py``) loads exactly that file
-    with :func:`importlib.util.spec_from_file_location`.  No path is ever
-    searched for.  Loading runs the user's code.  FUNCTION may be dotted
-    (``Class.method``).
+Loading and isolation
+    ``MODULE:FUNCTION`` imports exactly the named module; ``path/file.py:FUNCTION``
+    loads exactly that file (:func:`ptoverify.userlaw.load_callable`).  From the
+    command line (:func:`conform_spec`) the law is loaded and called in a child
+    process (multiprocessing ``spawn``), its stdout/stderr captured, its address
+    space limited (RLIMIT_AS, 4 GiB, where the OS has it), the whole conformance
+    bounded by ``--timeout`` (default 120 s) and each batch by 10 s + 1 ms per
+    state.  A timeout, a signal, any exit of the child (code 0 included) or a
+    lost pipe is the finding ``isolation``: every property not evaluated yet is
+    ``unverified``.  :func:`conform_callable` runs a callable in this process
+    (fast path for the reference and tests).
 Interface errors versus findings
-    Everything about the *interface* is bad input (exit 2): the module cannot be
-    imported, the attribute is missing or not callable, its signature does not
-    take (x1, x2, cfg), it returns something that is not a number (scalar mode)
-    or an array of the wrong shape.  Everything about the *values at states* is
-    a finding (exit 1, naming the state): the function raises at a state,
-    returns NaN or an infinity there, or is not a pure function of the state
-    (two calls at the same state differ, e.g. a law with memory or a delay).
-    A law with memory has no u(x) to compare or to simulate state by state in a
-    batch, so after that finding the other properties are ``not_run``.
+    The interface is bad input (exit 2): import error, missing attribute, not
+    callable, wrong signature, a non-number or a wrong shape returned.  Values
+    at states are findings (exit 1, naming the state): the law raises, returns
+    NaN or an infinity (``evaluation``), or is not a deterministic function of
+    the state (``pure-function``).
 Vectorized or scalar
     The law is called with arrays of 8 probe states; if that returns a float
-    array of the same shape that agrees with element-wise calls on Python floats
-    to 1e-12 w_max, the law is used vectorized, otherwise it is wrapped in a
-    scalar loop.  The output says which and why.
-Agreement (:mod:`ptoverify.agreement`)
-    On the conformance grid (:func:`conformance_grid`, what ``--emit-grid``
-    writes) or the table's points: |u - u_ref| <= ``rtol`` w_max, default
-    rtol = 1e-6 (float32 implementations round at ~6e-8 relative, so they pass
-    with headroom, while every seeded fault of the mutation suite is at least
-    two orders of magnitude above).  Reported per reference
-    region: largest |du|, its state, count of points.  Points outside the
-    linear zone within ``tie_band`` (1e-9 (w_max + a position_range) mm/s, the
-    tolerance of ``properties``) of a computed curve, l1/l2 or l1*/l2*, are
-    excluded and counted: there a float tie can flip the region and u jumps
-    by up to 2 w_max.  The linear-zone edge |x1| = d, x2 = 0 and the origin
-    are exact comparisons in floats, so no point near them is excluded.
+    array equal to element-wise calls to 1e-12 w_max it is used vectorized,
+    otherwise in a scalar loop.  The output says which and why.
+Determinism (``pure-function``, every mode)
+    On ``N_DETERMINISM`` states (grid states, 200 of them curve ties, and
+    random states): the same batch twice, shuffled, and in chunks of 1, 2, 3,
+    5, 8, 13, 21 and 34 states must give bit-identical u, and once more after all other
+    calls.  A latch, a cache, a debounce, a delay or a call counter shows here;
+    after this finding the other properties are ``not_run``.
+Agreement (:mod:`ptoverify.agreement`) where the law is used
+    |u - u_ref| <= ``rtol`` w_max (default 1e-6) at the conformance grid
+    (``--emit-grid``), at ``N_RANDOM`` = 100000 seeded uniform states over the
+    envelope, and at every state the closed-loop and settling sweeps visit
+    (their u is the law's, already computed).  Points outside |x1| < d within
+    ``verdict.tie_band`` of l1/l2 or l1*/l2* are excluded and counted.  The
+    largest disc of the envelope with no probed state is reported (``gap``).
+Odd symmetry
+    u(-x) = -u(x) to the agreement tolerance on the grid, curve ties included:
+    on a mirrored tie the law must pick the mirrored branch.
 Closed loop (callable only)
-    The sweep of ``check`` (:func:`ptoverify.properties.initial_grid`, 101 x 101
-    + 200 rest states, vectorized; 21 x 21 + 40 in scalar mode, where every
-    state and sample is a Python call) with the same definitions as
-    :mod:`ptoverify.properties`: stride-overs (sources in a switching zone are
-    judged by the reference's zone geometry, since a user law has no region
-    codes), limit cycles and states not settled within 1e-3 mm, |u| <= w_max.
-    Odd symmetry u(-x) = -u(x) on the grid to the agreement tolerance (as
-    ``check``'s odd-symmetry gate for every law).
-Settling against N* T
-    On a settling sweep (11 x 11 + 20 rest states) N* is the discrete-time
-    limit (fewest ZOH samples to the origin).  The settling step s is the
-    first sample after which |x1| stays within 1e-3 mm.  The excess s - N* of
-    the reference is computed for the same states; a law passes when its
-    worst excess is at most E_ref + max(2, ceil(E_ref / 2)) samples, with
-    E_ref the reference's worst excess: the reference passes with that margin,
-    an implementation that agrees to tolerance moves its settling sample by at
-    most one where a trajectory grazes the band, and a law that loses more
-    than half again what the reference loses to the discrete optimum fails.
-    If N* cannot be established for a state, the property is ``unverified``
-    and the law does not conform (fail closed).
+    The sweep of ``check`` (101 x 101 + 200 states vectorized, 21 x 21 + 40
+    scalar) with :mod:`ptoverify.properties`' definitions: stride-overs, limit
+    cycles or not settled within 1e-3 mm, |u| <= w_max; settling against the
+    discrete-time limit N* (worst excess <= E_ref + max(2, ceil(E_ref / 2))
+    samples, E_ref the reference's worst; ``unverified`` if N* is unknown).
 Tables
-    Only the agreement and |u| <= w_max are judged where the table has points;
-    the closed-loop properties need a callable and are reported ``not_run``.
-    The reference is evaluated at the table's x1, x2 as written, so an
-    implementation that rounds the state (float32 firmware) must write back
-    the state it evaluated: near a curve, a rounded state can lie on the other
-    side, where u differs by up to 2 w_max.
+    Regular files only, parsed in chunks.  States beyond 1000 x the envelope
+    are bad input (as ``mintime``).  ``coverage``: every region the reference
+    has on the conformance grid needs ``MIN_PER_REGION`` judged table states
+    (100; the origin 1), else "insufficient coverage".  Agreement and
+    |u| <= w_max are judged at the table's states; the closed-loop properties
+    need a callable and are ``not_run``.  The reference is evaluated at the
+    table's x1, x2 as written: firmware that rounds the state must write back
+    the state it evaluated.
 """
 
 from __future__ import annotations
@@ -86,43 +77,77 @@ from numpy.typing import NDArray
 
 from ptoverify.agreement import (
     DEFAULT_RTOL,
-    FAIL,
-    NOT_RUN,
-    PASS,
-    UNVERIFIED,
     agreement,
     conformance_grid,
     failure,
     grid_csv,
-    input_bound,
+    largest_gap,
     read_table,
     reference,
+    region_counts,
     ties,
 )
 from ptoverify.config import Config
-from ptoverify.laws import Law
-from ptoverify.userlaw import LawFault, UserLaw, load_callable, wrap_callable
+from ptoverify.errors import InputError
+from ptoverify.laws import Law, Region
+from ptoverify.userlaw import (
+    DEFAULT_TIMEOUT_S,
+    IsolatedLaw,
+    LawAborted,
+    LawFault,
+    UserLaw,
+    load_callable,
+    wrap_callable,
+)
+from ptoverify.verdict import FAIL, NOT_RUN, PASS, UNVERIFIED, Verdict
 
 __all__ = [
     "reference_law",
     "reference_law_scalar",
     "load_callable",
     "UserLaw",
+    "IsolatedLaw",
     "wrap_callable",
     "LawFault",
+    "LawAborted",
     "conformance_grid",
     "grid_csv",
     "read_table",
     "agreement",
     "closed_loop",
+    "determinism",
     "ConformResult",
     "conform_callable",
+    "conform_spec",
     "conform_table",
     "format_result",
     "DEFAULT_RTOL",
+    "DEFAULT_TIMEOUT_S",
+    "N_RANDOM",
+    "N_DETERMINISM",
+    "MIN_PER_REGION",
+    "PROPERTIES",
 ]
 
 _BAND_MM = 1e-3  #: settling / oscillation band [mm], as properties
+N_RANDOM = 100_000  #: seeded uniform agreement states over the envelope
+RANDOM_SEED = 15  #: seed of those states (issue 15)
+N_DETERMINISM = 2000  #: states of the determinism check
+_CHUNKS = (1, 2, 3, 5, 8, 13, 21, 34)  #: chunk sizes of the determinism check, cycled
+MIN_PER_REGION = 100  #: judged table states per reference region (the origin: 1)
+
+#: every property of a callable, in the order they are evaluated
+PROPERTIES = (
+    "pure-function",
+    "agreement",
+    "input-bound-grid",
+    "odd-symmetry",
+    "no-stride-over",
+    "no-limit-cycle",
+    "input-bound",
+    "settling-vs-discrete-limit",
+)
+_CLOSED = PROPERTIES[4:]
 
 
 # ------------------------------------------------------------------ reference
@@ -158,8 +183,78 @@ def reference_law_scalar(x1: float, x2: float, cfg: Config) -> float:
     return reference(cfg).scalar(x1, x2)[0]
 
 
+# ------------------------------------------------------------------ determinism
+def _determinism_states(cfg: Config, grid: tuple[NDArray, NDArray]) -> tuple[NDArray, NDArray]:
+    """Probe-like states: grid points on/near curves and edges, and random states."""
+    rng = np.random.default_rng(RANDOM_SEED + 1)
+    g1, g2 = grid
+    tie = ties(g1, g2, cfg)
+    pick = np.concatenate(
+        [
+            rng.choice(np.flatnonzero(tie), min(200, int(tie.sum())), replace=False),
+            rng.choice(g1.size, min(N_DETERMINISM // 2, g1.size), replace=False),
+        ]
+    )
+    n = N_DETERMINISM - pick.size
+    R, w = cfg.plant.position_range, cfg.plant.w_max
+    x1 = np.concatenate([g1[pick], rng.uniform(-R, R, n)])
+    x2 = np.concatenate([g2[pick], rng.uniform(-w, w, n)])
+    return x1, x2
+
+
+def determinism(user, x1: NDArray, x2: NDArray) -> tuple[NDArray, list[dict]]:
+    """Call the law on the same states twice, shuffled and in chunks; all must agree.
+
+    Parameters
+    ----------
+    user : UserLaw or IsolatedLaw
+        The law.
+    x1, x2 : ndarray
+        States [mm], [mm/s].
+
+    Returns
+    -------
+    u : ndarray
+        u of the first pass [mm/s] (kept for the re-check after all other calls).
+    failures : list of dict
+        One ``pure-function`` failure at the first differing state, or none.
+    """
+    first = user(x1, x2)
+    perm = np.random.default_rng(RANDOM_SEED + 2).permutation(x1.size)
+    shuffled = np.empty_like(first)
+    shuffled[perm] = user(x1[perm], x2[perm])
+    chunked, i, k = np.empty_like(first), 0, 0
+    while i < x1.size:
+        j = min(x1.size, i + _CHUNKS[k % len(_CHUNKS)])
+        chunked[i:j] = user(x1[i:j], x2[i:j])
+        i, k = j, k + 1
+    passes = (("a second call", user(x1, x2)), ("a shuffled call", shuffled))
+    passes += (("calls in chunks of " + "/".join(map(str, _CHUNKS)), chunked),)
+    for how, other in passes:
+        fails = _differs(first, other, x1, x2, how)
+        if fails:
+            return first, fails
+    return first, []
+
+
+def _differs(first, other, x1, x2, how: str) -> list[dict]:
+    diff = first != other
+    if not diff.any():
+        return []
+    i = int(np.argmax(diff))
+    return [
+        failure(
+            "pure-function",
+            (x1[i], x2[i]),
+            f"has memory or is not deterministic: u = {float(first[i])!r} mm/s at the first "
+            f"call, {float(other[i])!r} mm/s at {how} ({int(diff.sum())} of {x1.size} "
+            "states differ)",
+        )
+    ]
+
+
 # ------------------------------------------------------------------ closed loop
-def _as_law(user: UserLaw, cfg: Config) -> Law:
+def _as_law(user, cfg: Config) -> Law:
     """Wrap a user law as a :class:`Law` whose regions are the reference's (geometry)."""
     ref = reference(cfg)
 
@@ -180,24 +275,6 @@ def _first(mask: NDArray[np.bool_]) -> tuple[int, int] | None:
         return None
     j = int(np.argmax(cols))
     return int(np.argmax(mask[:, j])), j
-
-
-def _sweep_analysis(res, x1: NDArray, cfg: Config, band: float, window: int) -> dict:
-    """Masks of :func:`ptoverify.properties.law_properties` (same definitions)."""
-    from ptoverify.properties import _oscillating, crossing_masks
-
-    w = cfg.plant.w_max
-    X1 = res.x1
-    stride, _ = crossing_masks(res.x1, res.x2, res.region, cfg)
-    osc = _oscillating(X1[-window:], band)
-    unsettled = np.abs(X1[-1]) > band
-    return {
-        "stride": stride,
-        "osc": osc,
-        "unsettled": unsettled,
-        "over": np.abs(res.u) > w,
-        "max_u": float(np.abs(res.u).max()),
-    }
 
 
 def _settle_steps(X1: NDArray, band: float) -> NDArray[np.float64]:
@@ -235,50 +312,49 @@ def _settling_reference(cfg: Config) -> dict:
     }
 
 
-def _settling(law: Law, cfg: Config) -> tuple[dict, list[dict]]:
+def _settling(law: Law, cfg: Config, visited: list) -> tuple[Verdict, list[dict]]:
     from ptoverify.simulate import simulate_batch
 
+    name = "settling-vs-discrete-limit"
     ref = _settling_reference(cfg)
-    T = cfg.plant.sample_time
     if ref["failed"] or not math.isfinite(ref["e_ref"]):
-        s = ref["failed"][0] if ref["failed"] else (math.nan, math.nan, "reference unsettled")
-        prop = {
-            "status": UNVERIFIED,
-            "measured": None,
-            "limit": None,
-            "detail": f"N* could not be established at ({s[0]:g}, {s[1]:g}): {s[2]}",
-        }
-        return prop, [failure("settling-vs-discrete-limit", s[:2], prop["detail"])]
+        s = ref["failed"][0] if ref["failed"] else (0.0, 0.0, "reference unsettled")
+        detail = f"N* could not be established at ({s[0]:g}, {s[1]:g}): {s[2]}"
+        return Verdict(name, UNVERIFIED, None, None, detail, "<=", "samples"), [
+            failure(name, s[:2], detail)
+        ]
     res = simulate_batch(law, cfg.plant, ref["x1"], ref["x2"], ref["steps"])
+    visited.append(res)
     s = _settle_steps(res.x1, _BAND_MM)
     excess = s - ref["n_star"]
     e_ref = ref["e_ref"]
     limit = e_ref + max(2.0, math.ceil(e_ref / 2.0))
     worst = float(np.max(excess))
     ratio = float(np.max(s / np.maximum(ref["n_star"], 1.0)))
-    prop = {
-        "status": PASS if worst <= limit else FAIL,
-        "measured": worst,
-        "limit": limit,
-        "detail": f"worst (settling samples - N*) over {s.size} states (settling: |x1| <= "
-        f"{_BAND_MM:g} mm for good); reference worst {e_ref:g} samples; "
-        f"limit E_ref + max(2, ceil(E_ref/2)); worst ratio t_s / (N* T) = "
-        f"{ratio:.3g}",
-        "sample_time_s": T,
-        "worst_ratio_to_nstar": ratio,
-    }
+    v = Verdict(
+        name,
+        PASS if worst <= limit else FAIL,
+        worst,
+        limit,
+        f"worst (settling samples - N*) over {s.size} states (settling: |x1| <= "
+        f"{_BAND_MM:g} mm for good); reference worst {e_ref:g} samples; limit E_ref + "
+        f"max(2, ceil(E_ref/2)); worst ratio t_s / (N* T) = {ratio:.3g} "
+        f"(T = {cfg.plant.sample_time:g} s)",
+        "<=",
+        "samples",
+    )
     fails = []
     if worst > limit:
         i = int(np.argmax(excess > limit))
         fails.append(
             failure(
-                "settling-vs-discrete-limit",
+                name,
                 (ref["x1"][i], ref["x2"][i]),
                 f"settles in {s[i]:g} samples, N* = {ref['n_star'][i]:g} (reference "
                 f"{ref['s_ref'][i]:g}); excess {excess[i]:g} > {limit:g} samples",
             )
         )
-    return prop, fails
+    return v, fails
 
 
 def _grid_sizes(mode: str, sweep: tuple[int, int, int] | None) -> tuple[int, int, int]:
@@ -287,56 +363,85 @@ def _grid_sizes(mode: str, sweep: tuple[int, int, int] | None) -> tuple[int, int
     return (101, 101, 200) if mode == "vectorized" else (21, 21, 40)
 
 
+def _count(name: str, count: int, where: str, detail: str) -> Verdict:
+    return Verdict(name, PASS if count == 0 else FAIL, count, 0, f"{detail} {where}", "<=", "1")
+
+
 def closed_loop(
-    user: UserLaw, cfg: Config, *, sweep: tuple[int, int, int] | None = None
-) -> tuple[dict, list[dict]]:
+    user, cfg: Config, *, sweep: tuple[int, int, int] | None = None, visited: list | None = None
+) -> tuple[dict[str, Verdict], list[dict]]:
     """Closed-loop properties of a user law, as ``check`` gates them.
 
     Parameters
     ----------
-    user : UserLaw
+    user : UserLaw or IsolatedLaw
         The wrapped law.
     cfg : Config
         Configuration.
     sweep : (n1, n2, rest), optional
         Sweep grid (:func:`ptoverify.properties.initial_grid`); default
         101 x 101 + 200 vectorized, 21 x 21 + 40 scalar.
+    visited : list, optional
+        Receives the :class:`~ptoverify.simulate.BatchResult` of each sweep
+        (the states the law was used at, for the agreement).
 
     Returns
     -------
-    properties : dict
+    properties : dict of str to Verdict
         ``no-stride-over``, ``no-limit-cycle``, ``input-bound`` (closed loop),
-        ``settling-vs-discrete-limit``: each status, measured, limit, detail.
+        ``settling-vs-discrete-limit``.
     failures : list of dict
         Failing properties with the first initial state that shows each.
     """
-    from ptoverify.properties import default_steps, initial_grid
+    from ptoverify.properties import crossing_masks, default_steps, initial_grid, oscillating
     from ptoverify.simulate import simulate_batch
 
+    visited = [] if visited is None else visited
     law = _as_law(user, cfg)
     n1, n2, rest = _grid_sizes(user.mode, sweep)
     x1, x2, _ = initial_grid(cfg, n1, n2, rest)
     steps = default_steps(cfg)
-    window = max(20, steps // 4)
     try:
         res = simulate_batch(law, cfg.plant, x1, x2, steps)
     except LawFault as fault:
         detail = f"closed-loop simulation stopped: {fault.message}"
-        return (
-            {"evaluation": {"status": FAIL, "measured": None, "limit": None, "detail": detail}},
-            [failure("evaluation", fault.state, detail)],
-        )
-    m = _sweep_analysis(res, x1, cfg, _BAND_MM, window)
+        props = {n: Verdict(n, FAIL, None, None, detail) for n in _CLOSED}
+        return props, [failure("evaluation", fault.state, detail)]
+    visited.append(res)
+    w = cfg.plant.w_max
+    stride, _ = crossing_masks(res.x1, res.x2, res.region, cfg)
+    osc = oscillating(res.x1[-max(20, steps // 4) :], _BAND_MM)
+    unsettled = np.abs(res.x1[-1]) > _BAND_MM
+    over = np.abs(res.u) > w
     where = f"over {x1.size} initial states x {steps} samples"
+    at_end = np.zeros((steps + 1, x1.size), dtype=bool)
+    at_end[-1] = osc | unsettled
+    checks = (
+        (
+            "no-stride-over",
+            stride,
+            "stride-overs (sample outside zone and linear zone whose next sample is "
+            "strictly across l1/l2 and outside the linear zone)",
+            "stride-over",
+        ),
+        (
+            "no-limit-cycle",
+            at_end,
+            f"states with sustained oscillation ({int(osc.sum())}) or not settled within "
+            f"{_BAND_MM:g} mm ({int(unsettled.sum())})",
+            "sustained oscillation or not settled",
+        ),
+        (
+            "input-bound",
+            over,
+            f"samples with |u| > w_max = {w:g} mm/s (max {float(np.abs(res.u).max()):.10g})",
+            "|u| > w_max",
+        ),
+    )
     props, fails = {}, []
-
-    def add(name: str, count: int, mask, detail: str, what: str):
-        props[name] = {
-            "status": PASS if count == 0 else FAIL,
-            "measured": count,
-            "limit": 0,
-            "detail": f"{detail} {where}",
-        }
+    for name, mask, detail, what in checks:
+        count = int(mask.sum())
+        props[name] = _count(name, count, where, detail)
         hit = _first(mask)
         if hit is not None:
             k, j = hit
@@ -344,81 +449,93 @@ def closed_loop(
                 failure(
                     name,
                     (x1[j], x2[j]),
-                    f"{what} (first from initial state ({x1[j]:.6g}, "
-                    f"{x2[j]:.6g}), sample {k}: ({res.x1[k, j]:.6g}, "
-                    f"{res.x2[k, j]:.6g})); {count} in all",
+                    f"{what} (first from initial state ({x1[j]:.6g}, {x2[j]:.6g}), sample "
+                    f"{k}: ({res.x1[k, j]:.6g}, {res.x2[k, j]:.6g})); {count} in all",
                     sample=k,
                     at=[float(res.x1[k, j]), float(res.x2[k, j])],
                 )
             )
-
-    add(
-        "no-stride-over",
-        int(m["stride"].sum()),
-        m["stride"],
-        "stride-overs (sample outside zone and linear zone whose next sample is strictly "
-        "across l1/l2 and outside the linear zone)",
-        "stride-over",
-    )
-    cyc = m["osc"] | m["unsettled"]
-    at_end = np.zeros((steps + 1, x1.size), dtype=bool)
-    at_end[-1] = cyc
-    add(
-        "no-limit-cycle",
-        int(m["osc"].sum() + m["unsettled"].sum()),
-        at_end,
-        f"states with sustained oscillation ({int(m['osc'].sum())}) or not settled within "
-        f"{_BAND_MM:g} mm ({int(m['unsettled'].sum())})",
-        "sustained oscillation or not settled",
-    )
-    add(
-        "input-bound",
-        int(m["over"].sum()),
-        m["over"],
-        f"samples with |u| > w_max = {cfg.plant.w_max:g} mm/s (max {m['max_u']:.10g})",
-        "|u| > w_max",
-    )
+    name = "settling-vs-discrete-limit"
     try:
-        props["settling-vs-discrete-limit"], f = _settling(law, cfg)
+        props[name], f = _settling(law, cfg, visited)
     except LawFault as fault:
         detail = f"settling simulation stopped: {fault.message}"
-        props["settling-vs-discrete-limit"] = {
-            "status": FAIL,
-            "measured": None,
-            "limit": None,
-            "detail": detail,
-        }
+        props[name] = Verdict(name, FAIL, None, None, detail, "<=", "samples")
         f = [failure("evaluation", fault.state, detail)]
-    fails += f
-    return props, fails
+    return props, fails + f
 
 
-def _odd_symmetry(
-    user: UserLaw, x1: NDArray, x2: NDArray, u: NDArray, cfg: Config, rtol: float
-) -> tuple[dict, list[dict]]:
-    """u(-x) = -u(x) on the grid (tie points excluded), to the agreement tolerance."""
+def _odd_symmetry(user, x1: NDArray, x2: NDArray, u: NDArray, cfg: Config, rtol: float):
+    """u(-x) = -u(x) on the grid, curve ties included, to the agreement tolerance."""
     tol = rtol * cfg.plant.w_max
     um = user(-x1, -x2)
-    err = np.where(ties(x1, x2, cfg), 0.0, np.abs(u + um))
+    err = np.abs(u + um)
     bad = err > tol
-    prop = {
-        "status": FAIL if bad.any() else PASS,
-        "measured": float(err.max()),
-        "limit": tol,
-        "detail": f"max |u(x) + u(-x)| [mm/s] over {x1.size} grid states (curve ties "
-        "excluded); the plant is odd, so the law must be",
-    }
+    tie = ties(x1, x2, cfg)
+    v = Verdict(
+        "odd-symmetry",
+        FAIL if bad.any() else PASS,
+        float(err.max()),
+        tol,
+        f"max |u(x) + u(-x)| over {x1.size} grid states, {int(tie.sum())} of them curve "
+        "ties (a mirrored tie must take the mirrored branch); the plant is odd, so the "
+        "law must be",
+        "<=",
+        "mm/s",
+    )
     fails = []
     if bad.any():
         i = int(np.argmax(bad))
+        on = " (a curve tie)" if tie[i] else ""
         fails.append(
             failure(
-                "odd-symmetry", (x1[i], x2[i]), f"u(x) = {u[i]:.10g}, u(-x) = {um[i]:.10g} mm/s"
+                "odd-symmetry",
+                (x1[i], x2[i]),
+                f"u(x) = {u[i]:.10g}, u(-x) = {um[i]:.10g} mm/s{on}",
             )
         )
-    return prop, fails
+    return v, fails
 
 
+def _input_bound(x1, x2, u, cfg: Config, where: str) -> tuple[Verdict, list[dict]]:
+    w = cfg.plant.w_max
+    over = np.abs(u) > w
+    v = Verdict(
+        "input-bound-grid",
+        FAIL if over.any() else PASS,
+        float(np.abs(u).max()) if u.size else 0.0,
+        w,
+        f"max |u| {where}; limit w_max",
+        "<=",
+        "mm/s",
+    )
+    fails = []
+    if over.any():
+        i = int(np.argmax(over))
+        fails.append(
+            failure(
+                "input-bound-grid",
+                (x1[i], x2[i]),
+                f"|u| = {abs(u[i]):.10g} mm/s > w_max = {w:g} mm/s {where}",
+            )
+        )
+    return v, fails
+
+
+def _agreement_verdict(agree: dict) -> Verdict:
+    return Verdict(
+        "agreement",
+        PASS if agree["pass"] else FAIL,
+        agree["max_abs_du"],
+        agree["tolerance_mm_s"],
+        f"max |u - u_ref| over {agree['points']} states ({agree['excluded']} curve ties "
+        f"excluded): {', '.join(f'{k} {v}' for k, v in agree.get('sources', {}).items())}",
+        "<=",
+        "mm/s",
+    )
+
+
+# ------------------------------------------------------------------ result
 @dataclass
 class ConformResult:
     """Outcome of ``ptoverify conform`` (the JSON object, see :meth:`to_json`).
@@ -426,7 +543,7 @@ class ConformResult:
     Attributes
     ----------
     conforms : bool
-        True when every judged property passes.
+        True when every property is ``pass`` and nothing failed.
     mode : str
         ``vectorized``, ``scalar`` or ``table``.
     target : str
@@ -434,13 +551,19 @@ class ConformResult:
     mode_reason : str
         Why the mode was chosen.
     agreement : dict
-        Per-region agreement with the reference (:func:`agreement`).
-    properties : dict
-        Name -> status, measured, limit, detail.
+        Agreement with the reference (:func:`ptoverify.agreement.agreement`),
+        with ``sources`` (states per source) and ``gap`` (largest unprobed disc).
+    properties : dict of str to Verdict
+        Every property, in evaluation order.
     failures : list of dict
-        Each with ``property``, ``state`` [x1, x2] (the first that shows it), ``detail``.
+        Each with ``property``, ``state`` [x1, x2] (the first that shows it, or
+        None for ``isolation``), ``detail``.
     timings_s : dict
         Wall time per phase [s].
+    unverified : list of str
+        Properties that could not be evaluated (``unverified``).
+    law_output : str
+        What an isolated law printed (stdout and stderr), first and last 2000 characters.
     """
 
     conforms: bool
@@ -452,6 +575,12 @@ class ConformResult:
     failures: list[dict]
     timings_s: dict = field(default_factory=dict)
     config: str = ""
+    law_output: str = ""
+
+    @property
+    def unverified(self) -> list[str]:
+        """Names of the properties whose status is ``unverified``."""
+        return [k for k, v in self.properties.items() if v.status == UNVERIFIED]
 
     def to_json(self) -> dict:
         """Return the JSON object printed by ``--json``."""
@@ -462,14 +591,122 @@ class ConformResult:
             "mode_reason": self.mode_reason,
             "config": self.config,
             "agreement": self.agreement,
-            "properties": self.properties,
+            "properties": {k: v.to_json() for k, v in self.properties.items()},
             "failures": self.failures,
+            "unverified": self.unverified,
             "timings_s": self.timings_s,
         }
 
     def failed_properties(self) -> list[str]:
         """Names of the failing properties, in order, without repeats."""
         return list(dict.fromkeys(f["property"] for f in self.failures))
+
+
+def _random_states(cfg: Config, n: int) -> tuple[NDArray, NDArray]:
+    rng = np.random.default_rng(RANDOM_SEED)
+    R, w = cfg.plant.position_range, cfg.plant.w_max
+    return rng.uniform(-R, R, n), rng.uniform(-w, w, n)
+
+
+def _judge(user, failures: list[dict], cfg: Config, rtol, sweep, grid, n_random) -> tuple:
+    """Evaluate every property in order; returns (props, agreement, timings)."""
+    props: dict[str, Verdict] = {}
+    agree: dict = {"pass": False, "detail": "not run"}
+    timings: dict[str, float] = {}
+    blocked = next((f for f in failures if f["property"] in ("evaluation", "pure-function")), None)
+    if blocked is None:
+        t = time.perf_counter()
+        d1, d2 = _determinism_states(cfg, grid)
+        try:
+            u_det, f = determinism(user, d1, d2)
+        except LawFault as fault:
+            f = [failure("evaluation", fault.state, fault.message)]
+        failures += f
+        blocked = f[0] if f else None
+        timings["determinism"] = time.perf_counter() - t
+    if blocked is not None:
+        why = f"not run: {blocked['property']} failed ({blocked['detail']})"
+        agree = {"pass": False, "detail": why}
+        return {n: Verdict(n, NOT_RUN, None, None, why) for n in PROPERTIES[1:]}, agree, timings
+    props["pure-function"] = Verdict(
+        "pure-function",
+        PASS,
+        0,
+        0,
+        f"{N_DETERMINISM} states called twice, shuffled and in chunks gave identical u",
+        "<=",
+        "1",
+    )
+    t = time.perf_counter()
+    g1, g2 = grid
+    r1, r2 = _random_states(cfg, n_random)
+    xs, us, sources = [g1, r1], [], {"grid": g1.size, "random": r1.size}
+    try:
+        u_grid = user(g1, g2)
+        us = [u_grid, user(r1, r2)]
+        ys = [g2, r2]
+        props["input-bound-grid"], f = _input_bound(g1, g2, u_grid, cfg, "on the grid")
+        failures += f
+        props["odd-symmetry"], f = _odd_symmetry(user, g1, g2, u_grid, cfg, rtol)
+        failures += f
+    except LawFault as fault:
+        failures.append(failure("evaluation", fault.state, fault.message))
+        for n in ("agreement", "input-bound-grid", "odd-symmetry"):
+            props.setdefault(n, Verdict(n, FAIL, None, None, fault.message))
+        us = []
+    timings["agreement_grid_random"] = time.perf_counter() - t
+    t = time.perf_counter()
+    visited: list = []
+    cl, f = closed_loop(user, cfg, sweep=sweep, visited=visited)
+    props.update(cl)
+    failures += f
+    timings["closed_loop"] = time.perf_counter() - t
+    t = time.perf_counter()
+    if us:
+        for res, label in zip(visited, ("sweep", "settling")):
+            xs.append(res.x1[:-1].ravel())
+            ys.append(res.x2[:-1].ravel())
+            us.append(res.u.ravel())
+            sources[label] = res.u.size
+        x1, x2, u = np.concatenate(xs), np.concatenate(ys), np.concatenate(us)
+        agree, f = agreement(x1, x2, u, cfg, rtol)
+        agree["sources"] = sources
+        agree["gap"] = largest_gap(x1, x2, cfg)
+        failures += f
+        props["agreement"] = _agreement_verdict(agree)
+    try:
+        props["pure-function"], f = _recheck(user, d1, d2, u_det, props["pure-function"])
+    except LawFault as fault:
+        f = [failure("evaluation", fault.state, f"at the determinism re-check: {fault.message}")]
+    failures += f
+    timings["agreement"] = time.perf_counter() - t
+    return props, agree, timings
+
+
+def _recheck(user, d1, d2, u_det, v: Verdict) -> tuple[Verdict, list[dict]]:
+    """Call the law at the determinism states once more, after every other call."""
+    f = _differs(u_det, user(d1, d2), d1, d2, f"the end (after {user.calls} calls)")
+    if f:
+        return Verdict(v.name, FAIL, 1, 0, f[0]["detail"], "<=", "1"), f
+    return v, []
+
+
+def _finish(user, props, failures, agree, timings, t0, cfg, target, output="") -> ConformResult:
+    ordered = {n: props[n] for n in PROPERTIES if n in props}
+    timings["total"] = time.perf_counter() - t0
+    ok = not failures and all(v.passed for v in ordered.values()) and agree.get("pass", False)
+    return ConformResult(
+        ok,
+        user.mode,
+        target,
+        user.reason,
+        agree,
+        ordered,
+        failures,
+        {k: round(v, 4) for k, v in timings.items()},
+        cfg.name,
+        _clip(output),
+    )
 
 
 def conform_callable(
@@ -480,8 +717,9 @@ def conform_callable(
     rtol: float = DEFAULT_RTOL,
     sweep: tuple[int, int, int] | None = None,
     grid: tuple[NDArray, NDArray] | None = None,
+    n_random: int = N_RANDOM,
 ) -> ConformResult:
-    """Judge a user law ``u = f(x1, x2, cfg)`` against the reference PTO law.
+    """Judge a law ``u = f(x1, x2, cfg)`` in this process (no isolation).
 
     Parameters
     ----------
@@ -496,7 +734,9 @@ def conform_callable(
     sweep : (n1, n2, rest), optional
         Closed-loop sweep grid (see :func:`closed_loop`).
     grid : (x1, x2), optional
-        Agreement states; default :func:`conformance_grid`.
+        Agreement grid; default :func:`conformance_grid`.
+    n_random : int
+        Seeded random agreement states over the envelope.
 
     Returns
     -------
@@ -511,74 +751,115 @@ def conform_callable(
     (True, 'vectorized')
     """
     t0 = time.perf_counter()
-    timings = {}
     user, failures = wrap_callable(fn, cfg)
-    timings["detect"] = time.perf_counter() - t0
-    x1, x2 = conformance_grid(cfg) if grid is None else grid
-    props: dict[str, dict] = {}
-    agree: dict = {"pass": False, "detail": "not run: the law failed at a probe state"}
-    memory = any(f["property"] == "pure-function" for f in failures)
-    if memory:
-        agree = {
-            "pass": False,
-            "detail": "not run: the law has memory, so u is not a "
-            "function of the state and there is nothing to compare state by state",
-        }
-        for name in (
-            "input-bound-grid",
-            "odd-symmetry",
-            "no-stride-over",
-            "no-limit-cycle",
-            "input-bound",
-            "settling-vs-discrete-limit",
-        ):
-            props[name] = {"status": NOT_RUN, "detail": "the law has memory (pure-function)"}
-    elif not any(f["property"] == "evaluation" for f in failures):
-        t = time.perf_counter()
-        try:
-            u = user(x1, x2)
-        except LawFault as fault:
-            failures.append(failure("evaluation", fault.state, fault.message))
-            agree = {"pass": False, "detail": f"not run: {fault.message}"}
-        else:
-            agree, f = agreement(x1, x2, u, cfg, rtol)
-            failures += f
-            props["input-bound-grid"], f = input_bound(x1, x2, u, cfg, "on the grid")
-            failures += f
-            try:
-                props["odd-symmetry"], f = _odd_symmetry(user, x1, x2, u, cfg, rtol)
-            except LawFault as fault:
-                props["odd-symmetry"] = {"status": FAIL, "detail": fault.message}
-                f = [failure("evaluation", fault.state, fault.message)]
-            failures += f
-        timings["agreement"] = time.perf_counter() - t
-        t = time.perf_counter()
-        cl, f = closed_loop(user, cfg, sweep=sweep)
-        props.update(cl)
-        failures += f
-        timings["closed_loop"] = time.perf_counter() - t
-    props.setdefault(
-        "pure-function",
-        {"status": PASS, "detail": "two calls at 8 probe states returned the same u"},
-    )
-    if any(f["property"] == "pure-function" for f in failures):
-        props["pure-function"] = {
-            "status": FAIL,
-            "detail": "two calls at the same state returned different u",
-        }
+    timings = {"detect": time.perf_counter() - t0}
+    grid = conformance_grid(cfg) if grid is None else grid
+    props, agree, t = _judge(user, failures, cfg, rtol, sweep, grid, n_random)
+    timings.update(t)
+    return _finish(user, props, failures, agree, timings, t0, cfg, target)
+
+
+def conform_spec(
+    spec: str,
+    cfg: Config,
+    *,
+    rtol: float = DEFAULT_RTOL,
+    timeout: float = DEFAULT_TIMEOUT_S,
+    sweep: tuple[int, int, int] | None = None,
+    grid: tuple[NDArray, NDArray] | None = None,
+    n_random: int = N_RANDOM,
+) -> ConformResult:
+    """Judge ``MODULE:FUNCTION`` or ``file.py:FUNCTION`` isolated in a child process.
+
+    Parameters
+    ----------
+    spec : str
+        The law to load (its code runs only in the child).
+    cfg : Config
+        Configuration.
+    rtol : float
+        Agreement tolerance relative to w_max.
+    timeout : float
+        Budget for the whole conformance [s] (each batch also gets 10 s + 1 ms
+        per state).
+    sweep, grid, n_random
+        As :func:`conform_callable`.
+
+    Returns
+    -------
+    ConformResult
+        The verdict; a hang, crash or exit of the law is the failure
+        ``isolation`` and leaves the properties not yet evaluated ``unverified``.
+    """
+    t0 = time.perf_counter()
+    user = IsolatedLaw(spec, cfg, timeout=timeout)
+    grid = conformance_grid(cfg) if grid is None else grid  # while the child loads
+    try:
+        user.ready()
+    except LawAborted as ab:
+        return _aborted(None, {}, [], ab, {}, t0, cfg, spec, user.close())
+    except InputError:
+        user.close()
+        raise
+    failures = list(user.init_failures)
+    timings = {"detect": time.perf_counter() - t0}
+    props: dict[str, Verdict] = {}
+    try:
+        props, agree, t = _judge(user, failures, cfg, rtol, sweep, grid, n_random)
+        timings.update(t)
+    except LawAborted as ab:
+        return _aborted(user, props, failures, ab, timings, t0, cfg, spec, user.close())
+    return _finish(user, props, failures, agree, timings, t0, cfg, spec, user.close())
+
+
+def _aborted(user, props, failures, ab, timings, t0, cfg, target, output) -> ConformResult:
+    """Build the result after a hang, crash or exit of the isolated law (rest unverified)."""
+    failures.append({"property": "isolation", "state": None, "detail": ab.message})
+    why = f"could not be evaluated: {ab.message}"
+    for n in PROPERTIES:
+        props.setdefault(n, Verdict(n, UNVERIFIED, None, None, why))
     timings["total"] = time.perf_counter() - t0
-    ok = not failures and agree.get("pass", False)
+    mode = "unknown" if user is None else user.mode
+    reason = "the law's process ended before its mode was known" if user is None else user.reason
+    agree = {"pass": False, "detail": why}
     return ConformResult(
-        ok,
-        user.mode,
+        False,
+        mode,
         target,
-        user.reason,
+        reason,
         agree,
-        props,
+        {n: props[n] for n in PROPERTIES},
         failures,
         {k: round(v, 4) for k, v in timings.items()},
         cfg.name,
+        _clip(output),
     )
+
+
+def _clip(text: str, n: int = 2000) -> str:
+    """Keep the first and last n characters of what the law printed."""
+    if len(text) <= 2 * n:
+        return text
+    return f"{text[:n]}\n[... {len(text) - 2 * n} characters left out ...]\n{text[-n:]}"
+
+
+def _coverage(agree: dict, cfg: Config) -> Verdict:
+    """Every region the reference has on the grid needs MIN_PER_REGION judged states."""
+    need = region_counts(*conformance_grid(cfg), cfg)
+    have = {k: v["points"] - v["excluded"] for k, v in agree["regions"].items()}
+    short = []
+    for name in need:
+        want = 1 if name == Region.ORIGIN.name else MIN_PER_REGION
+        if have.get(name, 0) < want:
+            short.append(f"{name} {have.get(name, 0)} < {want}")
+    worst = min((have.get(n, 0) for n in need if n != Region.ORIGIN.name), default=0)
+    detail = (
+        f"judged table states per reference region (need {MIN_PER_REGION} in each of "
+        f"{', '.join(need)}; the origin 1)"
+    )
+    if short:
+        detail = f"insufficient coverage: {'; '.join(short)}; " + detail
+    return Verdict("coverage", FAIL if short else PASS, worst, MIN_PER_REGION, detail, ">=", "1")
 
 
 def conform_table(path: str | Path, cfg: Config, *, rtol: float = DEFAULT_RTOL) -> ConformResult:
@@ -587,7 +868,7 @@ def conform_table(path: str | Path, cfg: Config, *, rtol: float = DEFAULT_RTOL) 
     Parameters
     ----------
     path : str or Path
-        CSV with columns x1, x2, u.
+        CSV with columns x1, x2, u (a regular file).
     cfg : Config
         Configuration.
     rtol : float
@@ -596,67 +877,71 @@ def conform_table(path: str | Path, cfg: Config, *, rtol: float = DEFAULT_RTOL) 
     Returns
     -------
     ConformResult
-        Agreement and |u| <= w_max; closed-loop properties ``not_run``.
+        ``coverage``, ``agreement`` and ``input-bound-grid``; closed-loop
+        properties ``not_run``.
     """
     t0 = time.perf_counter()
-    x1, x2, u = read_table(path)
+    x1, x2, u = read_table(path, cfg)
+    t_read = time.perf_counter() - t0
     agree, failures = agreement(x1, x2, u, cfg, rtol)
-    props = {}
-    props["input-bound-grid"], f = input_bound(x1, x2, u, cfg, "at the table's points")
+    agree["sources"] = {"table": int(x1.size)}
+    props = {"coverage": _coverage(agree, cfg), "agreement": _agreement_verdict(agree)}
+    if not props["coverage"].passed:
+        failures.insert(
+            0, {"property": "coverage", "state": None, "detail": props["coverage"].detail}
+        )
+    props["input-bound-grid"], f = _input_bound(x1, x2, u, cfg, "at the table's states")
     failures += f
-    for name in (
-        "odd-symmetry",
-        "no-stride-over",
-        "no-limit-cycle",
-        "input-bound",
-        "settling-vs-discrete-limit",
-    ):
-        props[name] = {"status": NOT_RUN, "detail": "needs a callable law (--law)"}
-    ok = not failures and agree["pass"]
+    for name in ("odd-symmetry",) + _CLOSED:
+        props[name] = Verdict(name, NOT_RUN, None, None, "needs a callable law (--law)")
+    ok = not failures and agree["pass"] and props["coverage"].passed
+    total = time.perf_counter() - t0
     return ConformResult(
         ok,
         "table",
         str(path),
-        f"table of {x1.size} points",
+        f"table of {x1.size} states",
         agree,
         props,
         failures,
-        {"total": round(time.perf_counter() - t0, 4)},
+        {"read": round(t_read, 4), "total": round(total, 4)},
         cfg.name,
     )
 
 
 def format_result(r: ConformResult) -> str:
     """Human-readable report: verdict, agreement per region, properties, failures."""
-    lines = [
-        f"{'CONFORMS' if r.conforms else 'DOES NOT CONFORM'}: {r.target} "
-        f"(mode {r.mode}: {r.mode_reason})"
-    ]
+    why = f": {r.mode_reason}" if r.mode_reason else ""
+    lines = [f"{'CONFORMS' if r.conforms else 'DOES NOT CONFORM'}: {r.target} (mode {r.mode}{why})"]
     a = r.agreement
     if "regions" in a:
+        src = ", ".join(f"{k} {v}" for k, v in a.get("sources", {}).items())
         lines.append(
-            f"agreement with reference PTO: {a['points']} points, {a['excluded']} "
+            f"agreement with reference PTO: {a['points']} states ({src}), {a['excluded']} "
             f"excluded (within {a['tie_band_mm_s']:.3g} mm/s of l1/l2/l1*/l2*), "
             f"tolerance {a['tolerance_mm_s']:.3g} mm/s ({a['rtol']:g} w_max), "
             f"max |du| = {a['max_abs_du']:.3g} mm/s"
         )
         for name, e in a["regions"].items():
-            where = (
-                "" if e["state"] is None else f" at ({e['state'][0]:.10g}, {e['state'][1]:.10g})"
-            )
+            s = e["state"]
+            where = "" if s is None else f" at ({s[0]:.10g}, {s[1]:.10g})"
             lines.append(
-                f"  {'ok  ' if e['pass'] else 'FAIL'} {name:<10} {e['points']:>6} "
-                f"points ({e['excluded']} excluded) max |du| = "
+                f"  {'ok  ' if e['pass'] else 'FAIL'} {name:<10} {e['points']:>8} "
+                f"states ({e['excluded']} excluded) max |du| = "
                 f"{e['max_abs_du']:.3g} mm/s{where}"
             )
-    else:
-        lines.append(f"agreement: {a.get('detail', '')}")
-    for name, pr in r.properties.items():
-        lines.append(f"  {pr['status'].upper():<10} {name:<28} {pr.get('detail', '')}")
+        if "gap" in a:
+            g = a["gap"]
+            lines.append(
+                f"  largest unprobed disc: centre ({g['center'][0]:.4g}, {g['center'][1]:.4g}), "
+                f"half-widths {g['half_width_mm']:.3g} mm x {g['half_width_mm_s']:.3g} mm/s"
+            )
+    elif a.get("detail"):
+        lines.append(f"agreement: {a['detail']}")
+    for name, v in r.properties.items():
+        lines.append(f"  {v.status.upper():<10} {name:<28} {v.detail}")
     for f in r.failures:
-        lines.append(
-            f"FAILED {f['property']} at state ({f['state'][0]:.10g}, "
-            f"{f['state'][1]:.10g}): {f['detail']}"
-        )
+        at = "" if f["state"] is None else f" at state ({f['state'][0]:.10g}, {f['state'][1]:.10g})"
+        lines.append(f"FAILED {f['property']}{at}: {f['detail']}")
     lines.append(f"time {r.timings_s.get('total', 0.0):.2f} s")
     return "\n".join(lines)

@@ -119,12 +119,12 @@ def h(r: ArrayLike) -> Array:
     Parameters
     ----------
     r : array_like
-        Argument, r > -1.
+        Argument [-], r > -1.
 
     Returns
     -------
     ndarray
-        h(r) >= 0.
+        h(r) >= 0 [-].
 
     Examples
     --------

@@ -65,6 +65,9 @@ __all__ = [
     "Trajectory",
     "Compared",
     "ExactMetrics",
+    "grid_settling_time",
+    "grid_overshoot",
+    "grid_rise_time",
     "overshoot",
     "settling_time",
     "rise_time",
@@ -621,11 +624,17 @@ def rise_time(tr: Trajectory, target: float, *, low: float = 0.1, high: float = 
 
 
 def _rise(p: _Pieces, x0: float, target: float, low: float, high: float, xv=None) -> float:
+    t_lo, t_hi = _rise_pair(p, x0, target, low, high, xv)
+    return t_hi - t_lo
+
+
+def _rise_pair(p: _Pieces, x0: float, target: float, low: float, high: float, xv=None):
+    """Absolute first times [s] x1 reaches the low and the high level."""
     sgn = 1.0 if target > x0 else -1.0
     xv = _value(p, p.brk, "x1") if xv is None else xv
     t_lo = _first_reach(p, x0 + low * (target - x0), sgn, xv)
     t_hi = _first_reach(p, x0 + high * (target - x0), sgn, xv)
-    return t_hi - t_lo
+    return t_lo, t_hi
 
 
 def _preimage(p: _Pieces, k: int, s0: float, s1: float, v0: float, v1: float, lim: float, what):
@@ -818,11 +827,118 @@ def _grid_phase(t, x1, r, freq: float, ta: float) -> float:
     return _wrap_deg(math.degrees(math.atan2(br, ar) - math.atan2(bx, ax)))
 
 
-def _grid_settling(t, e, band: float) -> float:
-    out = np.flatnonzero(np.abs(e) > band)
-    if out.size == 0:
-        return 0.0
-    return math.nan if out[-1] == t.size - 1 else float(t[out[-1] + 1] - t[0])
+def grid_settling_time(t: ArrayLike, e: ArrayLike, band: float, *, hold: float = 0.0) -> float:
+    """Settling time on the sample grid: the sample after the last one outside the band.
+
+    t_s = t_k for the first sample k such that |e_j| <= band for every j >= k
+    up to the end of the record.  A record that ends outside the band, or whose
+    settled tail is shorter than ``hold``, has not settled: NaN.  This is the
+    sample-grid twin of :func:`settling_time` (the ``grid`` value of
+    :class:`Compared`), and ``ptoverify.metrics.settling_time``.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,)
+        Sample times [s].
+    e : array_like, shape (n,)
+        Error [mm] (or any signal that should settle to 0).
+    band : float
+        Half-width of the band [same unit as e], > 0.
+    hold : float
+        Shortest settled tail that counts as settled [s] (default 0).
+
+    Returns
+    -------
+    float
+        Settling time [s] measured from t[0]; NaN if it never settles.
+
+    Examples
+    --------
+    >>> t = np.linspace(0, 1, 1001)
+    >>> round(grid_settling_time(t, np.exp(-10 * t), 0.1), 3)
+    0.231
+    """
+    t, e = _arr(t), _arr(e)
+    outside = np.flatnonzero(np.abs(e) > band)
+    k = 0 if outside.size == 0 else outside[-1] + 1
+    if k >= t.size or t[-1] - t[k] < hold:
+        return math.nan
+    return float(t[k] - t[0])
+
+
+def grid_overshoot(x: ArrayLike, target: float, start: float = 0.0) -> float:
+    """Overshoot on the samples: largest excursion past the target, in the direction of travel.
+
+    The sample-grid twin of :func:`overshoot` (and ``ptoverify.metrics.overshoot``).
+
+    Parameters
+    ----------
+    x : array_like
+        Position [mm].
+    target : float
+        Final value of the reference [mm].
+    start : float
+        Initial value [mm]; the direction of travel is sign(target - start).
+
+    Returns
+    -------
+    float
+        max(0, max_k s (x_k - target)) [mm], s = sign(target - start).
+
+    Examples
+    --------
+    >>> grid_overshoot([0.0, 4.0, 5.3, 4.9, 5.0], 5.0)
+    0.2999999999999998
+    """
+    s = 1.0 if target >= start else -1.0
+    return float(max(0.0, np.max(s * (_arr(x) - target))))
+
+
+def grid_rise_time(
+    t: ArrayLike,
+    x: ArrayLike,
+    target: float,
+    *,
+    low: float = 0.1,
+    high: float = 0.9,
+    start: float | None = None,
+) -> float:
+    """Rise time on the samples, from ``low`` to ``high`` of the way from ``start`` to target.
+
+    The sample-grid twin of :func:`rise_time` (and ``ptoverify.metrics.rise_time``):
+    the first sample at or past the high level minus the first at or past the low level.
+
+    Parameters
+    ----------
+    t : array_like
+        Sample times [s].
+    x : array_like
+        Position [mm].
+    target : float
+        Final value [mm], different from ``start``.
+    low, high : float
+        Fractions of the way [-].
+    start : float, optional
+        Initial value [mm]; default x[0].
+
+    Returns
+    -------
+    float
+        Rise time [s]; NaN if a level is never reached.
+
+    Examples
+    --------
+    >>> t = np.linspace(0, 1, 1001)
+    >>> round(grid_rise_time(t, 1 - np.exp(-10 * t), 1.0), 3)
+    0.22
+    """
+    t, x = _arr(t), _arr(x)
+    x0 = float(x[0]) if start is None else float(start)
+    if target == x0:
+        return math.nan
+    sgn = 1.0 if target > x0 else -1.0
+    lo, hi = (x0 + f * (target - x0) for f in (low, high))
+    return _grid_first(t, sgn * (x - hi) >= 0) - _grid_first(t, sgn * (x - lo) >= 0)
 
 
 def _grid_first(t, y) -> float:
@@ -842,11 +958,18 @@ class Compared:
         On the samples t_k only.
     tol : float
         Tolerance of :attr:`differs`, same unit.
+    accuracy : float
+        Bound on the error of :attr:`exact` from root finding and round-off,
+        same unit (0 when the value is decided without a root, NaN when the
+        metric is undefined); see :func:`metrics_from_arrays`.  Two exact values
+        closer than the sum of their accuracies are a true tie
+        (:meth:`compare`).
     """
 
     exact: float
     grid: float
     tol: float
+    accuracy: float = 0.0
 
     @property
     def delta(self) -> float:
@@ -860,6 +983,36 @@ class Compared:
         if ne or ng:
             return ne != ng
         return abs(self.exact - self.grid) > self.tol
+
+    def compare(self, other: Compared, *, grid: bool = False) -> int | None:
+        """Order two values of one metric: -1 (self smaller), 0 (true tie), +1.
+
+        Exact values tie when |self - other| <= self.accuracy + other.accuracy
+        (neither can be told from the other to the precision they are computed
+        to); grid values tie only when equal (they are sample times).
+
+        Parameters
+        ----------
+        other : Compared
+            The other response's value of the same metric.
+        grid : bool
+            Compare the grid values instead of the exact ones.
+
+        Returns
+        -------
+        int or None
+            -1, 0 or +1; None when either value is NaN (undefined, never settled).
+
+        Examples
+        --------
+        >>> Compared(0.1, 0.1, 0.0, 1e-12).compare(Compared(0.1 + 1e-13, 0.1, 0.0, 1e-12))
+        0
+        """
+        x, y = (self.grid, other.grid) if grid else (self.exact, other.exact)
+        if math.isnan(x) or math.isnan(y):
+            return None
+        tie = 0.0 if grid else self.accuracy + other.accuracy
+        return 0 if abs(x - y) <= tie else (-1 if x < y else 1)
 
 
 @dataclass(frozen=True)
@@ -891,14 +1044,17 @@ class ExactMetrics:
         """Sample-grid values by key."""
         return {k: v.grid for k, v in self.values.items()}
 
-    def json_metrics(self) -> dict[str, float | None]:
+    def json_metrics(self, *, grid: bool = False) -> dict[str, float | None]:
         """Return ``simulate --json`` ``metrics`` (DESIGN.md): exact values, None if undefined.
 
         Keys ``overshoot_mm``, ``settling_2pct_s``, ``settling_0p01mm_s``,
-        ``rise_time_s``, and ``phase_delay_deg`` for a sine only.
+        ``rise_time_s``, and ``phase_delay_deg`` for a sine only.  With
+        ``grid=True`` the same keys hold the sample-grid values
+        (``simulate --json`` ``metrics_grid``).
         """
         keys = [k for k in METRIC_KEYS[:5] if k != "phase_delay_deg" or self.signal.kind == "sine"]
-        return {k: None if math.isnan(v := self.values[k].exact) else v for k in keys}
+        pick = self.grid() if grid else self.exact()
+        return {k: None if math.isnan(v := pick[k]) else v for k in keys}
 
     def differing(self) -> list[str]:
         """Keys whose exact and grid values differ beyond tolerance."""
@@ -945,6 +1101,14 @@ def metrics_from_arrays(
     Returns
     -------
     ExactMetrics
+        Each value's :attr:`Compared.accuracy` bounds its error: a position
+        (overshoot) is exact up to the round-off of evaluating eq. (7),
+        dx = 8 eps X with X = max|x1| + |amplitude| + max|u| h + max|x2 - u| / a
+        (every term of the evaluation is at most X); a crossing time t* up to
+        brentq's tolerance on the offset in its sample (xtol + rtol s <= 8 eps h) plus
+        the round-off of t_k + s (2 eps t*) plus dx over the slope of the crossed
+        signal there (|r' - x2| for e, |x2| for x1); a rise time is the sum of its
+        two crossings'; the phase up to 16 N eps rad for its N quadrature terms.
 
     Examples
     --------
@@ -964,46 +1128,77 @@ def metrics_from_arrays(
     nan = math.nan
     p = _pieces(tr, sig)
     ev = _value(p, p.brk, "e")
+    acc = _Accuracy(tr, sig)
     vals: dict[str, Compared] = {}
     details: dict[str, float] = {"band_2pct_mm": band2, "t_peak_s": nan}
     for key, b in (("settling_2pct_s", band2), ("settling_0p01mm_s", band)):
         ex = _settling(p, b, ev) - float(tt[0]) if b > 0 else nan
-        vals[key] = Compared(
-            ex, _grid_settling(tt, e_grid, b) if b > 0 else nan, TIME_TOL_SAMPLES * T
-        )
+        g = grid_settling_time(tt, e_grid, b) if b > 0 else nan
+        err = acc.time(float(tt[0]) + ex, "e") if ex > 0 else (0.0 if ex == 0 else nan)
+        vals[key] = Compared(ex, g, TIME_TOL_SAMPLES * T, err)
     if sig.kind in ("step", "ramp"):
         target = float(sig.r(tt[-1]))
         ov, tp = overshoot(tr, target)
-        sgn = 1.0 if target >= y1[0] else -1.0
-        vals["overshoot_mm"] = Compared(
-            ov, max(0.0, float(np.max(sgn * (y1 - target)))), POSITION_TOL
-        )
+        g = grid_overshoot(y1, target, float(y1[0]))
+        vals["overshoot_mm"] = Compared(ov, g, POSITION_TOL, acc.position)
         details["t_peak_s"] = tp
-        if sig.kind == "step":  # r constant: the e-pieces are the x1-pieces
-            rt = _rise(p, float(y1[0]), target, 0.1, 0.9, target - ev) if target != y1[0] else nan
-        else:
-            rt = rise_time(tr, target)
-        lo, hi = (y1[0] + f * (target - y1[0]) for f in (0.1, 0.9))
-        g = _grid_first(tt, sgn * (y1 - hi) >= 0) - _grid_first(tt, sgn * (y1 - lo) >= 0)
-        vals["rise_time_s"] = Compared(rt, g, TIME_TOL_SAMPLES * T)
+        rt = err = nan
+        if target != y1[0]:  # for a step r is constant: the e-pieces are the x1-pieces
+            q, xv = (p, target - ev) if sig.kind == "step" else (_pieces(tr, None, "x1"), None)
+            t_lo, t_hi = _rise_pair(q, float(y1[0]), target, 0.1, 0.9, xv)
+            rt, err = t_hi - t_lo, acc.time(t_lo, "x1") + acc.time(t_hi, "x1")
+        vals["rise_time_s"] = Compared(
+            rt, grid_rise_time(tt, y1, target), TIME_TOL_SAMPLES * T, err
+        )
     else:
-        vals["overshoot_mm"] = Compared(nan, nan, POSITION_TOL)
-        vals["rise_time_s"] = Compared(nan, nan, TIME_TOL_SAMPLES * T)
+        vals["overshoot_mm"] = Compared(nan, nan, POSITION_TOL, nan)
+        vals["rise_time_s"] = Compared(nan, nan, TIME_TOL_SAMPLES * T, nan)
     if sig.kind == "sine":
         ph, ratio, (ta, tb) = sine_phase(tr, sig)
         g = _grid_phase(tt, y1, sig.r(tt), sig.rate, ta) if math.isfinite(ta) else nan
-        vals["phase_delay_deg"] = Compared(ph, g, PHASE_TOL_DEG)
+        vals["phase_delay_deg"] = Compared(ph, g, PHASE_TOL_DEG, acc.phase_deg(sig))
         details.update(amplitude_ratio=ratio, fit_from_s=ta, fit_to_s=tb)
     else:
-        vals["phase_delay_deg"] = Compared(nan, nan, PHASE_TOL_DEG)
+        vals["phase_delay_deg"] = Compared(nan, nan, PHASE_TOL_DEG, nan)
     if d is None:
-        vals["linear_zone_s"] = Compared(nan, nan, TIME_TOL_SAMPLES * T)
+        vals["linear_zone_s"] = Compared(nan, nan, TIME_TOL_SAMPLES * T, nan)
     else:
         ez = _linear_zone(p, d, v_max, ev) - float(tt[0])
         inside = (np.abs(e_grid) < d) & (np.abs(y2 - sig.r_dot(tt)) <= v_max)
         gz = _grid_first(tt, inside) - float(tt[0])
-        vals["linear_zone_s"] = Compared(ez, gz, TIME_TOL_SAMPLES * T)
+        err = acc.time(float(tt[0]) + ez, "e") if ez > 0 else (0.0 if ez == 0 else nan)
+        vals["linear_zone_s"] = Compared(ez, gz, TIME_TOL_SAMPLES * T, err)
     return ExactMetrics(sig, {k: vals[k] for k in METRIC_KEYS}, details)
+
+
+class _Accuracy:
+    """Error bounds of the exact values of one response (see metrics_from_arrays)."""
+
+    def __init__(self, tr: Trajectory, sig: Signal):
+        eps = float(np.finfo(float).eps)
+        h = np.diff(tr.t)
+        scale = (
+            float(np.max(np.abs(tr.x1)))
+            + abs(sig.amplitude)
+            + float(np.max(np.abs(tr.u) * h))
+            + float(np.max(np.abs(tr.x2[:-1] - tr.u))) / tr.a
+        )
+        self.tr, self.sig, self.eps, self.h = tr, sig, eps, float(h.max())
+        self.position = 8.0 * eps * scale
+
+    def time(self, t: float, what: str) -> float:
+        """Bound [s] on the error of a crossing of e (``e``) or x1 (``x1``) found at t [s]."""
+        if not math.isfinite(t):
+            return math.nan
+        _, v = self.tr.state(np.array([t]))
+        slope = abs(float(v[0]) - (float(self.sig.r_dot(t)) if what == "e" else 0.0))
+        root = 8.0 * self.eps * self.h + 2.0 * self.eps * abs(t)
+        return root + (self.position / slope if slope > 0 else math.inf)
+
+    def phase_deg(self, sig: Signal) -> float:
+        """Bound [deg] on the round-off of the fitted phase: N eps rad for N quadrature terms."""
+        J = max(1, math.ceil((self.tr.a + sig.omega) * self.h))
+        return math.degrees(16.0 * self.tr.intervals * J * self.eps * 8)
 
 
 def exact_metrics(res: Any, plant: Any, reference: Any = None, **kwargs: Any) -> ExactMetrics:

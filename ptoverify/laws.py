@@ -91,7 +91,23 @@ _H_COEF = tuple((-1.0) ** n / n for n in range(25, 1, -1))  # Horner order, high
 
 
 def h_scalar(r: float) -> float:
-    """Return r - ln(1 + r) for a Python float, exact near 0 (see ``curves.h``)."""
+    """Return r - ln(1 + r) for a Python float, exact near 0 (see ``curves.h``).
+
+    Parameters
+    ----------
+    r : float
+        Argument [-], r > -1.
+
+    Returns
+    -------
+    float
+        h(r) >= 0 [-].
+
+    Examples
+    --------
+    >>> h_scalar(1e-10)
+    4.999999999666667e-21
+    """
     if -0.2 < r < 0.2:
         acc = 0.0
         for c in _H_COEF:
@@ -101,7 +117,27 @@ def h_scalar(r: float) -> float:
 
 
 def sigma_scalar(x1: float, x2: float, a: float, omega: float) -> float:
-    """Scalar :func:`ptoverify.curves.level_residual`."""
+    """Scalar :func:`ptoverify.curves.level_residual` (eqs. 9, 11, 13, 14).
+
+    Parameters
+    ----------
+    x1, x2 : float
+        State [mm], [mm/s].
+    a : float
+        Bandwidth [rad/s].
+    omega : float
+        Input level of the curve [mm/s], omega > 0.
+
+    Returns
+    -------
+    float
+        a x1 + sgn(x2) omega h(|x2|/omega) [mm/s]: > 0 right of the curve.
+
+    Examples
+    --------
+    >>> sigma_scalar(1.0, 0.0, 100.0, 300.0)
+    100.0
+    """
     if x2 > 0:
         return a * x1 + omega * h_scalar(x2 / omega)
     if x2 < 0:
@@ -159,7 +195,28 @@ def to_law(cfg: Config) -> Law:
 
 
 def saturate_linear(v: NDArray[np.float64], w: float):
-    """Clip a linear input to +-w; region LINEAR where unclipped, SATURATED where clipped."""
+    """Clip a linear input to +-w; region LINEAR where unclipped, SATURATED where clipped.
+
+    Parameters
+    ----------
+    v : ndarray
+        Unsaturated input [mm/s].
+    w : float
+        Saturation level w_max [mm/s].
+
+    Returns
+    -------
+    u : ndarray
+        Clipped input [mm/s].
+    region : ndarray of int8
+        :class:`Region` code per entry.
+
+    Examples
+    --------
+    >>> u, r = saturate_linear(np.array([1.0, -500.0]), 300.0)
+    >>> u.tolist(), [Region(k).name for k in r]
+    ([1.0, -300.0], ['LINEAR', 'SATURATED'])
+    """
     u = np.clip(v, -w, w)
     region = np.where(np.abs(v) > w, Region.SATURATED, Region.LINEAR).astype(np.int8)
     return u, region

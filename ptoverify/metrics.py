@@ -1,9 +1,16 @@
 """Response metrics of Section 6: settling, overshoot, oscillation, lag, phase.
 
-Every metric is a pure numpy function of sampled arrays (or of a
-:class:`~ptoverify.simulate.SimResult` through :func:`summarize`).  Samples
-are the controller's samples t_k = k T; the plant is exact between them, but
-the metrics look at the samples only (the paper's figures are sampled too).
+The functions here are pure numpy functions of sampled arrays: they look at
+the controller's samples t_k = k T only.  :func:`summarize` reports the time
+metrics of a :class:`~ptoverify.simulate.SimResult` on the exact continuous
+trajectory between the samples (:mod:`ptoverify.exact`: overshoot, settling,
+rise time, linear-zone entry, sine phase), with the sample-grid value of the
+same definition beside each under the key suffixed ``_grid``.  The sample-grid
+definitions of settling, overshoot and rise time are
+:func:`ptoverify.exact.grid_settling_time`, :func:`~ptoverify.exact.grid_overshoot`
+and :func:`~ptoverify.exact.grid_rise_time`, exported here under their older
+names :func:`settling_time`, :func:`overshoot`, :func:`rise_time`: one
+definition of each.
 
 The paper's wording each metric stands for:
 
@@ -30,12 +37,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ptoverify.errors import InputError
+from ptoverify.exact import STEP_FRACTION, TIGHT_BAND, exact_metrics
+from ptoverify.exact import grid_overshoot as overshoot
+from ptoverify.exact import grid_rise_time as rise_time
+from ptoverify.exact import grid_settling_time as settling_time
 
 if TYPE_CHECKING:  # pragma: no cover
     from ptoverify.simulate import SimResult
@@ -57,78 +67,9 @@ __all__ = [
     "summarize",
 ]
 
-TIGHT_BAND = 0.01
-"""Tight settling band [mm]: 2 % of the paper's linear zone d = 0.5 mm."""
-
-STEP_FRACTION = 0.02
-"""Classical settling band as a fraction of the step height [-] (2 %)."""
-
 
 def _arr(x: ArrayLike) -> NDArray[np.float64]:
     return np.asarray(x, dtype=float)
-
-
-def settling_time(t: ArrayLike, e: ArrayLike, band: float, *, hold: float = 0.0) -> float:
-    """Time after which |e| stays within a band: the "adjustment time".
-
-    t_s = t_k for the first sample k such that |e_j| <= band for every j >= k
-    up to the end of the record.  A record that ends outside the band, or whose
-    settled tail is shorter than ``hold``, has not settled: NaN.
-
-    Parameters
-    ----------
-    t : array_like, shape (n,)
-        Sample times [s].
-    e : array_like, shape (n,)
-        Error [mm] (or any signal that should settle to 0).
-    band : float
-        Half-width of the band [same unit as e], > 0.
-    hold : float
-        Shortest settled tail that counts as settled [s] (default 0).
-
-    Returns
-    -------
-    float
-        Settling time [s] measured from t[0]; NaN if it never settles.
-
-    Examples
-    --------
-    >>> t = np.linspace(0, 1, 1001)
-    >>> round(settling_time(t, np.exp(-10 * t), 0.1), 3)
-    0.231
-    """
-    t, e = _arr(t), _arr(e)
-    outside = np.flatnonzero(np.abs(e) > band)
-    k = 0 if outside.size == 0 else outside[-1] + 1
-    if k >= t.size or t[-1] - t[k] < hold:
-        return math.nan
-    return float(t[k] - t[0])
-
-
-def overshoot(x: ArrayLike, target: float, start: float = 0.0) -> float:
-    """Overshoot: largest excursion past the target, in the direction of travel.
-
-    Parameters
-    ----------
-    x : array_like
-        Position [mm].
-    target : float
-        Final value of the reference [mm].
-    start : float
-        Initial value [mm]; the direction of travel is sign(target - start).
-
-    Returns
-    -------
-    float
-        max(0, max_k s (x_k - target)) [mm], s = sign(target - start).
-
-    Examples
-    --------
-    >>> overshoot([0.0, 4.0, 5.3, 4.9, 5.0], 5.0)
-    0.2999999999999998
-    """
-    s = 1.0 if target >= start else -1.0
-    return float(max(0.0, np.max(s * (_arr(x) - target))))
 
 
 def oscillation_amplitude(e: ArrayLike) -> float:
@@ -322,40 +263,6 @@ def phase_delay(ref: SineFit, out: SineFit) -> float:
     return 180.0 if d == -180.0 else d
 
 
-def rise_time(
-    t: ArrayLike, x: ArrayLike, target: float, *, low: float = 0.1, high: float = 0.9
-) -> float:
-    """Rise time from ``low`` to ``high`` of a step from 0 to ``target``.
-
-    Parameters
-    ----------
-    t : array_like
-        Sample times [s].
-    x : array_like
-        Position [mm], starting at 0.
-    target : float
-        Step height [mm], nonzero.
-    low, high : float
-        Fractions of the step [-].
-
-    Returns
-    -------
-    float
-        First time x/target >= high minus first time >= low [s]; NaN if not reached.
-
-    Examples
-    --------
-    >>> t = np.linspace(0, 1, 1001)
-    >>> round(rise_time(t, 1 - np.exp(-10 * t), 1.0), 3)
-    0.22
-    """
-    t, y = _arr(t), _arr(x) / target
-    k_lo, k_hi = np.flatnonzero(y >= low), np.flatnonzero(y >= high)
-    if k_lo.size == 0 or k_hi.size == 0:
-        return math.nan
-    return float(t[k_hi[0]] - t[k_lo[0]])
-
-
 def time_to_linear_zone(
     t: ArrayLike, region: ArrayLike, codes: tuple[int, ...] | None = None
 ) -> float:
@@ -415,62 +322,101 @@ def input_switches(u: ArrayLike, *, tol: float = 0.0) -> int:
 
 
 def summarize(
-    res: SimResult, *, band: float = TIGHT_BAND, step_fraction: float = STEP_FRACTION
+    res: SimResult,
+    plant: Any,
+    *,
+    d: float | None = None,
+    band: float = TIGHT_BAND,
+    step_fraction: float = STEP_FRACTION,
 ) -> dict[str, float]:
     """All metrics of one simulated response, by name (units in the names).
 
-    The steady part is the last half of the record.  The signal, its final
-    value and the sine's frequency are read from ``res.reference``.  For the
-    sine, the fit starts after the first period.
+    The time metrics are measured on the exact continuous trajectory between
+    the samples (:func:`ptoverify.exact.exact_metrics`); each has its
+    sample-grid value beside it under the same key suffixed ``_grid`` (the
+    same definition restricted to the samples), so a reader sees both where
+    they differ: ``settling_tight_s``, ``settling_2pct_s``, ``overshoot_mm``,
+    ``rise_time_s`` (step), ``linear_zone_s``, ``phase_delay_deg`` and
+    ``amplitude_ratio`` (sine).  The other metrics are properties of the
+    sampled sequence and have no ``_grid`` twin: ``steady_amplitude_mm`` and
+    ``steady_velocity_amplitude_mm_s`` (last half of the record),
+    ``error_reversals``, ``input_switches``, ``ramp_lag_mm`` (ramp) and
+    ``fit_residual_rms_mm`` (sine, over whole periods of samples; NaN when a
+    period is not a whole number of samples).  The signal, its final value and
+    the sine's frequency are read from ``res.reference``.
 
     Parameters
     ----------
     res : SimResult
         A simulated response (any step, ramp or sine).
+    plant : Plant or float
+        The plant simulated (its bandwidth a [rad/s]), or a.
+    d : float, optional
+        Half-width of the law's linear zone in position error [mm] (PTO:
+        cfg.pto.d; PD: inf, linear everywhere; TO: no zone, leave None).  Given,
+        ``linear_zone_s`` is the first time |r - x1| <= d on the continuous
+        trajectory (the grid twin: the first sample with |r - x1| < d, the PTO
+        law's own test).  None: both are the first sample the law reports a
+        linear region (:func:`time_to_linear_zone`), which needs no d but
+        cannot see between samples.
     band : float
         Tight band [mm].
     step_fraction : float
-        Classical band as a fraction of the reference's final value [-].
+        Classical band as a fraction of the reference's size [-].
 
     Returns
     -------
     dict
         Metric name -> value (NaN where undefined for this signal).
 
-    Raises
-    ------
-    InputError
-        For a sine whose period is not a whole number of samples.
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> from ptoverify.laws import make_law
+    >>> from ptoverify.simulate import simulate
+    >>> cfg = paper_config()
+    >>> s = summarize(simulate(make_law("pd", cfg), cfg.plant, "step"), cfg.plant)
+    >>> s["overshoot_mm"] >= s["overshoot_mm_grid"]
+    True
     """
     t, e, ref = res.t, res.e, res.reference
     half = t.size // 2
+    em = exact_metrics(res, plant, ref, d=d, band=band, step_fraction=step_fraction)
+    m = em.values
     out = {
-        "settling_tight_s": settling_time(t, e, band),
         "steady_amplitude_mm": oscillation_amplitude(e[half:]),
         "steady_velocity_amplitude_mm_s": oscillation_amplitude((res.x2 - res.r_dot)[half:]),
         "error_reversals": float(sign_reversals(e, band)),
         "input_switches": float(input_switches(res.u)),
-        "linear_zone_s": time_to_linear_zone(t, res.region),
     }
+
+    def both(key: str, name: str) -> None:
+        out[key], out[key + "_grid"] = m[name].exact, m[name].grid
+
+    both("settling_tight_s", "settling_0p01mm_s")
+    if d is None:
+        out["linear_zone_s"] = out["linear_zone_s_grid"] = time_to_linear_zone(t, res.region)
+    else:
+        both("linear_zone_s", "linear_zone_s")
     if ref.name in ("step", "ramp"):
-        final = float(ref.target)
-        out["settling_2pct_s"] = settling_time(t, e, step_fraction * abs(final))
-        out["overshoot_mm"] = overshoot(res.x1, final)
+        both("settling_2pct_s", "settling_2pct_s")
+        both("overshoot_mm", "overshoot_mm")
     if ref.name == "step":
-        out["rise_time_s"] = rise_time(t, res.x1, final)
+        both("rise_time_s", "rise_time_s")
     if ref.name == "ramp":
         out["ramp_lag_mm"] = ramp_lag(t, e, res.r_dot)
     if ref.name == "sine":
         freq = ref.frequency  # the simulated sine's, never a global table's
-        per = 1.0 / (freq * (t[1] - t[0]))
-        if abs(per - round(per)) > 1e-9 * per:
-            raise InputError(
-                f"the phase of a {freq:g} Hz sine is fitted over whole periods: its period must "
-                f"be a whole number of samples, got {per:.6g} (T = {t[1] - t[0]:g} s)"
-            )
-        fit_r = sine_fit(t, res.r, freq, t_from=1.0 / freq)
-        pos = sine_fit(t, res.x1, freq, t_from=1.0 / freq)
-        out["phase_delay_deg"] = phase_delay(fit_r, pos)
-        out["amplitude_ratio"] = pos.amplitude / fit_r.amplitude
-        out["fit_residual_rms_mm"] = pos.residual_rms
+        both("phase_delay_deg", "phase_delay_deg")
+        out["amplitude_ratio"] = em.details.get("amplitude_ratio", math.nan)
+        out["amplitude_ratio_grid"] = math.nan
+        out["fit_residual_rms_mm"] = math.nan
+        try:
+            fit_r = sine_fit(t, res.r, freq, t_from=1.0 / freq)
+            pos = sine_fit(t, res.x1, freq, t_from=1.0 / freq)
+        except ValueError:  # no whole number of samples per period, or < 1 period
+            pass
+        else:
+            out["amplitude_ratio_grid"] = pos.amplitude / fit_r.amplitude
+            out["fit_residual_rms_mm"] = pos.residual_rms
     return out

@@ -6,7 +6,7 @@ flow) from an ``n1`` x ``n2`` grid over the envelope |x1| <= position_range,
 x2 = 0, d <= |x1| <= position_range (the step responses).
 
 Definitions (sigma is the switching function of l1 - o - l2, eqs. 9, 11; tol =
-1e-9 (w_max + a position_range) [mm/s]; d is the PTO linear-zone half-width,
+:func:`ptoverify.verdict.tie_band` [mm/s]; d is the PTO linear-zone half-width,
 used as the yardstick for every law):
 
 stride-over
@@ -41,6 +41,7 @@ from ptoverify.config import Config
 from ptoverify.curves import switching_function
 from ptoverify.laws import Law, Region, make_law
 from ptoverify.simulate import simulate_batch
+from ptoverify.verdict import tie_band
 
 __all__ = [
     "LawProperties",
@@ -49,6 +50,8 @@ __all__ = [
     "law_properties",
     "all_properties",
     "zone_outcome",
+    "oscillating",
+    "crossing_masks",
 ]
 
 
@@ -159,25 +162,43 @@ def initial_grid(
 
 
 def default_steps(cfg: Config) -> int:
-    """Horizon: 2 R / w_max + 60 / a seconds, in samples (room to settle)."""
+    """Horizon: 2 R / w_max + 60 / a seconds, in samples (room to settle).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (position_range R [mm], w_max [mm/s], a [rad/s], T [s]).
+
+    Returns
+    -------
+    int
+        Number of samples [-].
+    """
     p = cfg.plant
     return int(math.ceil((2.0 * p.position_range / p.w_max + 60.0 / p.a) / p.sample_time))
 
 
 def oscillating(x1: np.ndarray, band: float) -> np.ndarray:
-    """Sustained-oscillation test on a window of trajectories (see module docstring).
+    """Sustained-oscillation test (module docstring) on a window of samples.
 
     Parameters
     ----------
     x1 : ndarray, shape (window, n)
-        Positions over the window [mm].
+        Positions over the last ``window`` samples of ``n`` runs [mm].
     band : float
-        Samples with |x1| <= band do not count [mm].
+        Samples with |x1| <= band do not count as a sign [mm].
 
     Returns
     -------
     ndarray of bool, shape (n,)
-        Whether each trajectory oscillates without decaying.
+        At least 4 sign changes and a second-half peak above ``band`` and at
+        least half the first-half peak.
+
+    Examples
+    --------
+    >>> t = np.arange(200)[:, None]
+    >>> oscillating(np.sin(0.3 * t), 1e-3).tolist(), oscillating(np.exp(-0.1 * t), 1e-3).tolist()
+    ([True], [False])
     """
     big = np.abs(x1) > band
     sgn = np.where(big, np.sign(x1), 0.0)
@@ -199,8 +220,8 @@ def crossing_masks(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Stride-overs and crossings into the linear zone, per sample transition.
 
-    A transition k -> k+1 crosses when sigma changes side strictly beyond a tolerance
-    1e-9 (w_max + a position_range) [mm/s]; it starts outside the zone and the linear zone.
+    A transition k -> k+1 crosses when sigma changes side strictly beyond the tie band
+    :func:`ptoverify.verdict.tie_band` [mm/s]; it starts outside the zone and the linear zone.
     A stride-over lands outside the linear zone; otherwise it is a crossing into it.
 
     Parameters
@@ -218,7 +239,7 @@ def crossing_masks(
     """
     p = cfg.plant
     a, w, d = p.a, p.w_max, cfg.pto.d
-    tol = 1e-9 * (w + a * p.position_range)
+    tol = tie_band(w, a, p.position_range)
     sig = switching_function(X1, X2, a, w)
     out = np.abs(X1) >= d
     R = R[: X1.shape[0] - 1]
@@ -376,6 +397,3 @@ def zone_outcome(cfg: Config, *, n1: int = 41, n2: int = 41, rest: int = 40) -> 
             "max_entry_speed": p.max_entry_speed,
         }
     return out
-
-
-_oscillating = oscillating  # former private name, kept while callers move

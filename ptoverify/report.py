@@ -75,17 +75,16 @@ def _clean(obj: Any) -> Any:
 
 # ------------------------------------------------------------------ collection
 def _ground_truth(cfg: Config) -> dict[str, Any]:
-    from ptoverify.mintime import discrete_min_steps, min_time
-    from ptoverify.ocp import CollocationOCP, TwoPhaseOCP, convergence_study
+    from ptoverify.groundtruth import verified_mintime
+    from ptoverify.ocp import convergence_study
 
     p = cfg.plant
     scale = (p.position_range / 50.0, p.w_max / 300.0)
     states = [(x1 * scale[0], x2 * scale[1]) for x1, x2 in GROUND_TRUTH_STATES]
-    tp, co = TwoPhaseOCP(p), CollocationOCP(p, intervals=100)
     rows = []
     for x1, x2 in states:
-        mt = min_time(x1, x2, p)
-        r2, rc, dm = tp.solve(x1, x2), co.solve(x1, x2), discrete_min_steps(x1, x2, p)
+        gt = verified_mintime(x1, x2, cfg, intervals=100)  # checked a posteriori, as mintime
+        mt, r2, rc, dm = gt.closed_form, gt.two_phase, gt.collocation, gt.discrete
         t_f = float(mt.t_f)
         rows.append(
             {
@@ -228,7 +227,11 @@ def collect(cfg: Config, progress: Progress | None = None) -> dict[str, Any]:
     say = progress or (lambda stage: None)
     out: dict[str, Any] = {}
     say("derivations")
-    out["derivations"] = [r.to_json() for r in derivations.all_records()]
+    p = cfg.plant
+    plant = derivations.PlantNumbers(
+        a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
+    )
+    out["derivations"] = [r.to_json() for r in derivations.all_records(plant)]
     say("ground truth")
     out["ground_truth"] = _ground_truth(cfg)
     say("switching zone")

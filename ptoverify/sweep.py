@@ -231,7 +231,20 @@ class SweepResult:
 
 
 def grid_states(plant: Plant, n1: int, n2: int) -> tuple[NDArray, NDArray]:
-    """Even grid over the envelope, shape (n2, n1) each: (x1 [mm], x2 [mm/s])."""
+    """Even grid over the envelope, shape (n2, n1) each: (x1 [mm], x2 [mm/s]).
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant (position_range [mm], w_max [mm/s]).
+    n1, n2 : int
+        Grid points along x1 and x2 [-].
+
+    Returns
+    -------
+    x1, x2 : ndarray, shape (n2, n1)
+        Positions [mm] and velocities [mm/s] (meshgrid, x1 along columns).
+    """
     x1 = np.linspace(-plant.position_range, plant.position_range, n1)
     x2 = np.linspace(-plant.w_max, plant.w_max, n2)
     return np.meshgrid(x1, x2)
@@ -306,7 +319,20 @@ def settling_times(
 
 
 def discrete_limit(plant: Plant, x1: NDArray, x2: NDArray) -> NDArray[np.int64]:
-    """N* for each state (-1 where N* > 20000), by zonotope membership."""
+    """N* for each state (-1 where N* > 20000), by zonotope membership.
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant (a [rad/s], w_max [mm/s], T [s]).
+    x1, x2 : ndarray
+        Initial states [mm], [mm/s] (any shape; raveled).
+
+    Returns
+    -------
+    ndarray of int64
+        Fewest ZOH samples to the origin [-], flat.
+    """
     return discrete_min_steps_batch(np.ravel(x1), np.ravel(x2), plant).steps
 
 

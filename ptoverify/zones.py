@@ -37,7 +37,7 @@ Decisions, and why:
   so the lenient principle already holds with no zone at all (omega0 = w_max),
   while the time-optimal law then lands in the linear zone at nearly -w_max on
   the wrong side of l1; that reading cannot be what the zone is for.
-* A tolerance of 1e-9 (w_max + a * position_range) [mm/s] on sigma absorbs
+* A tolerance of :func:`ptoverify.verdict.tie_band` [mm/s] on sigma absorbs
   round-off for states that ride a curve exactly.
 
 Exact per-velocity test.  At fixed x2, F1 = x1 + c(x2) and F2 do not depend
@@ -62,6 +62,7 @@ from numpy.typing import NDArray
 from ptoverify.config import Config, PTOSettings
 from ptoverify.curves import level_curve_x1, level_residual, root_22, root_k
 from ptoverify.plant import flow
+from ptoverify.verdict import tie_band
 
 __all__ = [
     "PTOZone",
@@ -78,7 +79,7 @@ READINGS = ("strict", "lenient")
 _NAN = float("nan")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class PTOZone:
     """A switching zone S~_P / S~_N (boundary l1*, l2*, eqs. 13-14) and its verdict.
 
@@ -107,10 +108,10 @@ class PTOZone:
         ``strict`` or ``lenient`` (module docstring).
     margin : float
         Worst landing residual sigma(F) over the sources [mm/s] (>= 0 holds).
-    grid_violations : int
-        Violations found on the 2-D verification grid (-1: not run).
-    grid_points : int
-        Number of source states the grid checked.
+    grid_violations : int or None
+        Violations found on the 2-D verification grid (None: not run).
+    grid_points : int or None
+        Number of source states the grid checked (None: not run).
     d_min : float
         Smallest d [mm] for which some omega0 > 0 satisfies the principle
         (an infimum, reached as omega0 -> 0+).
@@ -131,8 +132,8 @@ class PTOZone:
     feasible_intervals: tuple[tuple[float, float], ...] = ()
     reading: str = "strict"
     margin: float = _NAN
-    grid_violations: int = -1
-    grid_points: int = 0
+    grid_violations: int | None = None
+    grid_points: int | None = None
     d_min: float = _NAN
     details: dict = field(default_factory=dict)
 
@@ -166,7 +167,8 @@ class PTOZone:
 
 # ------------------------------------------------------------------ principle
 def _tol(cfg: Config) -> float:
-    return 1e-9 * (cfg.plant.w_max + cfg.plant.a * cfg.plant.position_range)
+    """Curve tie band of :func:`ptoverify.verdict.tie_band` for ``cfg`` [mm/s]."""
+    return tie_band(cfg.plant.w_max, cfg.plant.a, cfg.plant.position_range)
 
 
 def _l1star_x1(x2: NDArray[np.float64], a: float, omega0: float) -> NDArray[np.float64]:
@@ -294,14 +296,14 @@ def principle_violations(
     reading: str = "strict",
     n1: int = 801,
     n2: int = 801,
-    band: int = 201,
+    n_band: int = 201,
 ) -> tuple[int, int]:
     """Count violations of the principle on 2-D grids of source states.
 
     Independent of the monotonicity argument: every grid state in the source set
     is stepped with u = -w_max and its landing is judged.  Two grids: the
     envelope |x1| <= position_range, |x2| <= w_max (``n1`` x ``n2``), and the
-    band from max(l1*, d) out to 3 w_max T to its right (``n2`` x ``band``).
+    band from max(l1*, d) out to 3 w_max T to its right (``n2`` x ``n_band``).
 
     Parameters
     ----------
@@ -311,8 +313,8 @@ def principle_violations(
         Level of l1* [mm/s].
     reading : {"strict", "lenient"}
         Landing rule.
-    n1, n2, band : int
-        Grid sizes in x1, x2 and across the band.
+    n1, n2, n_band : int
+        Grid sizes in x1, x2 and across the band [-].
 
     Returns
     -------
@@ -324,7 +326,7 @@ def principle_violations(
     x2 = np.linspace(-w, w, n2)
     g1, g2 = np.meshgrid(np.linspace(-R, R, n1), x2)
     (lo_a, _), _ = _source_intervals(cfg, omega0, x2, d)
-    off = np.linspace(0.0, 3.0 * w * T, band)
+    off = np.linspace(0.0, 3.0 * w * T, n_band)
     b1 = lo_a[:, None] + off[None, :]
     b2 = np.broadcast_to(x2[:, None], b1.shape)
     x1 = np.concatenate([g1.ravel(), b1.ravel()])
@@ -434,23 +436,20 @@ def printed_zone(cfg: Config) -> PTOZone:
     valid = usable and holds and not degenerate
     details = {"usable": usable, "margin_lenient_mm_s": margin_l, **img}
     return PTOZone(
-        "printed",
-        om,
-        x20,
-        num["b0"],
-        num["y_star"],
-        num["k"],
-        num["z_star"],
-        valid,
-        degenerate,
-        "; ".join(reasons),
-        (),
-        "strict",
-        margin,
-        -1,
-        0,
-        smallest_d(cfg, "strict"),
-        details,
+        construction="printed",
+        omega0=om,
+        x20_tilde=x20,
+        b0=num["b0"],
+        y_star=num["y_star"],
+        k=num["k"],
+        z_star=num["z_star"],
+        valid=valid,
+        degenerate=degenerate,
+        reason="; ".join(reasons),
+        reading="strict",
+        margin=margin,
+        d_min=smallest_d(cfg, "strict"),
+        details=details,
     )
 
 
@@ -576,30 +575,27 @@ def corrected_zone(
             f"which one does is {dmin:.6g} mm"
         )
         return PTOZone(
-            "corrected",
-            _NAN,
-            _NAN,
-            _NAN,
-            _NAN,
-            _NAN,
-            _NAN,
-            False,
-            False,
-            reason,
-            (),
-            reading,
-            _worst_margin(cfg, 0.0, reading),
-            -1,
-            0,
-            dmin,
-            {"usable": False},
+            construction="corrected",
+            omega0=_NAN,
+            x20_tilde=_NAN,
+            b0=_NAN,
+            y_star=_NAN,
+            k=_NAN,
+            z_star=_NAN,
+            valid=False,
+            degenerate=False,
+            reason=reason,
+            reading=reading,
+            margin=_worst_margin(cfg, 0.0, reading),
+            d_min=dmin,
+            details={"usable": False},
         )
     top = intervals[-1][1]
     no_zone_needed = top >= w
     omega0 = (w if no_zone_needed else top) * (1.0 - 1e-6)
     margin = _worst_margin(cfg, omega0, reading)
     degenerate = _degenerate(cfg, omega0)
-    viol, pts = principle_violations(cfg, omega0, reading=reading) if verify else (-1, 0)
+    viol, pts = principle_violations(cfg, omega0, reading=reading) if verify else (0, 0)
     y = float(root_22(a * d / omega0))  # l1* meets x1 = d: h(y) = a d / omega0
     x20 = -y * omega0 if y * omega0 <= w else _NAN
     k = 1.0 + a * d / x20 if math.isfinite(x20) else _NAN
@@ -617,7 +613,7 @@ def corrected_zone(
         )
     if verify:
         parts.append(f"grid check: {viol} violations in {pts} source states")
-    valid = (not degenerate) and omega0 < w and margin >= -_tol(cfg) and viol <= 0
+    valid = (not degenerate) and omega0 < w and margin >= -_tol(cfg) and viol == 0
     details = {
         "usable": 0 < omega0 < w,
         "no_zone_needed": no_zone_needed,
@@ -625,23 +621,23 @@ def corrected_zone(
         "l1_x1_at_wmax_mm": float(level_curve_x1(-w, a, w)),
     }
     return PTOZone(
-        "corrected",
-        omega0,
-        x20,
-        a * d / omega0,
-        y if math.isfinite(x20) else _NAN,
-        k,
-        y if math.isfinite(x20) else _NAN,
-        valid,
-        degenerate,
-        "; ".join(parts),
-        tuple(intervals),
-        reading,
-        margin,
-        viol,
-        pts,
-        dmin,
-        details,
+        construction="corrected",
+        omega0=omega0,
+        x20_tilde=x20,
+        b0=a * d / omega0,
+        y_star=y if math.isfinite(x20) else _NAN,
+        k=k,
+        z_star=y if math.isfinite(x20) else _NAN,
+        valid=valid,
+        degenerate=degenerate,
+        reason="; ".join(parts),
+        feasible_intervals=tuple(intervals),
+        reading=reading,
+        margin=margin,
+        grid_violations=viol if verify else None,
+        grid_points=pts if verify else None,
+        d_min=dmin,
+        details=details,
     )
 
 

@@ -1,11 +1,20 @@
-"""Shared fixtures: the paper plant and other plants."""
+"""Shared fixtures and helpers: plants, random states, the ZOH reference, ``with_d``.
+
+The helpers are imported by the test modules (``from conftest import ...``);
+they live here once.
+"""
+
+import dataclasses
 
 import matplotlib
 
 matplotlib.use("Agg")
 
+import numpy as np  # noqa: E402
 import pytest  # noqa: E402
+from scipy.signal import cont2discrete  # noqa: E402
 
+from derivations.common import PlantNumbers  # noqa: E402
 from ptoverify.config import Config, PDGains, Plant, PTOSettings, paper_config  # noqa: E402
 
 
@@ -34,7 +43,54 @@ def other_configs() -> list[Config]:
 
 ALL_CONFIGS = [paper_config(), *other_configs()]
 
+#: The plants of :data:`ALL_CONFIGS` by name.
+PLANTS = {c.name: c.plant for c in ALL_CONFIGS}
+
 
 @pytest.fixture(params=ALL_CONFIGS, ids=lambda c: c.name)
 def any_cfg(request) -> Config:
     return request.param
+
+
+def with_d(cfg: Config, d: float) -> Config:
+    """``cfg`` with the PTO linear-zone half-width set to ``d`` [mm]."""
+    return dataclasses.replace(cfg, pto=dataclasses.replace(cfg.pto, d=d))
+
+
+def random_states(plant: Plant, n: int, seed: int) -> np.ndarray:
+    """``n`` states uniform in the envelope |x1| <= position_range, |x2| < w_max, shape (n, 2)."""
+    rng = np.random.default_rng(seed)
+    x1 = rng.uniform(-1.0, 1.0, n) * plant.position_range
+    x2 = rng.uniform(-1.0, 1.0, n) * plant.w_max * (1.0 - 1e-9)
+    return np.column_stack([x1, x2])
+
+
+def zoh_reference(a: float, T: float) -> tuple[np.ndarray, np.ndarray]:  # noqa: N803
+    """(Ad, Bd) of eq. (1) by ``scipy.signal.cont2discrete(method="zoh")``.
+
+    Independent of ``ptoverify.plant`` (scipy builds it from expm of the
+    augmented matrix): the reference for every one-sample map.
+    """
+    A = np.array([[0.0, 1.0], [0.0, -a]])
+    B = np.array([[0.0], [a]])
+    Ad, Bd, *_ = cont2discrete((A, B, np.eye(2), np.zeros((2, 1))), T, method="zoh")
+    return Ad, Bd
+
+
+def zoh_step(x1, x2, u, a: float, T: float):  # noqa: N803
+    """One ZOH sample of eq. (1) from (x1, x2) under held u (broadcasting), by :func:`zoh_reference`."""
+    Ad, Bd = zoh_reference(a, T)
+    X = np.stack(
+        np.broadcast_arrays(np.asarray(x1, float), np.asarray(x2, float), np.asarray(u, float))
+    )
+    y1 = Ad[0, 0] * X[0] + Ad[0, 1] * X[1] + Bd[0, 0] * X[2]
+    y2 = Ad[1, 0] * X[0] + Ad[1, 1] * X[1] + Bd[1, 0] * X[2]
+    return y1, y2
+
+
+def plant_numbers(cfg: Config) -> PlantNumbers:
+    """The configuration's numbers as the derivations take them."""
+    p = cfg.plant
+    return PlantNumbers(
+        a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
+    )

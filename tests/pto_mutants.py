@@ -42,7 +42,18 @@ MUTANTS: dict[str, str] = {
     "k2_sign": "sign of the damping term flipped: -k1 x1 + k2 x2",
     "zone_n_sign": "mirror zone returns +omega_c (sign error in eq. 33)",
     "pd_gains": "linear zone uses the PD gains kp, kd instead of k1, k2",
+    "slow_band_x1": "bang-bang input 5 % low for 30.2 < |x1| < 31.4 mm (between grid columns)",
+    "slow_band_x2": "bang-bang input 5 % low for 101 < |x2| < 109 mm/s, |x1| > 2 mm",
+    "tie_asym": "within the tie band of l2* (x2 > 0) the bang branch -w_max, not the zone "
+    "(the mirrored tie on l1* keeps the zone: the old examples/my_pto.py fault)",
+    "latch": "a latch: once a call has seen |x2| > 0.95 w_max at |x1| > 40 mm, u is 0.1 % low",
+    "cache": "an LRU cache of 64 entries keyed by the state rounded to 0.5 mm, 5 mm/s",
+    "debounce": "a debounce: a sign change of u at an array index is held for one call",
+    "call_count": "u 0.1 % high after the 50th call (a call counter)",
 }
+
+#: faults that give the law memory: ``conform`` must name them ``pure-function``
+MEMORY = ("delay", "latch", "cache", "debounce", "call_count")
 
 #: numerical variants that are not faults: each must conform (no false rejections)
 BENIGN: dict[str, str] = {
@@ -139,6 +150,15 @@ def _pto(x1, x2, cfg, f):
         sign_n = 1.0 if "zone_n_sign" in f else -1.0
         u = u.copy()
         u[inz] = np.where(zp[inz], wc, sign_n * wc)
+    if "tie_asym" in f:
+        band = 1e-9 * (w + a * p.position_range)
+        u = np.where((x2 > 0) & (sig < 0) & (np.abs(r0) <= band), -w, u)
+    bang = np.abs(u) == w
+    if "slow_band_x1" in f:
+        u = np.where(bang & (np.abs(x1) > 30.2) & (np.abs(x1) < 31.4), 0.95 * u, u)
+    if "slow_band_x2" in f:
+        band2 = (np.abs(x2) > 101.0) & (np.abs(x2) < 109.0) & (np.abs(x1) > 2.0)
+        u = np.where(bang & band2, 0.95 * u, u)
     lin = np.abs(x1) <= d if "boundary_tie" in f else np.abs(x1) < d
     damp = k2 if "k2_sign" in f else -k2
     ul = -k1 * x1 + damp * x2
@@ -168,6 +188,91 @@ class _Delayed:
         return out
 
 
+class _Latch:
+    """Scales u by 0.999 for good once a call has seen a fast state far out."""
+
+    def __init__(self, inner):
+        self.inner, self.on = inner, False
+
+    def __call__(self, x1, x2, cfg):
+        u = self.inner(x1, x2, cfg)
+        out = u * 0.999 if self.on else u
+        w = cfg.plant.w_max
+        self.on |= bool(np.any((np.abs(x2) > 0.95 * w) & (np.abs(x1) > 40.0)))
+        return out
+
+
+class _Cache:
+    """LRU cache of 64 entries keyed by the rounded state (nearby states share u)."""
+
+    def __init__(self, inner):
+        from collections import OrderedDict
+
+        self.inner, self.store = inner, OrderedDict()
+
+    def one(self, a, b, cfg):
+        key = (round(a / 0.5), round(b / 5.0))
+        if key in self.store:
+            self.store.move_to_end(key)
+            return self.store[key]
+        u = float(self.inner(a, b, cfg))
+        self.store[key] = u
+        if len(self.store) > 64:
+            self.store.popitem(last=False)
+        return u
+
+    def __call__(self, x1, x2, cfg):
+        if np.ndim(x1) == 0:
+            return self.one(float(x1), float(x2), cfg)
+        u = self.inner(x1, x2, cfg)  # vectorized for speed; the cache overrides hits
+        out = np.array(u, dtype=float, copy=True)
+        for i, (a, b) in enumerate(zip(np.ravel(x1).tolist(), np.ravel(x2).tolist())):
+            key = (round(a / 0.5), round(b / 5.0))
+            if key in self.store:
+                self.store.move_to_end(key)
+                out.flat[i] = self.store[key]
+            else:
+                self.store[key] = float(out.flat[i])
+                if len(self.store) > 64:
+                    self.store.popitem(last=False)
+        return out
+
+
+class _Debounce:
+    """A sign change of u at an array index (same shape as the last call) waits one call."""
+
+    def __init__(self, inner):
+        self.inner, self.prev = inner, None
+
+    def __call__(self, x1, x2, cfg):
+        u = self.inner(x1, x2, cfg)
+        prev, self.prev = self.prev, u
+        if prev is None or np.shape(prev) != np.shape(u):
+            return u
+        return np.where(np.sign(u) * np.sign(prev) < 0, prev, u)
+
+
+class _CallCount:
+    """u 0.1 % high after the 50th call."""
+
+    def __init__(self, inner):
+        self.inner, self.calls = inner, 0
+
+    def __call__(self, x1, x2, cfg):
+        self.calls += 1
+        u = self.inner(x1, x2, cfg)
+        return u * 1.001 if self.calls > 50 else u
+
+
+_STATEFUL = {
+    "delay": lambda inner: _Delayed(inner),
+    "latch": _Latch,
+    "cache": _Cache,
+    "debounce": _Debounce,
+    "call_count": _CallCount,
+}
+
+
 def make_law(faults=()):
     """Return the copy with the given fault flags as ``u = f(x1, x2, cfg)``.
 
@@ -179,7 +284,7 @@ def make_law(faults=()):
     Returns
     -------
     callable
-        Vectorized law (a float for scalar input), stateful for ``delay``.
+        Vectorized law (a float for scalar input), stateful for :data:`MEMORY` faults.
     """
     f = frozenset(faults) - {"faithful"}
     unknown = f - set(MUTANTS) - set(BENIGN)
@@ -191,7 +296,10 @@ def make_law(faults=()):
         u = _pto(np.atleast_1d(x1a), np.atleast_1d(x2a), cfg, f).reshape(x1a.shape)
         return float(u) if u.ndim == 0 else u
 
-    return _Delayed(law) if "delay" in f else law
+    for name, wrap in _STATEFUL.items():
+        if name in f:
+            law = wrap(law)
+    return law
 
 
 def faithful(x1, x2, cfg):

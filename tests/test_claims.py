@@ -8,10 +8,13 @@ import numpy as np
 import pytest
 
 from ptoverify import claims as cl
+from ptoverify import exact
 from ptoverify import metrics as mt
 from ptoverify.config import paper_config
+from ptoverify.exact import Compared
 from ptoverify.laws import make_law
 from ptoverify.metrics import settling_time
+from ptoverify.plant import flow as plant_flow
 from ptoverify.plant import step as plant_step
 from ptoverify.simulate import simulate
 
@@ -111,14 +114,34 @@ def test_readings_cover_the_ambiguities(results):
     )
 
 
+def _dense_settling(res, a, band, per=2000):
+    """Last exit of |e| from the band on ``per`` points per sample of plant.flow (not exact.py)."""
+    h = np.diff(res.t)
+    s = h[:, None] * (np.arange(per) / per)[None, :]
+    x1, _ = plant_flow(res.x1[:-1, None], res.x2[:-1, None], res.u[:-1, None], s, a)
+    t = (res.t[:-1, None] + s).ravel()
+    out = np.flatnonzero(np.abs(res.reference.r(t) - x1.ravel()) > band)
+    return t[out[-1] + 1], h.max() / per
+
+
 def test_measured_value_is_recomputed_from_simulation(results):
-    """The headline number equals an independent recomputation, and moves with the plant."""
+    """The headline number is measured between samples (a dense evaluation of the flow brackets
+    its settling times within one dense spacing), its grid twin on the samples, and both move
+    with the plant.
+    """
     cfg = paper_config()
     by = {r.id: r for r in results}
     pd = simulate(make_law("pd", cfg), cfg.plant, "step")
     pto = simulate(make_law("pto", cfg), cfg.plant, "step")
-    ts_pd, ts_pto = (settling_time(r.t, r.e, 0.02 * 5.0) for r in (pd, pto))
+    primary = by["step-pd-31-percent"].readings[0]
+    for res, key in ((pd, "settling_pd_s"), (pto, "settling_pto_s")):
+        dense, dt = _dense_settling(res, cfg.plant.a, 0.02 * 5.0)
+        assert dense - dt <= primary.values[key] <= dense, key
+        assert primary.values_grid[key] == settling_time(res.t, res.e, 0.02 * 5.0), key
+    ts_pd, ts_pto = primary.values["settling_pd_s"], primary.values["settling_pto_s"]
     assert by["step-pd-31-percent"].measured == pytest.approx(100 * (ts_pd / ts_pto - 1), rel=1e-12)
+    gd, gp = (settling_time(r.t, r.e, 0.02 * 5.0) for r in (pd, pto))
+    assert by["step-pd-31-percent"].measured_grid == pytest.approx(100 * (gd / gp - 1), rel=1e-12)
     other = {r.id: r for r in cl.evaluate_claims(cfg.with_plant(w_max=250.0))}
     changed = [
         i for i in REQUIRED if by[i].measured is not None and other[i].measured != by[i].measured
@@ -143,15 +166,16 @@ def test_cached():
     assert all(a is b for a, b in zip(first, again, strict=True)), "cache"
 
 
-def _hand_loop_error_tracking(law, plant, r, r_dot):
+def _hand_loop_error_tracking(law, plant, r, r_dot, full=False):
     """u_k = sat(law(x1_k - r_k, x2_k - r'_k)), nothing added; x_{k+1} = plant.step(x_k, u_k)."""
     x1, x2, X1 = 0.0, 0.0, np.empty(r.size)
+    X2, U = np.empty(r.size), np.empty(r.size)
     for k in range(r.size):
         v, _ = law.scalar(x1 - r[k], x2 - r_dot[k])
         u = min(max(v, -plant.w_max), plant.w_max)
-        X1[k] = x1
+        X1[k], X2[k], U[k] = x1, x2, u
         x1, x2 = (float(z) for z in plant_step(x1, x2, u, plant))
-    return X1
+    return (X1, X2, U) if full else X1
 
 
 @pytest.mark.parametrize("a_reading", ["2pi*f", "f"])
@@ -185,12 +209,146 @@ def test_error_tracking_reading_against_a_hand_built_loop(results, a_reading):
     w = 2 * np.pi * 5.0
     r, r_dot = 5.0 * np.sin(w * t), 5.0 * w * np.cos(w * t)
     for law, cid, pto in (("pd", "sine-pd-delay", None), ("pto", "sine-pto-delay", "corrected")):
-        x1 = _hand_loop_error_tracking(make_law(law, cfg), cfg.plant, r, r_dot)
+        x1, x2, u = _hand_loop_error_tracking(make_law(law, cfg), cfg.plant, r, r_dot, True)
         fit_r, fit_x = mt.sine_fit(t, r, 5.0, t_from=0.2), mt.sine_fit(t, x1, 5.0, t_from=0.2)
         got = reading(cid, "error", pto).values
-        assert got["phase_delay_deg"] == pytest.approx(
+        grid = reading(cid, "error", pto).values_grid
+        assert grid["phase_delay_deg"] == pytest.approx(
             mt.phase_delay(fit_r, fit_x), rel=1e-9, abs=1e-9
-        ), f"{law} sine phase delay, error tracking"
+        ), f"{law} sine phase delay on the samples, error tracking"
+        tr = exact.Trajectory.from_samples(t, x1, x2, u, cfg.plant.a)
+        assert got["phase_delay_deg"] == pytest.approx(
+            exact.sine_phase(tr, ("sine", 5.0, 5.0))[0], rel=1e-9, abs=1e-9
+        ), f"{law} sine phase delay between samples, error tracking"
         assert got["residual_rms_mm"] == pytest.approx(fit_x.residual_rms, rel=1e-6, abs=1e-12)
         ff = reading(cid, "feed-forward", pto).values["phase_delay_deg"]
         assert abs(got["phase_delay_deg"] - ff) > 0.1, f"{law}: error reading is not feed-forward"
+
+
+def test_exact_overshoot_is_at_least_the_grid_overshoot_everywhere(results):
+    """Every overshoot any claim reading measured (every Section 6 step and ramp response the
+    claims use, all readings) is >= its sample-grid value: the samples lie on the trajectory.
+    """
+    seen = 0
+    for r in results:
+        for x in r.readings:
+            for key, value in x.values.items():
+                if "overshoot" in key:
+                    assert value >= x.values_grid[key] >= 0.0, f"{r.id} {x.label} {key}"
+                    seen += 1
+    assert seen >= 20, "the claims measure overshoots"
+
+
+def test_claims_json_is_backward_compatible(results):
+    """The grid values, grid verdicts and ties are added beside the old keys, none renamed."""
+    old_claim = {"id", "section", "signal", "claim", "paper_value", "unit", "rule", "verdict"}
+    old_claim |= {"measured", "detail", "readings"}
+    old_reading = {"reading", "label", "measured", "values", "verdict", "detail"}
+    for r in results:
+        j = r.to_json()
+        assert old_claim | {"measured_grid", "verdict_grid", "verdict_differs_on_grid"} == set(j)
+        for x in j["readings"]:
+            new = {"measured_grid", "values_grid", "verdict_grid", "verdict_differs_on_grid"}
+            assert old_reading | new | {"ties"} == set(x)
+            assert set(x["values_grid"]) == set(x["values"]), r.id
+
+
+def test_compare_true_tie_rule():
+    """Exact values tie within the sum of their accuracies; grid values only when equal."""
+    a = Compared(0.016, 0.016, 0.0, 1e-15)
+    assert a.compare(Compared(0.016 + 1.5e-15, 0.016, 0.0, 1e-15)) == 0, "within 2e-15: tie"
+    assert a.compare(Compared(0.016 + 3e-15, 0.016, 0.0, 1e-15)) == -1, "beyond: ordered"
+    assert a.compare(Compared(0.016 - 3e-15, 0.016, 0.0, 1e-15)) == 1
+    assert a.compare(Compared(0.02, 0.016, 0.0, 0.0), grid=True) == 0, "equal samples tie"
+    assert a.compare(Compared(math.nan, 0.016, 0.0, 0.0)) is None, "undefined: no order"
+
+
+@pytest.fixture
+def fresh_claim_caches():
+    """The claims cache their metrics per configuration: isolate a patched run."""
+    cl._metrics.cache_clear()
+    cl._evaluate_all.cache_clear()
+    yield
+    cl._metrics.cache_clear()
+    cl._evaluate_all.cache_clear()
+
+
+def _quicker_with_pto_rise(monkeypatch, offset):
+    """Evaluate the rise-time claim with PTO's exact rise time set to PD's + offset(tie band).
+
+    ``offset`` maps the tie band (the two values' summed accuracy) [s] to the shift [s].  The
+    grid values are left alone, so only a verdict computed from the exact values can move.
+    """
+    cfg = paper_config()
+    cfgs = {c.plant.a: c for c in (cfg, cfg.with_plant(a=cfg.bandwidth_hz))}
+    real = cl.exact_metrics
+
+    def patched(res, plant, reference=None, **kw):
+        em = real(res, plant, reference, **kw)
+        if res.signal != "step" or not res.law.startswith("pto"):
+            return em
+        pd = simulate(make_law("pd", cfgs[plant.a]), plant, "step")
+        pd_rise = real(pd, plant, pd.reference, **kw).values["rise_time_s"]
+        own = em.values["rise_time_s"]
+        shift = offset(own.accuracy + pd_rise.accuracy)
+        vals = dict(em.values)
+        vals["rise_time_s"] = dataclasses.replace(own, exact=pd_rise.exact + shift)
+        return dataclasses.replace(em, values=vals)
+
+    monkeypatch.setattr(cl, "exact_metrics", patched)
+    entry = next(c for c in cl.CLAIMS if c.id == "conclusion-quicker-response")
+    out = cl.evaluate_claims(cfg, (entry,))[0]
+    cl._metrics.cache_clear()
+    cl._evaluate_all.cache_clear()
+    return out
+
+
+def test_verdicts_are_computed_from_the_exact_metrics(monkeypatch, fresh_claim_caches):
+    """Shift PTO's exact rise time 1 ms below PD's: every reading becomes quicker, though the
+    sample-grid values (and the grid verdicts) are untouched; the flag says where they differ.
+    """
+    quick = _quicker_with_pto_rise(monkeypatch, lambda band: -1e-3)
+    slow = _quicker_with_pto_rise(monkeypatch, lambda band: +1e-3)
+    assert {x.verdict for x in quick.readings} == {"reproduced"}
+    assert {x.verdict for x in slow.readings} == {"not reproduced"}
+    for q, s in zip(quick.readings, slow.readings, strict=True):
+        assert q.verdict_grid == s.verdict_grid, "the grid verdict does not see the exact values"
+        assert q.values_grid == s.values_grid
+        assert q.differs_on_grid == (q.verdict_grid != "reproduced")
+        assert not q.ties and not s.ties
+
+
+def test_a_true_tie_is_reported_and_is_not_quicker(monkeypatch, fresh_claim_caches):
+    """Within the tie band (the two exact values' summed accuracy) PTO is not quicker, even when
+    its value is numerically below PD's; just beyond the band the order decides.
+    """
+    below = _quicker_with_pto_rise(monkeypatch, lambda band: -0.5 * band)
+    beyond = _quicker_with_pto_rise(monkeypatch, lambda band: -2.0 * band)
+    for x in below.readings:
+        assert x.verdict == "not reproduced" and x.ties, x.label
+        assert "true tie" in x.detail and "rise_time_pto_s = rise_time_pd_s" in x.ties[0]
+        assert 0 < x.values["rise_time_pd_s"] - x.values["rise_time_pto_s"] < 1e-12
+    for x in beyond.readings:
+        assert x.verdict == "reproduced" and not x.ties, x.label
+
+
+def test_response_metrics_show_exact_and_grid_for_every_section6_response():
+    """The report's table: every law and signal, each time metric with its grid twin; the exact
+    overshoot is >= the samples', the PTO linear-zone entry precedes the law's first linear
+    sample by less than one sample, PD is linear from the start and TO never.
+    """
+    cfg = paper_config()
+    got = cl.response_metrics(cfg)
+    assert set(got) == {"to", "pd", "pto", "pto-printed"}
+    T = cfg.plant.T
+    for law, by_sig in got.items():
+        assert set(by_sig) == {"step", "ramp", "sine"}
+        for sig, m in by_sig.items():
+            exact_keys = [k for k in m if k + "_grid" in m]
+            assert "settling_tight_s" in exact_keys and "linear_zone_s" in exact_keys
+            if sig != "sine":
+                assert m["overshoot_mm"] >= m["overshoot_mm_grid"], (law, sig)
+            if law.startswith("pto"):
+                assert m["linear_zone_s_grid"] - T < m["linear_zone_s"] <= m["linear_zone_s_grid"]
+    assert got["pd"]["step"]["linear_zone_s"] == 0.0
+    assert math.isnan(got["to"]["step"]["linear_zone_s"])

@@ -118,10 +118,20 @@ def test_bad_config_every_command_exit_2_writes_nothing(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"], "something was written"
 
 
-def test_every_command_help_has_an_example(capsys):
-    from ptoverify.cli import COMMANDS
+def command_names(capsys) -> list[str]:
+    """The commands as ``ptoverify --help`` lists them (tests use nothing of cli but main)."""
+    with pytest.raises(SystemExit) as exc:
+        main(["--help"])
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    block = out.split("COMMAND\n", 1)[1].split("\n\n", 1)[0]
+    return [line.split()[0] for line in block.splitlines() if line.startswith("    ")]
 
-    for name, _ in COMMANDS:
+
+def test_every_command_help_has_an_example(capsys):
+    names = command_names(capsys)
+    assert "mintime" in names and "check" in names, names
+    for name in names:
         with pytest.raises(SystemExit) as exc:
             main([name, "--help"])
         assert exc.value.code == 0
@@ -208,3 +218,102 @@ def test_mintime_converged_but_inaccurate_ocp_is_not_truth(capsys):
     data = json.loads(capsys.readouterr().out)
     assert data["analytic_s"] > 0
     assert data["two_phase_s"] is None and data["two_phase_status"].startswith("inaccurate")
+
+
+def test_internal_error_is_exit_1_one_line_not_bad_input(capsys, monkeypatch):
+    """An injected bug in a numeric function is an internal error (exit 1), not exit 2."""
+    import ptoverify.groundtruth as gt
+
+    def broken(*args, **kwargs):
+        return 1 / 0
+
+    monkeypatch.setattr(gt, "min_time", broken)
+    code, out, err = run(capsys, "mintime", "5", "0", "--json")
+    assert code == 1 and out == ""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("ptoverify: internal error: ZeroDivisionError: division by zero")
+    assert "--debug" in lines[0] and "Traceback" not in err
+
+
+@pytest.mark.parametrize("where", ["before", "after"])
+def test_debug_shows_the_traceback(capsys, monkeypatch, where):
+    import ptoverify.groundtruth as gt
+
+    monkeypatch.setattr(gt, "min_time", lambda *a, **k: 1 / 0)
+    argv = ["mintime", "5", "0"]
+    argv = ["--debug", *argv] if where == "before" else [*argv, "--debug"]
+    with pytest.raises(ZeroDivisionError):
+        main(argv)
+
+
+def test_debug_in_a_subprocess_prints_a_traceback(tmp_path):
+    """A real process: without --debug one line, with it the traceback; exit 1 both ways."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, ptoverify.groundtruth as g\n"
+        "g.min_time = lambda *a, **k: 1 / 0\n"
+        "from ptoverify.cli import main\n"
+        "sys.exit(main(sys.argv[1:]))\n"
+    )
+    for flag, want_trace in (([], False), (["--debug"], True)):
+        proc = subprocess.run(
+            [sys.executable, "-c", code, *flag, "mintime", "5", "0"],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        assert proc.returncode == 1, proc.stderr
+        assert ("Traceback" in proc.stderr) == want_trace, proc.stderr
+        assert "ZeroDivisionError" in proc.stderr
+
+
+def test_version(capsys):
+    import re
+
+    import ptoverify
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    assert out == f"ptoverify {ptoverify.__version__}\n"
+    assert re.fullmatch(r"\d+\.\d+\.\d+", ptoverify.__version__)
+
+
+def test_usage_error_has_one_prefix(capsys):
+    code, out, err = run(capsys, "mintime", "1", "2", "--intervals", "many")
+    assert code == 2 and out == ""
+    assert err.startswith("ptoverify: error: mintime: ") and "ptoverify mintime" not in err
+
+
+def test_cli_imports_no_solver_and_no_simulator():
+    """cli.py parses, calls and formats: it imports no solver, simulator or law directly."""
+    import ast
+    from pathlib import Path
+
+    import ptoverify
+
+    src = Path(ptoverify.__file__).with_name("cli.py").read_text()
+    names = set()
+    for node in ast.walk(ast.parse(src)):
+        if isinstance(node, ast.Import):
+            names.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            names.add(node.module)
+            names.update(f"{node.module}.{a.name}" for a in node.names)
+    forbidden = {
+        "casadi",
+        "scipy",
+        "ptoverify.ocp",
+        "ptoverify.simulate",
+        "ptoverify.mintime",
+        "ptoverify.plant",
+        "ptoverify.properties",
+        "ptoverify.zones",
+    }
+    assert not names & forbidden, names & forbidden
+    private = [n for n in names if n.rsplit(".", 1)[-1][:1] == "_" and "__" not in n]
+    assert not private, private

@@ -7,10 +7,12 @@ everything.  The score is computed once per session by ``mutation_score``
 (``PYTHONPATH=. python tests/pto_mutants.py`` prints it).
 """
 
+import numpy as np
 import pytest
-from pto_mutants import BENIGN, MUTANTS, make_law, mutation_score
+from pto_mutants import BENIGN, MEMORY, MUTANTS, make_law, mutation_score
 
-from ptoverify.conform import conform_callable
+from ptoverify.agreement import agreement
+from ptoverify.conform import conform_callable, conformance_grid
 
 SWEEP = (11, 11, 20)  # 141 closed-loop states: every mutant is killed well inside this grid
 
@@ -41,9 +43,11 @@ def test_mutation_score_all_killed(score):
 def test_mutant_rejected(score, name):
     props = score[2][name]
     assert props, f"mutant {name} ({MUTANTS[name]}) conforms: a gap in the gate"
-    # every mutant differs from the reference where the grid has points; the delay has no
-    # u(x) to compare (a law with memory), its finding is pure-function
-    expected = "pure-function" if name == "delay" else "agreement"
+    # a law with memory has no u(x) to compare: its finding is pure-function; a fault only at
+    # curve ties (excluded from the agreement) is seen by odd symmetry; the rest disagree
+    expected = (
+        "pure-function" if name in MEMORY else "odd-symmetry" if name == "tie_asym" else "agreement"
+    )
     assert expected in props, f"{name}: {expected} did not see it ({props})"
 
 
@@ -59,9 +63,48 @@ def test_no_saturation_breaks_input_bound(score):
     assert "input-bound" in score[2]["no_saturation"]
 
 
-@pytest.mark.slow
-def test_delay_is_not_a_pure_function(score):
-    assert "pure-function" in score[2]["delay"]
+@pytest.mark.parametrize("name", MEMORY)
+def test_memory_is_a_pure_function_finding(paper_cfg, name):
+    """Latch, cache, debounce, counter, delay: found before any other property runs."""
+    r = conform_callable(make_law([name]), paper_cfg, sweep=(3, 3, 2), n_random=1000)
+    assert r.failed_properties() == ["pure-function"], r.failures[:2]
+    assert "has memory or is not deterministic" in r.failures[0]["detail"]
+    assert r.properties["agreement"].status == "not_run"
+
+
+def test_memory_in_scalar_mode(paper_cfg):
+    """A call counter behind a float-only interface (scalar mode) is found too."""
+    inner = make_law(["call_count"])
+
+    def law(x1, x2, cfg):
+        if not isinstance(x1, float):
+            raise TypeError("floats only")
+        return float(inner(x1, x2, cfg))
+
+    r = conform_callable(law, paper_cfg, sweep=(3, 3, 2), n_random=1000)
+    assert r.mode == "scalar" and r.failed_properties() == ["pure-function"]
+
+
+@pytest.mark.parametrize("name", ["slow_band_x1", "slow_band_x2"])
+def test_band_faults_between_grid_points(paper_cfg, name):
+    """5 % slow in a band the grid steps over: the grid alone passes, conform does not."""
+    cfg = paper_cfg
+    x1, x2 = conformance_grid(cfg)
+    law = make_law([name])
+    alone, _ = agreement(x1, x2, law(x1, x2, cfg), cfg)
+    assert alone["pass"], "the fixed grid alone already sees the band (test is moot)"
+    r = conform_callable(law, cfg, sweep=(3, 3, 2))
+    fail = next(f for f in r.failures if f["property"] == "agreement")
+    s1, s2 = np.abs(fail["state"])
+    in_band = 30.2 < s1 < 31.4 if name == "slow_band_x1" else (101 < s2 < 109 and s1 > 2)
+    assert in_band, f"failure state {fail['state']} not in the band"
+    assert r.agreement["sources"]["random"] >= 100_000
+
+
+def test_tie_asymmetry_is_odd_symmetry_finding(paper_cfg):
+    r = conform_callable(make_law(["tie_asym"]), paper_cfg, sweep=(3, 3, 2), n_random=1000)
+    assert r.failed_properties() == ["odd-symmetry"]
+    assert "curve tie" in r.failures[0]["detail"]
 
 
 @pytest.mark.parametrize("name", sorted(BENIGN))

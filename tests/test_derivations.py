@@ -11,6 +11,7 @@ import mpmath
 import numpy as np
 import pytest
 import sympy as sp
+from conftest import ALL_CONFIGS, plant_numbers, zoh_reference
 from numpy.testing import assert_allclose
 
 import derivations
@@ -22,7 +23,6 @@ from ptoverify.config import paper_config
 from ptoverify.curves import level_residual, omega_c, root_22, root_k
 from ptoverify.mintime import min_time
 from ptoverify.plant import flow as np_flow
-from ptoverify.plant import zoh_matrices
 
 a, wm, T, t = S["a"], S["omega_m"], S["T"], S["t"]
 x1, x2, x10, x20 = S["x1"], S["x2"], S["x10"], S["x20"]
@@ -32,7 +32,7 @@ RNG_SEED = 12345
 
 @pytest.fixture(scope="module")
 def records():
-    return {r.id: r for r in derivations.all_records()}
+    return {r.id: r for r in derivations.all_records(plant_numbers(paper_config()))}
 
 
 def _mp(expr, syms):
@@ -48,7 +48,7 @@ def _mp(expr, syms):
 
 # ------------------------------------------------------------------ catalogue and records
 def test_every_equation_has_a_record(records):
-    ids = [r.id for r in derivations.all_records()]
+    ids = list(records)
     for i in range(1, 40):
         assert str(i) in ids
     numbered = [int(i) for i in ids if i.isdigit()]
@@ -142,7 +142,7 @@ def test_unchecked_record_36z(records):
 
 
 def test_erratum_16_at_paper_defaults(records):
-    ce = records["16"].counterexample["at_paper_defaults"]
+    ce = records["16"].counterexample["at_plant"]
     p = ce["point"]
     tx1, tx2 = np_flow(p["x1"], p["x2"], p["omega_m"], p["T"], p["a"])
     assert_allclose(
@@ -336,7 +336,7 @@ def test_one_step_map_and_inverse_match_zoh():
     tx1, tx2 = S["tx1"], S["tx2"]
     rng = np.random.default_rng(RNG_SEED)
     c = paper_config().plant
-    Ad, Bd = zoh_matrices(c.a, c.sample_time)
+    Ad, Bd = zoh_reference(c.a, c.sample_time)
     n = 200
     x = np.vstack([rng.uniform(-50, 50, n), rng.uniform(-300, 300, n)])
     for sgn in (+1, -1):
@@ -399,7 +399,7 @@ def test_closed_loop_and_lyapunov():
     assert sp.simplify(Acl - sp.Matrix([[0, 1], [-a * k1, -a * (1 + k2)]])) == sp.zeros(2, 2)
     assert sp.simplify(section5.lyapunov_derivative() + 2 * a * (1 + k2) * x2**2) == 0
     c = paper_config()
-    Ad, Bd = zoh_matrices(c.plant.a, c.plant.sample_time)
+    Ad, Bd = zoh_reference(c.plant.a, c.plant.sample_time)
     M = Ad - Bd @ np.array([[c.pto.k1, c.pto.k2]])
     rho = max(abs(np.linalg.eigvals(M)))
     assert_allclose(
@@ -412,7 +412,7 @@ def test_closed_loop_and_lyapunov():
 
 # ------------------------------------------------------------------ renderers
 def test_render_markdown_and_html(records):
-    recs = derivations.all_records()
+    recs = list(records.values())
     md = derivations.render_markdown(recs)
     for i in range(1, 40):
         assert f"| {i} |" in md
@@ -420,3 +420,40 @@ def test_render_markdown_and_html(records):
     html = derivations.render_html(recs + [evil])
     assert "<math" in html and "<script>" not in html and "&lt;script&gt;" in html
     assert html.count("<tr class=") == len(recs) + 1
+
+
+# ------------------------------------------------------------------ numbers come from the caller
+@pytest.mark.parametrize("cfg", ALL_CONFIGS[1:], ids=lambda c: c.name)
+def test_numeric_examples_use_the_callers_plant(cfg, records):
+    """A non-paper configuration's numbers reach records 16, 27, 36Z and 39L."""
+    num = plant_numbers(cfg)
+    recs = {r.id: r for r in derivations.all_records(num)}
+    p = recs["16"].counterexample["at_plant"]["point"]
+    assert_allclose(
+        [p["a"], p["omega_m"], p["T"]],
+        [num.a, num.w_max, num.T],
+        rtol=0,
+        err_msg="(16) evaluated at the caller's plant",
+    )
+    pr = section4.intersection(num.a, num.w_max, num.T, num.d, corrected=False)
+    assert f"omega0 = {pr['omega0']:.6g} mm/s" in recs["27"].note
+    assert f"a = {num.a:.6g} rad/s" in recs["36Z"].note
+    Ad, Bd = zoh_reference(num.a, num.T)
+    rho = max(abs(np.linalg.eigvals(Ad - Bd @ np.array([[num.k1, num.k2]]))))
+    assert f"spectral radius of Ad - Bd K = {rho:.6g}" in recs["39L"].note
+    # the symbolic records do not depend on the plant
+    for id_ in ("15", "19c", "22W", "37", "39"):
+        assert recs[id_] == records[id_]
+    assert recs["27"].note != records["27"].note
+
+
+def test_derivations_take_plant_numbers_only():
+    with pytest.raises(TypeError, match="PlantNumbers"):
+        derivations.all_records(paper_config())
+    with pytest.raises(ValueError, match="w_max"):
+        derivations.PlantNumbers(a=1.0, w_max=-1.0, T=0.1, d=0.0, k1=1.0, k2=0.0)
+
+
+def test_record_json_round_trip(records):
+    for r in records.values():
+        assert EquationRecord.from_json(json.loads(json.dumps(r.to_json()))) == r

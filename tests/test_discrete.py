@@ -18,11 +18,12 @@ import math
 
 import numpy as np
 import pytest
+from conftest import PLANTS, random_states, zoh_reference, zoh_step
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from ptoverify.config import Plant, paper_config
+from ptoverify.config import Plant
 from ptoverify.errors import InputError
 from ptoverify.mintime import (
     ZOHReach,
@@ -30,20 +31,6 @@ from ptoverify.mintime import (
     discrete_min_steps_batch,
     min_time,
 )
-from ptoverify.plant import flow, zoh_matrices
-
-PLANTS = {
-    "paper": paper_config().plant,
-    "slow-a": Plant(a=30.0, w_max=300.0, sample_time=0.002, position_range=50.0),
-    "fine-T": Plant(a=100.0, w_max=100.0, sample_time=0.001, position_range=20.0),
-}
-
-
-def random_states(plant: Plant, n: int, seed: int) -> np.ndarray:
-    rng = np.random.default_rng(seed)
-    x1 = rng.uniform(-1.0, 1.0, n) * plant.position_range
-    x2 = rng.uniform(-1.0, 1.0, n) * plant.w_max * (1.0 - 1e-9)
-    return np.column_stack([x1, x2])
 
 
 def zonotope_margin(x1: float, x2: float, plant: Plant, n: int) -> float:
@@ -51,7 +38,7 @@ def zonotope_margin(x1: float, x2: float, plant: Plant, n: int) -> float:
 
     >= 0 iff the origin is reachable from (x1, x2) in n samples.
     """
-    Ad, Bd = zoh_matrices(plant.a, plant.sample_time)
+    Ad, Bd = zoh_reference(plant.a, plant.sample_time)
     gens, P = [], np.eye(2)
     for _ in range(n):
         gens.append(P @ Bd[:, 0] * plant.w_max)
@@ -67,8 +54,9 @@ def zonotope_margin(x1: float, x2: float, plant: Plant, n: int) -> float:
 
 
 def simulate(x1, x2, u, plant):
+    """Apply the input sequence with the scipy ZOH reference (independent of eq. 7 code)."""
     for uk in u:
-        x1, x2 = flow(x1, x2, uk, plant.sample_time, plant.a)
+        x1, x2 = zoh_step(x1, x2, uk, plant.a, plant.sample_time)
     return float(x1), float(x2)
 
 
@@ -97,12 +85,11 @@ def test_grid_aligned_bang_bang_state():
     """A state whose continuous optimum switches on the sample grid: N* T = t_f* exactly."""
     plant = PLANTS["paper"]
     w, T, a = plant.w_max, plant.sample_time, plant.a
-    x1, x2 = 0.0, 0.0
-    for _ in range(3):  # backwards along l1 (u = +w)
-        x1, x2 = flow(x1, x2, w, -T, a)
-    for _ in range(9):  # backwards under u = -w
-        x1, x2 = flow(x1, x2, -w, -T, a)
-    x1, x2 = float(x1), float(x2)
+    Ad, Bd = zoh_reference(a, T)
+    x = np.zeros(2)
+    for u in [w] * 3 + [-w] * 9:  # backwards along l1 (u = +w), then under u = -w
+        x = np.linalg.solve(Ad, x - Bd[:, 0] * u)
+    x1, x2 = float(x[0]), float(x[1])
     t_f = float(min_time(x1, x2, plant).t_f)
     assert_allclose(t_f, 12 * T, rtol=1e-12, err_msg="constructed t_f* = 12 T")
     d = discrete_min_steps(x1, x2, plant)

@@ -1,5 +1,7 @@
+import mpmath
 import numpy as np
 import pytest
+from conftest import ALL_CONFIGS
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -25,16 +27,32 @@ def test_law_properties(name, x):
     assert uv[0] == u and rv[0] == region, "vector and scalar paths disagree"
 
 
-def test_to_law_on_curves_and_origin():
-    law = make_law("to", CFG)
-    from ptoverify.curves import level_curve_x1
+def l1_x1_mp(x2: float, a: float, w: float) -> mpmath.mpf:
+    """x1 on l1 (x2 < 0) or l2 (x2 > 0) in 50 digits: a x1 = -x2 -+ w ln(1 -+ x2/w) (eqs. 9, 11)."""
+    with mpmath.workdps(50):
+        x2m, s = mpmath.mpf(x2), -mpmath.sign(x2)
+        return (-x2m - s * w * mpmath.log(1 - s * x2m / w)) / a
 
-    x2 = -150.0
-    x1 = float(level_curve_x1(x2, CFG.plant.a, W))  # on l1: +w_max (eq. 12)
-    assert law.scalar(x1, x2)[0] == W or abs(law.scalar(x1, x2)[0]) == W
+
+@pytest.mark.parametrize("cfg", ALL_CONFIGS, ids=lambda c: c.name)
+def test_to_law_switches_on_the_curve(cfg):
+    """Either side of l1 - o - l2, 1e-9 of the range away: +w_max left, -w_max right (eq. 12).
+
+    The curve is evaluated in 50 digits from eqs. (9), (11), independently of
+    ``ptoverify.curves``; the offset is 1e-9 R [mm], far above the round-off of
+    the switching function (~1e-13 of its scale).
+    """
+    law = make_law("to", cfg)
+    a, w, R = cfg.plant.a, cfg.plant.w_max, cfg.plant.position_range
+    delta = 1e-9 * R
+    for x2 in np.concatenate([-np.geomspace(1e-3, 0.999, 12), np.geomspace(1e-3, 0.999, 12)]) * w:
+        xc = l1_x1_mp(float(x2), a, w)
+        left, right = float(xc - delta), float(xc + delta)
+        assert law.scalar(left, x2) == (w, Region.BANG_P), f"left of the curve at x2 = {x2}"
+        assert law.scalar(right, x2) == (-w, Region.BANG_N), f"right of the curve at x2 = {x2}"
     assert law.scalar(0.0, 0.0) == (0.0, Region.ORIGIN)
-    assert law.scalar(1.0, 0.0) == (-W, Region.BANG_N)
-    assert law.scalar(-1.0, 0.0) == (W, Region.BANG_P)
+    assert law.scalar(delta, 0.0) == (-w, Region.BANG_N)
+    assert law.scalar(-delta, 0.0) == (w, Region.BANG_P)
 
 
 def test_pd_law_saturates():

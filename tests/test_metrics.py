@@ -1,5 +1,6 @@
 """Metrics against analytic signals with known answers."""
 
+import json
 import math
 
 import numpy as np
@@ -7,10 +8,12 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.signal import cont2discrete
 
+from ptoverify import exact
 from ptoverify import metrics as m
-from ptoverify.errors import InputError
+from ptoverify.cli import main
 from ptoverify.laws import Region, make_law
-from ptoverify.simulate import Reference, simulate
+from ptoverify.plant import flow
+from ptoverify.simulate import SIGNALS, Reference, simulate
 
 T = 0.002
 t = np.arange(0, 1.0 + T / 2, T)
@@ -107,11 +110,13 @@ def test_linear_zone_and_switches():
 
 def test_summarize_on_simulations(paper_cfg):
     """Summaries are finite where they should be, and PD settles while TO oscillates."""
-    pd = m.summarize(simulate(make_law("pd", paper_cfg), paper_cfg.plant, "step"))
-    to = m.summarize(simulate(make_law("to", paper_cfg), paper_cfg.plant, "step"))
+    pd = m.summarize(simulate(make_law("pd", paper_cfg), paper_cfg.plant, "step"), paper_cfg.plant)
+    to = m.summarize(simulate(make_law("to", paper_cfg), paper_cfg.plant, "step"), paper_cfg.plant)
     assert math.isfinite(pd["settling_2pct_s"]) and math.isfinite(pd["rise_time_s"])
     assert to["steady_amplitude_mm"] > m.TIGHT_BAND > pd["steady_amplitude_mm"]
-    sine = m.summarize(simulate(make_law("pd", paper_cfg), paper_cfg.plant, "sine"))
+    sine = m.summarize(
+        simulate(make_law("pd", paper_cfg), paper_cfg.plant, "sine"), paper_cfg.plant
+    )
     assert 0 < sine["phase_delay_deg"] < 45 and 0.5 < sine["amplitude_ratio"] < 2
 
 
@@ -148,7 +153,7 @@ def test_pd_ramp_lag_without_feedforward(paper_cfg):
     window = range(k0, moving[-1] + 1)
     z0 = np.array([e_ss, -v])  # x(0) = 0 minus x_ss(0) = (-e_ss, v)
     transient = np.array([(np.linalg.matrix_power(Acl, k) @ z0)[0] for k in window])
-    lag = m.summarize(res)["ramp_lag_mm"]
+    lag = m.summarize(res, paper_cfg.plant)["ramp_lag_mm"]
     assert_allclose(lag, e_ss - transient.mean(), rtol=1e-12, atol=1e-12, err_msg="lag [mm]")
     bound = np.max(np.abs(transient))
     assert bound < 1e-6 * e_ss, "the window starts late enough for e_ss to be a sharp check"
@@ -157,7 +162,7 @@ def test_pd_ramp_lag_without_feedforward(paper_cfg):
 
 @pytest.mark.parametrize("tracking", ["feedforward", "none", "error"])
 def test_phase_delay_of_a_2hz_sine_is_the_sampled_frequency_response(paper_cfg, tracking):
-    """A 3 mm, 2 Hz sine: summarize's phase delay is the loop's exact frequency response.
+    """A 3 mm, 2 Hz sine: summarize's grid phase delay is the loop's exact frequency response.
 
     In its linear range the sampled PD loop is x+ = Acl x + Bd (kp r + c r'), with c = 1 + kd
     (feed-forward), kd (law on the error) or 0 (no feed-forward; then the law sees x2 itself).
@@ -178,13 +183,96 @@ def test_phase_delay_of_a_2hz_sine_is_the_sampled_frequency_response(paper_cfg, 
     z = np.exp(1j * w * paper_cfg.plant.T)
     X = np.linalg.solve(z * np.eye(2) - Acl, Bd[:, 0]) * A * (kp + 1j * w * c)
     expect = -math.degrees(np.angle(X[0]))
-    got = m.summarize(res)
-    assert_allclose(got["phase_delay_deg"], expect, atol=1e-7, err_msg="phase delay [deg]")
-    assert_allclose(got["amplitude_ratio"], abs(X[0]) / A, rtol=1e-9, err_msg="gain")
+    got = m.summarize(res, paper_cfg.plant)
+    assert_allclose(got["phase_delay_deg_grid"], expect, atol=1e-7, err_msg="phase delay [deg]")
+    assert_allclose(got["amplitude_ratio_grid"], abs(X[0]) / A, rtol=1e-9, err_msg="gain")
+    # between samples the output is the ZOH flow, not the samples' sinusoid: close, not equal
+    assert abs(got["phase_delay_deg"] - expect) < 360 * f * paper_cfg.plant.T, "within a sample"
 
 
-def test_summarize_rejects_a_sine_of_fractional_period(paper_cfg):
-    """7 Hz at T = 2 ms is 71.4 samples a period: no whole-period fit, a clear input error."""
+def test_summarize_of_a_sine_of_fractional_period(paper_cfg):
+    """7 Hz at T = 2 ms is 71.4 samples a period: the continuous fit needs no whole number of
+    samples, so the phase is measured; the sampled residual RMS (whole periods of samples) is NaN.
+    """
     res = simulate(make_law("pd", paper_cfg), paper_cfg.plant, Reference.sine(1.0, 7.0))
-    with pytest.raises(InputError, match="whole number of samples"):
-        m.summarize(res)
+    got = m.summarize(res, paper_cfg.plant)
+    assert 0 < got["phase_delay_deg"] < 45 and math.isfinite(got["phase_delay_deg_grid"])
+    assert math.isnan(got["fit_residual_rms_mm"]) and math.isnan(got["amplitude_ratio_grid"])
+
+
+SECTION6 = [(law, sig) for law in ("to", "pd", "pto", "pto-printed") for sig in SIGNALS]
+
+
+@pytest.mark.parametrize(("law", "sig"), SECTION6)
+def test_summarize_time_metrics_between_samples(paper_cfg, law, sig):
+    """Every Section 6 response: the exact overshoot is >= the samples' (the samples are points
+    of the continuous trajectory), a settling time is within one sample before its grid twin
+    (the last exit happens in the interval before the first settled sample), and the linear-zone
+    entry is within one sample before the first sample the law reports linear.
+    """
+    res = simulate(make_law(law, paper_cfg), paper_cfg.plant, sig)
+    d = {"to": None, "pd": math.inf}.get(law, paper_cfg.pto.d)
+    s = m.summarize(res, paper_cfg.plant, d=d)
+    T = paper_cfg.plant.T
+    if sig != "sine":
+        assert s["overshoot_mm"] >= s["overshoot_mm_grid"] >= 0.0
+    for key in ("settling_tight_s", "settling_2pct_s", "linear_zone_s"):
+        if key in s and math.isfinite(s[key + "_grid"]):
+            assert s[key + "_grid"] - T <= s[key] <= s[key + "_grid"], f"{key} {s[key]}"
+    grid_zone = m.time_to_linear_zone(res.t, res.region)
+    if d is not None:
+        assert s["linear_zone_s_grid"] == grid_zone or (
+            math.isnan(grid_zone) and math.isnan(s["linear_zone_s_grid"])
+        )
+
+
+def test_sample_grid_metrics_have_one_definition():
+    """metrics' sample-grid settling, overshoot and rise time are exact.py's grid twins."""
+    assert m.settling_time is exact.grid_settling_time
+    assert m.overshoot is exact.grid_overshoot
+    assert m.rise_time is exact.grid_rise_time
+    assert (m.TIGHT_BAND, m.STEP_FRACTION) == (exact.TIGHT_BAND, exact.STEP_FRACTION)
+
+
+def _dense(res, a, per):
+    """The exact flow at ``per`` uniform points per sample (plant.flow, not exact.py)."""
+    h = np.diff(res.t)
+    s = h[:, None] * (np.arange(per) / per)[None, :]
+    x1, _ = flow(res.x1[:-1, None], res.x2[:-1, None], res.u[:-1, None], s, a)
+    return np.append((res.t[:-1, None] + s).ravel(), res.t[-1]), np.append(x1.ravel(), res.x1[-1])
+
+
+@pytest.mark.parametrize(("law", "sig"), [("pd", "step"), ("pto-printed", "ramp")])
+def test_simulate_json_metrics_between_samples(capsys, paper_cfg, law, sig):
+    """``simulate --json`` carries ``metrics`` (DESIGN.md keys) measured between samples, and
+    ``metrics_grid`` on the samples; both against an independent dense evaluation of the flow
+    (10^4 points per sample): a dense crossing brackets the true one within one dense spacing,
+    and the dense maximum is below the true one by at most max|x2| times half that spacing.
+    """
+    assert main(["simulate", "--law", law, "--signal", sig, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out["metrics"]) == {
+        "overshoot_mm",
+        "settling_2pct_s",
+        "settling_0p01mm_s",
+        "rise_time_s",
+    }
+    assert set(out["metrics_grid"]) == set(out["metrics"])
+    res = simulate(make_law(law, paper_cfg), paper_cfg.plant, sig)
+    per = 10_000
+    t, x1 = _dense(res, paper_cfg.plant.a, per)
+    dt = paper_cfg.plant.T / per
+    target = res.reference.target
+    e = res.reference.r(t) - x1
+    got, grid = out["metrics"], out["metrics_grid"]
+    ov = max(0.0, float(np.max(x1 - target)))
+    assert ov <= got["overshoot_mm"] <= ov + np.max(np.abs(res.x2)) * dt, "overshoot"
+    assert got["overshoot_mm"] > grid["overshoot_mm"] + 1e-6, "the peak is between samples"
+    for key, band in (("settling_2pct_s", 0.02 * abs(target)), ("settling_0p01mm_s", 0.01)):
+        out_idx = np.flatnonzero(np.abs(e) > band)
+        dense_ts = t[out_idx[-1] + 1] if out_idx.size else 0.0  # never outside: 0
+        assert dense_ts - dt <= got[key] <= dense_ts, key
+        assert grid[key] == m.settling_time(res.t, res.e, band), key
+    lo, hi = (np.argmax(x1 >= f * target) for f in (0.1, 0.9))
+    assert abs(got["rise_time_s"] - (t[hi] - t[lo])) <= dt, "rise time"
+    assert grid["rise_time_s"] == m.rise_time(res.t, res.x1, target)

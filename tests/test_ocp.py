@@ -14,27 +14,15 @@ import math
 
 import numpy as np
 import pytest
+from conftest import PLANTS, random_states
 from numpy.testing import assert_allclose
 
-from ptoverify.cli import main, mintime_result
-from ptoverify.config import Config, PDGains, Plant, PTOSettings, paper_config
+from ptoverify.cli import main
+from ptoverify.config import Config, PDGains, PTOSettings, paper_config
 from ptoverify.curves import level_curve_x1
+from ptoverify.groundtruth import verified_mintime
 from ptoverify.mintime import min_time
 from ptoverify.ocp import CollocationOCP, TwoPhaseOCP, convergence_study
-
-PLANTS = {
-    "paper": paper_config().plant,
-    "slow-a": Plant(a=30.0, w_max=300.0, sample_time=0.002, position_range=50.0),
-    "fine-T": Plant(a=100.0, w_max=100.0, sample_time=0.001, position_range=20.0),
-}
-
-
-def random_states(plant: Plant, n: int, seed: int) -> np.ndarray:
-    """States in the envelope |x1| <= position_range, |x2| < w_max."""
-    rng = np.random.default_rng(seed)
-    x1 = rng.uniform(-1.0, 1.0, n) * plant.position_range
-    x2 = rng.uniform(-1.0, 1.0, n) * plant.w_max * (1.0 - 1e-9)
-    return np.column_stack([x1, x2])
 
 
 @pytest.mark.parametrize("name", PLANTS)
@@ -165,7 +153,7 @@ def test_forced_failure_is_never_a_pass():
 
 def test_mintime_result_reports_failures_as_null():
     """Two IPOPT iterations cannot converge: the numbers are null, the status says why."""
-    out = mintime_result(paper_config(), 30.0, 100.0, 50, max_iter=2)
+    out = verified_mintime(30.0, 100.0, paper_config(), intervals=50, max_iter=2).to_json()
     for key in ("two_phase_s", "collocation_s", "two_phase_switch_time_s"):
         assert out[key] is None, key
     assert "Maximum" in out["two_phase_status"] and "Maximum" in out["collocation_status"]
@@ -206,19 +194,47 @@ def test_cli_rejects_far_outside(capsys):
 
 def test_mintime_result_other_config():
     cfg = Config("fine-T", PLANTS["fine-T"], PDGains(), PTOSettings())
-    out = mintime_result(cfg, 3.0, -20.0, 60)
+    out = verified_mintime(3.0, -20.0, cfg, intervals=60).to_json()
     assert out["collocation_intervals"] == 60
     assert_allclose(out["two_phase_s"], out["analytic_s"], rtol=1e-9, err_msg="two-phase")
     assert out["discrete_steps"] * cfg.plant.sample_time == pytest.approx(out["discrete_s"])
 
 
 def test_convergence_study_order():
+    """Errors against the two-phase OCP (an independent solver); the pooled slope recomputed.
+
+    Observed: the error falls by 2^5 to 2^7 from N = 10 to 20, then plateaus near
+    1e-5 to 1e-4 (where the switch falls inside an interval), so no asymptotic order
+    is asserted; asserted are second order or better over the first doubling, the
+    issue's 5e-4 bound from N = 20 on, and the pooled slope as defined.
+    """
     plant = PLANTS["paper"]
-    study = convergence_study(plant, [(5.0, 0.0), (-20.0, 250.0)], intervals=(10, 20, 40, 80))
+    states = [(5.0, 0.0), (-20.0, 250.0)]
+    ns = (10, 20, 40, 80)
+    study = convergence_study(plant, states, intervals=ns)
     assert study.success.all()
     assert study.rel_error.shape == (2, 4)
-    # the smeared switch limits collocation to about second order in t_f
-    assert 1.0 < study.order < 4.0, study.order_per_state
+    two = TwoPhaseOCP(plant)
+    ref = np.array([two.solve(x1, x2).t_f for x1, x2 in states])
+    assert_allclose(
+        study.rel_error,
+        np.abs(study.t_f - ref[:, None]) / ref[:, None],
+        rtol=1e-6,
+        atol=1e-12,
+        err_msg="collocation relative t_f error vs the two-phase OCP",
+    )
+    e = study.rel_error
+    assert np.all(e[:, 1] <= e[:, 0] / 4), f"not second order over N = 10 -> 20: {e}"
+    assert np.all(e[:, 1:] <= 5e-4), f"collocation error above the 5e-4 bound: {e}"
+    logn, loge = np.log(np.array(ns, float)), np.log(e)
+    cn = np.tile(logn - logn.mean(), (2, 1))
+    ce = loge - loge.mean(axis=1, keepdims=True)
+    assert_allclose(
+        study.order,
+        -np.sum(cn * ce) / np.sum(cn * cn),
+        rtol=1e-12,
+        err_msg="pooled least-squares slope of -log(error) on log(N)",
+    )
 
 
 def test_convergence_figures(tmp_path):

@@ -1,18 +1,14 @@
 import numpy as np
+from conftest import zoh_reference, zoh_step
 from numpy.testing import assert_allclose
 from scipy.integrate import solve_ivp
-from scipy.linalg import expm
 
 from ptoverify.plant import flow, step, zoh_matrices
 
 
 def augmented_expm(a, u, t, x0):
-    """State after t via expm of [[A, B u], [0, 0]] (independent of eq. 7)."""
-    M = np.zeros((3, 3))
-    M[0, 1] = 1.0
-    M[1, 1] = -a
-    M[1, 2] = a * u
-    return (expm(M * t) @ np.array([x0[0], x0[1], 1.0]))[:2]
+    """State after t by the scipy ZOH reference held for t (independent of eq. 7)."""
+    return np.array(zoh_step(x0[0], x0[1], u, a, t))
 
 
 def test_flow_matches_expm_and_solve_ivp(any_cfg):
@@ -47,11 +43,9 @@ def test_flow_matches_expm_and_solve_ivp(any_cfg):
 def test_zoh_matrices_match_expm(any_cfg):
     p = any_cfg.plant
     Ad, Bd = zoh_matrices(p.a, p.T)
-    M = np.zeros((3, 3))
-    M[0, 1], M[1, 1], M[1, 2] = 1.0, -p.a, p.a
-    E = expm(M * p.T)
-    assert_allclose(Ad, E[:2, :2], rtol=1e-13, atol=1e-16, err_msg="Ad")
-    assert_allclose(Bd[:, 0], E[:2, 2], rtol=1e-12, atol=1e-16, err_msg="Bd")
+    Ad_ref, Bd_ref = zoh_reference(p.a, p.T)
+    assert_allclose(Ad, Ad_ref, rtol=1e-13, atol=1e-16, err_msg="Ad vs scipy cont2discrete")
+    assert_allclose(Bd, Bd_ref, rtol=1e-12, atol=1e-16, err_msg="Bd vs scipy cont2discrete")
     x = np.array([3.0, -120.0])
     assert_allclose(
         Ad @ x + Bd[:, 0] * 250.0,

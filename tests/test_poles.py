@@ -2,8 +2,8 @@
 
 import numpy as np
 import pytest
+from conftest import zoh_reference
 from numpy.testing import assert_allclose
-from scipy.linalg import expm
 
 from ptoverify.config import paper_config
 from ptoverify.poles import all_loop_poles, critical_gain, loop_poles, lyapunov_counterexample
@@ -17,11 +17,9 @@ CONFIGS = {
 
 
 def expm_closed_loop(a, T, K):
-    """Ad - Bd K with Ad, Bd from expm of the augmented matrix (independent of zoh_matrices)."""
-    M = np.zeros((3, 3))
-    M[0, 1], M[1, 1], M[1, 2] = 1.0, -a, a
-    E = expm(M * T)
-    return E[:2, :2] - E[:2, 2:3] @ np.atleast_2d(K)
+    """Ad - Bd K with Ad, Bd from scipy's cont2discrete (independent of zoh_matrices)."""
+    Ad, Bd = zoh_reference(a, T)
+    return Ad - Bd @ np.atleast_2d(K)
 
 
 def as_complex(pairs):

@@ -1,19 +1,14 @@
 """Closed-loop properties over a grid of initial states (simulation)."""
 
-import dataclasses
-
 import numpy as np
 import pytest
+from conftest import with_d
 
 from ptoverify.config import paper_config
 from ptoverify.laws import make_law
-from ptoverify.properties import _oscillating, initial_grid, law_properties
+from ptoverify.properties import initial_grid, law_properties, oscillating
 
 PAPER = paper_config()
-
-
-def with_d(cfg, d):
-    return dataclasses.replace(cfg, pto=dataclasses.replace(cfg.pto, d=d))
 
 
 CONFIGS = {
@@ -38,7 +33,7 @@ def test_oscillation_criterion():
     settled = np.full((80, 1), 1e-5)
     one_sided = 0.3 + 0.0 * k
     x = np.hstack([sustained, decaying, settled, one_sided])
-    assert _oscillating(x, 1e-3).tolist() == [True, False, False, False]
+    assert oscillating(x, 1e-3).tolist() == [True, False, False, False]
 
 
 def test_paper_corrected_pto():

@@ -206,8 +206,17 @@ def test_cli_simulate_custom_sine(capsys):
             "samples",
             "final_error_mm",
             "max_abs_error_second_half_mm",
+            "metrics",
+            "metrics_grid",
             "series",
         ]
-    ), "JSON keys unchanged"
+    ), "JSON keys: the earlier ones plus metrics (DESIGN.md) and metrics_grid"
+    assert set(out["metrics"]) == {
+        "overshoot_mm",
+        "settling_2pct_s",
+        "settling_0p01mm_s",
+        "rise_time_s",
+        "phase_delay_deg",
+    }
     assert main(["simulate", "--signal", "ramp", "--step", "3"]) == 2
     assert "does not apply" in capsys.readouterr().err

@@ -5,27 +5,26 @@ import functools
 import json
 import math
 
+import mpmath
 import numpy as np
 import pytest
+import sympy as sp
+from conftest import with_d, zoh_step
 from numpy.testing import assert_allclose
-from scipy.linalg import expm
 
-from ptoverify import cli
+from derivations.printed import SYMBOLS, printed
+from ptoverify.cli import main
 from ptoverify.config import paper_config
-from ptoverify.curves import level_curve_x1, level_residual, root_22_bisect, root_k_bisect
+from ptoverify.curves import level_curve_x1, level_residual
 from ptoverify.plant import flow
 from ptoverify.zones import (
+    PTOZone,
     corrected_zone,
     principle_margin,
     principle_violations,
     printed_zone,
     smallest_d,
 )
-
-
-def with_d(cfg, d):
-    return dataclasses.replace(cfg, pto=dataclasses.replace(cfg.pto, d=d))
-
 
 PAPER = paper_config()
 CONFIGS = {
@@ -42,49 +41,79 @@ def cz(name, reading="strict"):
     return corrected_zone(CONFIGS[name], reading=reading, verify=False)
 
 
-def expm_step(x1, x2, u, a, T):
-    """One ZOH sample by expm of the augmented matrix [[A, B], [0, 0]] (reference)."""
-    M = np.zeros((3, 3))
-    M[0, 1], M[1, 1], M[1, 2] = 1.0, -a, a
-    E = expm(M * T)
-    X = np.stack(
-        np.broadcast_arrays(np.asarray(x1, float), np.asarray(x2, float), np.asarray(u, float))
-    )
-    Y = np.tensordot(E, X, axes=1)
-    return Y[0], Y[1]
-
-
-def test_flow_matches_expm():
+def test_flow_matches_zoh_reference():
     rng = np.random.default_rng(1)
     x1, x2 = rng.uniform(-50, 50, 500), rng.uniform(-300, 300, 500)
     u = rng.choice([-300.0, 300.0, 37.0], 500)
     for a, T in ((PAPER.plant.a, 0.002), (30.0, 0.002), (PAPER.plant.a, 0.001)):
-        ref = expm_step(x1, x2, u, a, T)
+        ref = zoh_step(x1, x2, u, a, T)
         got = flow(x1, x2, u, T, a)
-        # expm is accurate to a few ulps of the state magnitude (50 mm, 300 mm/s)
+        # the scipy ZOH (expm) is accurate to a few ulps of the state size (50 mm, 300 mm/s)
         assert_allclose(got[0], ref[0], atol=1e-11, rtol=0, err_msg="x1 one-sample map")
         assert_allclose(got[1], ref[1], atol=1e-10, rtol=0, err_msg="x2 one-sample map")
 
 
-def test_printed_numbers_paper():
-    cfg = PAPER
+def printed_chain_reference(a, w, T, d):
+    """Eqs. (21)-(27) solved from their printed transcriptions (derivations.printed).
+
+    Independent of ``ptoverify``: the linear equations by ``sympy.solve``, the
+    transcendental (22) and (26) by 40-digit bisection (mpmath) on brackets that
+    hold the non-trivial root: y > 0 for (22); z > 0 if 0 < k < 1 and
+    -1 < z < 0 if k > 1 for (26).
+    """
+    S = SYMBOLS
+    num = {S["a"]: a, S["omega_m"]: w, S["T"]: T, S["tx10"]: d}
+    (_, r21b), (r22,), (r23,) = printed("21"), printed("22"), printed("23")
+    (r25k, _), (r26,), (r27,) = printed("25"), printed("26"), printed("27")
+    b0 = sp.solve(r21b.subs(num), S["b0"])[0]
+    with mpmath.workdps(40):
+        f22 = sp.lambdify(S["y"], r22.subs({**num, S["b0"]: b0}), "mpmath")
+        y = mpmath.findroot(f22, (mpmath.mpf("1e-30"), 10 * (float(b0) + 2)), solver="bisect")
+        x20 = sp.solve(r23.subs({**num, S["y"]: y}), S["tx20"])[0]
+        k = sp.solve(r25k.subs({**num, S["tx20"]: x20}), S["k"])[0]
+        f26 = sp.lambdify(S["z"], r26.subs(S["k"], k), "mpmath")
+        lo, hi = (
+            (mpmath.mpf("1e-30"), mpmath.mpf(1e6))
+            if k < 1
+            else (-1 + mpmath.mpf("1e-30"), -mpmath.mpf("1e-30"))
+        )
+        z = mpmath.findroot(f26, (lo, hi), solver="bisect")
+        om = sp.solve(r27.subs({S["tx20"]: x20, S["z"]: z}), S["omega_0"])[0]
+    return {k_: float(v) for k_, v in dict(b0=b0, y=y, x20=x20, k=k, z=z, omega0=om).items()}
+
+
+@pytest.mark.parametrize("name", ["paper", "a30", "T1ms", "d1"])
+def test_printed_numbers_vs_printed_equations(name):
+    cfg = CONFIGS[name]
     a, w, T, d = cfg.plant.a, cfg.plant.w_max, cfg.plant.sample_time, cfg.pto.d
     z = printed_zone(cfg)
-    b0 = a * d / w + 2 * a * T
-    assert_allclose(z.b0, b0, rtol=1e-15, err_msg="b0, eq. (21)")
-    y_ref = float(root_22_bisect(b0))
-    assert_allclose(z.y_star, y_ref, rtol=1e-13, err_msg="y*, eq. (22) vs bisection")
-    assert_allclose(z.x20_tilde, -y_ref * w, rtol=1e-13, err_msg="x~20, eq. (23)")
-    m = -a * d / z.x20_tilde
-    assert_allclose(z.k, 1 - m, rtol=1e-15, err_msg="k, eq. (25)")
-    z_ref = float(root_k_bisect(m))
-    assert_allclose(z.z_star, z_ref, rtol=1e-12, err_msg="z*, eq. (26) vs bisection")
-    assert_allclose(z.omega0, -z.x20_tilde / z_ref, rtol=1e-12, err_msg="omega0, eq. (27)")
+    ref = printed_chain_reference(a, w, T, d)
+    # references to 40 digits; the code's float64 chain (Lambert W near its branch
+    # point, then a division) is accurate to ~1e-13 relative
+    assert_allclose(z.b0, ref["b0"], rtol=1e-15, err_msg="b0, eq. (21)")
+    assert_allclose(z.y_star, ref["y"], rtol=1e-12, err_msg="y*, eq. (22)")
+    assert_allclose(z.x20_tilde, ref["x20"], rtol=1e-12, err_msg="x~20, eq. (23)")
+    assert_allclose(z.k, ref["k"], rtol=1e-12, err_msg="k, eq. (25)")
+    assert_allclose(z.z_star, ref["z"], rtol=1e-11, err_msg="z*, eq. (26)")
+    assert_allclose(z.omega0, ref["omega0"], rtol=1e-11, err_msg="omega0, eq. (27)")
+
+
+def test_printed_zone_paper_verdict():
+    z = printed_zone(PAPER)
+    w = PAPER.plant.w_max
     # the verdict: beyond the envelope, omega0 above w_max, so invalid
     assert z.x20_tilde < -w
     assert z.omega0 > w
     assert not z.valid and not z.usable
     assert "empty" in z.reason and "eq. (16)" in z.reason
+    assert z.grid_violations is None and z.grid_points is None, "no grid run: None, not -1"
+
+
+def test_zone_fields_are_keywords():
+    z = printed_zone(PAPER)
+    with pytest.raises(TypeError):
+        PTOZone("printed", z.omega0)  # positional construction is refused
+    assert dataclasses.replace(z, valid=True).valid
 
 
 @pytest.mark.parametrize("name", ["paper", "a30", "T1ms", "d1"])
@@ -99,7 +128,7 @@ def test_eq16_sign_error():
     a, w, T = PAPER.plant.a, PAPER.plant.w_max, PAPER.plant.sample_time
     x2 = -np.linspace(1.0, w, 50)
     x1 = level_curve_x1(x2, a, w)
-    f1, f2 = expm_step(x1, x2, w, a, T)
+    f1, f2 = zoh_step(x1, x2, w, a, T)
     res = a * f1 + f2 + w * np.log1p(-f2 / w)
     assert_allclose(res, 0.0, atol=1e-9, err_msg="image of l1 under +w_max is on l1")
     assert np.all(np.abs(res + 2 * a * w * T) > 100), "not on the printed curve (19)"
@@ -113,7 +142,7 @@ def test_eq16_sign_error():
 
 
 def brute_margin(cfg, omega0, x2, reading, n=2001):
-    """Worst landing sigma at each velocity over a dense x1 grid, landing by expm."""
+    """Worst landing sigma at each velocity over a dense x1 grid, landing by scipy ZOH."""
     a, w, T, d = cfg.plant.a, cfg.plant.w_max, cfg.plant.sample_time, cfg.pto.d
     R = cfg.plant.position_range
     out = []
@@ -122,7 +151,7 @@ def brute_margin(cfg, omega0, x2, reading, n=2001):
         sig = level_residual(x1, v, a, w)
         zone = (v < 0) & (sig >= 0) & (level_residual(x1, v, a, omega0) < 0)
         src = (np.abs(x1) >= d) & ((sig > 0) | ((sig == 0) & (v > 0))) & ~zone
-        f1, f2 = expm_step(x1[src], v, -w, a, T)
+        f1, f2 = zoh_step(x1[src], v, -w, a, T)
         r = level_residual(f1, f2, a, w)
         if reading == "lenient":
             r = np.where(np.abs(f1) >= d, r, np.inf)
@@ -163,16 +192,16 @@ def test_corrected_zone_valid_and_largest(name):
     assert 0 < z.omega0 < w
     assert z.feasible_intervals and z.feasible_intervals[-1][0] == 0.0
     assert z.feasible_intervals[-1][1] >= z.omega0
-    # just above the edge, some state on l1* strides over l1 (landing by expm)
+    # just above the edge, some state on l1* strides over l1 (landing by scipy ZOH)
     om = z.feasible_intervals[-1][1] * 1.01
     s = np.linspace(1e-3, 1.0, 20001) * w
     x1 = level_curve_x1(-s, a, om)
     x1 = np.maximum(x1, cfg.pto.d)
-    f1, f2 = expm_step(x1, -s, -w, a, T)
+    f1, f2 = zoh_step(x1, -s, -w, a, T)
     assert level_residual(f1, f2, a, w).min() < 0, "omega0 1% above the edge fails"
     # and at the chosen omega0 none does
     x1 = np.maximum(level_curve_x1(-s, a, z.omega0), cfg.pto.d)
-    f1, f2 = expm_step(x1, -s, -w, a, T)
+    f1, f2 = zoh_step(x1, -s, -w, a, T)
     assert level_residual(f1, f2, a, w).min() > -1e-6, "chosen omega0 holds on l1*"
 
 
@@ -194,7 +223,7 @@ def test_mirror_rule():
     sig = level_residual(x1, x2, a, w)
     zone_n = (x2 > 0) & (sig <= 0) & (level_residual(x1, x2, a, om) > 0)
     src = (np.abs(x1) >= d) & ((sig < 0) | ((sig == 0) & (x2 < 0))) & ~zone_n
-    f1, f2 = expm_step(x1[src], x2[src], w, a, T)
+    f1, f2 = zoh_step(x1[src], x2[src], w, a, T)
     assert level_residual(f1, f2, a, w).max() <= 1e-6
 
 
@@ -224,12 +253,12 @@ def test_degenerate_large_d():
 def test_violations_counted_above_edge():
     cfg = PAPER
     z = cz("paper")
-    bad, pts = principle_violations(cfg, 2 * z.omega0, n1=201, n2=201, band=51)
+    bad, pts = principle_violations(cfg, 2 * z.omega0, n1=201, n2=201, n_band=51)
     assert bad > 0 and pts > 0
 
 
 def test_cli_zone_json(capsys):
-    assert cli.main(["zone", "--json", "--no-verify"]) == 0
+    assert main(["zone", "--json", "--no-verify"]) == 0
     out = json.loads(capsys.readouterr().out)
     for key in ("printed", "corrected", "d", "w_max"):
         assert key in out
@@ -240,5 +269,5 @@ def test_cli_zone_json(capsys):
 
 
 def test_cli_zone_bad_config(tmp_path, capsys):
-    assert cli.main(["zone", "--config", str(tmp_path / "missing.toml")]) == 2
+    assert main(["zone", "--config", str(tmp_path / "missing.toml")]) == 2
     assert capsys.readouterr().err.startswith("ptoverify: error:")

@@ -1,0 +1,107 @@
+"""``conform --table``: regular files only, chunked parsing, envelope, coverage."""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ptoverify import agreement as agreement_mod
+from ptoverify.agreement import read_table
+from ptoverify.cli import main
+from ptoverify.conform import MIN_PER_REGION, conformance_grid, reference_law
+from ptoverify.errors import InputError
+from ptoverify.laws import Region, make_law
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def write(path, x1, x2, u):
+    path.write_text(
+        "x1,x2,u\n"
+        + "".join(f"{a!r},{b!r},{c!r}\n" for a, b, c in zip(x1.tolist(), x2.tolist(), u.tolist()))
+    )
+    return path
+
+
+def test_dev_zero_is_bad_input_at_once():
+    if not os.path.exists("/dev/zero"):
+        pytest.skip("no /dev/zero on this OS")
+    p = subprocess.run(
+        [sys.executable, "-m", "ptoverify", "conform", "--table", "/dev/zero"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=dict(os.environ, PYTHONPATH=str(ROOT)),
+    )
+    assert p.returncode == 2 and "not a regular file" in p.stderr and p.stdout == ""
+
+
+def test_fifo_is_bad_input(tmp_path):
+    fifo = tmp_path / "t.csv"
+    os.mkfifo(fifo)
+    with pytest.raises(InputError, match="not a regular file"):
+        read_table(fifo)
+
+
+def test_one_row_table_is_insufficient_coverage(capsys, tmp_path):
+    table = tmp_path / "one.csv"
+    table.write_text("x1,x2,u\n0.0,0.0,0.0\n")
+    code, out, _ = run(capsys, "conform", "--table", str(table), "--json")
+    data = json.loads(out)
+    assert code == 1 and data["conforms"] is False
+    assert data["properties"]["coverage"]["status"] == "fail"
+    assert data["failures"][0]["property"] == "coverage"
+    assert "insufficient coverage" in data["failures"][0]["detail"]
+
+
+def test_coverage_counts_each_region(capsys, tmp_path, paper_cfg):
+    """The grid covers every region; dropping one region's states fails coverage."""
+    x1, x2 = conformance_grid(paper_cfg, n=11, n_curve=11)
+    u = reference_law(x1, x2, paper_cfg)
+    code, out, _ = run(capsys, "conform", "--table", str(write(tmp_path / "a.csv", x1, x2, u)))
+    assert code == 0, out
+    keep = make_law("pto", paper_cfg)(x1, x2)[1] != Region.ZONE_P
+    table = write(tmp_path / "b.csv", x1[keep], x2[keep], u[keep])
+    code, out, _ = run(capsys, "conform", "--table", str(table), "--json")
+    data = json.loads(out)
+    assert code == 1 and data["properties"]["coverage"]["limit"] == MIN_PER_REGION
+    assert "ZONE_P" in data["properties"]["coverage"]["detail"]
+
+
+@pytest.mark.parametrize("value", ["1e308", "-5.1e4"])
+def test_state_far_outside_envelope_is_bad_input(capsys, tmp_path, value):
+    table = tmp_path / "far.csv"
+    table.write_text(f"x1,x2,u\n1.0,2.0,-300\n{value},0.0,300\n")
+    code, out, err = run(capsys, "conform", "--table", str(table))
+    assert code == 2 and out == "" and "line 3" in err and "envelope" in err
+
+
+def test_error_line_named_across_chunks(monkeypatch, tmp_path):
+    monkeypatch.setattr(agreement_mod, "_CHUNK_LINES", 7)
+    rows = ["x1,x2,u"] + [f"{i * 0.01},0.0,0.0" for i in range(30)]
+    rows[23] = "0.5,abc,0.0"  # line 24 of the file, in the fourth chunk
+    rows.insert(10, "")  # a blank line still counts as a line
+    table = tmp_path / "t.csv"
+    table.write_text("\n".join(rows) + "\n")
+    with pytest.raises(InputError, match=r"line 25: column x2 = 'abc'"):
+        read_table(table)
+
+
+def test_chunked_read_equals_whole(monkeypatch, tmp_path, paper_cfg):
+    x1, x2 = conformance_grid(paper_cfg, n=11, n_curve=11)
+    u = reference_law(x1, x2, paper_cfg)
+    table = write(tmp_path / "t.csv", x1, x2, u)
+    monkeypatch.setattr(agreement_mod, "_CHUNK_LINES", 97)
+    got = read_table(table, paper_cfg)
+    for a, b in zip(got, (x1, x2, u)):
+        assert np.array_equal(a, b), "round trip through repr is exact"
