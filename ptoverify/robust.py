@@ -44,8 +44,10 @@ from numpy.typing import NDArray
 from scipy.optimize import differential_evolution, minimize
 
 from ptoverify.config import Config, Plant
+from ptoverify.errors import InputError
 from ptoverify.laws import Law, make_law
 from ptoverify.mintime import discrete_min_steps_batch, min_time
+from ptoverify.plant import zoh_matrices
 from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import crossing_masks, oscillating
 from ptoverify.simulate import Mismatch, simulate_batch
@@ -99,6 +101,10 @@ class RobustSettings:
         Generations of differential evolution per law, property and delay.
     search_population : int
         Population size of differential evolution (candidates per generation).
+    properties : tuple of str
+        Properties searched for their worst case (subset of :data:`PROPERTIES`).
+    margins : bool
+        Also compute the margins (bisections on a_ratio).
     """
 
     n_a: int = 5
@@ -109,6 +115,8 @@ class RobustSettings:
     laws: tuple[str, ...] = LAWS
     search_iterations: int = 12
     search_population: int = 24
+    properties: tuple[str, ...] = PROPERTIES
+    margins: bool = True
 
 
 # -- per-trajectory properties -------------------------------------------------
@@ -424,12 +432,14 @@ def _edge(
     return None
 
 
-def linear_loop_margin(law: str, cfg: Config) -> dict[str, Any]:
+def linear_loop_margin(law: str, cfg: Config, *, delay_samples: int = 0) -> dict[str, Any]:
     """Largest interval of a_true / a_design around 1 where the sampled linear loop is stable.
 
     The linear loop is PD's u = -kp x1 - kd x2 or the PTO's linear zone
     u = -k1 x1 - k2 x2 (eq. 34), unsaturated, on the ZOH plant with the true a
-    and the design T; stable means spectral radius < 1.
+    and the design T; stable means spectral radius < 1.  With a one-sample
+    computation delay the loop state is (x1, x2, u_{k-1}):
+    z_{k+1} = [[Ad, Bd], [-K, 0]] z_k.
 
     Parameters
     ----------
@@ -437,14 +447,16 @@ def linear_loop_margin(law: str, cfg: Config) -> dict[str, Any]:
         Law name (TO has no linear loop).
     cfg : Config
         Nominal configuration.
+    delay_samples : int
+        0 or 1 [samples].
 
     Returns
     -------
     dict
-        ``linear_loop_a_ratio_stable``: [lo, hi] with each endpoint the last stable
-        ratio to 1e-6 relative (``None`` where stability reaches past the searched
-        range [0.1, 10]), or ``None`` with a ``note`` when there is no linear loop
-        or it is unstable at the design point.
+        ``linear_loop_a_ratio_stable`` (``..._delay1`` with a delay): [lo, hi] with
+        each endpoint the last stable ratio to 1e-12 relative (``None`` where
+        stability reaches past the searched range [0.1, 10]), or ``None`` with a
+        note when there is no linear loop or it is unstable at the design point.
 
     Examples
     --------
@@ -453,22 +465,28 @@ def linear_loop_margin(law: str, cfg: Config) -> dict[str, Any]:
     >>> lo is None and hi > 1.0
     True
     """
+    if delay_samples not in (0, 1):
+        raise InputError(f"linear_loop_margin: delay_samples must be 0 or 1, got {delay_samples}")
+    key = "linear_loop_a_ratio_stable" + ("_delay1" if delay_samples else "")
+    note = key.replace("_a_ratio_stable", "_note")
     gains = _linear_gains(law, cfg)
     if gains is None:
-        return {"linear_loop_a_ratio_stable": None, "linear_loop_note": "no linear loop"}
+        return {key: None, note: "no linear loop"}
     a, T = cfg.plant.a, cfg.plant.sample_time
 
     def stable(r: float) -> bool:
-        return sampled_spectral_radius(a * r, T, *gains) < 1.0
+        if delay_samples == 0:
+            return sampled_spectral_radius(a * r, T, *gains) < 1.0
+        Ad, Bd = zoh_matrices(a * r, T)
+        K = np.array([gains])  # noqa: N806
+        M = np.block([[Ad, Bd], [-K, np.zeros((1, 1))]])  # noqa: N806
+        return float(np.abs(np.linalg.eigvals(M)).max()) < 1.0
 
     if not stable(1.0):
-        return {
-            "linear_loop_a_ratio_stable": None,
-            "linear_loop_note": "unstable at the design point",
-        }
+        return {key: None, note: "unstable at the design point"}
     lo = _edge(stable, MARGIN_RANGE[0])
     hi = _edge(stable, MARGIN_RANGE[1])
-    return {"linear_loop_a_ratio_stable": [lo, hi], "linear_loop_note": ""}
+    return {key: [lo, hi], note: ""}
 
 
 def no_limit_cycle_margin(
@@ -634,6 +652,7 @@ def worst_case(
     searched = best["value"]
     return {
         "grid": grid_value if grid_value > -math.inf else None,
+        "grid_unbounded": grid_value == math.inf,
         "searched": searched if searched > -math.inf else None,
         "unbounded": searched == math.inf,  # e.g. never settles: JSON shows searched null
         "state": [float(z[0]), float(z[1])] if z is not None else None,
@@ -805,10 +824,18 @@ def run_robust(
     timings["maps"] = time.perf_counter() - t0
     t1 = time.perf_counter()
     report("margins", 0.4)
-    margins = {
-        law: {**linear_loop_margin(law, cfg), **no_limit_cycle_margin(law, cfg, s)}
-        for law in s.laws
-    }
+    margins = (
+        {
+            law: {
+                **linear_loop_margin(law, cfg),
+                **linear_loop_margin(law, cfg, delay_samples=1),
+                **no_limit_cycle_margin(law, cfg, s),
+            }
+            for law in s.laws
+        }
+        if s.margins
+        else {}
+    )
     timings["margins"] = time.perf_counter() - t1
     t2 = time.perf_counter()
     worst: dict[str, Any] = {}
@@ -816,7 +843,7 @@ def run_robust(
         report(f"worst case {law}", 0.5 + 0.5 * i / len(s.laws))
         worst[law] = {
             prop: worst_case(law, prop, cfg, grid_worst(maps["laws"][law], prop), s)
-            for prop in PROPERTIES
+            for prop in s.properties
         }
     timings["worst_case"] = time.perf_counter() - t2
     timings["total"] = time.perf_counter() - t0
