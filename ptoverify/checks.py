@@ -28,7 +28,16 @@ from ptoverify.config import Config
 from ptoverify.errors import InputError, SolverError
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED, Verdict, at_most
 
-__all__ = ["CheckResult", "GATES", "GATE_UNITS", "GateContext", "run_checks", "summarize"]
+__all__ = [
+    "CheckResult",
+    "GATES",
+    "GATE_UNITS",
+    "GateContext",
+    "ROBUST_GATES",
+    "robust_verdicts",
+    "run_checks",
+    "summarize",
+]
 
 #: Former name of the gates' result type, kept for compatibility: it *is* :class:`Verdict`.
 CheckResult = Verdict
@@ -584,7 +593,11 @@ def _claims_computed(ctx: GateContext) -> Verdict:
 
 
 def run_checks(
-    cfg: Config, names: list[str] | None = None, *, max_iter: int | None = None
+    cfg: Config,
+    names: list[str] | None = None,
+    *,
+    max_iter: int | None = None,
+    robust: bool = False,
 ) -> list[Verdict]:
     """Run the gates (all, or the named ones) in registration order.
 
@@ -597,6 +610,8 @@ def run_checks(
     max_iter : int, optional
         Cap on IPOPT iterations (to exercise the fail-closed path: a capped solver
         that does not converge makes its gate ``unverified``).
+    robust : bool
+        Also run :data:`ROBUST_GATES` (naming one in ``names`` runs it too).
 
     Returns
     -------
@@ -608,12 +623,59 @@ def run_checks(
     InputError
         A name that is not a gate.
     """
+    known = (*GATES, *ROBUST_GATES)
     if names is not None:
-        unknown = [g for g in names if g not in GATES]
+        unknown = [g for g in names if g not in known]
         if unknown:
-            raise InputError(f"unknown gate '{unknown[0]}' (choose from {', '.join(GATES)})")
+            raise InputError(f"unknown gate '{unknown[0]}' (choose from {', '.join(known)})")
     ctx = GateContext(cfg, max_iter=max_iter)
-    return [fn(ctx) for name, fn in GATES.items() if names is None or name in names]
+    out = [fn(ctx) for name, fn in GATES.items() if names is None or name in names]
+    wanted = [g for g in ROBUST_GATES if (names is None and robust) or (names and g in names)]
+    if wanted:
+        out += [v for v in robust_verdicts(cfg) if v.name in wanted]
+    return out
+
+
+#: Gates over the uncertainty box of ``[robustness]`` (``check --robust``), not run by default.
+ROBUST_GATES = ("robust-no-limit-cycle", "robust-settling")
+
+
+def robust_verdicts(cfg: Config) -> list[Verdict]:
+    """Run the robustness study for the corrected PTO and judge it (fails closed).
+
+    Parameters
+    ----------
+    cfg : Config
+        Nominal configuration with its ``[robustness]`` box.
+
+    Returns
+    -------
+    list of Verdict
+        ``robust-no-limit-cycle`` and ``robust-settling``
+        (:func:`ptoverify.robust.robust_gates`); both ``unverified`` when the
+        study could not be computed.
+    """
+    from ptoverify.robust import GATE_LAW, RobustSettings, robust_gates, run_robust
+
+    settings = RobustSettings(
+        laws=(GATE_LAW,), properties=("limit_cycle_mm", "settling_ratio_nt"), margins=False
+    )
+    try:
+        return robust_gates(run_robust(cfg, settings))
+    except Exception as exc:  # noqa: BLE001 - a gate fails closed on any fault
+        why = f"could not be computed: {type(exc).__name__}: {exc}"
+        return [
+            Verdict("robust-no-limit-cycle", UNVERIFIED, None, 0.0, why, "<=", "mm"),
+            Verdict(
+                "robust-settling",
+                UNVERIFIED,
+                None,
+                cfg.robustness.settling_ratio_limit,
+                why,
+                "<=",
+                "1",
+            ),
+        ]
 
 
 def summarize(results: list[Verdict]) -> dict[str, Any]:

@@ -221,7 +221,7 @@ def _add_simulate(sub) -> None:
     p.add_argument(
         "--signal",
         choices=("step", "ramp", "sine"),
-        default="step",
+        default=None,
         help="reference signal (default step)",
     )
     p.add_argument(
@@ -241,6 +241,24 @@ def _add_simulate(sub) -> None:
         ("--frequency", "HZ", "sine frequency [Hz] (default 5)"),
     ):
         p.add_argument(flag, type=finite_float, metavar=metavar, default=None, help=text)
+    p.add_argument(
+        "--x0",
+        nargs=2,
+        type=finite_float,
+        metavar=("X1", "X2"),
+        default=None,
+        help="regulate from this state [mm] [mm/s] to the origin instead of tracking a "
+        "reference (reproduces a counterexample of `ptoverify robust`)",
+    )
+    for flag, kind, metavar, text in (
+        ("--a-ratio", finite_float, "R", "true a over design a (with --x0; default 1)"),
+        ("--w-max-ratio", finite_float, "R", "drive saturation over w_max (with --x0; default 1)"),
+        ("--delay", int, "N", "computation delay [samples] (with --x0; default 0)"),
+        ("--quantum", finite_float, "MM", "encoder resolution [mm] (with --x0; default 0)"),
+        ("--velocity-noise", finite_float, "MM_S", "velocity noise sd [mm/s] (with --x0)"),
+        ("--seed", int, "N", "noise seed (with --x0; default 0)"),
+    ):
+        p.add_argument(flag, type=kind, metavar=metavar, default=None, help=text)
     p.add_argument("--csv", metavar="FILE", default=None, help="write the time series as CSV")
     p.set_defaults(handler=_cmd_simulate)
 
@@ -253,10 +271,23 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         raise InputError("--csv and --json are exclusive")
     if args.csv is not None and (args.csv.strip() == "" or Path(args.csv).is_dir()):
         raise InputError(f"--csv must name a file, got {args.csv!r}")
+    mismatch = {
+        "a_ratio": args.a_ratio,
+        "w_max_ratio": args.w_max_ratio,
+        "delay_samples": args.delay,
+        "position_quantum": args.quantum,
+        "velocity_noise": args.velocity_noise,
+        "seed": args.seed,
+    }
+    if args.x0 is not None:
+        return _simulate_regulation(args, cfg, {k: v for k, v in mismatch.items() if v is not None})
+    given = [k for k, v in mismatch.items() if v is not None]
+    if given:
+        raise InputError(f"the plant/measurement mismatch options need --x0 (got {given[0]})")
     run = run_simulation(
         cfg,
         args.law,
-        args.signal,
+        args.signal or "step",
         duration=args.duration,
         feedforward=not args.no_feedforward,
         step=args.step,
@@ -287,6 +318,134 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         metrics, grid = run.metrics()
         for key, value in metrics.items():
             print(f"{key:>30}: {value} (sample grid: {grid[key]})")
+    return 0
+
+
+def _simulate_regulation(args: argparse.Namespace, cfg: Config, mismatch: dict) -> int:
+    from ptoverify.commands import run_regulation
+
+    ref_flags = (args.signal, args.step, args.ramp_speed, args.ramp_to, args.amplitude)
+    if any(v is not None for v in (*ref_flags, args.frequency)) or args.no_feedforward:
+        raise InputError("--x0 regulates to the origin: no reference options with it")
+    out = run_regulation(cfg, args.law, tuple(args.x0), duration=args.duration, **mismatch)
+    if args.csv is not None:
+        cols = out["series"]
+        lines = [",".join(cols)]
+        for row in zip(*cols.values(), strict=True):
+            lines.append(",".join(repr(float(v)) for v in row))
+        write_atomic(args.csv, "\n".join(lines) + "\n")
+        return 0
+    if args.json:
+        print_json(out)
+    else:
+        for key in ("law", "x0", "mismatch", "samples", "final_state", "properties"):
+            print(f"{key:>14}: {out[key]}")
+    return 0
+
+
+# ---------------------------------------------------------------- robust
+def _add_robust(sub) -> None:
+    p = sub.add_parser(
+        "robust",
+        help="robustness under model mismatch: maps, margins, worst cases",
+        description="Simulate TO, PD, PTO and PTO-printed (designed for the nominal plant) on "
+        "plants and measurements across the [robustness] box of the configuration (true a / "
+        "design a, drive saturation, computation delay, encoder quantum, velocity noise): "
+        "maps over a perturbation grid, margins in a_true / a_design, and a seeded "
+        "worst-case search (differential evolution started from the grid's worst cells).",
+        epilog="example:\n  ptoverify robust --json > robust.json\n"
+        "  ptoverify robust --dask local --grid 21",
+    )
+    p.add_argument(
+        "--dask",
+        metavar="ADDRESS",
+        default=None,
+        help="run the maps on a dask.distributed scheduler (tcp://host:port), or 'local' to "
+        "start a LocalCluster on this machine",
+    )
+    p.add_argument(
+        "--grid", type=positive_int, default=15, metavar="N", help="N x N initial states (15)"
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
+    p.set_defaults(handler=_cmd_robust)
+
+
+def _cmd_robust(args: argparse.Namespace) -> int:
+    from ptoverify.commands import run_robust_study
+    from ptoverify.progress import stderr_bar
+
+    cfg = _config(args)
+    if not 3 <= args.grid <= 101:
+        raise InputError(f"--grid must be in [3, 101], got {args.grid}")
+    res = run_robust_study(cfg, grid=args.grid, dask=args.dask, progress=stderr_bar(args.quiet))
+    if args.json:
+        print_json(res)
+        return 0
+    for law, m in res["margins"].items():
+        print(f"{law:<12} margins: {m}")
+    for law, w in res["worst"].items():
+        for prop, v in w.items():
+            shown = "inf" if v.get("unbounded") else v["searched"]
+            print(f"{law:<12} worst {prop:<18} grid {v['grid']}  searched {shown}  at {v['state']}")
+    print(f"most robust linear loop: {res['most_robust']['law']}")
+    return 0
+
+
+# ---------------------------------------------------------------- tune
+def _add_tune(sub) -> None:
+    p = sub.add_parser(
+        "tune",
+        help="tune PD (kp, kd) or PTO (d, k1, k2) for a fair comparison",
+        description="Search a law's gains (differential evolution, fixed seed; the PTO's "
+        "omega0 from the corrected construction for each d) for the best response under an "
+        "overshoot bound (between samples), a stable sampled linear loop and no limit cycle "
+        "(PTO: nor stride-over) on the gate grid. Prints the gains as a TOML configuration.",
+        epilog="example:\n  ptoverify tune --law pd --signal step --max-overshoot 0\n"
+        "  ptoverify tune --law pto --json > tuned.json",
+    )
+    p.add_argument("--law", choices=("pd", "pto"), required=True, help="law to tune")
+    p.add_argument(
+        "--signal", choices=("step", "ramp", "sine"), default="step", help="response (step)"
+    )
+    p.add_argument(
+        "--max-overshoot",
+        type=finite_float,
+        default=None,
+        metavar="MM",
+        help="overshoot bound [mm], between samples (default: none)",
+    )
+    p.add_argument(
+        "--objective",
+        choices=("settling_2pct", "settling_0p01mm", "worst_ratio_nt"),
+        default="settling_2pct",
+        help="what to minimize (default settling_2pct)",
+    )
+    p.add_argument("--seed", type=int, default=0, help="search seed (default 0)")
+    p.set_defaults(handler=_cmd_tune)
+
+
+def _cmd_tune(args: argparse.Namespace) -> int:
+    from ptoverify.tune import tune
+
+    cfg = _config(args)
+    res = tune(
+        cfg,
+        args.law,
+        args.signal,
+        max_overshoot=args.max_overshoot,
+        objective=args.objective,
+        seed=args.seed,
+    )
+    if args.json:
+        print_json(res.to_json())
+        return 0
+    b = res.best
+    print(
+        f"# best {args.law} on the {args.signal}: settling (2 %) {b.settling_2pct_s * 1e3:.4g} ms, "
+        f"overshoot {b.overshoot_mm:.4g} mm, {res.evaluations} evaluations, "
+        f"{res.seconds:.1f} s"
+    )
+    print(res.toml(), end="")
     return 0
 
 
@@ -365,6 +524,12 @@ def _add_check(sub) -> None:
         help="cap IPOPT iterations (a solver that then fails makes its gate "
         "unverified, and the run fails)",
     )
+    p.add_argument(
+        "--robust",
+        action="store_true",
+        help="also run the robustness gates over the [robustness] box "
+        "(robust-no-limit-cycle, robust-settling; about a minute)",
+    )
     _add_junit(p)
     p.set_defaults(handler=_cmd_check)
 
@@ -374,7 +539,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
     cfg = _config(args)
     _check_junit(args)
-    results = run_checks(cfg, args.gate, max_iter=args.max_iter)
+    results = run_checks(cfg, args.gate, max_iter=args.max_iter, robust=args.robust)
     summary = summarize(results)
     if args.junit:
         from ptoverify.junit import junit_xml
@@ -699,6 +864,8 @@ COMMANDS: list[tuple[str, Callable[[Any], None]]] = [
     ("sweep", _add_sweep),
     ("zone", _add_zone),
     ("conform", _add_conform),
+    ("robust", _add_robust),
+    ("tune", _add_tune),
 ]
 
 

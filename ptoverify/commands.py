@@ -11,6 +11,7 @@ argument parsing): ``simulate`` -> :func:`run_simulation`, ``zone`` ->
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,7 +23,15 @@ from ptoverify.exact import exact_metrics
 from ptoverify.laws import make_law
 from ptoverify.simulate import SimResult, reference, simulate
 
-__all__ = ["SimulationRun", "run_simulation", "run_zone", "mintime_states", "MAX_DURATION_S"]
+__all__ = [
+    "SimulationRun",
+    "run_simulation",
+    "run_regulation",
+    "run_robust_study",
+    "run_zone",
+    "mintime_states",
+    "MAX_DURATION_S",
+]
 
 #: Longest simulated time accepted from a user [s].
 MAX_DURATION_S = 100.0
@@ -210,3 +219,134 @@ def mintime_states(path: str, cfg: Config) -> dict[str, np.ndarray]:
     from ptoverify.mintime import batch_table
 
     return batch_table(path, cfg)
+
+
+def run_regulation(
+    cfg: Config,
+    law: str,
+    x0: tuple[float, float],
+    *,
+    duration: float | None = None,
+    a_ratio: float = 1.0,
+    w_max_ratio: float = 1.0,
+    delay_samples: int = 0,
+    position_quantum: float = 0.0,
+    velocity_noise: float = 0.0,
+    seed: int = 0,
+) -> dict[str, Any]:
+    """Regulate from ``x0`` to the origin, optionally on a mismatched plant (``simulate --x0``).
+
+    The law is built from ``cfg`` (the design); the plant and measurement follow
+    the mismatch (:class:`ptoverify.simulate.Mismatch`).  The properties are those
+    of ``ptoverify robust`` (:func:`ptoverify.robust.trajectory_properties`), so a
+    counterexample it reports is reproduced here number for number.
+
+    Parameters
+    ----------
+    cfg : Config
+        Nominal configuration.
+    law : str
+        Law name.
+    x0 : tuple of float
+        Initial state (x1 [mm], x2 [mm/s]).
+    duration : float, optional
+        Simulated time [s]; default the robustness horizon.
+    a_ratio, w_max_ratio : float
+        True a over design a [-]; drive saturation over w_max [-].
+    delay_samples : int
+        Computation delay [samples].
+    position_quantum : float
+        Encoder resolution [mm].
+    velocity_noise : float
+        Velocity-measurement noise standard deviation [mm/s].
+    seed : int
+        Noise seed.
+
+    Returns
+    -------
+    dict
+        ``law``, ``x0``, ``mismatch``, ``samples``, ``final_state``,
+        ``properties`` and ``series`` (``t``, ``x1``, ``x2``, ``u``, ``region``).
+    """
+    from ptoverify.robust import horizon_steps, trajectory_properties
+    from ptoverify.simulate import Mismatch, simulate_batch
+
+    for name, value, lo, hi in (
+        ("--a-ratio", a_ratio, 0.01, 100.0),
+        ("--w-max-ratio", w_max_ratio, 1e-3, 1.0),
+        ("--quantum", position_quantum, 0.0, cfg.plant.position_range),
+        ("--velocity-noise", velocity_noise, 0.0, cfg.plant.w_max),
+    ):
+        if not lo <= value <= hi:
+            raise InputError(f"{name} must be in [{lo:g}, {hi:g}], got {value:g}")
+    if not 0 <= delay_samples <= 100:
+        raise InputError(f"--delay must be in [0, 100] samples, got {delay_samples}")
+    p = cfg.plant
+    if abs(x0[0]) > 1e3 * p.position_range or abs(x0[1]) > 1e3 * p.w_max:
+        raise InputError(f"--x0 ({x0[0]:g}, {x0[1]:g}) is far outside the envelope")
+    steps = horizon_steps(cfg)
+    if duration is not None:
+        if not p.sample_time <= duration <= MAX_DURATION_S:
+            raise InputError(
+                f"--duration must be in [{p.sample_time:g}, {MAX_DURATION_S:g}] s, got {duration:g}"
+            )
+        steps = int(round(duration / p.sample_time))
+    m = Mismatch(
+        a_ratio=a_ratio,
+        w_max_ratio=w_max_ratio,
+        delay_samples=delay_samples,
+        position_quantum=position_quantum,
+        velocity_noise=velocity_noise,
+        seed=seed,
+    )
+    fn = make_law(law, cfg)
+    b = simulate_batch(fn, p, [x0[0]], [x0[1]], steps, mismatch=m)
+    props = trajectory_properties(law, cfg, np.array([x0[0]]), np.array([x0[1]]), m, steps=steps)
+    t = np.arange(steps + 1) * p.sample_time
+    return {
+        "law": law,
+        "note": fn.note,
+        "x0": [float(x0[0]), float(x0[1])],
+        "mismatch": m.to_json(),
+        "samples": steps + 1,
+        "final_state": [float(b.x1[-1, 0]), float(b.x2[-1, 0])],
+        "properties": {k: float(v[0]) for k, v in props.items()},
+        "series": {
+            "t": t,
+            "x1": b.x1[:, 0],
+            "x2": b.x2[:, 0],
+            "u": np.append(b.u[:, 0], np.nan),
+            "region": np.append(b.region[:, 0], -1),
+        },
+    }
+
+
+def run_robust_study(
+    cfg: Config,
+    *,
+    grid: int = 15,
+    dask: str | None = None,
+    progress: Callable[[str, float], None] | None = None,
+) -> dict[str, Any]:
+    """Return the ``ptoverify robust --json`` object.
+
+    Parameters
+    ----------
+    cfg : Config
+        Nominal configuration with its ``[robustness]`` box.
+    grid : int
+        Initial states per axis of the maps.
+    dask : str, optional
+        Scheduler address or ``local`` (None: in-process).
+    progress : callable, optional
+        ``progress(stage, fraction)``.
+
+    Returns
+    -------
+    dict
+        ``box``, ``margins``, ``worst``, ``maps``, ``most_robust``, ``timings_s``, ``backend``.
+    """
+    from ptoverify.robust import RobustSettings, run_robust
+
+    settings = RobustSettings(n1=grid, n2=grid)
+    return run_robust(cfg, settings, dask=dask, progress=progress).to_json()

@@ -43,6 +43,8 @@ __all__ = [
     "paper_config",
     "load_config",
     "config_from_mapping",
+    "Robustness",
+    "robustness_from_mapping",
 ]
 
 
@@ -109,6 +111,54 @@ class PTOSettings:
 
 
 @dataclass(frozen=True)
+class Robustness:
+    """The uncertainty box of ``ptoverify robust`` (table ``[robustness]``).
+
+    The law is always built from the nominal configuration; only the simulated
+    plant and the measurement change within the box.
+
+    Attributes
+    ----------
+    a_ratio : tuple of float
+        Range of true a over design a [-]; must contain 1.
+    w_max_ratio : tuple of float
+        Range of the drive's saturation over the law's w_max [-], in (0, 1].
+    delay_samples : tuple of int
+        Range of the computation delay [samples]: the input computed from x_k is
+        applied at k + delay.
+    position_quantum : float
+        Encoder resolution [mm] (0: exact measurement).
+    velocity_noise : float
+        Standard deviation of Gaussian velocity-measurement noise [mm/s].
+    settling_ratio_limit : float
+        Limit of the ``robust-settling`` gate: the worst settling time over
+        N*T of the true plant, anywhere in the box [-].
+    seed : int
+        Seed of the noise and of the worst-case search.
+    """
+
+    a_ratio: tuple[float, float] = (0.8, 1.25)
+    w_max_ratio: tuple[float, float] = (0.9, 1.0)
+    delay_samples: tuple[int, int] = (0, 1)
+    position_quantum: float = 0.001
+    velocity_noise: float = 0.0
+    settling_ratio_limit: float = 10.0
+    seed: int = 0
+
+    def to_mapping(self) -> dict[str, Any]:
+        """Return the box as a plain dict (the TOML layout)."""
+        return {
+            "a_ratio": list(self.a_ratio),
+            "w_max_ratio": list(self.w_max_ratio),
+            "delay_samples": list(self.delay_samples),
+            "position_quantum": self.position_quantum,
+            "velocity_noise": self.velocity_noise,
+            "settling_ratio_limit": self.settling_ratio_limit,
+            "seed": self.seed,
+        }
+
+
+@dataclass(frozen=True)
 class Config:
     """A full configuration: plant, PD gains and PTO settings.
 
@@ -122,6 +172,8 @@ class Config:
         PD gains.
     pto : PTOSettings
         PTO settings.
+    robustness : Robustness
+        The uncertainty box of ``ptoverify robust``.
     bandwidth_hz : float or None
         The bandwidth as given in Hz, when the file gave it in Hz.
     """
@@ -131,6 +183,7 @@ class Config:
     pd: PDGains = field(default_factory=PDGains)
     pto: PTOSettings = field(default_factory=PTOSettings)
     bandwidth_hz: float | None = None
+    robustness: Robustness = field(default_factory=Robustness)
 
     def with_plant(self, **changes: float) -> Config:
         """Return a copy with plant fields replaced (``a``, ``w_max``...)."""
@@ -168,6 +221,7 @@ class Config:
             "plant": plant,
             "pd": {"kp": self.pd.kp, "kd": self.pd.kd},
             "pto": {"d": self.pto.d, "k1": self.pto.k1, "k2": self.pto.k2},
+            "robustness": self.robustness.to_mapping(),
         }
 
 
@@ -321,7 +375,7 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
         infinities and out-of-range values; the message names the key.
     """
     for key in data:
-        if key not in {"name", *_SECTIONS}:
+        if key not in {"name", "robustness", *_SECTIONS}:
             raise ConfigError(f"unknown config key '{key}'")
     name = data.get("name", "custom")
     if (
@@ -372,6 +426,87 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
         pd=PDGains(kp=pd["kp"], kd=pd["kd"]),
         pto=PTOSettings(d=pto["d"], k1=pto["k1"], k2=pto["k2"]),
         bandwidth_hz=bandwidth_hz,
+        robustness=robustness_from_mapping(data.get("robustness", {}), plant),
+    )
+
+
+def _pair(key: str, value: Any, lo: float, hi: float, *, integer: bool = False) -> tuple:
+    where = f"robustness.{key}"
+    if not isinstance(value, list) or len(value) != 2:
+        raise ConfigError(f"config key '{where}' must be a list [low, high], got {value!r}")
+    if integer:
+        if any(isinstance(v, bool) or not isinstance(v, int) for v in value):
+            raise ConfigError(f"config key '{where}' must hold integers, got {value!r}")
+        out = (int(value[0]), int(value[1]))
+    else:
+        out = (_number("robustness", key, value[0]), _number("robustness", key, value[1]))
+    if not lo <= out[0] <= out[1] <= hi:
+        raise ConfigError(
+            f"config key '{where}' must satisfy {lo:g} <= low <= high <= {hi:g}, got {value!r}"
+        )
+    return out
+
+
+def robustness_from_mapping(raw: Any, plant: dict[str, float]) -> Robustness:
+    """Validate the ``[robustness]`` table (every key optional; defaults of :class:`Robustness`).
+
+    Parameters
+    ----------
+    raw : dict
+        The parsed table.
+    plant : dict
+        The validated ``[plant]`` numbers (w_max [mm/s], position_range [mm]).
+
+    Returns
+    -------
+    Robustness
+        The box.
+
+    Raises
+    ------
+    ConfigError
+        On unknown keys, wrong types or out-of-range values (the key is named).
+
+    Examples
+    --------
+    >>> robustness_from_mapping({"a_ratio": [0.5, 2.0]}, {"w_max": 300.0,
+    ...     "position_range": 50.0}).a_ratio
+    (0.5, 2.0)
+    """
+    if not isinstance(raw, dict):
+        raise ConfigError(f"config key 'robustness' must be a table [robustness], got {raw!r}")
+    base = Robustness()
+    known = set(base.to_mapping())
+    for key in raw:
+        if key not in known:
+            raise ConfigError(f"unknown config key 'robustness.{key}'")
+    a_ratio = _pair("a_ratio", raw.get("a_ratio", list(base.a_ratio)), 0.1, 10.0)
+    if not a_ratio[0] <= 1.0 <= a_ratio[1]:
+        raise ConfigError(f"config key 'robustness.a_ratio' must contain 1, got {list(a_ratio)}")
+    w_ratio = _pair("w_max_ratio", raw.get("w_max_ratio", list(base.w_max_ratio)), 0.05, 1.0)
+    delay = _pair(
+        "delay_samples", raw.get("delay_samples", list(base.delay_samples)), 0, 10, integer=True
+    )
+    scalars = {}
+    limits = {
+        "position_quantum": (0.0, 0.1 * plant["position_range"]),
+        "velocity_noise": (0.0, plant["w_max"]),
+        "settling_ratio_limit": (1.0, 1e6),
+    }
+    for key, (lo, hi) in limits.items():
+        v = _number("robustness", key, raw.get(key, getattr(base, key)))
+        if not lo <= v <= hi:
+            raise ConfigError(
+                f"config key 'robustness.{key}' must be in [{lo:g}, {hi:g}], got {v!r}"
+            )
+        scalars[key] = v
+    seed = raw.get("seed", base.seed)
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**32:
+        raise ConfigError(
+            f"config key 'robustness.seed' must be an integer in [0, 2^32), got {seed!r}"
+        )
+    return Robustness(
+        a_ratio=a_ratio, w_max_ratio=w_ratio, delay_samples=delay, seed=seed, **scalars
     )
 
 

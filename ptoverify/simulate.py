@@ -46,6 +46,7 @@ __all__ = [
     "SimResult",
     "simulate",
     "BatchResult",
+    "Mismatch",
     "simulate_batch",
 ]
 
@@ -441,6 +442,70 @@ def simulate(
 
 
 @dataclass(frozen=True)
+class Mismatch:
+    """How the simulated plant and measurement differ from the design.
+
+    The law is always the nominal one; only the plant it drives and what it
+    measures change.  The identity mismatch (the default) reproduces the
+    nominal loop bit for bit.
+
+    Attributes
+    ----------
+    a_ratio : float or ndarray, shape (n,)
+        True bandwidth over design bandwidth a [-], per state or shared.
+    w_max_ratio : float or ndarray, shape (n,)
+        The drive saturates at ``w_max_ratio * w_max`` [-] (at or below what the
+        law assumes); the commanded input is recorded unclipped.
+    delay_samples : int
+        Computation delay: the input computed from x_k is applied from sample
+        k + delay.  Before the first computed input acts, the loop holds the
+        input computed from the initial state (the controller was already running).
+    position_quantum : float
+        Encoder resolution [mm]: the law sees ``q round(x1 / q)`` (0: exact).
+    velocity_noise : float
+        Standard deviation of Gaussian noise on the measured x2 [mm/s] (0: none).
+        One sequence (seeded) is drawn per run and added to every state of the
+        batch, so a state's trajectory does not depend on the batch it ran in.
+    seed : int
+        Seed of the noise sequence.
+    """
+
+    a_ratio: float | NDArray[np.float64] = 1.0
+    w_max_ratio: float | NDArray[np.float64] = 1.0
+    delay_samples: int = 0
+    position_quantum: float = 0.0
+    velocity_noise: float = 0.0
+    seed: int = 0
+
+    @property
+    def is_identity(self) -> bool:
+        """Whether this is the nominal loop (no mismatch of any kind)."""
+        return (
+            np.all(np.asarray(self.a_ratio) == 1.0)
+            and np.all(np.asarray(self.w_max_ratio) == 1.0)
+            and self.delay_samples == 0
+            and self.position_quantum == 0.0
+            and self.velocity_noise == 0.0
+        )
+
+    def to_json(self) -> dict:
+        """Return the mismatch as a JSON-able dict (arrays as lists)."""
+
+        def num(v):
+            v = np.asarray(v, dtype=float)
+            return float(v) if v.ndim == 0 else v.tolist()
+
+        return {
+            "a_ratio": num(self.a_ratio),
+            "w_max_ratio": num(self.w_max_ratio),
+            "delay_samples": int(self.delay_samples),
+            "position_quantum": float(self.position_quantum),
+            "velocity_noise": float(self.velocity_noise),
+            "seed": int(self.seed),
+        }
+
+
+@dataclass(frozen=True)
 class BatchResult:
     """Regulation to the origin from many initial states.
 
@@ -452,15 +517,26 @@ class BatchResult:
         Inputs [mm/s].
     region : ndarray of int8, shape (steps, n)
         Region codes.
+    mismatch : Mismatch or None
+        The plant/measurement mismatch simulated (None: the nominal loop).
     """
 
     x1: NDArray[np.float64]
     x2: NDArray[np.float64]
     u: NDArray[np.float64]
     region: NDArray[np.int8]
+    mismatch: Mismatch | None = None
 
 
-def simulate_batch(law: Law, plant: Plant, x1: ArrayLike, x2: ArrayLike, steps: int) -> BatchResult:
+def simulate_batch(
+    law: Law,
+    plant: Plant,
+    x1: ArrayLike,
+    x2: ArrayLike,
+    steps: int,
+    *,
+    mismatch: Mismatch | None = None,
+) -> BatchResult:
     """Simulate the sampled loop to the origin from many initial states at once.
 
     Parameters
@@ -468,17 +544,35 @@ def simulate_batch(law: Law, plant: Plant, x1: ArrayLike, x2: ArrayLike, steps: 
     law : Law
         Feedback law (its vectorized path is used).
     plant : Plant
-        Plant and sample time.
+        Design plant and sample time (the law's).
     x1, x2 : array_like, shape (n,)
         Initial states [mm], [mm/s].
     steps : int
         Number of samples.
+    mismatch : Mismatch, optional
+        True plant and measurement relative to ``plant`` (see :class:`Mismatch`);
+        None or the identity is the nominal loop, bit for bit.
 
     Returns
     -------
     BatchResult
-        The trajectories.
+        The trajectories; ``u`` is the commanded input of each sample.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> from ptoverify.laws import pd_law
+    >>> cfg = paper_config()
+    >>> b = simulate_batch(pd_law(cfg), cfg.plant, [5.0], [0.0], 300)
+    >>> bool(abs(b.x1[-1, 0]) < 1e-6)
+    True
+    >>> slow = simulate_batch(pd_law(cfg), cfg.plant, [5.0], [0.0], 300,
+    ...                       mismatch=Mismatch(a_ratio=0.8, delay_samples=1))
+    >>> bool(abs(slow.x1[-1, 0]) < 1e-3), bool(slow.x1[40, 0] != b.x1[40, 0])
+    (True, True)
     """
+    if mismatch is not None and not mismatch.is_identity:
+        return _simulate_mismatch(law, plant, x1, x2, steps, mismatch)
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     x2 = np.atleast_1d(np.asarray(x2, dtype=float))
     n = x1.shape[0]
@@ -498,4 +592,44 @@ def simulate_batch(law: Law, plant: Plant, x1: ArrayLike, x2: ArrayLike, steps: 
         X1[k + 1] += X1[k]
         dv /= a
         X1[k + 1] += dv
-    return BatchResult(X1, X2, U, R)
+    return BatchResult(X1, X2, U, R, mismatch)
+
+
+def _simulate_mismatch(
+    law: Law, plant: Plant, x1: ArrayLike, x2: ArrayLike, steps: int, m: Mismatch
+) -> BatchResult:
+    """Run the loop of :func:`simulate_batch` with a true plant and a measurement model."""
+    x1 = np.atleast_1d(np.asarray(x1, dtype=float))
+    x2 = np.atleast_1d(np.asarray(x2, dtype=float))
+    n = x1.shape[0]
+    if m.delay_samples < 0 or m.position_quantum < 0 or m.velocity_noise < 0:
+        raise InputError("mismatch: delay, quantum and noise must be >= 0")
+    X1, X2 = np.empty((steps + 1, n)), np.empty((steps + 1, n))
+    U, R = np.empty((steps, n)), np.empty((steps, n), dtype=np.int8)
+    X1[0], X2[0] = x1, x2
+    T = plant.sample_time
+    a = plant.a * np.broadcast_to(np.asarray(m.a_ratio, dtype=float), (n,))
+    w_true = plant.w_max * np.broadcast_to(np.asarray(m.w_max_ratio, dtype=float), (n,))
+    g = -np.expm1(-a * T)
+    q = float(m.position_quantum)
+    noise = (
+        np.random.default_rng(m.seed).normal(0.0, m.velocity_noise, steps)
+        if m.velocity_noise > 0
+        else np.zeros(steps)
+    )
+    pending: list[np.ndarray] = []  # commanded inputs not yet applied (the delay line)
+    applied = None
+    for k in range(steps):
+        y1 = q * np.round(X1[k] / q) if q > 0 else X1[k]
+        y2 = X2[k] + noise[k]
+        U[k], R[k] = law(y1, y2)
+        pending.append(U[k])
+        if applied is None:  # the controller was running: hold what x_0 commands
+            applied = U[0]
+        if len(pending) > m.delay_samples:
+            applied = pending.pop(0)
+        uk = np.clip(applied, -w_true, w_true)
+        dv = (X2[k] - uk) * g
+        X2[k + 1] = X2[k] - dv
+        X1[k + 1] = X1[k] + uk * T + dv / a
+    return BatchResult(X1, X2, U, R, m)

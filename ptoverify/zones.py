@@ -641,9 +641,18 @@ def corrected_zone(
     )
 
 
-@functools.lru_cache(maxsize=32)
 def zone_for_law(cfg: Config, variant: str) -> PTOZone:
-    """Zone the ``pto`` (``corrected``) or ``pto-printed`` (``printed``) law uses."""
+    """Zone the ``pto`` (``corrected``) or ``pto-printed`` (``printed``) law uses.
+
+    Memoized on what a zone depends on (the plant and d), so laws that differ
+    only in gains (a tuning search) share one construction.
+    """
+    key = Config(name="zone", plant=cfg.plant, pto=PTOSettings(d=cfg.pto.d))
+    return _zone_for_law(key, variant)
+
+
+@functools.lru_cache(maxsize=256)
+def _zone_for_law(cfg: Config, variant: str) -> PTOZone:
     return corrected_zone(cfg, verify=False) if variant == "corrected" else printed_zone(cfg)
 
 

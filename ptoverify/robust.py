@@ -1,0 +1,938 @@
+"""Robustness under model mismatch: maps, margins and a worst-case search.
+
+The law is always built from the nominal configuration; the simulated plant
+and the measurement vary inside the uncertainty box of ``[robustness]``
+(:class:`ptoverify.config.Robustness`): true a over design a, the drive's
+saturation over the law's w_max, a computation delay of whole samples, an
+encoder quantum on x1 and Gaussian noise on the measured x2.
+
+Per trajectory (regulation to the origin from x0, by
+:func:`ptoverify.simulate.simulate_batch` with a :class:`Mismatch`):
+
+stride_overs
+    Stride-overs of the law's own switching curves (the design a and w_max:
+    the curves the law decides with), :func:`ptoverify.properties.crossing_masks`.
+limit_cycle_mm
+    Peak |x1| over the last quarter of the horizon when the trajectory
+    oscillates there (:func:`ptoverify.properties.oscillating`), else 0 [mm].
+overshoot_mm
+    From rest (x2 = 0, |x1| >= d): the largest excursion beyond the origin
+    on the side opposite to x1_0, at the samples [mm].
+settling_ratio_nt, settling_ratio_tf
+    Settling time (|x1| <= 0.01 mm and |x2| <= 0.01 a mm/s, held 0.05 s, the
+    sweep's band) over N*T and over t_f* of the *true* plant (true a, true
+    saturation) [-]; inf when the trajectory does not settle in the horizon.
+
+Maps evaluate a grid of perturbations (a_ratio x w_max_ratio x each delay)
+times a grid of initial states.  Margins bisect a_true / a_design around 1.
+The worst-case search runs ``scipy.optimize.differential_evolution`` (seeded,
+its initial population seeded with the grid's worst cells) and a bounded
+Nelder-Mead polish, so the searched value is never below the grid's worst.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import differential_evolution, minimize
+
+from ptoverify.config import Config, Plant
+from ptoverify.errors import InputError
+from ptoverify.laws import Law, make_law
+from ptoverify.mintime import discrete_min_steps_batch, min_time
+from ptoverify.plant import zoh_matrices
+from ptoverify.poles import sampled_spectral_radius
+from ptoverify.properties import crossing_masks, oscillating
+from ptoverify.simulate import Mismatch, simulate_batch
+from ptoverify.sweep import settle_steps
+from ptoverify.verdict import FAIL, PASS, UNVERIFIED, Verdict
+
+__all__ = [
+    "LAWS",
+    "PROPERTIES",
+    "RobustSettings",
+    "trajectory_properties",
+    "horizon_steps",
+    "map_states",
+    "robust_maps",
+    "linear_loop_margin",
+    "no_limit_cycle_margin",
+    "worst_case",
+    "grid_worst",
+    "dask_runner",
+    "most_robust",
+    "RobustResult",
+    "run_robust",
+    "robust_gates",
+]
+
+LAWS = ("to", "pd", "pto", "pto-printed")
+#: Properties searched for their worst case (larger is worse for each).
+PROPERTIES = ("stride_overs", "limit_cycle_mm", "overshoot_mm", "settling_ratio_nt")
+SETTLE_BAND_MM = 0.01  #: settling band on x1 [mm], as the sweep's
+SETTLE_HOLD_S = 0.05  #: shortest settled tail [s], as the sweep's
+MARGIN_RANGE = (0.1, 10.0)  #: a_true / a_design searched for margins [-]
+MARGIN_RTOL = 1e-12  #: relative accuracy of the margin endpoints (the contract asks 1e-6)
+
+
+@dataclass(frozen=True)
+class RobustSettings:
+    """Sizes of the robustness study.
+
+    Attributes
+    ----------
+    n_a, n_w : int
+        Points of the a_ratio and w_max_ratio grids (geometric in a_ratio,
+        with 1 included when the box contains it).
+    n1, n2 : int
+        Initial-state grid over the envelope (x1 [mm] by x2 [mm/s]).
+    rest : int
+        Initial states at rest, |x1| in [d, position_range], both signs.
+    laws : tuple of str
+        Laws studied.
+    search_iterations : int
+        Generations of differential evolution per law, property and delay.
+    search_population : int
+        Population size of differential evolution (candidates per generation).
+    properties : tuple of str
+        Properties searched for their worst case (subset of :data:`PROPERTIES`).
+    margins : bool
+        Also compute the margins (bisections on a_ratio).
+    """
+
+    n_a: int = 5
+    n_w: int = 3
+    n1: int = 15
+    n2: int = 15
+    rest: int = 20
+    laws: tuple[str, ...] = LAWS
+    search_iterations: int = 12
+    search_population: int = 24
+    properties: tuple[str, ...] = PROPERTIES
+    margins: bool = True
+
+
+# -- per-trajectory properties -------------------------------------------------
+
+
+def horizon_steps(cfg: Config) -> int:
+    """Return the horizon [samples]: twice the envelope at the slowest drive, + 60/a.
+
+    Parameters
+    ----------
+    cfg : Config
+        Nominal configuration with its box (the slowest a and w_max of the box).
+
+    Returns
+    -------
+    int
+        Samples simulated per trajectory.
+    """
+    p, box = cfg.plant, cfg.robustness
+    w = p.w_max * box.w_max_ratio[0]
+    a = p.a * box.a_ratio[0]
+    return int(math.ceil((2.0 * p.position_range / w + 60.0 / a) / p.sample_time))
+
+
+def _true_plant(plant: Plant, a_ratio: float, w_ratio: float) -> Plant:
+    return replace(plant, a=plant.a * a_ratio, w_max=plant.w_max * w_ratio)
+
+
+def _n_star(x1: NDArray, x2: NDArray, plant: Plant) -> NDArray[np.float64]:
+    """N* of each state for ``plant`` (nan where it could not be computed), memoized."""
+    x1, x2 = np.ascontiguousarray(x1, dtype=float), np.ascontiguousarray(x2, dtype=float)
+    return _n_star_memo(plant, x1.tobytes(), x2.tobytes())
+
+
+@functools.lru_cache(maxsize=256)
+def _n_star_memo(plant: Plant, b1: bytes, b2: bytes) -> NDArray[np.float64]:
+    x1, x2 = np.frombuffer(b1), np.frombuffer(b2)
+    steps = discrete_min_steps_batch(x1, x2, plant).steps
+    out = np.where(steps >= 0, steps, np.nan).astype(float)
+    out.setflags(write=False)
+    return out
+
+
+LawSpec = str | Callable[[Config], Law]
+
+
+def _law(spec: LawSpec, cfg: Config) -> Law:
+    """Build the nominal law: a name for :func:`make_law`, or a factory ``f(cfg) -> Law``."""
+    return make_law(spec, cfg) if isinstance(spec, str) else spec(cfg)
+
+
+def trajectory_properties(
+    law_name: LawSpec,
+    cfg: Config,
+    x1: NDArray,
+    x2: NDArray,
+    mismatch: Mismatch,
+    *,
+    steps: int | None = None,
+    with_settling: bool = True,
+) -> dict[str, NDArray[np.float64]]:
+    """Simulate ``law_name`` (nominal design) on a mismatched plant and measure each state.
+
+    Parameters
+    ----------
+    law_name : str or callable
+        ``to``, ``pd``, ``pto`` or ``pto-printed``, or a factory ``f(cfg) -> Law``.
+    cfg : Config
+        Nominal configuration (the law's design and the box).
+    x1, x2 : ndarray, shape (n,)
+        Initial states [mm], [mm/s].
+    mismatch : Mismatch
+        The plant and measurement (a_ratio and w_max_ratio may be arrays of shape (n,)).
+    steps : int, optional
+        Horizon [samples]; default covers the slowest plant of the box.
+    with_settling : bool
+        Also compute the settling ratios (needs t_f* and N* of each true plant).
+
+    Returns
+    -------
+    dict
+        Arrays of shape (n,): ``stride_overs`` [-], ``limit_cycle_mm`` [mm],
+        ``overshoot_mm`` [mm] (nan where x0 is not at rest), ``settling_s`` [s],
+        ``settling_ratio_nt`` and ``settling_ratio_tf`` [-] (see module docstring).
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> cfg = paper_config()
+    >>> out = trajectory_properties("pd", cfg, np.array([5.0]), np.array([0.0]), Mismatch())
+    >>> float(out["stride_overs"][0]), bool(out["settling_ratio_nt"][0] > 1.0)
+    (0.0, True)
+    """
+    x1 = np.atleast_1d(np.asarray(x1, dtype=float))
+    x2 = np.atleast_1d(np.asarray(x2, dtype=float))
+    n = x1.size
+    steps = horizon_steps(cfg) if steps is None else steps
+    law = _law(law_name, cfg)
+    b = simulate_batch(law, cfg.plant, x1, x2, steps, mismatch=mismatch)
+    stride, _ = crossing_masks(b.x1, b.x2, b.region, cfg)
+    window = max(20, steps // 4)
+    tail = b.x1[-window:]
+    osc = oscillating(tail, 1e-3)
+    amp = np.where(osc, np.abs(tail).max(axis=0), 0.0)
+    rest = (x2 == 0.0) & (np.abs(x1) >= cfg.pto.d) & (x1 != 0.0)
+    over = (-np.sign(x1)[None, :] * b.x1).max(axis=0)
+    over = np.where(rest, np.maximum(over, 0.0), np.nan)
+    out = {
+        "stride_overs": stride.sum(axis=0).astype(float),
+        "limit_cycle_mm": amp,
+        "overshoot_mm": over,
+    }
+    if not with_settling:
+        return out
+    T = cfg.plant.sample_time
+    hold = math.ceil(SETTLE_HOLD_S / T - 1e-9)
+    k = settle_steps(b.x1, b.x2, SETTLE_BAND_MM, cfg.plant.a * SETTLE_BAND_MM, hold)
+    settle = np.where(k >= 0, k * T, np.inf)
+    ar = np.broadcast_to(np.asarray(mismatch.a_ratio, dtype=float), (n,))
+    wr = np.broadcast_to(np.asarray(mismatch.w_max_ratio, dtype=float), (n,))
+    t_f, n_star = np.empty(n), np.empty(n)
+    for key in set(zip(ar.tolist(), wr.tolist(), strict=True)):
+        sel = (ar == key[0]) & (wr == key[1])
+        true = _true_plant(cfg.plant, *key)
+        t_f[sel] = min_time(x1[sel], x2[sel], true).t_f
+        n_star[sel] = _n_star(x1[sel], x2[sel], true)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out["settling_s"] = settle
+        out["settling_ratio_nt"] = np.where(n_star > 0, settle / (n_star * T), 0.0)
+        out["settling_ratio_tf"] = np.where(t_f > 0, settle / t_f, 0.0)
+    return out
+
+
+# -- maps ----------------------------------------------------------------------
+
+
+def _ratio_grid(lo: float, hi: float, n: int) -> NDArray[np.float64]:
+    """Geometric grid on [lo, hi] with 1 included when lo <= 1 <= hi."""
+    if n <= 1 or lo == hi:
+        return np.array([1.0 if lo <= 1.0 <= hi else lo])
+    g = np.geomspace(lo, hi, n)
+    if lo <= 1.0 <= hi:
+        g[np.argmin(np.abs(np.log(g)))] = 1.0
+    return np.unique(g)
+
+
+def map_states(cfg: Config, s: RobustSettings | None = None) -> tuple[NDArray, NDArray]:
+    """Return the initial states of the maps: an n1 x n2 envelope grid plus states at rest.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (position_range [mm], w_max [mm/s], d [mm]).
+    s : RobustSettings, optional
+        Grid sizes.
+
+    Returns
+    -------
+    x1, x2 : ndarray
+        Initial states [mm], [mm/s].
+    """
+    s = s or RobustSettings()
+    p, d = cfg.plant, cfg.pto.d
+    g1, g2 = np.meshgrid(
+        np.linspace(-p.position_range, p.position_range, s.n1), np.linspace(-p.w_max, p.w_max, s.n2)
+    )
+    r1 = np.linspace(max(d, 1e-3 * p.position_range), p.position_range, max(s.rest // 2, 1))
+    x1 = np.concatenate([g1.ravel(), r1, -r1])
+    x2 = np.concatenate([g2.ravel(), np.zeros(2 * r1.size)])
+    return x1, x2
+
+
+def _cell_task(
+    law: LawSpec, cfg: Config, x1: NDArray, x2: NDArray, ar: float, wr: float, delay: int
+) -> dict[str, Any]:
+    """One map cell: every grid state on one perturbed plant (a picklable task)."""
+    box = cfg.robustness
+    m = Mismatch(
+        a_ratio=ar,
+        w_max_ratio=wr,
+        delay_samples=delay,
+        position_quantum=box.position_quantum,
+        velocity_noise=box.velocity_noise,
+        seed=box.seed,
+    )
+    props = trajectory_properties(law, cfg, x1, x2, m)
+    summary: dict[str, Any] = {"a_ratio": ar, "w_max_ratio": wr, "delay_samples": delay}
+    for key in PROPERTIES:
+        v = props[key]
+        fin = v[~np.isnan(v)]
+        k = int(np.nanargmax(np.where(np.isnan(v), -np.inf, v)))
+        summary[key] = {
+            "max": float(fin.max()) if fin.size else math.nan,
+            "state": [float(x1[k]), float(x2[k])],
+        }
+    summary["states_with_stride_over"] = int((props["stride_overs"] > 0).sum())
+    summary["limit_cycle_states"] = int((props["limit_cycle_mm"] > 0).sum())
+    summary["not_settled"] = int(np.isinf(props["settling_s"]).sum())
+    r = props["settling_ratio_nt"]
+    summary["settling_ratio_nt"]["median"] = float(np.median(r))
+    summary["settling_ratio_nt"]["p95"] = float(np.percentile(r, 95, method="higher"))
+    return summary
+
+
+def robust_maps(
+    cfg: Config,
+    settings: RobustSettings | None = None,
+    *,
+    runner: Callable[[list[tuple]], list[dict]] | None = None,
+) -> dict[str, Any]:
+    """Evaluate every law on a grid of perturbations times a grid of initial states.
+
+    Parameters
+    ----------
+    cfg : Config
+        Nominal configuration with its box.
+    settings : RobustSettings, optional
+        Grid sizes and laws.
+    runner : callable, optional
+        ``runner(tasks) -> results`` evaluating ``_cell_task(*task)`` for each task,
+        in order (in-process by default; :func:`dask_runner` distributes them).
+
+    Returns
+    -------
+    dict
+        ``a_ratio``, ``w_max_ratio``, ``delay_samples`` (the grid axes) and per law a
+        list of cell summaries (``cells``), in the order delay, w_max_ratio, a_ratio.
+    """
+    s = settings or RobustSettings()
+    box = cfg.robustness
+    ars = _ratio_grid(*box.a_ratio, s.n_a)
+    wrs = _ratio_grid(*box.w_max_ratio, s.n_w)
+    delays = list(range(box.delay_samples[0], box.delay_samples[1] + 1))
+    x1, x2 = map_states(cfg, s)
+    tasks = [
+        (law, cfg, x1, x2, float(ar), float(wr), int(dl))
+        for law in s.laws
+        for dl in delays
+        for wr in wrs
+        for ar in ars
+    ]
+    run = runner or (lambda ts: [_cell_task(*t) for t in ts])
+    results = run(tasks)
+    per = len(delays) * len(wrs) * len(ars)
+    laws = {law: results[i * per : (i + 1) * per] for i, law in enumerate(s.laws)}
+    return {
+        "a_ratio": ars.tolist(),
+        "w_max_ratio": wrs.tolist(),
+        "delay_samples": delays,
+        "states": int(x1.size),
+        "laws": laws,
+    }
+
+
+def dask_runner(address: str) -> Callable[[list[tuple]], list[dict]]:
+    """Return a runner for :func:`robust_maps` on a ``dask.distributed`` cluster.
+
+    Parameters
+    ----------
+    address : str
+        Scheduler address (``tcp://host:port``), or ``local`` to start a
+        LocalCluster on this machine for the run.
+
+    Returns
+    -------
+    callable
+        ``runner(tasks) -> results`` in task order.
+    """
+    from dask.distributed import Client, LocalCluster
+
+    def run(tasks: list[tuple]) -> list[dict]:
+        if address == "local":
+            with (
+                LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster,
+                Client(cluster) as client,
+            ):
+                return client.gather(client.map(_cell_task, *zip(*tasks, strict=True), pure=False))
+        with Client(address, timeout=30) as client:
+            return client.gather(client.map(_cell_task, *zip(*tasks, strict=True), pure=False))
+
+    return run
+
+
+# -- margins -------------------------------------------------------------------
+
+
+def _linear_gains(law: str, cfg: Config) -> tuple[float, float] | None:
+    if law == "pd":
+        return cfg.pd.kp, cfg.pd.kd
+    if law in ("pto", "pto-printed"):
+        return cfg.pto.k1, cfg.pto.k2
+    return None
+
+
+def _edge(
+    stable: Callable[[float], bool], toward: float, *, grid: int = 400, rtol: float = MARGIN_RTOL
+) -> float | None:
+    """Where ``stable`` first fails going from 1 toward ``toward`` (None: never in range).
+
+    Scans a geometric grid of ``grid`` points from 1 to ``toward``, then bisects
+    the first stable/unstable pair to ``rtol`` relative.
+    """
+    pts = np.geomspace(1.0, toward, grid)
+    prev = 1.0
+    for r in pts[1:]:
+        if not stable(float(r)):
+            lo, hi = prev, float(r)
+            while abs(hi - lo) > rtol * min(abs(lo), abs(hi)):
+                mid = math.sqrt(lo * hi)
+                lo, hi = (mid, hi) if stable(mid) else (lo, mid)
+            return lo
+        prev = float(r)
+    return None
+
+
+def linear_loop_margin(law: str, cfg: Config, *, delay_samples: int = 0) -> dict[str, Any]:
+    """Largest interval of a_true / a_design around 1 where the sampled linear loop is stable.
+
+    The linear loop is PD's u = -kp x1 - kd x2 or the PTO's linear zone
+    u = -k1 x1 - k2 x2 (eq. 34), unsaturated, on the ZOH plant with the true a
+    and the design T; stable means spectral radius < 1.  With a one-sample
+    computation delay the loop state is (x1, x2, u_{k-1}):
+    z_{k+1} = [[Ad, Bd], [-K, 0]] z_k.
+
+    Parameters
+    ----------
+    law : str
+        Law name (TO has no linear loop).
+    cfg : Config
+        Nominal configuration.
+    delay_samples : int
+        0 or 1 [samples].
+
+    Returns
+    -------
+    dict
+        ``linear_loop_a_ratio_stable`` (``..._delay1`` with a delay): [lo, hi] with
+        each endpoint the last stable ratio to 1e-12 relative (``None`` where
+        stability reaches past the searched range [0.1, 10]), or ``None`` with a
+        note when there is no linear loop or it is unstable at the design point.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> lo, hi = linear_loop_margin("pd", paper_config())["linear_loop_a_ratio_stable"]
+    >>> lo is None and hi > 1.0
+    True
+    """
+    if delay_samples not in (0, 1):
+        raise InputError(f"linear_loop_margin: delay_samples must be 0 or 1, got {delay_samples}")
+    key = "linear_loop_a_ratio_stable" + ("_delay1" if delay_samples else "")
+    note = key.replace("_a_ratio_stable", "_note")
+    gains = _linear_gains(law, cfg)
+    if gains is None:
+        return {key: None, note: "no linear loop"}
+    a, T = cfg.plant.a, cfg.plant.sample_time
+
+    def stable(r: float) -> bool:
+        if delay_samples == 0:
+            return sampled_spectral_radius(a * r, T, *gains) < 1.0
+        Ad, Bd = zoh_matrices(a * r, T)
+        K = np.array([gains])  # noqa: N806
+        M = np.block([[Ad, Bd], [-K, np.zeros((1, 1))]])  # noqa: N806
+        return float(np.abs(np.linalg.eigvals(M)).max()) < 1.0
+
+    if not stable(1.0):
+        return {key: None, note: "unstable at the design point"}
+    lo = _edge(stable, MARGIN_RANGE[0])
+    hi = _edge(stable, MARGIN_RANGE[1])
+    return {key: [lo, hi], note: ""}
+
+
+def no_limit_cycle_margin(
+    law: LawSpec, cfg: Config, settings: RobustSettings | None = None, *, rtol: float = 1e-3
+) -> dict[str, Any]:
+    """Interval of a_true / a_design around 1 with no limit cycle from any grid state.
+
+    Saturation, delay and measurement stay nominal (ratio 1, no delay, exact
+    measurement) so the interval isolates the bandwidth error.  The property is
+    checked on the map's state grid; the endpoints come from a 40-point
+    geometric scan then bisection to ``rtol`` relative (each evaluation is one
+    batch simulation).
+
+    Parameters
+    ----------
+    law : str
+        Law name.
+    cfg : Config
+        Nominal configuration.
+    settings : RobustSettings, optional
+        The state grid.
+    rtol : float
+        Relative accuracy of the endpoints [-].
+
+    Returns
+    -------
+    dict
+        ``no_limit_cycle_a_ratio``: [lo, hi] (``None`` endpoints beyond [0.1, 10]),
+        or ``None`` with a note when the nominal loop already has a limit cycle.
+    """
+    s = settings or RobustSettings()
+    x1, x2 = map_states(cfg, s)
+
+    def clean(r: float) -> bool:
+        props = trajectory_properties(law, cfg, x1, x2, Mismatch(a_ratio=r), with_settling=False)
+        return not bool((props["limit_cycle_mm"] > 0).any())
+
+    if not clean(1.0):
+        return {"no_limit_cycle_a_ratio": None, "no_limit_cycle_note": "limit cycles nominally"}
+    lo = _edge(clean, MARGIN_RANGE[0], grid=40, rtol=rtol)
+    hi = _edge(clean, MARGIN_RANGE[1], grid=40, rtol=rtol)
+    return {"no_limit_cycle_a_ratio": [lo, hi], "no_limit_cycle_note": ""}
+
+
+# -- worst-case search ---------------------------------------------------------
+
+
+def worst_case(
+    law: LawSpec,
+    prop: str,
+    cfg: Config,
+    grid_worst: list[dict[str, Any]],
+    settings: RobustSettings | None = None,
+) -> dict[str, Any]:
+    """Search the box for the worst value of ``prop`` under ``law``.
+
+    Variables: x1_0 [mm], x2_0 [mm/s] (for ``overshoot_mm`` x2_0 = 0 and
+    d <= |x1_0|), a_ratio, w_max_ratio; each delay of the box is searched
+    separately.  Differential evolution (seed ``box.seed``) starts from a
+    population holding the grid's worst cells, then a bounded Nelder-Mead
+    polish from the best; the value returned is the best found, so it is never
+    below the grid's worst.
+
+    Parameters
+    ----------
+    law, prop : str
+        Law name and one of :data:`PROPERTIES`.
+    cfg : Config
+        Nominal configuration with its box.
+    grid_worst : list of dict
+        Starting points: each ``state`` [x1 mm, x2 mm/s], ``params``
+        (``a_ratio``, ``w_max_ratio``, ``delay_samples``) and ``value``.
+    settings : RobustSettings, optional
+        Population and generations.
+
+    Returns
+    -------
+    dict
+        ``grid`` (the best starting value), ``searched``, ``state`` and ``params``
+        (with the full mismatch: quantum, noise, seed), ``evaluations``.
+    """
+    s = settings or RobustSettings()
+    box, p = cfg.robustness, cfg.plant
+    R, w, d = p.position_range, p.w_max, cfg.pto.d
+    rest = prop == "overshoot_mm"
+    bounds = [
+        (max(d, 1e-3 * R), R) if rest else (-R, R),
+        (0.0, 0.0) if rest else (-w, w),
+        tuple(box.a_ratio),
+        tuple(box.w_max_ratio),
+    ]
+    rng = np.random.default_rng(box.seed)
+    evaluations = 0
+    best = {"value": -math.inf, "z": None, "delay": box.delay_samples[0]}
+
+    def evaluate(Z: NDArray, delay: int) -> NDArray:  # noqa: N803 - Z is (4, S)
+        nonlocal evaluations
+        Z = np.atleast_2d(Z)
+        evaluations += Z.shape[1]
+        m = Mismatch(
+            a_ratio=Z[2],
+            w_max_ratio=Z[3],
+            delay_samples=delay,
+            position_quantum=box.position_quantum,
+            velocity_noise=box.velocity_noise,
+            seed=box.seed,
+        )
+        v = trajectory_properties(
+            law, cfg, Z[0], Z[1], m, with_settling=prop.startswith("settling")
+        )[prop]
+        v = np.where(np.isnan(v), -np.inf, v)
+        k = int(np.argmax(v))
+        if v[k] > best["value"]:
+            best.update(value=float(v[k]), z=Z[:, k].copy(), delay=delay)
+        return v
+
+    starts: list[tuple[NDArray, int]] = []
+    grid_value = -math.inf
+    for g in grid_worst:
+        z = np.array([*g["state"], g["params"]["a_ratio"], g["params"]["w_max_ratio"]])
+        if rest:
+            z[0], z[1] = abs(z[0]), 0.0
+        starts.append((z, int(g["params"]["delay_samples"])))
+        grid_value = max(grid_value, float(g["value"]))
+    for delay in range(box.delay_samples[0], box.delay_samples[1] + 1):
+        lo = np.array([b[0] for b in bounds])
+        hi = np.array([b[1] for b in bounds])
+        pop = lo + (hi - lo) * rng.random((s.search_population, 4))
+        mine = [z for z, dl in starts if dl == delay]
+        for i, z in enumerate(mine[: s.search_population]):
+            pop[i] = np.clip(z, lo, hi)
+        free = [i for i in range(4) if hi[i] > lo[i]]
+        if mine:  # the grid's worst cells, evaluated as the map evaluated them
+            evaluate(np.clip(np.array(mine), lo, hi).T, delay)
+
+        def objective(x: NDArray, delay: int = delay, free: list[int] = free) -> NDArray:
+            x = np.atleast_2d(x.T).T if x.ndim == 1 else x
+            Z = np.tile(lo[:, None], (1, x.shape[1]))  # noqa: N806
+            Z[free] = x
+            return -evaluate(Z, delay)
+
+        res = differential_evolution(
+            objective,
+            [bounds[i] for i in free],
+            init=pop[:, free],
+            maxiter=s.search_iterations,
+            seed=box.seed,
+            polish=False,
+            vectorized=True,
+            updating="deferred",
+            tol=0.0,
+        )
+        x0 = res.x
+        minimize(
+            lambda x, delay=delay, free=free: float(objective(x[:, None], delay, free)[0]),
+            x0,
+            method="Nelder-Mead",
+            bounds=[bounds[i] for i in free],
+            options={"maxfev": 60, "xatol": 1e-6, "fatol": 0.0},
+        )
+    z = best["z"]
+    # the grid's worst cells were evaluated first, so best >= the grid's worst
+    searched = best["value"]
+    return {
+        "grid": grid_value if grid_value > -math.inf else None,
+        "grid_unbounded": grid_value == math.inf,
+        "searched": searched if searched > -math.inf else None,
+        "unbounded": searched == math.inf,  # e.g. never settles: JSON shows searched null
+        "state": [float(z[0]), float(z[1])] if z is not None else None,
+        "params": {
+            "a_ratio": float(z[2]) if z is not None else None,
+            "w_max_ratio": float(z[3]) if z is not None else None,
+            "delay_samples": int(best["delay"]),
+            "position_quantum": box.position_quantum,
+            "velocity_noise": box.velocity_noise,
+            "seed": box.seed,
+        },
+        "evaluations": evaluations,
+    }
+
+
+def grid_worst(cells: list[dict[str, Any]], prop: str, k: int = 4) -> list[dict[str, Any]]:
+    """Return the ``k`` worst cells of a map for ``prop`` as search starting points.
+
+    Parameters
+    ----------
+    cells : list of dict
+        Cell summaries of one law (``robust_maps(...)["laws"][law]``).
+    prop : str
+        One of :data:`PROPERTIES`.
+    k : int
+        How many cells.
+
+    Returns
+    -------
+    list of dict
+        ``state`` [x1 mm, x2 mm/s], ``value``, ``params`` of each cell, worst first.
+    """
+    scored = [c for c in cells if math.isfinite(c[prop]["max"])]
+    scored.sort(key=lambda c: -c[prop]["max"])
+    return [
+        {
+            "state": c[prop]["state"],
+            "value": c[prop]["max"],
+            "params": {
+                "a_ratio": c["a_ratio"],
+                "w_max_ratio": c["w_max_ratio"],
+                "delay_samples": c["delay_samples"],
+            },
+        }
+        for c in scored[:k]
+    ]
+
+
+# -- the whole study -----------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class RobustResult:
+    """Everything ``ptoverify robust`` computes.
+
+    Attributes
+    ----------
+    config : Config
+        The nominal configuration (with its box).
+    settings : RobustSettings
+        Sizes of the study.
+    maps : dict
+        :func:`robust_maps`.
+    margins : dict
+        Per law: :func:`linear_loop_margin` and :func:`no_limit_cycle_margin`.
+    worst : dict
+        Per law and property: :func:`worst_case`.
+    timings_s : dict
+        Wall time per stage [s].
+    backend : str
+        ``in-process`` or the Dask scheduler used.
+    """
+
+    config: Config
+    settings: RobustSettings
+    maps: dict[str, Any]
+    margins: dict[str, Any]
+    worst: dict[str, Any]
+    timings_s: dict[str, float] = field(default_factory=dict)
+    backend: str = "in-process"
+
+    def to_json(self) -> dict[str, Any]:
+        """Return the JSON of ``ptoverify robust --json`` (non-finite numbers as None)."""
+        return _finite(
+            {
+                "box": self.config.robustness.to_mapping(),
+                "margins": self.margins,
+                "worst": self.worst,
+                "maps": self.maps,
+                "most_robust": most_robust(self.margins),
+                "timings_s": self.timings_s,
+                "backend": self.backend,
+            }
+        )
+
+
+def _finite(v: Any) -> Any:
+    if isinstance(v, dict):
+        return {k: _finite(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_finite(x) for x in v]
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    if isinstance(v, np.floating):
+        return _finite(float(v))
+    if isinstance(v, np.integer):
+        return int(v)
+    return v
+
+
+def most_robust(margins: dict[str, Any]) -> dict[str, Any]:
+    """Which law's linear loop tolerates the widest bandwidth error (log-width of the interval).
+
+    Parameters
+    ----------
+    margins : dict
+        Per law, the output of :func:`linear_loop_margin`.
+
+    Returns
+    -------
+    dict
+        ``law`` and ``log_width`` per law (ln(hi/lo), endpoints beyond the searched
+        range taken at the range's ends), or ``law`` None when no law has a margin.
+    """
+    widths: dict[str, float] = {}
+    for law, m in margins.items():
+        iv = m.get("linear_loop_a_ratio_stable")
+        if iv is None:
+            continue
+        lo = iv[0] if iv[0] is not None else MARGIN_RANGE[0]
+        hi = iv[1] if iv[1] is not None else MARGIN_RANGE[1]
+        widths[law] = math.log(hi / lo)
+    if not widths:
+        return {"law": None, "log_width": {}}
+    return {"law": max(widths, key=widths.get), "log_width": widths}
+
+
+def run_robust(
+    cfg: Config,
+    settings: RobustSettings | None = None,
+    *,
+    dask: str | None = None,
+    progress: Callable[[str, float], None] | None = None,
+) -> RobustResult:
+    """Run the robustness study: maps, margins and worst cases.
+
+    Parameters
+    ----------
+    cfg : Config
+        Nominal configuration with its box (``[robustness]``).
+    settings : RobustSettings, optional
+        Sizes of the study.
+    dask : str, optional
+        Scheduler address or ``local`` to distribute the maps on Dask; None runs in-process.
+    progress : callable, optional
+        ``progress(stage, fraction)``.
+
+    Returns
+    -------
+    RobustResult
+        The study.
+    """
+    s = settings or RobustSettings()
+    report = progress or (lambda stage, frac: None)
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    report("maps", 0.0)
+    maps = robust_maps(cfg, s, runner=dask_runner(dask) if dask else None)
+    timings["maps"] = time.perf_counter() - t0
+    t1 = time.perf_counter()
+    report("margins", 0.4)
+    margins = (
+        {
+            law: {
+                **linear_loop_margin(law, cfg),
+                **linear_loop_margin(law, cfg, delay_samples=1),
+                **no_limit_cycle_margin(law, cfg, s),
+            }
+            for law in s.laws
+        }
+        if s.margins
+        else {}
+    )
+    timings["margins"] = time.perf_counter() - t1
+    t2 = time.perf_counter()
+    worst: dict[str, Any] = {}
+    for i, law in enumerate(s.laws):
+        report(f"worst case {law}", 0.5 + 0.5 * i / len(s.laws))
+        worst[law] = {
+            prop: worst_case(law, prop, cfg, grid_worst(maps["laws"][law], prop), s)
+            for prop in s.properties
+        }
+    timings["worst_case"] = time.perf_counter() - t2
+    timings["total"] = time.perf_counter() - t0
+    return RobustResult(cfg, s, maps, margins, worst, timings, dask or "in-process")
+
+
+# -- gates ---------------------------------------------------------------------
+
+GATE_LAW = "pto"  #: the law the robustness gates judge (the corrected PTO)
+
+
+def robust_gates(result: RobustResult, law: str = GATE_LAW) -> list[Verdict]:
+    """Judge the box: ``robust-no-limit-cycle`` and ``robust-settling`` for ``law``.
+
+    Parameters
+    ----------
+    result : RobustResult
+        A study that includes ``law``.
+    law : str
+        The law judged.
+
+    Returns
+    -------
+    list of Verdict
+        ``robust-no-limit-cycle``: the worst searched limit-cycle amplitude [mm]
+        must be 0 (no limit cycle anywhere in the box); ``robust-settling``: the
+        worst searched settling / N*T [-] must be within ``settling_ratio_limit``
+        (a trajectory that never settles fails).  A property the search could not
+        evaluate is ``unverified``.
+    """
+    box = result.config.robustness
+    worst = result.worst.get(law, {})
+    out = []
+    lc = worst.get("limit_cycle_mm", {})
+    v = lc.get("searched")
+    where = f" at x0 = {lc.get('state')} with {lc.get('params')}" if v else ""
+    if v is None:
+        out.append(
+            Verdict(
+                "robust-no-limit-cycle",
+                UNVERIFIED,
+                None,
+                0.0,
+                f"{law}: the worst-case search did not evaluate the limit-cycle amplitude",
+                "<=",
+                "mm",
+            )
+        )
+    else:
+        out.append(
+            Verdict(
+                "robust-no-limit-cycle",
+                PASS if v <= 0.0 else FAIL,
+                float(v),
+                0.0,
+                f"{law}: largest limit-cycle amplitude found in the box (grid, then "
+                f"differential evolution){where}",
+                "<=",
+                "mm",
+            )
+        )
+    st = worst.get("settling_ratio_nt", {})
+    v = st.get("searched")
+    limit = box.settling_ratio_limit
+    if v is None and not st.get("unbounded"):
+        out.append(
+            Verdict(
+                "robust-settling",
+                UNVERIFIED,
+                None,
+                limit,
+                f"{law}: the worst-case search did not evaluate settling / N*T",
+                "<=",
+                "1",
+            )
+        )
+    else:
+        value = math.inf if st.get("unbounded") else float(v)
+        out.append(
+            Verdict(
+                "robust-settling",
+                PASS if value <= limit else FAIL,
+                value,
+                limit,
+                f"{law}: worst settling time / N*T of the true plant found in the box "
+                f"(inf: never settles) at x0 = {st.get('state')} with {st.get('params')}; "
+                f"limit from [robustness] settling_ratio_limit",
+                "<=",
+                "1",
+            )
+        )
+    return out

@@ -1,0 +1,520 @@
+"""Fair comparisons: tune PD (kp, kd) and PTO (d, k1, k2) before judging the paper.
+
+``ptoverify tune`` searches a law's gains for the best response under the same
+constraints for every law:
+
+* overshoot <= a bound [mm] (between samples, as ``simulate --json`` measures it);
+* the sampled linear loop (PD, or the PTO's linear zone, eq. 34) is stable
+  (spectral radius < 1 on the ZOH plant);
+* no limit cycle, and for the PTO no stride-over, from any state of the gates'
+  grid (:func:`ptoverify.properties.law_properties`, 101 x 101 + 200 states).
+
+The PTO's omega0 always comes from the corrected construction for the
+candidate's d (:func:`ptoverify.zones.corrected_zone`); a d for which no zone can
+be built is infeasible.
+
+Method (a non-smooth objective, so no gradients): PD by
+``scipy.optimize.differential_evolution`` over (log10 kp, kd), fixed seed.  The
+PTO's zone costs about a second per d, so d runs over a geometric grid and for
+each d differential evolution tunes (log10 k1, k2); the best d is then refined
+by a golden-section search between its grid neighbours.  The cheap constraints
+(stability, overshoot) are applied to every candidate; the grid properties,
+which cost seconds, are checked on the best candidates in order until one
+passes (never skipped: a candidate that has not passed them is not returned).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.optimize import differential_evolution
+
+from ptoverify.config import Config, PDGains, PTOSettings
+from ptoverify.errors import InputError
+from ptoverify.exact import exact_metrics
+from ptoverify.laws import make_law
+from ptoverify.poles import sampled_spectral_radius
+from ptoverify.properties import law_properties
+from ptoverify.simulate import reference, simulate
+
+__all__ = [
+    "OBJECTIVES",
+    "BOUNDS",
+    "Candidate",
+    "TuneResult",
+    "tuned_config",
+    "evaluate",
+    "tune",
+    "pareto_front",
+]
+
+OBJECTIVES = ("settling_2pct", "settling_0p01mm", "worst_ratio_nt")
+#: Search ranges: gains [1/s] and [-], d [mm]; kp and k1 are searched in log10.
+BOUNDS: dict[str, dict[str, tuple[float, float]]] = {
+    "pd": {"kp": (10.0, 3000.0), "kd": (0.0, 4.0)},
+    "pto": {"d": (0.2, 5.0), "k1": (10.0, 3000.0), "k2": (0.0, 10.0)},
+}
+PENALTY = 1e3  #: objective of an infeasible candidate [s or -]; above any feasible value
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One evaluated set of gains.
+
+    Attributes
+    ----------
+    gains : dict
+        ``kp``, ``kd`` (PD) or ``d``, ``k1``, ``k2`` (PTO) [1/s], [-], [mm].
+    objective : float
+        The objective's value ([s] for settling, [-] for worst_ratio_nt); inf if infeasible.
+    settling_2pct_s, settling_0p01mm_s : float
+        Settling times of the signal's response [s] (nan: never settles).
+    overshoot_mm : float
+        Overshoot of the response [mm].
+    feasible : bool
+        Whether every constraint checked so far holds.
+    verified : bool
+        Whether the grid properties (no limit cycle, no stride-over) were checked and hold.
+    reason : str
+        Why it is infeasible ("" when feasible).
+    omega0 : float or None
+        The PTO's zone level [mm/s] for its d.
+    """
+
+    gains: dict[str, float]
+    objective: float
+    settling_2pct_s: float
+    settling_0p01mm_s: float
+    overshoot_mm: float
+    feasible: bool
+    verified: bool = False
+    reason: str = ""
+    omega0: float | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        """Return the candidate as a JSON-able dict (non-finite numbers as None)."""
+        d = dataclasses.asdict(self)
+        for k, v in d.items():
+            if isinstance(v, float) and not math.isfinite(v):
+                d[k] = None
+        return d
+
+
+def tuned_config(cfg: Config, law: str, gains: dict[str, float]) -> Config:
+    """Return ``cfg`` with the law's gains replaced (the PD or the PTO section).
+
+    Parameters
+    ----------
+    cfg : Config
+        Base configuration.
+    law : str
+        ``pd`` or ``pto``.
+    gains : dict
+        ``kp``, ``kd`` [1/s], [-] or ``d`` [mm], ``k1`` [1/s], ``k2`` [-].
+
+    Returns
+    -------
+    Config
+        The configuration the tuned law is built from.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> tuned_config(paper_config(), "pd", {"kp": 100.0, "kd": 0.5}).pd
+    PDGains(kp=100.0, kd=0.5)
+    """
+    if law == "pd":
+        return dataclasses.replace(cfg, pd=PDGains(kp=gains["kp"], kd=gains["kd"]))
+    return dataclasses.replace(cfg, pto=PTOSettings(d=gains["d"], k1=gains["k1"], k2=gains["k2"]))
+
+
+def _linear_gains(law: str, gains: dict[str, float]) -> tuple[float, float]:
+    return (gains["kp"], gains["kd"]) if law == "pd" else (gains["k1"], gains["k2"])
+
+
+def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:
+    """Settling (2 % and 0.01 mm), overshoot and rise time of ``law`` on ``signal``.
+
+    Measured between samples, on the exact trajectory (:mod:`ptoverify.exact`),
+    exactly as ``ptoverify simulate --json`` reports them in ``metrics``.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration the law is built from.
+    law : str
+        Law name.
+    signal : str
+        ``step``, ``ramp`` or ``sine``.
+
+    Returns
+    -------
+    dict
+        ``settling_2pct_s`` [s], ``settling_0p01mm_s`` [s], ``overshoot_mm`` [mm],
+        ``rise_time_s`` [s]; NaN where undefined (never settles).
+    """
+    res = simulate(make_law(law, cfg), cfg.plant, signal)
+    m = exact_metrics(res, cfg.plant).json_metrics()
+    return {k: math.nan if v is None else float(v) for k, v in m.items()}
+
+
+def evaluate(
+    cfg: Config,
+    law: str,
+    gains: dict[str, float],
+    *,
+    signal: str = "step",
+    objective: str = "settling_2pct",
+    max_overshoot: float | None = None,
+    worst_ratio: Callable[[Config], float] | None = None,
+) -> Candidate:
+    """Evaluate one set of gains under the cheap constraints (not the grid properties).
+
+    Parameters
+    ----------
+    cfg : Config
+        Base configuration.
+    law : str
+        ``pd`` or ``pto``.
+    gains : dict
+        The gains (see :func:`tuned_config`).
+    signal : str
+        Reference of the response.
+    objective : str
+        One of :data:`OBJECTIVES`.
+    max_overshoot : float, optional
+        Overshoot bound [mm].
+    worst_ratio : callable, optional
+        ``f(cfg) -> worst settling / N*T`` for ``objective="worst_ratio_nt"``.
+
+    Returns
+    -------
+    Candidate
+        The candidate (``verified`` False).
+    """
+    tcfg = tuned_config(cfg, law, gains)
+    p = cfg.plant
+    nan = math.nan
+    if sampled_spectral_radius(p.a, p.sample_time, *_linear_gains(law, gains)) >= 1.0:
+        return Candidate(
+            gains, math.inf, nan, nan, nan, False, reason="sampled linear loop unstable"
+        )
+    omega0 = None
+    try:
+        if law == "pto":
+            from ptoverify.zones import zone_for_law
+
+            z = zone_for_law(tcfg, "corrected")
+            omega0 = float(z.omega0) if z.omega0 is not None else None
+        m = response_metrics(tcfg, law, signal)
+    except InputError as exc:
+        return Candidate(gains, math.inf, nan, nan, nan, False, reason=str(exc))
+    if max_overshoot is not None and not m["overshoot_mm"] <= max_overshoot:
+        value = math.inf
+        reason = f"overshoot {m['overshoot_mm']:.4g} mm > {max_overshoot:.4g} mm"
+    else:
+        reason = ""
+        if objective == "worst_ratio_nt":
+            value = worst_ratio(tcfg) if worst_ratio else math.nan
+        else:
+            value = m[f"{objective}_s"]
+        if not math.isfinite(value):
+            reason, value = "does not settle", math.inf
+    return Candidate(
+        gains,
+        value,
+        m["settling_2pct_s"],
+        m["settling_0p01mm_s"],
+        m["overshoot_mm"],
+        not reason,
+        reason=reason,
+        omega0=omega0,
+    )
+
+
+def _grid_ok(cfg: Config, law: str, c: Candidate) -> Candidate:
+    """Check the grid properties of a candidate (no limit cycle; PTO: no stride-over)."""
+    tcfg = tuned_config(cfg, law, c.gains)
+    lp = law_properties(make_law(law, tcfg), tcfg)
+    bad = []
+    if lp.limit_cycles:
+        bad.append(f"{lp.limit_cycles} limit cycles on the gate grid")
+    if law == "pto" and lp.stride_overs:
+        bad.append(f"{lp.stride_overs} stride-overs on the gate grid")
+    if bad:
+        return dataclasses.replace(c, feasible=False, verified=True, reason="; ".join(bad))
+    return dataclasses.replace(c, verified=True)
+
+
+def pareto_front(cands: list[Candidate]) -> list[Candidate]:
+    """Return the candidates not dominated in (overshoot [mm], settling_2pct [s]).
+
+    Parameters
+    ----------
+    cands : list of Candidate
+        Candidates with finite overshoot and settling (others are ignored).
+
+    Returns
+    -------
+    list of Candidate
+        The front, by increasing overshoot.
+
+    Examples
+    --------
+    >>> c = lambda o, s: Candidate({}, s, s, s, o, True)
+    >>> [x.overshoot_mm for x in pareto_front([c(0, 3), c(1, 2), c(2, 2.5), c(3, 1)])]
+    [0, 1, 3]
+    """
+    ok = [c for c in cands if math.isfinite(c.overshoot_mm) and math.isfinite(c.settling_2pct_s)]
+    ok.sort(key=lambda c: (c.overshoot_mm, c.settling_2pct_s))
+    front, best = [], math.inf
+    for c in ok:
+        if c.settling_2pct_s < best:
+            front.append(c)
+            best = c.settling_2pct_s
+    return front
+
+
+@dataclass(frozen=True)
+class TuneResult:
+    """Outcome of :func:`tune`.
+
+    Attributes
+    ----------
+    law, signal, objective : str
+        What was tuned, on which response, for which objective.
+    max_overshoot_mm : float or None
+        The overshoot bound [mm].
+    best : Candidate
+        The best candidate that passed every constraint, grid properties included.
+    runner_up : Candidate or None
+        The best verified candidate at least 0.2 (normalized search units) from ``best``.
+    front : list of Candidate
+        Pareto front of settling vs overshoot among the evaluated candidates
+        (cheap constraints; ``verified`` says which were checked on the grid).
+    evaluations : int
+        Candidates evaluated.
+    seconds : float
+        Wall time [s].
+    config : Config
+        The tuned configuration.
+    """
+
+    law: str
+    signal: str
+    objective: str
+    max_overshoot_mm: float | None
+    best: Candidate
+    runner_up: Candidate | None
+    front: list[Candidate]
+    evaluations: int
+    seconds: float
+    config: Config = field(repr=False, default=None)  # type: ignore[assignment]
+
+    def toml(self) -> str:
+        """Return a TOML configuration that ``--config`` accepts, with the tuned gains."""
+        m = self.config.to_mapping()
+        lines = [f'name = "{m["name"]}"', "", "[plant]"]
+        lines += [f"{k} = {v!r}" for k, v in m["plant"].items()]
+        for sect in ("pd", "pto"):
+            lines += ["", f"[{sect}]"] + [f"{k} = {v!r}" for k, v in m[sect].items()]
+        return "\n".join(lines) + "\n"
+
+    def to_json(self) -> dict[str, Any]:
+        """Return the JSON of ``ptoverify tune --json`` (DESIGN.md key ``best``)."""
+        return {
+            "law": self.law,
+            "signal": self.signal,
+            "objective": self.objective,
+            "max_overshoot_mm": self.max_overshoot_mm,
+            "best": self.best.to_json(),
+            "evaluations": self.evaluations,
+            "runner_up": self.runner_up.to_json() if self.runner_up else None,
+            "front": [c.to_json() for c in self.front],
+            "seconds": self.seconds,
+            "config_toml": self.toml(),
+        }
+
+
+def _unit(law: str, gains: dict[str, float]) -> np.ndarray:
+    """Gains in normalized search units [0, 1] (log scale for kp, k1, d)."""
+    out = []
+    for k, (lo, hi) in BOUNDS[law].items():
+        v = gains[k]
+        if k in ("kp", "k1", "d"):
+            out.append((math.log(v) - math.log(lo)) / (math.log(hi) - math.log(lo)))
+        else:
+            out.append((v - lo) / (hi - lo))
+    return np.array(out)
+
+
+def _de(
+    fn: Callable[[dict[str, float]], Candidate],
+    keys: tuple[str, ...],
+    law: str,
+    seed: int,
+    maxiter: int,
+    popsize: int,
+    fixed: dict[str, float],
+) -> None:
+    """Differential evolution over ``keys`` (log10 for kp, k1), other gains ``fixed``."""
+    logk = {"kp", "k1"}
+    bounds = [
+        tuple(math.log10(b) for b in BOUNDS[law][k]) if k in logk else BOUNDS[law][k] for k in keys
+    ]
+
+    def f(x: np.ndarray) -> float:
+        g = dict(fixed)
+        for k, v in zip(keys, x, strict=True):
+            g[k] = float(10.0**v) if k in logk else float(v)
+        c = fn(g)
+        return c.objective if math.isfinite(c.objective) else PENALTY
+
+    differential_evolution(
+        f, bounds, seed=seed, maxiter=maxiter, popsize=popsize, polish=False, tol=1e-6
+    )
+
+
+def tune(
+    cfg: Config,
+    law: str,
+    signal: str = "step",
+    *,
+    max_overshoot: float | None = None,
+    objective: str = "settling_2pct",
+    seed: int = 0,
+    maxiter: int = 30,
+    popsize: int = 10,
+    d_grid: int = 9,
+    worst_ratio: Callable[[Config], float] | None = None,
+) -> TuneResult:
+    """Search the law's gains for the best response under the constraints.
+
+    Parameters
+    ----------
+    cfg : Config
+        Base configuration (plant; the other law's gains are kept).
+    law : str
+        ``pd`` or ``pto``.
+    signal : str
+        ``step``, ``ramp`` or ``sine``.
+    max_overshoot : float, optional
+        Overshoot bound [mm]; None: unconstrained.
+    objective : str
+        One of :data:`OBJECTIVES`.
+    seed : int
+        Seed of differential evolution.
+    maxiter, popsize : int
+        Differential-evolution generations and population factor.
+    d_grid : int
+        PTO: points of the geometric d grid.
+    worst_ratio : callable, optional
+        ``f(cfg) -> worst settling / N*T`` (needed for ``worst_ratio_nt``).
+
+    Returns
+    -------
+    TuneResult
+        Best, runner-up, Pareto front and the number of evaluations.
+
+    Raises
+    ------
+    InputError
+        Unknown law, signal or objective, or a negative overshoot bound.
+    """
+    if law not in BOUNDS:
+        raise InputError(f"tune: unknown law '{law}' (choose from pd, pto)")
+    if objective not in OBJECTIVES:
+        raise InputError(
+            f"tune: unknown objective '{objective}' (choose from {', '.join(OBJECTIVES)})"
+        )
+    if max_overshoot is not None and not (max_overshoot >= 0 and math.isfinite(max_overshoot)):
+        raise InputError(f"tune: --max-overshoot must be a finite number >= 0, got {max_overshoot}")
+    if objective == "worst_ratio_nt" and worst_ratio is None:
+        raise InputError("tune: objective worst_ratio_nt needs a worst-ratio function")
+    reference(signal)  # names the signal or raises InputError
+    t0 = time.perf_counter()
+    seen: dict[tuple, Candidate] = {}
+
+    def fn(g: dict[str, float]) -> Candidate:
+        key = tuple(sorted(g.items()))
+        if key not in seen:
+            seen[key] = evaluate(
+                cfg,
+                law,
+                g,
+                signal=signal,
+                objective=objective,
+                max_overshoot=max_overshoot,
+                worst_ratio=worst_ratio,
+            )
+        return seen[key]
+
+    if law == "pd":
+        _de(fn, ("kp", "kd"), law, seed, maxiter, popsize, {})
+    else:
+        lo, hi = BOUNDS["pto"]["d"]
+        ds = np.geomspace(lo, hi, d_grid)
+        score = {}
+        for d in ds:
+            _de(fn, ("k1", "k2"), law, seed, max(maxiter // 2, 5), popsize, {"d": float(d)})
+            score[float(d)] = min(
+                (c.objective for c in seen.values() if c.gains["d"] == float(d)), default=math.inf
+            )
+        # golden-section refinement of d between the best grid point's neighbours
+        i = int(np.argmin([score[float(d)] for d in ds]))
+        a, b = float(ds[max(i - 1, 0)]), float(ds[min(i + 1, len(ds) - 1)])
+        gr = (math.sqrt(5.0) - 1.0) / 2.0
+        for _ in range(4):
+            c1, c2 = b - gr * (b - a), a + gr * (b - a)
+            for d in (c1, c2):
+                if d not in score:
+                    _de(fn, ("k1", "k2"), law, seed, max(maxiter // 2, 5), popsize, {"d": d})
+                    score[d] = min(
+                        (c.objective for c in seen.values() if c.gains["d"] == d), default=math.inf
+                    )
+            a, b = (a, c2) if score[c1] <= score[c2] else (c1, b)
+    cands = sorted((c for c in seen.values() if c.feasible), key=lambda c: c.objective)
+    best = None
+    checked = 0
+    for c in cands:
+        v = _grid_ok(cfg, law, c)
+        checked += 1
+        seen[tuple(sorted(c.gains.items()))] = v
+        if v.feasible:
+            best = v
+            break
+        if checked >= 25:
+            break
+    if best is None:
+        raise InputError(
+            f"tune: no {law} gains in the search range meet the constraints "
+            f"(overshoot <= {max_overshoot} mm, stable, no limit cycle)"
+        )
+    runner_up = None
+    far = [c for c in cands if np.abs(_unit(law, c.gains) - _unit(law, best.gains)).max() > 0.2]
+    for c in far[:5]:
+        v = _grid_ok(cfg, law, c)
+        if v.feasible:
+            runner_up = v
+            break
+    front = pareto_front(list(seen.values()))
+    return TuneResult(
+        law=law,
+        signal=signal,
+        objective=objective,
+        max_overshoot_mm=max_overshoot,
+        best=best,
+        runner_up=runner_up,
+        front=front,
+        evaluations=len(seen),
+        seconds=time.perf_counter() - t0,
+        config=dataclasses.replace(
+            tuned_config(cfg, law, best.gains), name=f"{cfg.name}-tuned-{law}"
+        ),
+    )
