@@ -646,6 +646,18 @@ def zone_for_law(cfg: Config, variant: str) -> PTOZone:
 
     Memoized on what a zone depends on (the plant and d), so laws that differ
     only in gains (a tuning search) share one construction.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (a [rad/s], w_max [mm/s], T [s], d [mm]).
+    variant : str
+        ``corrected`` or ``printed``.
+
+    Returns
+    -------
+    PTOZone
+        The zone (not grid-verified).
     """
     key = Config(name="zone", plant=cfg.plant, pto=PTOSettings(d=cfg.pto.d))
     return _zone_for_law(key, variant)
