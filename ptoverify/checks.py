@@ -402,12 +402,10 @@ def _zone_valid(cfg: Config) -> CheckResult:
     )
 
 
-@functools.lru_cache(maxsize=4)
 def _pto_properties(cfg: Config):
-    from ptoverify.laws import make_law
-    from ptoverify.properties import law_properties
+    from ptoverify.properties import named_properties
 
-    return law_properties(make_law("pto", cfg), cfg)
+    return named_properties(cfg, "pto")  # memoized: shared with the report's section 6
 
 
 @gate("no-stride-over")
