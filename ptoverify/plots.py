@@ -762,11 +762,17 @@ def save_figure(path: str | Path, draw: Callable, size: tuple[float, float] = SI
     fig, ax = plt.subplots(figsize=size)
     try:
         draw(ax)
-        fig.tight_layout()
-        fig.savefig(path, dpi=DPI)
+        _write(fig, path)
     finally:
         plt.close(fig)
     return Path(path)
+
+
+def _write(fig, path: str | Path) -> None:
+    """Tight layout once, then save without the layout engine's extra draw pass."""
+    fig.tight_layout()
+    fig.set_layout_engine(None)  # margins are set; a placeholder engine would redraw
+    fig.savefig(path, dpi=DPI)
 
 
 def _folder(outdir: str | Path) -> Path:
@@ -807,8 +813,7 @@ def save_sweep(res: SweepResult, outdir: str | Path) -> list[Path]:
                 plot_sweep(res, law, which, ax, vmax=vmax)
             for ax in list(axes.flat)[len(laws) :]:
                 ax.set_visible(False)
-            fig.tight_layout()
-            fig.savefig(outdir / f"sweep_ratio_{which}.png", dpi=DPI)
+            _write(fig, outdir / f"sweep_ratio_{which}.png")
         finally:
             plt.close(fig)
         files.append(outdir / f"sweep_ratio_{which}.png")
