@@ -28,7 +28,8 @@ import math
 import platform
 import subprocess
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -316,17 +317,26 @@ def collect(cfg: Config, progress: Progress | None = None) -> dict[str, Any]:
         them from the JSON.
     """
     import derivations
+
+    say = progress or (lambda stage: None)
+    out: dict[str, Any] = {"derivations": None}
+    say("derivations")
+    with _in_background(derivations.all_records) as records_later:
+        _numerics(cfg, out, say)
+        records = records_later()
+    out["derivations"] = [r.to_json() for r in records]
+    out["_records"] = records
+    out["summary"] = _summary(out, out.pop("_gates"))
+    return out
+
+
+def _numerics(cfg: Config, out: dict[str, Any], say: Callable[[str], None]) -> None:
+    """Run the numeric stages of :func:`collect` in order, into ``out``."""
     from ptoverify.checks import run_checks, summarize
     from ptoverify.claims import evaluate_claims
     from ptoverify.sweep import run_sweep
     from ptoverify.zones import zone_summary
 
-    say = progress or (lambda stage: None)
-    out: dict[str, Any] = {}
-    say("derivations")
-    records = derivations.all_records()
-    out["derivations"] = [r.to_json() for r in records]
-    out["_records"] = records
     say("ground truth")
     out["ground_truth"] = _ground_truth(cfg)
     say("switching zone")
@@ -351,11 +361,36 @@ def collect(cfg: Config, progress: Progress | None = None) -> dict[str, Any]:
     say("gates")
     checks = run_checks(cfg)
     out["checks"] = [c.to_json() for c in checks]
-    out["summary"] = _summary(out, summarize(checks))
+    out["_gates"] = summarize(checks)
     out["environment"] = _environment(cfg)
     say("figure data")
     out["_figures"] = figure_inputs(cfg)
-    return out
+
+
+@contextmanager
+def _in_background(fn: Callable[[], Any]) -> Iterator[Callable[[], Any]]:
+    """Run ``fn()`` in a worker process while the body runs; yield a getter of its result.
+
+    The SymPy derivations take as long as all the numerics together and share
+    nothing with them, so on two cores the report overlaps the two.  The worker
+    is a fresh interpreter (``spawn``: no forked solver or BLAS state); an
+    exception in it is re-raised by the getter.  Where no worker process can be
+    started, ``fn`` runs here, in this process, when the result is asked for.
+    """
+    import multiprocessing
+
+    try:
+        pool = multiprocessing.get_context("spawn").Pool(1)
+        pending = pool.apply_async(fn)
+    except (OSError, ImportError):  # no process support (sandbox, no semaphores)
+        yield fn
+        return
+    try:
+        yield pending.get
+        pool.close()
+        pool.join()
+    finally:
+        pool.terminate()
 
 
 def _settings_json(settings: Any) -> dict[str, Any]:
