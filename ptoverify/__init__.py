@@ -24,10 +24,10 @@ claims      Section 6 and conclusion claims, each measured under every reading
             (a = 2 pi f or f, feed-forward, PTO printed/corrected, band); evaluate_claims
 sweep       run_sweep: settling time / t_f* and / N* T over a 50 x 50 grid of initial states
 plots       Figs. 2-14 for TO, PD, PTO (both), sweep heat maps, zone geometry, collocation
-            convergence (the only module importing matplotlib)
+            convergence, drawn from results passed in (the only module importing matplotlib)
 checks      the gates of ``ptoverify check``: CheckResult, GATES, run_checks
-report      collect, render_html / render_markdown, write_report (atomic);
-            report_sections builds the nine sections
+report      collect (every result once, figure_inputs), write_report (atomic);
+            report_sections builds the nine sections; render prints them (HTML, Markdown)
 conform     conform: gate a third-party PTO law (callable or table) against the reference
 agreement   conformance grid (--emit-grid), CSV tables, per-region agreement with the reference
 userlaw     loading a user law (MODULE:FUNCTION or file.py:FUNCTION), vectorized/scalar detection
