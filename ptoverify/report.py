@@ -316,12 +316,10 @@ def collect(cfg: Config, progress: Progress | None = None) -> dict[str, Any]:
         ``ground_truth._study`` (ConvergenceStudy); :func:`write_report` drops
         them from the JSON.
     """
-    import derivations
-
     say = progress or (lambda stage: None)
     out: dict[str, Any] = {"derivations": None}
     say("derivations")
-    with _in_background(derivations.all_records) as records_later:
+    with _in_background("derivations", "all_records") as records_later:
         _numerics(cfg, out, say)
         records = records_later()
     out["derivations"] = [r.to_json() for r in records]
@@ -367,30 +365,66 @@ def _numerics(cfg: Config, out: dict[str, Any], say: Callable[[str], None]) -> N
     out["_figures"] = figure_inputs(cfg)
 
 
+_CHILD = (
+    "import importlib, pickle, sys\n"
+    "fn = getattr(importlib.import_module(sys.argv[1]), sys.argv[2])\n"
+    "with open(sys.argv[3], 'wb') as f:\n"
+    "    pickle.dump(fn(), f)\n"
+)
+
+
 @contextmanager
-def _in_background(fn: Callable[[], Any]) -> Iterator[Callable[[], Any]]:
-    """Run ``fn()`` in a worker process while the body runs; yield a getter of its result.
+def _in_background(module: str, name: str) -> Iterator[Callable[[], Any]]:
+    """Run ``module.name()`` in a fresh Python process while the body runs.
 
-    The SymPy derivations take as long as all the numerics together and share
-    nothing with them, so on two cores the report overlaps the two.  The worker
-    is a fresh interpreter (``spawn``: no forked solver or BLAS state); an
-    exception in it is re-raised by the getter.  Where no worker process can be
-    started, ``fn`` runs here, in this process, when the result is asked for.
+    Yields a getter of its result.  The SymPy derivations take about as long
+    as all the numerics together and share nothing with them, so on two cores
+    the report overlaps the two.  The worker is a new interpreter started with
+    ``sys.executable`` (no fork of solver or BLAS state, no re-import of the
+    caller's ``__main__``), with this process's ``sys.path``; it returns its
+    result pickled through a temporary file.  A failure in it raises
+    ``RuntimeError`` with its last lines of stderr.  Where no process can be
+    started, ``module.name()`` runs here when the result is asked for.
     """
-    import multiprocessing
+    import importlib
+    import os
+    import pickle
+    import tempfile
 
+    fd, result = tempfile.mkstemp(suffix=".pickle")
+    os.close(fd)
+    log = tempfile.TemporaryFile()
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
     try:
-        pool = multiprocessing.get_context("spawn").Pool(1)
-        pending = pool.apply_async(fn)
-    except (OSError, ImportError):  # no process support (sandbox, no semaphores)
-        yield fn
-        return
-    try:
-        yield pending.get
-        pool.close()
-        pool.join()
+        try:
+            child = subprocess.Popen(
+                [sys.executable, "-c", _CHILD, module, name, result],
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=log,
+                env=env,
+            )
+        except OSError:  # no process can be started here: compute in this process
+            yield getattr(importlib.import_module(module), name)
+            return
+
+        def get() -> Any:
+            if child.wait() != 0:
+                log.seek(0)
+                tail = log.read().decode(errors="replace").strip().splitlines()[-3:]
+                raise RuntimeError(f"{module}.{name} failed in its worker: {' | '.join(tail)}")
+            with open(result, "rb") as f:
+                return pickle.load(f)  # noqa: S301 - our own child's output
+
+        try:
+            yield get
+        finally:
+            if child.poll() is None:
+                child.kill()
+                child.wait()
     finally:
-        pool.terminate()
+        log.close()
+        os.unlink(result)
 
 
 def _settings_json(settings: Any) -> dict[str, Any]:
