@@ -11,7 +11,9 @@ derivation section need.  The figures (:mod:`ptoverify.plots`) and the sections
 printed by :mod:`ptoverify.render`.  Work shared with the gates (the corrected
 zone and its grid check, the corrected PTO's closed-loop properties, the
 claims) is memoized per frozen configuration in the numeric modules, so it runs
-once per report.
+once per report.  The SymPy derivations share nothing with the numerics and
+take about a third of the time, so they run in a separate Python process while
+the numerics run (in this process where no process can be started).
 
 ``write_report`` writes the folder atomically: everything goes to a temporary
 sibling folder that is renamed into place only when complete.
