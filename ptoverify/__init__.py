@@ -32,11 +32,11 @@ claims      Section 6 and conclusion claims, each measured under every reading
             (a = 2 pi f or f, feed-forward, PTO printed/corrected, band); evaluate_claims
 sweep       run_sweep: settling time / t_f* and / N* T over a 200 x 200 grid of initial states
 plots       Figs. 2-14 for TO, PD, PTO (both), sweep heat maps, zone geometry, collocation
-            convergence (the only module importing matplotlib)
+            convergence, drawn from results passed in (the only module importing matplotlib)
 checks      the gates of ``ptoverify check``: GATES (each a Verdict with a unit), GateContext
-            (the run's options, e.g. the IPOPT cap), run_checks, summarize
-report      collect, render_html / render_markdown, write_report (atomic);
-            report_sections builds the nine sections
+            (the run's options, e.g. the IPOPT cap), run_checks, summarize, ROBUST_GATES
+report      collect (every result once, figure_inputs), write_report (atomic);
+            report_sections builds the nine sections; render prints them (HTML, Markdown)
 conform     conform: gate a third-party PTO law (callable or table) against the reference
 agreement   conformance grid (--emit-grid), CSV tables, per-region agreement with the reference
 userlaw     loading a user law (MODULE:FUNCTION or file.py:FUNCTION), vectorized/scalar detection
