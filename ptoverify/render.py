@@ -110,7 +110,18 @@ def table(headers: list[str], rows: list[list[Any]]) -> Block:
 
 
 def paragraph(text: str) -> Block:
-    """Return a paragraph block (plain text; escaped when rendered)."""
+    """Return a paragraph block (plain text; escaped when rendered).
+
+    Parameters
+    ----------
+    text : str
+        The paragraph.
+
+    Returns
+    -------
+    Block
+        A ``p`` block.
+    """
     return Block("p", text=text)
 
 
@@ -134,7 +145,20 @@ def image(figures: dict[str, str], key: str, caption: str) -> list[Block]:
 
 
 def link(anchor: str, text: str) -> Block:
-    """Return a paragraph linking to a section of the same page."""
+    """Return a paragraph linking to a section of the same page.
+
+    Parameters
+    ----------
+    anchor : str
+        The section's anchor.
+    text : str
+        The link text.
+
+    Returns
+    -------
+    Block
+        A raw block with the link.
+    """
     return Block(
         "raw",
         text=f"{text} (section {anchor})",
@@ -143,7 +167,18 @@ def link(anchor: str, text: str) -> Block:
 
 
 def md_cell(text: str) -> str:
-    """Escape a Markdown table cell (pipes, newlines)."""
+    """Escape a Markdown table cell (pipes, newlines).
+
+    Parameters
+    ----------
+    text : str
+        Cell content.
+
+    Returns
+    -------
+    str
+        The escaped cell.
+    """
     return text.replace("|", "\\|").replace("\n", " ")
 
 
