@@ -809,6 +809,14 @@ def _add_conform(sub) -> None:
         help="budget for the whole conformance of a --law [s] (default 120); the law runs "
         "in a child process, and a hang, crash or exit of it is a finding",
     )
+    p.add_argument(
+        "--report",
+        metavar="DIR",
+        default=None,
+        help="also write a report folder for a review (index.html, report.md, results.json, "
+        "figures/): verdict, properties, map of |u - u_ref| with the region boundaries, "
+        "closed loop, step/ramp/sine responses; checked before computing, written atomically",
+    )
     _add_junit(p)
     p.set_defaults(handler=_cmd_conform)
 
@@ -821,6 +829,13 @@ def _cmd_conform(args: argparse.Namespace) -> int:
     if not 0 < rtol < 1:
         raise InputError(f"--tolerance must be in (0, 1), got {rtol:g}")
     _check_junit(args)
+    target = None
+    if args.report is not None:
+        from ptoverify.conform_report import check_report_target
+
+        if args.emit_grid:
+            raise InputError("--report needs --law or --table, not --emit-grid")
+        target = check_report_target(args.report, cfg)
     if args.emit_grid:
         text = conform.grid_csv(cfg)
         write_atomic(args.emit_grid, text)
@@ -835,12 +850,19 @@ def _cmd_conform(args: argparse.Namespace) -> int:
         return 0
     if not 0 < args.timeout <= 86400:
         raise InputError(f"--timeout must be in (0, 86400] s, got {args.timeout:g}")
-    if args.table:
+    evidence = None
+    if target is not None:
+        from ptoverify.conform_evidence import conform_with_evidence
+
+        result, evidence = conform_with_evidence(
+            cfg, law=args.law, table=args.table, rtol=rtol, timeout=args.timeout
+        )
+    elif args.table:
         result = conform.conform_table(args.table, cfg, rtol=rtol)
     else:  # the law runs in a child process; what it prints goes to stderr afterwards
         result = conform.conform_spec(args.law, cfg, rtol=rtol, timeout=args.timeout)
-        if result.law_output:
-            print(result.law_output, end="", file=sys.stderr)
+    if args.law and result.law_output:
+        print(result.law_output, end="", file=sys.stderr)
     if args.junit:
         from ptoverify.junit import conform_verdicts, junit_xml
 
@@ -848,10 +870,19 @@ def _cmd_conform(args: argparse.Namespace) -> int:
         props = {"config": cfg.name, "target": result.target, "mode": result.mode}
         xml = junit_xml(verdicts, "ptoverify.conform", states, props, result.conforms)
         write_atomic(args.junit, xml)
+    if target is not None:
+        from ptoverify.conform_report import write_conform_report
+
+        write_conform_report(result, evidence, cfg, target)
     if args.json:
-        print_json(result.to_json())
+        out = result.to_json()
+        if target is not None:
+            out["report"] = str(target / "index.html")
+        print_json(out)
     else:
         print(conform.format_result(result))
+        if target is not None:
+            print(f"wrote report {target}/index.html, report.md, results.json, figures/")
     return 0 if result.conforms else 1
 
 

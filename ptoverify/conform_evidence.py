@@ -107,7 +107,7 @@ class DuMap:
         return float(np.nanmax(self.du_max)) if np.any(self.counts) else 0.0
 
     def hot_cells(self, k: int = 5) -> list[dict]:
-        """The ``k`` cells with the largest |u - u_ref| that exceed the tolerance.
+        """Return the ``k`` cells with the largest |u - u_ref| that exceed the tolerance.
 
         Returns
         -------
