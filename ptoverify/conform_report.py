@@ -170,7 +170,9 @@ def _verdict(r: ConformResult, ev: ConformEvidence, cfg: Config) -> list[Block]:
             ]
         )
         rows.append(["largest |u - u_ref|", quantity(a["max_abs_du"], "mm/s")])
-        rows.append(["states judged", f"{a['points']} ({a['excluded']} curve ties excluded)"])
+        rows.append(
+            ["states judged", f"{a['points']} states ({a['excluded']} curve ties excluded)"]
+        )
     rows.append(["run time", quantity(r.timings_s.get("total"), "s")])
     blocks.append(_table(["item", "value"], rows))
     return blocks
@@ -258,7 +260,7 @@ def _map(ev: ConformEvidence, figures: dict[str, str]) -> list[Block]:
         _p(
             f"Largest |u_user - u_reference| [mm/s] per cell ({env.du_max.shape[1]} x "
             f"{env.du_max.shape[0]} cells) over {ev.judged} judged states ({ev.excluded} curve "
-            f"ties excluded), logarithmic colours; blank cells hold no judged state. Left: the "
+            f"ties excluded), logarithmic colours (black: no difference); grey cells hold no judged state. Left: the "
             f"envelope; right: |x1| <= {quantity(b.zoom_x1, 'mm')}, where the regions meet. "
             f"Drawn: l1, l2 (eqs. 9, 11), {zone}, and the linear zone |x1| < d = "
             f"{quantity(b.d, 'mm')}. Largest cell: {quantity(env.max, 'mm/s')}; "
@@ -379,7 +381,7 @@ def _responses(ev: ConformEvidence, figures: dict[str, str]) -> list[Block]:
 
 def _failures(r: ConformResult) -> list[Block]:
     if not r.failures:
-        return [_p("None.")]
+        return [_p("No failures.")]
     rows = [[f["property"], state(f["state"]), f["detail"]] for f in r.failures]
     return [_table(["property", "first state that shows it", "detail"], rows)]
 

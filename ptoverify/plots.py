@@ -978,10 +978,11 @@ def plot_du_map(
     ax.set_xlabel("position x1 [mm]")
     ax.set_ylabel("velocity x2 [mm/s]")
     ax.set_title(
-        f"|u - u_ref| ({du_map.name}); cyan tick: tolerance {tol:.3g} mm/s; blank: no state",
+        f"|u - u_ref| ({du_map.name}); cyan tick: tolerance {tol:.3g} mm/s; grey: no state",
         fontsize=8,
     )
-    ax.legend(fontsize=6, loc="lower left", framealpha=0.6)
+    ax.set_facecolor("0.8")  # cells without a judged state
+    ax.legend(fontsize=6, loc="lower left", framealpha=0.9)
     return drawn
 
 
