@@ -40,6 +40,8 @@ DIMENSIONLESS = {
     "never settled",
 }
 
+#: columns that name a row (a property, region, law or metric), not a figure
+LABELS = {"property", "region", "law", "item"}
 #: rows of the summary table that hold names, not figures
 TEXT_ROWS = {"law", "evaluated as", "configuration"}
 
@@ -89,7 +91,8 @@ def check_complete(out: Path) -> dict:
             if row[0] in TEXT_ROWS:
                 continue
             for head, cell in zip(headers, row):
-                if not NUMBER.search(cell) or head in DIMENSIONLESS or head == "property":
+                label = head in LABELS or head.endswith(": metric")
+                if not NUMBER.search(cell) or head in DIMENSIONLESS or label:
                     continue
                 assert UNIT.search(cell), f"number without unit: {head!r} = {cell!r}"
     marker = json.loads((out / ".ptoverify").read_text())
