@@ -762,6 +762,11 @@ E_ref the reference's worst. Table: agreement and |u| <= w_max at its points onl
 reference is evaluated at the table's x1, x2, so firmware that rounds the state (float32) must
 write back the state it actually evaluated.
 
+--report DIR also writes a report for a review (verdict, properties with units, heat maps of
+|u - u_ref| with l1, l2, l1*, l2* and |x1| < d, closed loop, settling / N*T, step/ramp/sine
+responses of a --law next to the reference); DIR is checked before anything runs and written
+atomically.
+
 Exit codes: 0 conforms, 1 does not (each failing property named with the first state that
 shows it; a law that raises, returns NaN/inf, or has memory is a finding), 2 bad input
 (import error, missing attribute, not callable, wrong signature, a non-number or wrong
@@ -771,7 +776,8 @@ examples:
   ptoverify conform --law ptoverify.conform:reference_law
   ptoverify conform --law examples/my_pto.py:pto --json
   ptoverify conform --emit-grid grid.csv      # fill in column u, then:
-  ptoverify conform --table grid_with_u.csv"""
+  ptoverify conform --table grid_with_u.csv
+  ptoverify conform --law examples/my_pto.py:pto --report review    # HTML/Markdown/JSON report"""
 
 
 def _add_conform(sub) -> None:

@@ -182,7 +182,7 @@ def du_map(
 
     Examples
     --------
-    >>> m = du_map(np.array([0.0, 0.9]), np.array([0.0, 0.0]), np.array([1.0, 2.0]), 1, 1, 0.5,
+    >>> m = du_map(np.array([-0.5, 0.9]), np.array([0.0, 0.0]), np.array([1.0, 2.0]), 1, 1, 0.5,
     ...            cells=2)
     >>> m.max, m.counts.tolist()
     (2.0, [[0, 0], [1, 1]])

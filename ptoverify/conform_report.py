@@ -80,6 +80,15 @@ def quantity(v: Any, unit: str = "", digits: int = 4) -> str:
 def state(s: Any) -> str:
     """Format a state [mm, mm/s] with 10 significant digits (enough to reproduce it).
 
+    Parameters
+    ----------
+    s : sequence of 2 floats or None
+        The state x1 [mm], x2 [mm/s].
+
+    Returns
+    -------
+    str
+
     Examples
     --------
     >>> state([0.50000005, -115.0]), state(None)
@@ -387,13 +396,13 @@ def _failures(r: ConformResult) -> list[Block]:
 
 
 def build_sections(
-    r: ConformResult, ev: ConformEvidence, cfg: Config, figures: dict[str, str]
+    result: ConformResult, ev: ConformEvidence, cfg: Config, figures: dict[str, str]
 ) -> list[Section]:
     """Return the report's sections (anchor, title, blocks).
 
     Parameters
     ----------
-    r : ConformResult
+    result : ConformResult
         The verdict.
     ev : ConformEvidence
         Maps, boundaries, responses and settling summary.
@@ -406,6 +415,7 @@ def build_sections(
     -------
     list of Section
     """
+    r = result
     return [
         ("verdict", "Verdict", _verdict(r, ev, cfg)),
         ("properties", "Properties", _properties(r)),
@@ -432,12 +442,14 @@ def _jsonable(obj: Any) -> Any:
     return obj
 
 
-def write_conform_report(r: ConformResult, ev: ConformEvidence, cfg: Config, target: Path) -> Path:
+def write_conform_report(
+    result: ConformResult, ev: ConformEvidence, cfg: Config, target: Path
+) -> Path:
     """Write the report folder atomically (temporary folder, then one rename).
 
     Parameters
     ----------
-    r : ConformResult
+    result : ConformResult
         The verdict.
     ev : ConformEvidence
         Output of :func:`ptoverify.conform_evidence.conform_with_evidence`.
@@ -455,6 +467,7 @@ def write_conform_report(r: ConformResult, ev: ConformEvidence, cfg: Config, tar
     from ptoverify.outdir import discard, make_temp, publish
     from ptoverify.plots import save_conform_figures
 
+    r = result
     tmp = make_temp(target)
     try:
         marks = {}
