@@ -257,7 +257,10 @@ def _agreement(r: ConformResult) -> list[Block]:
     ]
 
 
-def _map(ev: ConformEvidence, figures: dict[str, str]) -> list[Block]:
+def _map(r: ConformResult, ev: ConformEvidence, figures: dict[str, str]) -> list[Block]:
+    if ev.judged == 0:
+        why = r.agreement.get("detail", "no state was judged")
+        return [_p(f"No map of |u - u_ref|: no state was judged ({why}).")]
     b = ev.boundaries
     zone = (
         f"l1*, l2* (eqs. 13, 14, omega0 = {quantity(b.omega0, 'mm/s')})"
@@ -420,7 +423,7 @@ def build_sections(
         ("verdict", "Verdict", _verdict(r, ev, cfg)),
         ("properties", "Properties", _properties(r)),
         ("agreement", "Agreement per region", _agreement(r)),
-        ("map", "Where your law differs: |u - u_ref|", _map(ev, figures)),
+        ("map", "Where your law differs: |u - u_ref|", _map(r, ev, figures)),
         ("closed-loop", "Closed loop and settling / N*T", _closed_loop(r, ev)),
         ("responses", "Step, ramp and sine responses", _responses(ev, figures)),
         ("failures", "Failures", _failures(r)),

@@ -1046,21 +1046,22 @@ def save_conform_figures(
     Returns
     -------
     dict of str to Path
-        ``du_map`` and, when the law has responses, ``response_step``,
+        ``du_map`` (when a state was judged) and, when the law has responses, ``response_step``,
         ``response_ramp``, ``response_sine``.
     """
     outdir = _folder(outdir)
     out: dict[str, Path] = {}
     maps = evidence.maps
-    top = max([m.max for m in maps] + [10.0 * maps[0].tolerance])
-    fig, axes = plt.subplots(1, len(maps), figsize=(13.0, 5.0))
-    try:
-        for m, ax in zip(maps, np.atleast_1d(axes)):
-            plot_du_map(m, evidence.boundaries, ax, vmax=top, marks=marks)
-        _write(fig, outdir / "du_map.png")
-    finally:
-        plt.close(fig)
-    out["du_map"] = outdir / "du_map.png"
+    if evidence.judged:
+        top = max([m.max for m in maps] + [10.0 * maps[0].tolerance])
+        fig, axes = plt.subplots(1, len(maps), figsize=(13.0, 5.0))
+        try:
+            for m, ax in zip(maps, np.atleast_1d(axes)):
+                plot_du_map(m, evidence.boundaries, ax, vmax=top, marks=marks)
+            _write(fig, outdir / "du_map.png")
+        finally:
+            plt.close(fig)
+        out["du_map"] = outdir / "du_map.png"
     for name, resp in (evidence.responses or {}).items():
         fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.4, 5.6), sharex=True)
         try:
