@@ -332,3 +332,24 @@ def test_c_law_report(capsys, tmp_path, paper_cfg):
     assert res["conform"]["conforms"] is True
     check_map_is_the_agreement(res)
     check_responses(res, paper_cfg, agree_mm=1e-9)
+
+
+def test_law_that_raises_gets_a_report_without_map(capsys, tmp_path):
+    """An evaluation finding: no state judged, so no map (and the report says why)."""
+    path = tmp_path / "raising.py"
+    path.write_text(
+        "def law(x1, x2, cfg):\n"
+        "    if x1 > 49.9:\n"
+        "        raise ValueError('boom')\n"
+        "    return -300.0 if x1 > 0 else 300.0\n"
+    )
+    out = tmp_path / "review"
+    code, stdout, _ = run(capsys, "conform", "--law", f"{path}:law", "--report", str(out))
+    assert code == 1
+    res = check_complete(out)
+    first = res["conform"]["failures"][0]
+    assert first["property"] == "evaluation" and first["state"][0] > 49.9
+    md = (out / "report.md").read_text()
+    assert "No map of |u - u_ref|: no state was judged" in md
+    assert "figures/du_map.png" not in res["meta"]["figures"]
+    assert f"First failing property: evaluation at {state(first['state'])}" in md
