@@ -56,6 +56,8 @@ robust      robustness under model mismatch: maps over the box, margins in a_tru
 tune        tune PD (kp, kd) and PTO (d, k1, k2) under the same constraints; Pareto fronts
 conform     conform: gate a third-party PTO law (callable or table) against the reference
 agreement   conformance grid (--emit-grid), CSV tables, per-region agreement with the reference
+conform_evidence  the evidence behind a conform verdict (conform --report): |u - u_ref| maps,
+            region boundaries, responses of the user law, settling / N* T
 userlaw     loading a user law (MODULE:FUNCTION or file.py:FUNCTION), isolated in a child
             process, vectorized/scalar detection
 testing     assert_conforms, for a team's own pytest suite
@@ -68,6 +70,7 @@ plots       Figs. 2-14 for TO, PD, PTO (both), sweep heat maps, zone geometry, c
             convergence, drawn from results passed in (the only module importing matplotlib)
 report      collect (every result once, figure_inputs), write_report (atomic);
             report_sections builds the sections; render prints them (HTML, Markdown)
+conform_report  conform --report DIR: the user's law as an atomic HTML/Markdown/JSON report
 junit       JUnit XML from verdicts (check --junit, conform --junit)
 outdir      atomic output folders with a manifest marker; SIGTERM handling
 progress    the one progress bar on stderr
