@@ -12,7 +12,9 @@ With ``--small`` the sizes are cut so the whole run takes seconds; ``check_s``
 then times ``ptoverify check --gate roots-closed-form-vs-bisection`` (one cheap
 gate) and ``report_s`` ``ptoverify report --help``, so the figures only show
 that the harness works.  At full size ``report_s`` times ``ptoverify report
---quiet --out TMPDIR`` (a temporary folder, so the tracked reports/ is untouched).
+--quiet --out TMPDIR`` (a temporary folder, so the tracked reports/ is untouched),
+and ``sweep_s`` ``ptoverify sweep --quiet --json`` (200 x 200 states, 4 laws, settling
+between samples; ``--small``: ``--grid 4``).
 """
 
 from __future__ import annotations
@@ -64,6 +66,7 @@ TARGETS = {  # key: (target, ">=" or "<=")
     "discrete_batch_vs_lp_ratio": (None, ""),
     "check_s": (60.0, "<="),
     "report_s": (120.0, "<="),
+    "sweep_s": (30.0, "<="),
 }
 
 FULL = {
@@ -399,6 +402,8 @@ def run(small: bool) -> tuple[dict, dict]:
     with tempfile.TemporaryDirectory() as tmp:  # never the tracked reports/ folder
         report = ["report", "--help"] if small else ["report", "--quiet", "--out", tmp]
         out["report_s"], extra["report_note"] = run_cli(report, size["cli_repeat"])
+    sweep = ["sweep", "--quiet", "--json"] + (["--grid", "4"] if small else [])
+    out["sweep_s"], extra["sweep_note"] = run_cli(sweep, size["cli_repeat"])
     extra["vector_vs_scalar"] = out["law_vector_evals_per_s"] * out["law_scalar_us"] * 1e-6
     return out, extra
 
@@ -434,7 +439,7 @@ def table(out: dict, extra: dict) -> str:
         f"scalar law on switching-zone states only (omega_c by Newton): "
         f"{extra['law_scalar_zone_us']:.3g} us",
     ]
-    for k in ("check_note", "report_note"):
+    for k in ("check_note", "report_note", "sweep_note"):
         if extra[k]:
             rows.append(f"{k}: {extra[k]}")
     return "\n".join(rows)
@@ -451,7 +456,11 @@ def main(argv: list[str] | None = None) -> int:
         obj["machine"] = machine()
         notes = {
             k: v
-            for k, v in (("check_s", extra["check_note"]), ("report_s", extra["report_note"]))
+            for k, v in (
+                ("check_s", extra["check_note"]),
+                ("report_s", extra["report_note"]),
+                ("sweep_s", extra["sweep_note"]),
+            )
             if v
         }
         if notes:  # reasons for a null (or a failing gate) ride with machine

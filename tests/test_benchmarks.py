@@ -35,6 +35,7 @@ KEYS = {
     "discrete_batch_vs_lp_ratio",
     "check_s",
     "report_s",
+    "sweep_s",
 }
 
 
