@@ -65,9 +65,15 @@ verdicts and the rule texts read them from there.
 * A qualitative claim whose metric cannot be measured (a law never settles)
   is ``not reproduced`` under that reading, and the detail says why.
 
-"At the same overshoot" (Sec. 6.1): the laws are compared as configured (the
-paper's gains); both overshoots are measured and reported beside the time
-ratio, and the premise is not enforced by retuning.
+"At the same overshoot" (Sec. 6.1): under the paper-gain readings the laws are
+compared as configured (the paper's gains), both overshoots reported beside the
+time ratio.  With ``evaluate_claims(tuned=True)`` the claims of
+:data:`TUNED_CLAIMS` get three more readings (``Reading.gains``), each under the
+primary reading otherwise: the PD retuned (best 2 % settling of the step) to the
+PTO's paper-gain overshoot, the PTO at the paper's gains; and both laws at their
+best tuning (:func:`ptoverify.tune.fair_tunings`) under a shared overshoot bound,
+once the PTO's paper-gain overshoot and once the PD's.  Their common verdict is
+``verdict_tuned``; ``verdict`` stays that of the paper's gains.
 """
 
 from __future__ import annotations
@@ -75,7 +81,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
 import numpy as np
@@ -85,6 +91,7 @@ from ptoverify.config import Config
 from ptoverify.exact import Compared, ExactMetrics, exact_metrics
 from ptoverify.laws import Law, make_law
 from ptoverify.simulate import SimResult, simulate
+from ptoverify.tune import FAIR_BOUNDS, FairTunings, TuneBudget, fair_tunings
 
 __all__ = [
     "Reading",
@@ -95,6 +102,7 @@ __all__ = [
     "response_metrics",
     "VERDICTS",
     "numeric_verdict",
+    "TUNED_CLAIMS",
 ]
 
 VERDICTS = ("reproduced", "not reproduced", "ambiguous")
@@ -122,12 +130,21 @@ class Reading:
         ``corrected`` or ``printed`` (None: does not apply).
     band : float or None
         Settling band as a fraction of the step [-] (None: does not apply).
+    gains : str or None
+        None: the paper's gains.  ``pd-retuned``: the PD tuned to the PTO's
+        paper-gain overshoot, the PTO at the paper's gains.  ``best@pto-paper``,
+        ``best@pd-paper``: both laws at their best tuning under the shared
+        overshoot bound of that name (:data:`ptoverify.tune.FAIR_BOUNDS`).
+    bound_mm : float or None
+        The overshoot bound of a tuned reading [mm].
     """
 
     a: str = "given"
     tracking: str | None = None
     pto: str | None = None
     band: float | None = None
+    gains: str | None = None
+    bound_mm: float | None = None
 
     def label(self, cfg: Config) -> str:
         """Describe the reading in words, with the value of a."""
@@ -147,11 +164,25 @@ class Reading:
             parts.append(f"PTO {self.pto}")
         if self.band is not None:
             parts.append(f"band {100 * self.band:g} %")
+        if self.gains == "pd-retuned":
+            parts.append(
+                f"PD retuned to overshoot <= {self.bound_mm:.4g} mm (the PTO's), PTO paper gains"
+            )
+        elif self.gains is not None:
+            meaning = FAIR_BOUNDS[self.gains.removeprefix("best@")]
+            parts.append(f"both laws best-tuned, overshoot <= {self.bound_mm:.4g} mm ({meaning})")
         return ", ".join(parts)
 
     def to_json(self) -> dict:
         """Return the reading as a dict."""
-        return {"a": self.a, "tracking": self.tracking, "pto": self.pto, "band": self.band}
+        return {
+            "a": self.a,
+            "tracking": self.tracking,
+            "pto": self.pto,
+            "band": self.band,
+            "gains": self.gains,
+            "bound_mm": self.bound_mm,
+        }
 
 
 @dataclass(frozen=True)
@@ -249,6 +280,11 @@ class ClaimResult:
         Headline value under the primary reading, time metrics on the sample grid.
     verdict_grid : str
         Overall verdict from the readings' grid verdicts.
+    verdict_tuned : str
+        Common verdict of the tuned readings (``Reading.gains`` set), ``ambiguous``
+        when they differ; "" when they were not computed.  ``verdict`` and
+        ``verdict_grid`` are over the paper-gain readings only, so asking for
+        the tuned readings never changes them.
     """
 
     id: str
@@ -264,6 +300,7 @@ class ClaimResult:
     readings: tuple[ReadingResult, ...]
     measured_grid: float | None = None
     verdict_grid: str = ""
+    verdict_tuned: str = ""
 
     @property
     def differs_on_grid(self) -> bool:
@@ -287,6 +324,7 @@ class ClaimResult:
             "measured_grid": self.measured_grid,
             "verdict_grid": self.verdict_grid,
             "verdict_differs_on_grid": self.differs_on_grid,
+            "verdict_tuned": self.verdict_tuned,
         }
 
 
@@ -321,9 +359,15 @@ class _Ctx:
     """Access to the responses under one reading."""
 
     def __init__(
-        self, cfg: Config, reading: Reading, paper: dict[str, float | None], grid: bool = False
+        self,
+        cfg: Config,
+        reading: Reading,
+        paper: dict[str, float | None],
+        grid: bool = False,
+        law_cfg: dict[str, Config] | None = None,
     ):
         self.cfg = _cfg_for(cfg, reading)
+        self.law_cfg = law_cfg or {}  # law -> its (tuned) configuration, else self.cfg
         self.reading = reading
         self.paper = paper  # claim id -> the registry's paper value
         self.tracking = reading.tracking or "feed-forward"
@@ -334,7 +378,8 @@ class _Ctx:
 
     def sim(self, law: str, signal: str) -> SimResult:
         name = self.pto if law == "pto" else law
-        return _sim(self.cfg, name, signal, self.tracking if signal != "step" else "feed-forward")
+        cfg = self.law_cfg.get(law, self.cfg)
+        return _sim(cfg, name, signal, self.tracking if signal != "step" else "feed-forward")
 
     def tail(self, law: str, signal: str, what: str = "e") -> np.ndarray:
         r = self.sim(law, signal)
@@ -352,7 +397,8 @@ class _Ctx:
         name = self.pto if law == "pto" else law
         tracking = self.tracking if signal != "step" else "feed-forward"
         frac = self.reading.band if self.reading.band is not None else mt.STEP_FRACTION
-        return _metrics(self.cfg, name, signal, tracking, frac).values[key]
+        cfg = self.law_cfg.get(law, self.cfg)
+        return _metrics(cfg, name, signal, tracking, frac).values[key]
 
     def value(self, m: Compared) -> float:
         """Return the value this pass decides on: exact, or the grid value in the grid pass."""
@@ -801,12 +847,37 @@ def _overall(verdicts: set[str]) -> str:
     return verdicts.pop() if len(verdicts) == 1 else "ambiguous"
 
 
-def _evaluate(cfg: Config, cl: _Claim, paper: dict[str, float | None]) -> ClaimResult:
+def _tuned_readings(cfg: Config, cl: _Claim, ft: FairTunings) -> list[tuple[Reading, dict]]:
+    """The tuned readings of a claim with each law's configuration (primary reading otherwise)."""
+    base = _readings(cfg, cl.dims)[0]
+    pto_bound = ft.bounds["pto-paper"]
+    out = [
+        (
+            replace(base, gains="pd-retuned", bound_mm=pto_bound),
+            {"pd": ft.config("pd", "pto-paper")},
+        )
+    ]
+    for name, bound in ft.bounds.items():
+        out.append(
+            (
+                replace(base, gains=f"best@{name}", bound_mm=bound),
+                {"pd": ft.config("pd", name), "pto": ft.config("pto", name)},
+            )
+        )
+    return out
+
+
+def _evaluate(
+    cfg: Config, cl: _Claim, paper: dict[str, float | None], ft: FairTunings | None = None
+) -> ClaimResult:
+    todo = [(rd, None) for rd in _readings(cfg, cl.dims)]
+    if ft is not None and cl.id in TUNED_CLAIMS:
+        todo += _tuned_readings(cfg, cl, ft)
     results = []
-    for rd in _readings(cfg, cl.dims):
-        exact = _Ctx(cfg, rd, paper)
+    for rd, law_cfg in todo:
+        exact = _Ctx(cfg, rd, paper, law_cfg=law_cfg)
         measured, values, ok, detail = cl.measure(exact, cl)
-        grid = _Ctx(cfg, rd, paper, grid=True)
+        grid = _Ctx(cfg, rd, paper, grid=True, law_cfg=law_cfg)
         measured_g, values_g, ok_g, _ = cl.measure(grid, cl)
         if exact.ties:
             detail += "; true tie between samples: " + ", ".join(exact.ties)
@@ -825,6 +896,8 @@ def _evaluate(cfg: Config, cl: _Claim, paper: dict[str, float | None]) -> ClaimR
             )
         )
     p = results[0]
+    plain = [r for r in results if r.reading.gains is None]
+    tuned = [r for r in results if r.reading.gains is not None]
     return ClaimResult(
         cl.id,
         cl.section,
@@ -833,23 +906,33 @@ def _evaluate(cfg: Config, cl: _Claim, paper: dict[str, float | None]) -> ClaimR
         cl.paper_value,
         cl.unit,
         cl.rule,
-        _overall({r.verdict for r in results}),
+        _overall({r.verdict for r in plain}),
         p.measured,
         p.detail,
         tuple(results),
         p.measured_grid,
-        _overall({r.verdict_grid for r in results}),
+        _overall({r.verdict_grid for r in plain}),
+        _overall({r.verdict for r in tuned}) if tuned else "",
     )
 
 
 @lru_cache(maxsize=8)
-def _evaluate_all(cfg: Config, claims: tuple[_Claim, ...]) -> tuple[ClaimResult, ...]:
+def _evaluate_all(
+    cfg: Config, claims: tuple[_Claim, ...], tuned: bool = False, budget: TuneBudget | None = None
+) -> tuple[ClaimResult, ...]:
     # paper values by id: the claims evaluated, over the registry's (a claim may quote another's)
     paper = {c.id: c.paper_value for c in CLAIMS} | {c.id: c.paper_value for c in claims}
-    return tuple(_evaluate(cfg, cl, paper) for cl in claims)
+    ft = fair_tunings(cfg, budget) if tuned else None
+    return tuple(_evaluate(cfg, cl, paper, ft) for cl in claims)
 
 
-def evaluate_claims(cfg: Config, claims: tuple[_Claim, ...] | None = None) -> list[ClaimResult]:
+def evaluate_claims(
+    cfg: Config,
+    claims: tuple[_Claim, ...] | None = None,
+    *,
+    tuned: bool = False,
+    budget: TuneBudget | None = None,
+) -> list[ClaimResult]:
     """Evaluate every claim under every reading (cached per configuration).
 
     Parameters
@@ -859,6 +942,13 @@ def evaluate_claims(cfg: Config, claims: tuple[_Claim, ...] | None = None) -> li
     claims : tuple of registry entries, optional
         The entries to evaluate; default :data:`CLAIMS`.  An entry with another
         ``paper_value`` (``dataclasses.replace``) is judged against that value.
+    tuned : bool
+        Also judge the claims of :data:`TUNED_CLAIMS` at the best tuning of
+        both laws (:func:`ptoverify.tune.fair_tunings`: minutes, memoized):
+        readings with ``gains`` set, summarized in ``verdict_tuned``.
+        ``ptoverify check`` leaves this off (see :data:`TUNED_CLAIMS`).
+    budget : TuneBudget, optional
+        Search effort of the tunings (default :class:`~ptoverify.tune.TuneBudget`).
 
     Returns
     -------
@@ -872,7 +962,63 @@ def evaluate_claims(cfg: Config, claims: tuple[_Claim, ...] | None = None) -> li
     >>> all(r.verdict in VERDICTS for r in res)
     True
     """
-    return list(_evaluate_all(cfg, CLAIMS if claims is None else tuple(claims)))
+    cl = CLAIMS if claims is None else tuple(claims)
+    return list(_evaluate_all(cfg, cl, tuned, budget))
+
+
+# ------------------------------------------------------------------ tuned sentences
+def _pct(x: float) -> str:
+    return "n/a" if not math.isfinite(x) else f"{x:+.1f} %"
+
+
+def _setting(r: ReadingResult) -> str:
+    if r.reading.gains == "pd-retuned":
+        return f"PD retuned to the PTO's overshoot ({r.reading.bound_mm:.3g} mm)"
+    return f"both laws best-tuned under overshoot <= {r.reading.bound_mm:.3g} mm"
+
+
+def _say_31(c: ClaimResult, rs: list[ReadingResult]) -> str:
+    parts = [
+        f"{_setting(r)}: PD {_ms(r.values['settling_pd_s'])} vs PTO "
+        f"{_ms(r.values['settling_pto_s'])}, PD takes {_pct(r.values['pd_more_percent'])} "
+        f"({r.verdict})"
+        for r in rs
+    ]
+    return f"31 % (paper {c.paper_value:g} %): " + "; ".join(parts) + "."
+
+
+def _say_settling(what: str) -> Callable[[ClaimResult, list[ReadingResult]], str]:
+    def say(c: ClaimResult, rs: list[ReadingResult]) -> str:
+        parts = []
+        for r in rs:
+            a, b = r.values["settling_pto_s"], r.values["settling_pd_s"]
+            holds = "holds" if a < b and "settling" not in " ".join(r.ties) else "does not hold"
+            parts.append(f"{_setting(r)}: PTO {_ms(a)} vs PD {_ms(b)} (2 % settling), {holds}")
+        return f"{what}: " + "; ".join(parts) + f"; claim verdict {c.verdict_tuned}."
+
+    return say
+
+
+def _say_rise(c: ClaimResult, rs: list[ReadingResult]) -> str:
+    parts = [
+        f"{_setting(r)}: 10-90 % rise PTO {_ms(r.values['rise_time_pto_s'])} vs PD "
+        f"{_ms(r.values['rise_time_pd_s'])} ({r.verdict})"
+        for r in rs
+    ]
+    return "Quicker dynamic response: " + "; ".join(parts) + "."
+
+
+#: Claims also judged at the best tuning of both laws (``evaluate_claims(tuned=True)``),
+#: with the sentence that states the result with its numbers.  ``ptoverify check``
+#: does not compute them: its claims-computed gate checks that every claim is
+#: measurable, which the paper-gain readings already show in seconds, while the
+#: tunings take minutes (the report computes them once, memoized).
+TUNED_CLAIMS: dict[str, Callable[[ClaimResult, list[ReadingResult]], str]] = {
+    "step-pd-31-percent": _say_31,
+    "step-pto-steadier-quicker": _say_settling("Quicker dynamic process (Sec. 6.1)"),
+    "conclusion-vs-to-and-pd": _say_settling("Shorter adjustment time"),
+    "conclusion-quicker-response": _say_rise,
+}
 
 
 @lru_cache(maxsize=8)

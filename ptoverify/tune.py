@@ -30,6 +30,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -41,7 +42,9 @@ from ptoverify.exact import exact_metrics
 from ptoverify.laws import make_law
 from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import law_properties
+from ptoverify.mintime import discrete_min_steps_batch, min_time
 from ptoverify.simulate import reference, simulate
+from ptoverify.sweep import SweepSettings, grid_states, settling_times
 
 __all__ = [
     "OBJECTIVES",
@@ -52,6 +55,12 @@ __all__ = [
     "evaluate",
     "tune",
     "pareto_front",
+    "worst_ratio_nt",
+    "WORST_GRID",
+    "TuneBudget",
+    "FairTunings",
+    "fair_tunings",
+    "fair_comparison",
 ]
 
 OBJECTIVES = ("settling_2pct", "settling_0p01mm", "worst_ratio_nt")
@@ -164,6 +173,72 @@ def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:
     return {k: math.nan if v is None else float(v) for k, v in m.items()}
 
 
+#: Default state grid of :func:`worst_ratio_nt` (n1 x n2 over the envelope).  Even
+#: counts keep the origin (N* = 0) off the grid, as the sweep's.
+WORST_GRID = (20, 20)
+
+
+@lru_cache(maxsize=16)
+def _envelope(plant, n1: int, n2: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, int]:
+    """States, N* T [s], horizon and hold [samples] of the grid; once per plant and grid."""
+    s = SweepSettings()
+    X1, X2 = grid_states(plant, n1, n2)
+    T = plant.sample_time
+    t_f = min_time(X1, X2, plant).t_f
+    hold = math.ceil(s.hold / T - 1e-9)
+    steps = math.ceil(s.horizon_factor * float(t_f.max()) / T) + hold
+    n_star = discrete_min_steps_batch(X1.ravel(), X2.ravel(), plant).steps
+    nt = np.where(n_star > 0, n_star * T, np.nan)
+    return X1.ravel(), X2.ravel(), nt, steps, hold
+
+
+def worst_ratio_nt(
+    cfg: Config, law: str, *, n1: int = WORST_GRID[0], n2: int = WORST_GRID[1]
+) -> float:
+    """Worst settling time / (N* T) of ``law`` over an n1 x n2 grid of the envelope.
+
+    The suboptimality the paper is about, with the sweep's definitions
+    (:mod:`ptoverify.sweep`): settled = |x1| <= 0.01 mm and |x2| <= a 0.01 mm/s
+    from a sample on, for at least the hold (0.05 s), read on the sample grid
+    (:func:`~ptoverify.sweep.settling_times`); N* the fewest ZOH samples to the
+    origin (:func:`~ptoverify.mintime.discrete_min_steps_batch`, computed once
+    per plant and grid).  A law that does not settle from some grid state has
+    an infinite worst ratio (the tuner treats it as infeasible).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration the law is built from.
+    law : str
+        Law name.
+    n1, n2 : int
+        Grid points along x1 [mm] and x2 [mm/s] over |x1| <= position_range,
+        |x2| <= w_max.
+
+    Returns
+    -------
+    float
+        max over the grid of settling / (N* T) [-]; inf if a state never settles.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> worst_ratio_nt(paper_config(), "pd", n1=4, n2=4) >= 1.0
+    True
+    """
+    if n1 < 2 or n2 < 2:
+        raise InputError("worst_ratio_nt: the grid needs at least 2 points per axis")
+    p = cfg.plant
+    x1, x2, nt, steps, hold = _envelope(p, n1, n2)
+    st = settling_times(
+        make_law(law, cfg), p, x1, x2, steps, SweepSettings().band, p.a * SweepSettings().band, hold
+    )
+    ok = np.isfinite(nt)
+    if not np.isfinite(st[ok]).all():
+        return math.inf
+    return float(np.max(st[ok] / nt[ok]))
+
+
 def evaluate(
     cfg: Config,
     law: str,
@@ -172,7 +247,7 @@ def evaluate(
     signal: str = "step",
     objective: str = "settling_2pct",
     max_overshoot: float | None = None,
-    worst_ratio: Callable[[Config], float] | None = None,
+    worst_ratio: Callable[[Config, str], float] | None = None,
 ) -> Candidate:
     """Evaluate one set of gains under the cheap constraints (not the grid properties).
 
@@ -191,7 +266,8 @@ def evaluate(
     max_overshoot : float, optional
         Overshoot bound [mm].
     worst_ratio : callable, optional
-        ``f(cfg) -> worst settling / N*T`` for ``objective="worst_ratio_nt"``.
+        ``f(cfg, law) -> worst settling / N*T`` for ``objective="worst_ratio_nt"``;
+        default :func:`worst_ratio_nt` on its default grid.
 
     Returns
     -------
@@ -221,7 +297,7 @@ def evaluate(
     else:
         reason = ""
         if objective == "worst_ratio_nt":
-            value = worst_ratio(tcfg) if worst_ratio else math.nan
+            value = (worst_ratio or worst_ratio_nt)(tcfg, law)
         else:
             value = m[f"{objective}_s"]
         if not math.isfinite(value):
@@ -392,7 +468,7 @@ def tune(
     maxiter: int = 30,
     popsize: int = 10,
     d_grid: int = 9,
-    worst_ratio: Callable[[Config], float] | None = None,
+    worst_ratio: Callable[[Config, str], float] | None = None,
 ) -> TuneResult:
     """Search the law's gains for the best response under the constraints.
 
@@ -415,7 +491,8 @@ def tune(
     d_grid : int
         PTO: points of the geometric d grid.
     worst_ratio : callable, optional
-        ``f(cfg) -> worst settling / N*T`` (needed for ``worst_ratio_nt``).
+        ``f(cfg, law) -> worst settling / N*T`` for ``worst_ratio_nt``; default
+        :func:`worst_ratio_nt` over the :data:`WORST_GRID` grid.
 
     Returns
     -------
@@ -435,8 +512,6 @@ def tune(
         )
     if max_overshoot is not None and not (max_overshoot >= 0 and math.isfinite(max_overshoot)):
         raise InputError(f"tune: --max-overshoot must be a finite number >= 0, got {max_overshoot}")
-    if objective == "worst_ratio_nt" and worst_ratio is None:
-        raise InputError("tune: objective worst_ratio_nt needs a worst-ratio function")
     reference(signal)  # names the signal or raises InputError
     t0 = time.perf_counter()
     seen: dict[tuple, Candidate] = {}
@@ -518,3 +593,200 @@ def tune(
             tuned_config(cfg, law, best.gains), name=f"{cfg.name}-tuned-{law}"
         ),
     )
+
+
+# ---------------------------------------------------------------- fair comparison
+@dataclass(frozen=True)
+class TuneBudget:
+    """Search effort of the fair-comparison tunings (:func:`fair_tunings`).
+
+    Attributes
+    ----------
+    maxiter, popsize : int
+        Differential-evolution generations and population factor.
+    d_grid : int
+        PTO: points of the geometric d grid.
+    seed : int
+        Seed (fixed, so the comparison is reproducible).
+    """
+
+    maxiter: int = 30
+    popsize: int = 10
+    d_grid: int = 9
+    seed: int = 0
+
+
+#: The shared overshoot bounds of the fair comparison, by name, with their meaning.
+FAIR_BOUNDS = {
+    "pto-paper": "the PTO's overshoot at the paper's gains",
+    "pd-paper": "the PD's overshoot at the paper's gains",
+}
+
+
+@dataclass(frozen=True)
+class FairTunings:
+    """Both laws tuned on the step under each shared overshoot bound.
+
+    Attributes
+    ----------
+    bounds : dict
+        Bound name (:data:`FAIR_BOUNDS`) -> overshoot bound [mm], measured between
+        samples on the paper-gain response of that law.
+    paper : dict
+        ``pd``, ``pto`` -> response metrics of the step at the paper's gains
+        (:func:`response_metrics`).
+    results : dict
+        (law, bound name) -> :class:`TuneResult` (settling_2pct objective).
+    budget : TuneBudget
+        The search effort used.
+    seconds : float
+        Wall time of the tunings [s].
+    """
+
+    bounds: dict[str, float]
+    paper: dict[str, dict[str, float]]
+    results: dict[tuple[str, str], TuneResult]
+    budget: TuneBudget
+    seconds: float
+
+    def config(self, law: str, bound: str) -> Config:
+        """Return the configuration of ``law`` tuned under the bound named ``bound``."""
+        return self.results[(law, bound)].config
+
+
+@lru_cache(maxsize=8)
+def _fair_tunings(cfg: Config, budget: TuneBudget) -> FairTunings:
+    t0 = time.perf_counter()
+    paper = {law: response_metrics(cfg, law, "step") for law in ("pd", "pto")}
+    bounds = {"pto-paper": paper["pto"]["overshoot_mm"], "pd-paper": paper["pd"]["overshoot_mm"]}
+    by_value: dict[tuple[str, float], TuneResult] = {}
+    results = {}
+    for name, bound in bounds.items():
+        for law in ("pd", "pto"):
+            key = (law, bound)
+            if key not in by_value:
+                by_value[key] = tune(
+                    cfg,
+                    law,
+                    "step",
+                    max_overshoot=bound,
+                    seed=budget.seed,
+                    maxiter=budget.maxiter,
+                    popsize=budget.popsize,
+                    d_grid=budget.d_grid,
+                )
+            results[(law, name)] = by_value[key]
+    return FairTunings(bounds, paper, results, budget, time.perf_counter() - t0)
+
+
+def fair_tunings(cfg: Config, budget: TuneBudget | None = None) -> FairTunings:
+    """Tune PD and PTO on the step under each shared overshoot bound (memoized).
+
+    The bounds (:data:`FAIR_BOUNDS`) are the overshoots, between samples, of the
+    PTO and of the PD at the paper's gains: under the first, "the same overshoot"
+    is the PTO's (the paper's premise for the 31 %), under the second the PD's.
+    Each law minimizes its 2 % settling time of the step under the bound
+    (:func:`tune`, fixed seed); a tuning shared by two bounds of equal value is
+    run once.  Results are cached per (configuration, budget): four tunings
+    cost about 2-3 minutes on the paper's plant.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (plant and the paper's gains).
+    budget : TuneBudget, optional
+        Search effort; default :class:`TuneBudget`.
+
+    Returns
+    -------
+    FairTunings
+        Bounds, paper-gain metrics and the tuned results.
+    """
+    return _fair_tunings(cfg, budget or TuneBudget())
+
+
+def _cand(c: Candidate) -> dict[str, Any]:
+    j = c.to_json()
+    return {k: j[k] for k in ("gains", "omega0", "settling_2pct_s", "overshoot_mm", "verified")}
+
+
+def fair_comparison(cfg: Config, budget: TuneBudget | None = None) -> dict[str, Any]:
+    """Everything the report section "Can any tuning reproduce the paper?" shows.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (plant and the paper's gains).
+    budget : TuneBudget, optional
+        Search effort of the tunings; default :class:`TuneBudget`.
+
+    Returns
+    -------
+    dict
+        ``bounds_mm`` (name -> [mm]) and ``bound_meaning`` (name -> words);
+        ``floor``: the step's ``nt_s`` (N* T) and ``tf_s`` (t_f*) [s], the
+        lower bounds of any settling time; ``paper``: law -> the step's metrics at
+        the paper's gains plus ``worst_ratio_nt``; ``fronts``: law -> the Pareto
+        front of 2 % settling [s] vs overshoot [mm] over every candidate the
+        tunings evaluated (cheap constraints; ``verified`` marks those checked on
+        the gate grid), by increasing overshoot; ``best``: bound name -> law ->
+        the best tuned gains with ``settling_2pct_s``, ``overshoot_mm``,
+        ``rise_time_s``, ``settling_0p01mm_s`` and ``worst_ratio_nt`` (over the
+        :data:`WORST_GRID` envelope grid); ``claims``: one entry per claim
+        judged at the best tuning (``id``, ``verdict``, ``sentence``,
+        ``readings``); ``evaluations``, ``seconds``, ``budget``.
+    """
+    from ptoverify.claims import TUNED_CLAIMS, evaluate_claims
+
+    ft = fair_tunings(cfg, budget)
+    step = reference("step").amplitude
+    floor = {
+        "nt_s": float(discrete_min_steps_batch([-step], [0.0], cfg.plant).time_s[0]),
+        "tf_s": float(min_time(np.array([-step]), np.array([0.0]), cfg.plant).t_f[0]),
+    }
+    paper = {law: dict(m, worst_ratio_nt=worst_ratio_nt(cfg, law)) for law, m in ft.paper.items()}
+    fronts = {}
+    for law in ("pd", "pto"):
+        pool = [c for (lw, _), r in ft.results.items() if lw == law for c in r.front]
+        uniq = {tuple(sorted(c.gains.items())): c for c in pool}
+        fronts[law] = [_cand(c) for c in pareto_front(list(uniq.values()))]
+    best: dict[str, dict[str, Any]] = {}
+    for name in ft.bounds:
+        best[name] = {}
+        for law in ("pd", "pto"):
+            r = ft.results[(law, name)]
+            m = response_metrics(r.config, law, "step")
+            best[name][law] = _cand(r.best) | {
+                "rise_time_s": m["rise_time_s"],
+                "settling_0p01mm_s": m["settling_0p01mm_s"],
+                "worst_ratio_nt": worst_ratio_nt(r.config, law),
+                "evaluations": r.evaluations,
+            }
+    results = evaluate_claims(cfg, tuned=True, budget=budget)
+    claims = []
+    for c in results:
+        if c.id not in TUNED_CLAIMS:
+            continue
+        tuned = [r for r in c.readings if r.reading.gains is not None]
+        claims.append(
+            {
+                "id": c.id,
+                "claim": c.claim,
+                "verdict": c.verdict_tuned,
+                "sentence": TUNED_CLAIMS[c.id](c, tuned),
+                "readings": [r.to_json() for r in tuned],
+            }
+        )
+    uniq_runs = {id(r): r for r in ft.results.values()}.values()
+    return {
+        "bounds_mm": dict(ft.bounds),
+        "bound_meaning": dict(FAIR_BOUNDS),
+        "floor": floor,
+        "paper": paper,
+        "fronts": fronts,
+        "best": best,
+        "claims": claims,
+        "evaluations": sum(r.evaluations for r in uniq_runs),
+        "seconds": ft.seconds,
+        "budget": dataclasses.asdict(ft.budget),
+    }
