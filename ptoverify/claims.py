@@ -848,7 +848,7 @@ def _overall(verdicts: set[str]) -> str:
 
 
 def _tuned_readings(cfg: Config, cl: _Claim, ft: FairTunings) -> list[tuple[Reading, dict]]:
-    """The tuned readings of a claim with each law's configuration (primary reading otherwise)."""
+    """Return the tuned readings of a claim, each with its laws' configurations."""
     base = _readings(cfg, cl.dims)[0]
     pto_bound = ft.bounds["pto-paper"]
     out = [
@@ -968,7 +968,12 @@ def evaluate_claims(
 
 # ------------------------------------------------------------------ tuned sentences
 def _pct(x: float) -> str:
-    return "n/a" if not math.isfinite(x) else f"{x:+.1f} %"
+    return "n/a" if not math.isfinite(x) else f"{x:+.2f} %"
+
+
+def _us(x: float) -> str:
+    """Milliseconds to the microsecond: tuned laws differ by tens of microseconds."""
+    return "never" if not math.isfinite(x) else f"{1e3 * x:.3f} ms"
 
 
 def _setting(r: ReadingResult) -> str:
@@ -979,8 +984,8 @@ def _setting(r: ReadingResult) -> str:
 
 def _say_31(c: ClaimResult, rs: list[ReadingResult]) -> str:
     parts = [
-        f"{_setting(r)}: PD {_ms(r.values['settling_pd_s'])} vs PTO "
-        f"{_ms(r.values['settling_pto_s'])}, PD takes {_pct(r.values['pd_more_percent'])} "
+        f"{_setting(r)}: PD {_us(r.values['settling_pd_s'])} vs PTO "
+        f"{_us(r.values['settling_pto_s'])}, PD takes {_pct(r.values['pd_more_percent'])} "
         f"({r.verdict})"
         for r in rs
     ]
@@ -993,7 +998,7 @@ def _say_settling(what: str) -> Callable[[ClaimResult, list[ReadingResult]], str
         for r in rs:
             a, b = r.values["settling_pto_s"], r.values["settling_pd_s"]
             holds = "holds" if a < b and "settling" not in " ".join(r.ties) else "does not hold"
-            parts.append(f"{_setting(r)}: PTO {_ms(a)} vs PD {_ms(b)} (2 % settling), {holds}")
+            parts.append(f"{_setting(r)}: PTO {_us(a)} vs PD {_us(b)} (2 % settling), {holds}")
         return f"{what}: " + "; ".join(parts) + f"; claim verdict {c.verdict_tuned}."
 
     return say
@@ -1001,8 +1006,8 @@ def _say_settling(what: str) -> Callable[[ClaimResult, list[ReadingResult]], str
 
 def _say_rise(c: ClaimResult, rs: list[ReadingResult]) -> str:
     parts = [
-        f"{_setting(r)}: 10-90 % rise PTO {_ms(r.values['rise_time_pto_s'])} vs PD "
-        f"{_ms(r.values['rise_time_pd_s'])} ({r.verdict})"
+        f"{_setting(r)}: 10-90 % rise PTO {_us(r.values['rise_time_pto_s'])} vs PD "
+        f"{_us(r.values['rise_time_pd_s'])} ({r.verdict})"
         for r in rs
     ]
     return "Quicker dynamic response: " + "; ".join(parts) + "."

@@ -34,15 +34,16 @@ from functools import lru_cache
 from typing import Any
 
 import numpy as np
-from scipy.optimize import differential_evolution
+from scipy.optimize import brentq, differential_evolution
 
 from ptoverify.config import Config, PDGains, PTOSettings
 from ptoverify.errors import InputError
 from ptoverify.exact import exact_metrics
 from ptoverify.laws import make_law
+from ptoverify.metrics import STEP_FRACTION
+from ptoverify.mintime import discrete_min_steps_batch, min_time
 from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import law_properties
-from ptoverify.mintime import discrete_min_steps_batch, min_time
 from ptoverify.simulate import reference, simulate
 from ptoverify.sweep import SweepSettings, grid_states, settling_times
 
@@ -372,8 +373,9 @@ class TuneResult:
     runner_up : Candidate or None
         The best verified candidate at least 0.2 (normalized search units) from ``best``.
     front : list of Candidate
-        Pareto front of settling vs overshoot among the evaluated candidates
-        (cheap constraints; ``verified`` says which were checked on the grid).
+        Pareto front of settling vs overshoot among the evaluated candidates,
+        whatever their overshoot (stable, settling; those the grid check
+        rejected are left out; ``verified`` says which were checked on the grid).
     evaluations : int
         Candidates evaluated.
     seconds : float
@@ -468,6 +470,7 @@ def tune(
     maxiter: int = 30,
     popsize: int = 10,
     d_grid: int = 9,
+    d_refine: int = 4,
     worst_ratio: Callable[[Config, str], float] | None = None,
 ) -> TuneResult:
     """Search the law's gains for the best response under the constraints.
@@ -490,6 +493,8 @@ def tune(
         Differential-evolution generations and population factor.
     d_grid : int
         PTO: points of the geometric d grid.
+    d_refine : int
+        PTO: golden-section steps refining d between the best grid point's neighbours.
     worst_ratio : callable, optional
         ``f(cfg, law) -> worst settling / N*T`` for ``worst_ratio_nt``; default
         :func:`worst_ratio_nt` over the :data:`WORST_GRID` grid.
@@ -512,6 +517,11 @@ def tune(
         )
     if max_overshoot is not None and not (max_overshoot >= 0 and math.isfinite(max_overshoot)):
         raise InputError(f"tune: --max-overshoot must be a finite number >= 0, got {max_overshoot}")
+    if maxiter < 1 or popsize < 1 or d_grid < 2 or d_refine < 0:
+        raise InputError(
+            f"tune: maxiter and popsize must be >= 1, d_grid >= 2 and d_refine >= 0 (got "
+            f"{maxiter}, {popsize}, {d_grid}, {d_refine})"
+        )
     reference(signal)  # names the signal or raises InputError
     t0 = time.perf_counter()
     seen: dict[tuple, Candidate] = {}
@@ -545,7 +555,7 @@ def tune(
         i = int(np.argmin([score[float(d)] for d in ds]))
         a, b = float(ds[max(i - 1, 0)]), float(ds[min(i + 1, len(ds) - 1)])
         gr = (math.sqrt(5.0) - 1.0) / 2.0
-        for _ in range(4):
+        for _ in range(d_refine):
             c1, c2 = b - gr * (b - a), a + gr * (b - a)
             for d in (c1, c2):
                 if d not in score:
@@ -578,7 +588,8 @@ def tune(
         if v.feasible:
             runner_up = v
             break
-    front = pareto_front(list(seen.values()))
+    # the front over the evaluated candidates, less those the grid check rejected
+    front = pareto_front([c for c in seen.values() if c.feasible or not c.verified])
     return TuneResult(
         law=law,
         signal=signal,
@@ -606,6 +617,8 @@ class TuneBudget:
         Differential-evolution generations and population factor.
     d_grid : int
         PTO: points of the geometric d grid.
+    d_refine : int
+        PTO: golden-section steps on d.
     seed : int
         Seed (fixed, so the comparison is reproducible).
     """
@@ -613,6 +626,7 @@ class TuneBudget:
     maxiter: int = 30
     popsize: int = 10
     d_grid: int = 9
+    d_refine: int = 4
     seed: int = 0
 
 
@@ -674,6 +688,7 @@ def _fair_tunings(cfg: Config, budget: TuneBudget) -> FairTunings:
                     maxiter=budget.maxiter,
                     popsize=budget.popsize,
                     d_grid=budget.d_grid,
+                    d_refine=budget.d_refine,
                 )
             results[(law, name)] = by_value[key]
     return FairTunings(bounds, paper, results, budget, time.perf_counter() - t0)
@@ -707,7 +722,8 @@ def fair_tunings(cfg: Config, budget: TuneBudget | None = None) -> FairTunings:
 
 def _cand(c: Candidate) -> dict[str, Any]:
     j = c.to_json()
-    return {k: j[k] for k in ("gains", "omega0", "settling_2pct_s", "overshoot_mm", "verified")}
+    keys = ("gains", "omega0", "settling_2pct_s", "overshoot_mm", "verified", "feasible")
+    return {k: j[k] for k in keys}
 
 
 def fair_comparison(cfg: Config, budget: TuneBudget | None = None) -> dict[str, Any]:
@@ -725,7 +741,10 @@ def fair_comparison(cfg: Config, budget: TuneBudget | None = None) -> dict[str, 
     dict
         ``bounds_mm`` (name -> [mm]) and ``bound_meaning`` (name -> words);
         ``floor``: the step's ``nt_s`` (N* T) and ``tf_s`` (t_f*) [s], the
-        lower bounds of any settling time; ``paper``: law -> the step's metrics at
+        least times to reach the target exactly, and ``band_entry_s`` [s], the
+        least time to reach the 2 % band at all (full input from rest: a lower
+        bound of any 2 % settling time, which can lie below t_f* since the band
+        is entered before the target is reached); ``paper``: law -> the step's metrics at
         the paper's gains plus ``worst_ratio_nt``; ``fronts``: law -> the Pareto
         front of 2 % settling [s] vs overshoot [mm] over every candidate the
         tunings evaluated (cheap constraints; ``verified`` marks those checked on
@@ -740,9 +759,19 @@ def fair_comparison(cfg: Config, budget: TuneBudget | None = None) -> dict[str, 
 
     ft = fair_tunings(cfg, budget)
     step = reference("step").amplitude
+    a, w = cfg.plant.a, cfg.plant.w_max
+    dist = (1.0 - STEP_FRACTION) * abs(step)  # to the edge of the 2 % band, from rest
     floor = {
         "nt_s": float(discrete_min_steps_batch([-step], [0.0], cfg.plant).time_s[0]),
         "tf_s": float(min_time(np.array([-step]), np.array([0.0]), cfg.plant).t_f[0]),
+        "band_entry_s": float(
+            brentq(
+                lambda t: w * (t - (1.0 - math.exp(-a * t)) / a) - dist,
+                0.0,
+                dist / w + 1.0,
+                xtol=1e-15,
+            )
+        ),
     }
     paper = {law: dict(m, worst_ratio_nt=worst_ratio_nt(cfg, law)) for law, m in ft.paper.items()}
     fronts = {}
