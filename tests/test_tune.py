@@ -11,6 +11,7 @@ from scipy.linalg import expm
 from scipy.signal import cont2discrete
 
 from ptoverify import cli
+from ptoverify.claims import fair_comparison
 from ptoverify.config import config_from_mapping, load_config, paper_config
 from ptoverify.errors import InputError
 from ptoverify.exact import exact_metrics
@@ -21,7 +22,6 @@ from ptoverify.simulate import simulate
 from ptoverify.tune import (
     BOUNDS,
     TuneBudget,
-    fair_comparison,
     fair_tunings,
     pareto_front,
     tune,
