@@ -35,6 +35,8 @@ KEYS = {
     "discrete_batch_vs_lp_ratio",
     "check_s",
     "report_s",
+    "tune_pd_s",
+    "tune_pto_s",
 }
 
 
