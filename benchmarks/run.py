@@ -67,6 +67,8 @@ TARGETS = {  # key: (target, ">=" or "<=")
     "check_s": (60.0, "<="),
     "report_s": (120.0, "<="),
     "sweep_s": (30.0, "<="),
+    "tune_pd_s": (20.0, "<="),
+    "tune_pto_s": (120.0, "<="),
 }
 
 FULL = {
@@ -82,6 +84,7 @@ FULL = {
     "discrete_lp": 30,
     "repeat": 7,
     "cli_repeat": 3,
+    "tune": {},  # tune's defaults, as `ptoverify tune` runs it
 }
 SMALL = {
     "law": 2000,
@@ -96,6 +99,7 @@ SMALL = {
     "discrete_lp": 3,
     "repeat": 2,
     "cli_repeat": 1,
+    "tune": {"maxiter": 1, "popsize": 3, "d_grid": 2, "d_refine": 0},
 }
 
 
@@ -314,6 +318,23 @@ def bench_discrete_batch(cfg, size: dict) -> dict:
     }
 
 
+def bench_tune(cfg, size: dict) -> dict:
+    """Wall time [s] of one PD and one PTO tune on the step (no bound, seed 0), once each.
+
+    Tuning is seconds to a minute, so it is timed once, not as a median.
+    """
+    from ptoverify.tune import tune
+
+    out = {}
+    for law in ("pd", "pto"):
+        t0 = time.perf_counter()
+        r = tune(cfg, law, "step", **size["tune"])
+        out[f"{law}_s"] = time.perf_counter() - t0
+        out[f"{law}_evaluations"] = r.evaluations
+        out[f"{law}_settling_ms"] = 1e3 * r.best.settling_2pct_s
+    return out
+
+
 # ---------------------------------------------------------------- whole process
 def run_cli(args: list[str], repeat: int) -> tuple[float | None, str]:
     """Median wall time [s] of ``python -m ptoverify ARGS`` (cwd repo root)."""
@@ -397,6 +418,9 @@ def run(small: bool) -> tuple[dict, dict]:
     out["discrete_lp_states_per_s"] = db["lp_states_per_s"]
     out["discrete_batch_vs_lp_ratio"] = db["ratio"]
     extra["discrete_batch"] = db
+    tu = bench_tune(cfg, size)
+    out["tune_pd_s"], out["tune_pto_s"] = tu["pd_s"], tu["pto_s"]
+    extra["tune"] = tu
     check = ["check", "--gate", "roots-closed-form-vs-bisection"] if small else ["check"]
     out["check_s"], extra["check_note"] = run_cli(check, size["cli_repeat"])
     with tempfile.TemporaryDirectory() as tmp:  # never the tracked reports/ folder
@@ -438,6 +462,9 @@ def table(out: dict, extra: dict) -> str:
         f"{extra['discrete_batch']['lp_states']} states",
         f"scalar law on switching-zone states only (omega_c by Newton): "
         f"{extra['law_scalar_zone_us']:.3g} us",
+        f"tune (step, no bound): PD {extra['tune']['pd_evaluations']} evaluations, best "
+        f"settling {extra['tune']['pd_settling_ms']:.4g} ms; PTO "
+        f"{extra['tune']['pto_evaluations']} evaluations, {extra['tune']['pto_settling_ms']:.4g} ms",
     ]
     for k in ("check_note", "report_note", "sweep_note"):
         if extra[k]:

@@ -418,9 +418,17 @@ def _add_tune(sub) -> None:
         "--objective",
         choices=("settling_2pct", "settling_0p01mm", "worst_ratio_nt"),
         default="settling_2pct",
-        help="what to minimize (default settling_2pct)",
+        help="what to minimize (default settling_2pct); worst_ratio_nt: the worst settling / "
+        "N*T over a 20 x 20 grid of the envelope",
     )
     p.add_argument("--seed", type=int, default=0, help="search seed (default 0)")
+    p.add_argument(
+        "--maxiter",
+        type=int,
+        default=30,
+        metavar="N",
+        help="differential-evolution generations (default 30; the PTO uses max(N/2, 5) per d)",
+    )
     p.set_defaults(handler=_cmd_tune)
 
 
@@ -435,6 +443,7 @@ def _cmd_tune(args: argparse.Namespace) -> int:
         max_overshoot=args.max_overshoot,
         objective=args.objective,
         seed=args.seed,
+        maxiter=args.maxiter,
     )
     if args.json:
         print_json(res.to_json())
@@ -442,7 +451,8 @@ def _cmd_tune(args: argparse.Namespace) -> int:
     b = res.best
     print(
         f"# best {args.law} on the {args.signal}: settling (2 %) {b.settling_2pct_s * 1e3:.4g} ms, "
-        f"overshoot {b.overshoot_mm:.4g} mm, {res.evaluations} evaluations, "
+        f"overshoot {b.overshoot_mm:.4g} mm, {args.objective} {b.objective:.6g}, "
+        f"{res.evaluations} evaluations, "
         f"{res.seconds:.1f} s"
     )
     print(res.toml(), end="")

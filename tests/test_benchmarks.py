@@ -36,6 +36,8 @@ KEYS = {
     "check_s",
     "report_s",
     "sweep_s",
+    "tune_pd_s",
+    "tune_pto_s",
 }
 
 
