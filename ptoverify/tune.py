@@ -230,8 +230,15 @@ def worst_ratio_nt(
     p = cfg.plant
     x1, x2, nt, steps, hold = _envelope(p, n1, n2)
     st = settling_times(
-        make_law(law, cfg), p, x1, x2, steps, SweepSettings().band, p.a * SweepSettings().band, hold
-    )
+        make_law(law, cfg),
+        p,
+        x1,
+        x2,
+        steps,
+        SweepSettings().band,
+        p.a * SweepSettings().band,
+        hold * p.sample_time,
+    ).grid  # the sweep's sample-grid reading (its between-samples twin differs by < T)
     ok = np.isfinite(nt)
     if not np.isfinite(st[ok]).all():
         return math.inf
