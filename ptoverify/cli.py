@@ -29,7 +29,7 @@ from typing import Any
 
 from ptoverify import __version__
 from ptoverify.config import Config, load_config
-from ptoverify.errors import InputError, SolverError
+from ptoverify.errors import ClusterError, InputError, SolverError
 from ptoverify.outdir import (
     OutputBusy,
     Terminated,
@@ -947,7 +947,7 @@ def main(argv: list[str] | None = None) -> int:
     except OutputBusy as exc:
         print(f"ptoverify: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 1
-    except SolverError as exc:
+    except (SolverError, ClusterError) as exc:  # the input was fine; the run could not be done
         print(f"ptoverify: error: {_one_line(exc)}", file=sys.stderr)
         return 1
     except InputError as exc:
