@@ -336,22 +336,34 @@ def _map_task(
     box = cfg.robustness
     cells = [(float(wr), float(ar)) for wr in wrs for ar in ars]
     n = x1.size
-    m = Mismatch(
-        a_ratio=np.repeat([ar for _, ar in cells], n),
-        w_max_ratio=np.repeat([wr for wr, _ in cells], n),
-        delay_samples=delay,
-        position_quantum=box.position_quantum,
-        velocity_noise=box.velocity_noise,
-        seed=box.seed,
-    )
-    props = trajectory_properties(law, cfg, np.tile(x1, len(cells)), np.tile(x2, len(cells)), m)
     out = []
-    for i, (wr, ar) in enumerate(cells):
-        cell = {k: v[i * n : (i + 1) * n] for k, v in props.items()}
-        out.append(
-            {"a_ratio": ar, "w_max_ratio": wr, "delay_samples": delay, **_summarize(cell, x1, x2)}
+    for group in _groups(len(cells), n):
+        part = [cells[i] for i in group]
+        m = Mismatch(
+            a_ratio=np.repeat([ar for _, ar in part], n),
+            w_max_ratio=np.repeat([wr for wr, _ in part], n),
+            delay_samples=delay,
+            position_quantum=box.position_quantum,
+            velocity_noise=box.velocity_noise,
+            seed=box.seed,
         )
+        props = trajectory_properties(law, cfg, np.tile(x1, len(part)), np.tile(x2, len(part)), m)
+        for i, (wr, ar) in enumerate(part):
+            cell = {k: v[i * n : (i + 1) * n] for k, v in props.items()}
+            out.append(
+                {"a_ratio": ar, "w_max_ratio": wr, "delay_samples": delay}
+                | _summarize(cell, x1, x2)
+            )
     return out
+
+
+BATCH_STATES = 16384  #: largest batch simulated at once (memory: ~4 x 8 bytes x states x horizon)
+
+
+def _groups(items: int, per_item: int) -> list[range]:
+    """Split ``items`` blocks of ``per_item`` states into batches of <= BATCH_STATES states."""
+    size = max(1, BATCH_STATES // max(per_item, 1))
+    return [range(i, min(i + size, items)) for i in range(0, items, size)]
 
 
 Runner = Callable[[list[tuple]], list[Any]]
@@ -613,17 +625,21 @@ def no_limit_cycle_margin(
     x1, x2 = map_states(cfg, s)
 
     def clean(ratios: NDArray) -> NDArray[np.bool_]:
-        """No limit cycle from any grid state, for each ratio: one batch for all."""
-        r = np.repeat(ratios, x1.size)
-        props = trajectory_properties(
-            law,
-            cfg,
-            np.tile(x1, ratios.size),
-            np.tile(x2, ratios.size),
-            Mismatch(a_ratio=r),
-            with_settling=False,
-        )
-        return ~(props["limit_cycle_mm"].reshape(ratios.size, x1.size) > 0).any(axis=1)
+        """No limit cycle from any grid state, for each ratio: few batches for all."""
+        out = np.empty(ratios.size, dtype=bool)
+        for g in _groups(ratios.size, x1.size):
+            r = ratios[g.start : g.stop]
+            props = trajectory_properties(
+                law,
+                cfg,
+                np.tile(x1, r.size),
+                np.tile(x2, r.size),
+                Mismatch(a_ratio=np.repeat(r, x1.size)),
+                with_settling=False,
+            )
+            lc = props["limit_cycle_mm"].reshape(r.size, x1.size)
+            out[g.start : g.stop] = ~(lc > 0).any(axis=1)
+        return out
 
     if not clean(np.array([1.0]))[0]:
         return {"no_limit_cycle_a_ratio": None, "no_limit_cycle_note": "limit cycles nominally"}

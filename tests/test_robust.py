@@ -242,3 +242,13 @@ def test_no_limit_cycle_margin_against_a_brute_force_scan():
     assert scan[first - 1] <= hi < scan[first], (hi, scan[first - 1], scan[first])
     step = scan[first] / scan[first - 1]
     assert any(not clean(hi * step ** (k / 64)) for k in range(1, 65))
+
+
+def test_maps_do_not_depend_on_batching(monkeypatch):
+    """Cells simulated together or in batches of one cell give the same maps, bit for bit."""
+    import ptoverify.robust as robust_mod
+
+    s = dataclasses.replace(TINY, laws=("pto",))
+    together = robust_maps(CFG, s)
+    monkeypatch.setattr(robust_mod, "BATCH_STATES", 1)
+    assert robust_maps(CFG, s) == together
