@@ -1,7 +1,13 @@
 """Figures 2-14 of the paper and the sweep's heat maps (the only matplotlib module).
 
-Every plot function takes ``ax=None`` (a new figure when None), draws on it
-and returns what it drew: a dict from legend label to artist.  Nothing is
+Plots draw; they do not compute.  Every plot function takes results computed
+by the caller (``SimResult``, ``BatchResult``, ``PTOZone``, ``SweepResult``,
+``ConvergenceStudy``, or plain arrays) and an optional ``ax`` (a new figure when
+None), and returns what it drew: a dict from legend label to artist.  As
+python-control's ``time_response_plot`` takes a ``TimeResponseData``, nothing
+here simulates, builds a law or constructs a zone; the curves l1, l2, l1*, l2*
+come from the pure functions of :mod:`ptoverify.curves`.  The report's collect
+step (:func:`ptoverify.report.collect`) computes the inputs once.  Nothing is
 shown; the backend is Agg unless the caller chose another one first.
 
 Figures: Fig. 2 trajectories under +-w_max with l1, l2 (eqs. 8-11); Fig. 3
@@ -18,6 +24,8 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -29,19 +37,21 @@ if "MPLBACKEND" not in os.environ:
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
+from numpy.typing import NDArray  # noqa: E402
 
-from ptoverify.config import Config  # noqa: E402
+from ptoverify.config import Config, Plant  # noqa: E402
 from ptoverify.curves import h, level_curve_x1  # noqa: E402
-from ptoverify.laws import LAW_NAMES, Region, make_law  # noqa: E402
+from ptoverify.laws import Region  # noqa: E402
 from ptoverify.metrics import TIGHT_BAND  # noqa: E402
-from ptoverify.plant import flow  # noqa: E402
-from ptoverify.simulate import SimResult, simulate, simulate_batch  # noqa: E402
-from ptoverify.zones import corrected_zone, printed_zone  # noqa: E402
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # data types for annotations only: no simulator, no zone construction
     from ptoverify.ocp import ConvergenceStudy
+    from ptoverify.simulate import BatchResult, SimResult
+    from ptoverify.sweep import SweepResult
+    from ptoverify.zones import PTOZone
 
 __all__ = [
+    "FigureInputs",
     "plot_fig2",
     "plot_fig3",
     "plot_zones",
@@ -50,16 +60,17 @@ __all__ = [
     "plot_response",
     "plot_state_trajectories",
     "plot_sweep",
-    "save_all",
-    "save_sweep",
     "plot_zone_geometry",
     "plot_convergence",
     "plot_switch_profiles",
+    "save_figure",
+    "save_all",
+    "save_sweep",
     "save_ground_truth",
-    "save_zone_geometry",
 ]
 
 DPI = 110
+SIZE = (6.4, 4.2)
 STYLE = {
     "to": dict(color="tab:red", lw=1.0, label="TO"),
     "pd": dict(color="tab:blue", lw=1.3, label="PD"),
@@ -75,11 +86,12 @@ REGION_STYLE = {
     Region.SATURATED: ("tab:cyan", "linear, clipped"),
     Region.ORIGIN: ("k", "origin"),
 }
+Arcs = tuple[NDArray[np.float64], NDArray[np.float64]]
 
 
 def _ax(ax):
     if ax is None:
-        _, ax = plt.subplots(figsize=(6.4, 4.2))
+        _, ax = plt.subplots(figsize=SIZE)
     return ax
 
 
@@ -88,55 +100,12 @@ def _curve(ax, a: float, omega: float, x2, drawn: dict, label: str, **kw) -> Non
     drawn[label] = line
 
 
-def _switching(ax, cfg: Config, drawn: dict, *, lim: float | None = None) -> None:
-    a, w = cfg.plant.a, cfg.plant.w_max
+def _switching(ax, plant: Plant, drawn: dict, *, lim: float | None = None) -> None:
+    a, w = plant.a, plant.w_max
     top = w if lim is None else lim
     neg, pos = np.linspace(-top, 0, 300), np.linspace(0, top, 300)
     _curve(ax, a, w, neg, drawn, "l1 (eq. 9), x2 <= 0", color="k", lw=1.8)
     _curve(ax, a, w, pos, drawn, "l2 (eq. 11), x2 >= 0", color="k", lw=1.8, ls="-.")
-
-
-def plot_fig2(cfg: Config, ax=None) -> dict:
-    """Fig. 2: trajectories under u = +-w_max (eqs. 8, 10) and the curves l1, l2.
-
-    Parameters
-    ----------
-    cfg : Config
-        Configuration (a [rad/s], w_max [mm/s]).
-    ax : matplotlib Axes, optional
-        Where to draw.
-
-    Returns
-    -------
-    dict
-        Label -> artist.
-    """
-    ax = _ax(ax)
-    a, w = cfg.plant.a, cfg.plant.w_max
-    drawn: dict = {}
-    t = np.linspace(0, 6 / a, 200)
-    span = 4 * w / a
-    for x10 in np.linspace(-span, span, 7):
-        for u, x20, col, lab in (
-            (w, -0.95 * w, "tab:blue", "u = +w_max (eq. 8)"),
-            (-w, 0.95 * w, "tab:cyan", "u = -w_max (eq. 10)"),
-        ):
-            x1, x2 = flow(x10, x20, u, t, a)
-            (line,) = ax.plot(x1, x2, color=col, lw=0.8)
-            drawn.setdefault(lab, line).set_label(lab)
-    neg, pos = np.linspace(-0.999 * w, 0, 200), np.linspace(0, 0.999 * w, 200)
-    l1 = {"neg": w * h(-neg / w) / a, "pos": w * h(-pos / w) / a}  # eq. (9) solved for x1
-    l2 = {"neg": -w * h(neg / w) / a, "pos": -w * h(pos / w) / a}  # eq. (11) solved for x1
-    for x1, x2, lab, kw in (
-        (l1["neg"], neg, "l1, x2 <= 0 (kept)", dict(color="k", lw=2)),
-        (l1["pos"], pos, "l1, x2 > 0 (runs away)", dict(color="k", lw=1, ls=":")),
-        (l2["pos"], pos, "l2, x2 >= 0 (kept)", dict(color="0.3", lw=2, ls="-.")),
-        (l2["neg"], neg, "l2, x2 < 0 (runs away)", dict(color="0.3", lw=1, ls=":")),
-    ):
-        (drawn[lab],) = ax.plot(x1, x2, label=lab, **kw)
-    ax.set_xlim(-span * 1.5, span * 1.5)
-    _finish(ax, "Fig. 2: trajectories under +-w_max and the switching curve", drawn)
-    return drawn
 
 
 def _finish(
@@ -149,17 +118,18 @@ def _finish(
     ax.legend(fontsize=7, loc="best")
 
 
-def plot_fig3(cfg: Config, ax=None, *, steps: int | None = None) -> dict:
-    """Fig. 3: sampled time-optimal trajectories with the saturation |x2| <= w_max.
+def plot_fig2(plant: Plant, plus: Arcs, minus: Arcs, ax=None) -> dict:
+    """Fig. 2: trajectories under u = +-w_max (eqs. 8, 10) and the curves l1, l2.
 
     Parameters
     ----------
-    cfg : Config
-        Configuration.
+    plant : Plant
+        Plant (a [rad/s], w_max [mm/s]) for the curves l1, l2.
+    plus, minus : tuple of ndarray, each shape (n_t, n_traj)
+        (x1 [mm], x2 [mm/s]) of open-loop trajectories under u = +w_max and
+        u = -w_max, one column per trajectory (the caller evaluates the flow).
     ax : matplotlib Axes, optional
         Where to draw.
-    steps : int, optional
-        Samples simulated (default 3 t_f* of the farthest start).
 
     Returns
     -------
@@ -167,30 +137,61 @@ def plot_fig3(cfg: Config, ax=None, *, steps: int | None = None) -> dict:
         Label -> artist.
     """
     ax = _ax(ax)
-    p = cfg.plant
+    a, w = plant.a, plant.w_max
     drawn: dict = {}
-    R, w = p.position_range, p.w_max
-    x10 = np.array([R, R, 0.6 * R, -R, -0.6 * R, -R, 0.3 * R, -0.3 * R])
-    x20 = np.array([0.0, -0.8 * w, 0.9 * w, 0.0, -0.9 * w, 0.8 * w, 0.0, 0.0])
-    n = steps or int(math.ceil(3 * (2 * R / w + 3 / p.a) / p.T))
-    b = simulate_batch(make_law("to", cfg), p, x10, x20, n)
-    for j in range(x10.size):
-        (line,) = ax.plot(b.x1[:, j], b.x2[:, j], color="tab:blue", lw=0.8)
-        drawn["TO closed loop (sampled)"] = line
-    line.set_label("TO closed loop (sampled)")
-    _switching(ax, cfg, drawn, lim=0.999 * w)
+    for (x1, x2), col, lab in (
+        (plus, "tab:blue", "u = +w_max (eq. 8)"),
+        (minus, "tab:cyan", "u = -w_max (eq. 10)"),
+    ):
+        lines = ax.plot(np.asarray(x1), np.asarray(x2), color=col, lw=0.8)
+        lines[0].set_label(lab)
+        drawn[lab] = lines[0]
+    neg, pos = np.linspace(-0.999 * w, 0, 200), np.linspace(0, 0.999 * w, 200)
+    l1 = {"neg": w * h(-neg / w) / a, "pos": w * h(-pos / w) / a}  # eq. (9) solved for x1
+    l2 = {"neg": -w * h(neg / w) / a, "pos": -w * h(pos / w) / a}  # eq. (11) solved for x1
+    for x1, x2, lab, kw in (
+        (l1["neg"], neg, "l1, x2 <= 0 (kept)", dict(color="k", lw=2)),
+        (l1["pos"], pos, "l1, x2 > 0 (runs away)", dict(color="k", lw=1, ls=":")),
+        (l2["pos"], pos, "l2, x2 >= 0 (kept)", dict(color="0.3", lw=2, ls="-.")),
+        (l2["neg"], neg, "l2, x2 < 0 (runs away)", dict(color="0.3", lw=1, ls=":")),
+    ):
+        (drawn[lab],) = ax.plot(x1, x2, label=lab, **kw)
+    span = max(float(np.max(np.abs(plus[0][0]))), float(np.max(np.abs(minus[0][0]))))
+    ax.set_xlim(-span * 1.5, span * 1.5)
+    _finish(ax, "Fig. 2: trajectories under +-w_max and the switching curve", drawn)
+    return drawn
+
+
+def plot_fig3(batch: BatchResult, plant: Plant, ax=None) -> dict:
+    """Fig. 3: sampled time-optimal trajectories with the saturation |x2| <= w_max.
+
+    Parameters
+    ----------
+    batch : BatchResult
+        Sampled TO closed-loop trajectories, one column per initial state.
+    plant : Plant
+        Plant (a [rad/s], w_max [mm/s]) for l1, l2 and the saturation lines.
+    ax : matplotlib Axes, optional
+        Where to draw.
+
+    Returns
+    -------
+    dict
+        Label -> artist (``TO closed loop (sampled)`` is the first trajectory).
+    """
+    ax = _ax(ax)
+    w = plant.w_max
+    drawn: dict = {}
+    lines = ax.plot(batch.x1, batch.x2, color="tab:blue", lw=0.8)
+    lines[0].set_label("TO closed loop (sampled)")
+    drawn["TO closed loop (sampled)"] = lines[0]
+    _switching(ax, plant, drawn, lim=0.999 * w)
     for s in (1, -1):
         ln = ax.axhline(s * w, color="tab:red", ls="--", lw=1)
     ln.set_label("saturation |x2| = w_max")
     drawn["saturation |x2| = w_max"] = ln
     _finish(ax, "Fig. 3: trajectories with velocity saturation (TO, eq. 12)", drawn)
     return drawn
-
-
-def _zone(cfg: Config, variant: str):
-    from ptoverify.zones import zone_for_law
-
-    return zone_for_law(cfg, variant)
 
 
 def _zone_xlim(cfg: Config, omega0: float) -> float:
@@ -201,84 +202,73 @@ def _zone_xlim(cfg: Config, omega0: float) -> float:
     return max(4 * d, 1.3 * reach)
 
 
-def plot_zones(cfg: Config, variant: str = "corrected", ax=None) -> dict:
+def plot_zones(zone: PTOZone, cfg: Config, ax=None) -> dict:
     """Fig. 4: switching zone (l1 to l1*, l2 to l2*) and linear zone |x1| < d.
 
     Parameters
     ----------
+    zone : PTOZone
+        The zone to draw (its ``construction`` names the figure).
     cfg : Config
-        Configuration.
-    variant : {"corrected", "printed"}
-        Which zone construction (``ptoverify.zones``).
+        Configuration (a [rad/s], w_max [mm/s], d [mm]).
     ax : matplotlib Axes, optional
         Where to draw.
 
     Returns
     -------
     dict
-        Label -> artist.
+        Label -> artist; ``no zone`` when omega0 is not in (0, w_max).
     """
     ax = _ax(ax)
     a, w, d = cfg.plant.a, cfg.plant.w_max, cfg.pto.d
-    z = _zone(cfg, variant)
+    variant = zone.construction
     drawn: dict = {}
     drawn["linear zone |x1| < d"] = ax.axvspan(
         -d, d, color="tab:green", alpha=0.15, label="linear zone |x1| < d"
     )
-    _switching(ax, cfg, drawn, lim=w)
+    _switching(ax, cfg.plant, drawn, lim=w)
     neg, pos = np.linspace(-w, 0, 300), np.linspace(0, w, 300)
-    if 0 < z.omega0 < w:
-        om = z.omega0
-        _curve(
-            ax,
-            a,
-            om,
-            neg,
-            drawn,
-            f"l1* (eq. 13), omega0 = {om:.4g} mm/s",
-            color="tab:orange",
-            lw=1.6,
-        )
+    if 0 < zone.omega0 < w:
+        om = zone.omega0
+        label = f"l1* (eq. 13), omega0 = {om:.4g} mm/s"
+        _curve(ax, a, om, neg, drawn, label, color="tab:orange", lw=1.6)
         _curve(ax, a, om, pos, drawn, "l2* (eq. 14)", color="tab:orange", lw=1.6, ls="-.")
+        fill = dict(color="tab:orange", alpha=0.25)
         drawn["switching zone"] = ax.fill_betweenx(
             neg,
             level_curve_x1(neg, a, w),
             level_curve_x1(neg, a, om),
-            color="tab:orange",
-            alpha=0.25,
             label="switching zone S~_P, S~_N",
+            **fill,
         )
-        ax.fill_betweenx(
-            pos,
-            level_curve_x1(pos, a, om),
-            level_curve_x1(pos, a, w),
-            color="tab:orange",
-            alpha=0.25,
-        )
+        ax.fill_betweenx(pos, level_curve_x1(pos, a, om), level_curve_x1(pos, a, w), **fill)
     else:
         drawn["no zone"] = ax.text(
             0.02,
             0.04,
-            f"{variant}: omega0 = {z.omega0:.4g} mm/s, no switching zone",
+            f"{variant}: omega0 = {zone.omega0:.4g} mm/s, no switching zone",
             transform=ax.transAxes,
             fontsize=7,
         )
-    lim = _zone_xlim(cfg, z.omega0)
+    lim = _zone_xlim(cfg, zone.omega0)
     ax.set_xlim(-lim, lim)
     ax.set_ylim(-1.05 * w, 1.05 * w)
     _finish(ax, f"Fig. 4: switching and linear zones ({variant})", drawn)
     return drawn
 
 
-def plot_fig5(cfg: Config, variant: str = "corrected", ax=None) -> dict:
+def plot_fig5(zone: PTOZone, cfg: Config, image: Arcs, ax=None) -> dict:
     """Fig. 5: l1, l1* and the one-sample image l~1 of l1 (eq. 19 and exact).
 
     Parameters
     ----------
+    zone : PTOZone
+        Zone whose l1* and (x~10, x~20) are drawn.
     cfg : Config
-        Configuration.
-    variant : {"corrected", "printed"}
-        Zone whose l1* is drawn.
+        Configuration (a [rad/s], w_max [mm/s], T [s], d [mm]).
+    image : tuple of ndarray
+        (x1 [mm], x2 [mm/s]): points of l1 moved one sample T under u = -w_max
+        (the caller evaluates the flow).
     ax : matplotlib Axes, optional
         Where to draw.
 
@@ -290,7 +280,7 @@ def plot_fig5(cfg: Config, variant: str = "corrected", ax=None) -> dict:
     ax = _ax(ax)
     p = cfg.plant
     a, w, d, T = p.a, p.w_max, cfg.pto.d, p.T
-    z = _zone(cfg, variant)
+    variant = zone.construction
     drawn: dict = {}
     neg = np.linspace(-w, 0, 300)
     _curve(ax, a, w, neg, drawn, "l1 (eq. 9)", color="k", lw=1.8)
@@ -302,92 +292,62 @@ def plot_fig5(cfg: Config, variant: str = "corrected", ax=None) -> dict:
         label="l~1 as printed (eq. 19)",
     )
     drawn[line.get_label()] = line
-    f1, f2 = flow(level_curve_x1(neg, a, w), neg, -w, T, a)
-    (line,) = ax.plot(f1, f2, color="tab:purple", label="image of l1 after T under -w_max")
+    (line,) = ax.plot(*image, color="tab:purple", label="image of l1 after T under -w_max")
     drawn[line.get_label()] = line
-    if 0 < z.omega0 < w:
-        _curve(
-            ax,
-            a,
-            z.omega0,
-            neg,
-            drawn,
-            f"l1* ({variant}, omega0 = {z.omega0:.4g} mm/s)",
-            color="tab:orange",
-            lw=1.6,
-        )
-    if math.isfinite(z.x20_tilde) and abs(z.x20_tilde) <= w:
-        (pt,) = ax.plot(
-            [d],
-            [z.x20_tilde],
-            "o",
-            color="tab:red",
-            label=f"(x~10, x~20) = ({d:g}, {z.x20_tilde:.4g})",
-        )
-        drawn[pt.get_label()] = pt
+    if 0 < zone.omega0 < w:
+        label = f"l1* ({variant}, omega0 = {zone.omega0:.4g} mm/s)"
+        _curve(ax, a, zone.omega0, neg, drawn, label, color="tab:orange", lw=1.6)
+    if math.isfinite(zone.x20_tilde) and abs(zone.x20_tilde) <= w:
+        label = f"(x~10, x~20) = ({d:g}, {zone.x20_tilde:.4g})"
+        (pt,) = ax.plot([d], [zone.x20_tilde], "o", color="tab:red", label=label)
+        drawn[label] = pt
     drawn["x1 = d"] = ax.axvline(d, color="tab:green", ls=":", label="x1 = d")
-    lim = _zone_xlim(cfg, z.omega0)
+    lim = _zone_xlim(cfg, zone.omega0)
     ax.set_xlim(-0.5 * lim, lim)
     ax.set_ylim(-1.05 * w, 0.05 * w)
     _finish(ax, f"Fig. 5: l1, l1* and l~1 ({variant})", drawn)
     return drawn
 
 
-def plot_fig6(
-    cfg: Config,
-    law: str = "pto",
-    ax=None,
-    *,
-    x0: tuple[float, float] | None = None,
-    steps: int = 60,
-) -> dict:
+def plot_fig6(zone: PTOZone, cfg: Config, batch: BatchResult, law: str, ax=None) -> dict:
     """Fig. 6: a trajectory from the fourth quadrant, each sample marked by region.
 
     Parameters
     ----------
+    zone : PTOZone
+        The zone the law uses (drawn as in Fig. 4).
     cfg : Config
         Configuration.
+    batch : BatchResult
+        The closed-loop trajectory (first column) with its region codes.
     law : str
-        ``pto`` or ``pto-printed``.
+        Law name for the labels (``pto`` or ``pto-printed``).
     ax : matplotlib Axes, optional
         Where to draw.
-    x0 : tuple of float, optional
-        Initial state (x1 [mm], x2 [mm/s]); default (4 d, -w_max / 3).
-    steps : int
-        Samples simulated.
 
     Returns
     -------
     dict
-        Label -> artist.
+        Label -> artist; one ``sample in ...`` entry per region visited.
     """
-    variant = "printed" if law == "pto-printed" else "corrected"
-    drawn = plot_zones(cfg, variant, ax)
+    drawn = plot_zones(zone, cfg, ax)
     ax = drawn["l1 (eq. 9), x2 <= 0"].axes
-    x0 = x0 or (4 * cfg.pto.d, -cfg.plant.w_max / 3)
-    b = simulate_batch(make_law(law, cfg), cfg.plant, [x0[0]], [x0[1]], steps)
-    (line,) = ax.plot(b.x1[:, 0], b.x2[:, 0], color="0.4", lw=0.8, label=f"{law} trajectory")
+    x1, x2 = batch.x1[:, 0], batch.x2[:, 0]
+    (line,) = ax.plot(x1, x2, color="0.4", lw=0.8, label=f"{law} trajectory")
     drawn[line.get_label()] = line
-    reg = b.region[:, 0]
+    reg = batch.region[:, 0]
     lo, hi = ax.get_xlim()
-    ax.set_xlim(min(lo, 1.15 * min(x0[0], 0)), max(hi, 1.15 * max(x0[0], 0)))
+    ax.set_xlim(min(lo, 1.15 * min(x1[0], 0)), max(hi, 1.15 * max(x1[0], 0)))
     for code, (col, lab) in REGION_STYLE.items():
         k = np.flatnonzero(reg == code)
         if k.size:
             key = f"sample in {lab}"
-            drawn[key] = ax.scatter(b.x1[k, 0], b.x2[k, 0], s=14, color=col, zorder=3, label=key)
+            drawn[key] = ax.scatter(x1[k], x2[k], s=14, color=col, zorder=3, label=key)
     ax.set_title(
-        f"Fig. 6: {law} from ({x0[0]:g} mm, {x0[1]:g} mm/s), region of each sample", fontsize=9
+        f"Fig. 6: {law} from ({x1[0]:g} mm, {x2[0]:g} mm/s), region of each sample", fontsize=9
     )
     ax.legend(fontsize=6, loc="lower left")
     return drawn
-
-
-def _sims(cfg: Config, signal: str, feedforward: bool) -> dict[str, SimResult]:
-    return {
-        name: simulate(make_law(name, cfg), cfg.plant, signal, feedforward=feedforward)
-        for name in LAW_NAMES
-    }
 
 
 _FIGNUM = {
@@ -406,31 +366,27 @@ _QUANT = {
 }
 
 
+def _tracking(res: SimResult) -> str:
+    return "feed-forward" if res.feedforward else "no feed-forward"
+
+
 def plot_response(
-    cfg: Config,
-    signal: str,
-    quantity: str = "position",
-    ax=None,
-    *,
-    feedforward: bool = True,
-    sims: dict | None = None,
+    sims: Mapping[str, SimResult], quantity: str = "position", ax=None, *, cfg: Config | None = None
 ) -> dict:
-    """Figs. 7-13: position, velocity or error of every law on a reference.
+    """Figs. 7-13: position, velocity or error of every law on one reference.
 
     Parameters
     ----------
-    cfg : Config
-        Configuration.
-    signal : {"step", "ramp", "sine"}
-        Reference.
+    sims : mapping of str to SimResult
+        Responses by law name (``to``, ``pd``, ``pto``, ``pto-printed``), all on
+        the same reference; signal and tracking are read from the results.
     quantity : {"position", "velocity", "error"}
         What to draw against time.
     ax : matplotlib Axes, optional
         Where to draw.
-    feedforward : bool
-        Reading: reference velocity fed forward.
-    sims : dict, optional
-        Precomputed responses by law name.
+    cfg : Config, optional
+        Configuration: the linear zone +-d [mm] on error plots and a [rad/s] in
+        the title.
 
     Returns
     -------
@@ -438,32 +394,35 @@ def plot_response(
         Label -> artist.
     """
     ax = _ax(ax)
-    sims = sims or _sims(cfg, signal, feedforward)
     attr, ylab = _QUANT[quantity]
     drawn: dict = {}
     for name, res in sims.items():
         (line,) = ax.plot(res.t, getattr(res, attr), **STYLE[name])
         drawn[STYLE[name]["label"]] = line
-    any_res = next(iter(sims.values()))
+    first = next(iter(sims.values()))
     if quantity in ("position", "velocity"):
-        ref = any_res.r if quantity == "position" else any_res.r_dot
-        (line,) = ax.plot(any_res.t, ref, color="k", lw=0.8, ls=":", label="reference")
+        ref = first.r if quantity == "position" else first.r_dot
+        (line,) = ax.plot(first.t, ref, color="k", lw=0.8, ls=":", label="reference")
         drawn["reference"] = line
     else:
-        d = cfg.pto.d
-        for s in (1, -1):
-            ld = ax.axhline(s * d, color="tab:green", ls="--", lw=0.7)
-            lb = ax.axhline(s * TIGHT_BAND, color="0.5", ls=":", lw=0.7)
-        ld.set_label(f"linear zone +-d = +-{d:g} mm")
-        lb.set_label(f"tight band +-{TIGHT_BAND:g} mm")
-        drawn[ld.get_label()], drawn[lb.get_label()] = ld, lb
-        ax.set_ylim(-3 * d, 3 * d) if signal != "sine" else None
-    ff = "feed-forward" if feedforward else "no feed-forward"
-    fig = _FIGNUM.get((signal, quantity))
+        bands = [(TIGHT_BAND, f"tight band +-{TIGHT_BAND:g} mm", dict(color="0.5", ls=":"))]
+        if cfg is not None:
+            d = cfg.pto.d
+            zone = dict(color="tab:green", ls="--")
+            bands.insert(0, (d, f"linear zone +-d = +-{d:g} mm", zone))
+            if first.signal != "sine":
+                ax.set_ylim(-3 * d, 3 * d)
+        for level, label, kw in bands:
+            for s in (1, -1):
+                line = ax.axhline(s * level, lw=0.7, **kw)
+            line.set_label(label)
+            drawn[label] = line
+    fig = _FIGNUM.get((first.signal, quantity))
     num = f"Fig. {fig}: " if fig else ""
+    plant = f", a = {cfg.plant.a:.4g} rad/s" if cfg is not None else ""
     _finish(
         ax,
-        f"{num}{signal} response: {quantity} ({ff}, a = {cfg.plant.a:.4g} rad/s)",
+        f"{num}{first.signal} response: {quantity} ({_tracking(first)}{plant})",
         drawn,
         xlab="time t [s]",
         ylab=ylab,
@@ -471,28 +430,15 @@ def plot_response(
     return drawn
 
 
-def plot_state_trajectories(
-    cfg: Config,
-    signal: str = "sine",
-    ax=None,
-    *,
-    feedforward: bool = True,
-    sims: dict | None = None,
-) -> dict:
+def plot_state_trajectories(sims: Mapping[str, SimResult], ax=None) -> dict:
     """Fig. 14: state trajectories (x1, x2) of every law, with the reference (r, r').
 
     Parameters
     ----------
-    cfg : Config
-        Configuration.
-    signal : str
-        Reference (default the sine of Sec. 6.3).
+    sims : mapping of str to SimResult
+        Responses by law name, all on the same reference.
     ax : matplotlib Axes, optional
         Where to draw.
-    feedforward : bool
-        Reading: reference velocity fed forward.
-    sims : dict, optional
-        Precomputed responses by law name.
 
     Returns
     -------
@@ -500,7 +446,6 @@ def plot_state_trajectories(
         Label -> artist.
     """
     ax = _ax(ax)
-    sims = sims or _sims(cfg, signal, feedforward)
     drawn: dict = {}
     for name, res in sims.items():
         (line,) = ax.plot(res.x1, res.x2, **{**STYLE[name], "lw": 0.8})
@@ -508,12 +453,13 @@ def plot_state_trajectories(
     res = next(iter(sims.values()))
     (line,) = ax.plot(res.r, res.r_dot, color="k", ls=":", lw=0.8, label="reference (r, r')")
     drawn["reference"] = line
-    ff = "feed-forward" if feedforward else "no feed-forward"
-    _finish(ax, f"Fig. 14: state trajectories, {signal} ({ff})", drawn)
+    _finish(ax, f"Fig. 14: state trajectories, {res.signal} ({_tracking(res)})", drawn)
     return drawn
 
 
-def plot_sweep(res, law: str, which: str = "tf", ax=None, *, vmax: float | None = None) -> dict:
+def plot_sweep(
+    res: SweepResult, law: str, which: str = "tf", ax=None, *, vmax: float | None = None
+) -> dict:
     """Heat map of a law's settling time over t_f* (``tf``) or N* T (``nt``).
 
     Parameters
@@ -577,124 +523,6 @@ def plot_sweep(res, law: str, which: str = "tf", ax=None, *, vmax: float | None 
     return drawn
 
 
-def _save(fig, path: Path, out: list[Path]) -> None:
-    fig.tight_layout()
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
-    out.append(path)
-
-
-def save_sweep(res, outdir: str | Path) -> list[Path]:
-    """Write the sweep's heat maps (one PNG per denominator, a panel per law).
-
-    The panels of one PNG share their colour scale, so the laws compare by eye.
-    """
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    files: list[Path] = []
-    laws = list(res.laws)
-    cols = 2 if len(laws) > 1 else 1
-    rows = math.ceil(len(laws) / cols)
-    for which in ("tf", "nt"):
-        ratios = [r.ratio_tf if which == "tf" else r.ratio_nt for r in res.laws.values()]
-        finite = np.concatenate([r[np.isfinite(r)] for r in ratios])
-        vmax = max(2.0, float(np.percentile(finite, 99))) if finite.size else 2.0
-        fig, axes = plt.subplots(rows, cols, figsize=(5.6 * cols, 4.2 * rows), squeeze=False)
-        for ax, law in zip(axes.flat, laws, strict=False):
-            plot_sweep(res, law, which, ax, vmax=vmax)
-        for ax in list(axes.flat)[len(laws) :]:
-            ax.set_visible(False)
-        _save(fig, outdir / f"sweep_ratio_{which}.png", files)
-    return files
-
-
-def save_all(cfg: Config, outdir: str | Path) -> list[Path]:
-    """Write Figs. 2-14 as PNGs (dpi 110) and return their paths.
-
-    Zone figures come for both constructions; response figures for ramp and
-    sine for both feed-forward readings (suffix ``_noff`` without).
-
-    Parameters
-    ----------
-    cfg : Config
-        Configuration.
-    outdir : str or Path
-        Folder (created if missing).
-
-    Returns
-    -------
-    list of Path
-        The files written.
-    """
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    files: list[Path] = []
-
-    def one(name: str, draw) -> None:
-        fig, ax = plt.subplots(figsize=(6.4, 4.2))
-        draw(ax)
-        _save(fig, outdir / f"{name}.png", files)
-
-    one("fig02_trajectories", lambda ax: plot_fig2(cfg, ax))
-    one("fig03_saturation", lambda ax: plot_fig3(cfg, ax))
-    for v in ("corrected", "printed"):
-        one(f"fig04_zones_{v}", lambda ax, v=v: plot_zones(cfg, v, ax))
-        one(f"fig05_l1_image_{v}", lambda ax, v=v: plot_fig5(cfg, v, ax))
-    for law in ("pto", "pto-printed"):
-        one(f"fig06_trajectory_{law}", lambda ax, law=law: plot_fig6(cfg, law, ax))
-    step = _sims(cfg, "step", True)
-    one("fig07_step_position", lambda ax: plot_response(cfg, "step", "position", ax, sims=step))
-    one("fig08_step_error", lambda ax: plot_response(cfg, "step", "error", ax, sims=step))
-    for ff, sfx in ((True, ""), (False, "_noff")):
-        ramp, sine = _sims(cfg, "ramp", ff), _sims(cfg, "sine", ff)
-        for num, q in ((9, "position"), (10, "velocity"), (11, "error")):
-            one(
-                f"fig{num:02d}_ramp_{q}{sfx}",
-                lambda ax, q=q, ff=ff, s=ramp: plot_response(
-                    cfg, "ramp", q, ax, feedforward=ff, sims=s
-                ),
-            )
-        for num, q in ((12, "position"), (13, "velocity")):
-            one(
-                f"fig{num:02d}_sine_{q}{sfx}",
-                lambda ax, q=q, ff=ff, s=sine: plot_response(
-                    cfg, "sine", q, ax, feedforward=ff, sims=s
-                ),
-            )
-        one(
-            f"fig14_sine_states{sfx}",
-            lambda ax, ff=ff, s=sine: plot_state_trajectories(
-                cfg, "sine", ax, feedforward=ff, sims=s
-            ),
-        )
-    return files
-
-
-def save_ground_truth(study, outdir: str | Path) -> list[Path]:
-    """Write the collocation convergence and switch-profile figures; return the paths."""
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    files: list[Path] = []
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    plot_convergence(study, ax)
-    _save(fig, outdir / "convergence.png", files)
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    plot_switch_profiles(study, 0, ax)
-    _save(fig, outdir / "collocation_switch.png", files)
-    return files
-
-
-def save_zone_geometry(cfg: Config, outdir: str | Path) -> list[Path]:
-    """Write the zone-geometry figure with sampled trajectories; return the path."""
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    files: list[Path] = []
-    fig, ax = plt.subplots(figsize=(7.5, 5.0))
-    plot_zone_geometry(cfg, ax)
-    _save(fig, outdir / "zone_geometry.png", files)
-    return files
-
-
 # ------------------------------------------------------------ zone geometry
 _ZONE_MARKERS = {
     Region.BANG_P: ("^", "tab:red"),
@@ -707,45 +535,66 @@ _ZONE_MARKERS = {
 }
 
 
+def zone_geometry_xlim(zone: PTOZone, cfg: Config) -> float:
+    """Half-width of the zone-geometry figure's x1 axis [mm]: 4 d or 1.3 l1*(-w_max).
+
+    Parameters
+    ----------
+    zone : PTOZone
+        The corrected zone (its omega0 [mm/s]; w_max when not usable).
+    cfg : Config
+        Configuration (a [rad/s], w_max [mm/s], d [mm]).
+
+    Returns
+    -------
+    float
+        The half-width [mm]; the caller picks trajectory starts inside it.
+    """
+    a, w = cfg.plant.a, cfg.plant.w_max
+    om = zone.omega0 if zone.usable else w
+    return max(4 * cfg.pto.d, 1.3 * float(level_curve_x1(-w, a, om)))
+
+
 def plot_zone_geometry(
+    zone: PTOZone,
+    printed: PTOZone,
     cfg: Config,
+    batch: BatchResult,
     ax=None,
-    starts: tuple[tuple[float, float], ...] | None = None,
-    steps: int = 60,
     x1_max: float | None = None,
 ) -> dict:
     """Draw the zone geometry and sampled PTO trajectories.
 
     Parameters
     ----------
+    zone : PTOZone
+        The corrected zone (l1*, l2* and the zones S~_P, S~_N).
+    printed : PTOZone
+        The printed construction (how far the printed curve (19) is drawn).
     cfg : Config
         Configuration (a [rad/s], w_max [mm/s], T [s], d [mm]).
+    batch : BatchResult
+        Sampled PTO trajectories, one column per initial state, with regions.
     ax : matplotlib Axes, optional
         Axes to draw on; a new figure when None.
-    starts : tuple of (x1, x2), optional
-        Initial states [mm], [mm/s] of the trajectories; default a few states
-        right of l1* and their mirror images.
-    steps : int
-        Samples per trajectory.
     x1_max : float, optional
-        Half-width of the x1 axis [mm]; default 4 d or l1* at -w_max, whichever is larger.
+        Half-width of the x1 axis [mm]; default :func:`zone_geometry_xlim`.
 
     Returns
     -------
     dict
-        ``figure``, ``ax``, ``lines`` (name -> Line2D), ``zone`` and ``printed``
-        (:class:`~ptoverify.zones.PTOZone`).
+        ``figure``, ``ax``, ``lines`` (name -> Line2D: ``l1``, ``l1*``, ``eq19``,
+        ``trajectories``), ``zone`` and ``printed`` (the zones drawn).
     """
     a, w, T, d = cfg.plant.a, cfg.plant.w_max, cfg.plant.sample_time, cfg.pto.d
-    zc, zp = corrected_zone(cfg, verify=False), printed_zone(cfg)
-    om = zc.omega0 if zc.usable else w
+    om = zone.omega0 if zone.usable else w
     if ax is None:
-        fig, ax = plt.subplots(figsize=(8, 6))
+        _, ax = plt.subplots(figsize=(8, 6))
     fig = ax.figure
     s = np.linspace(0.0, w, 400)
     l1 = level_curve_x1(-s, a, w)
     l1s = level_curve_x1(-s, a, om)
-    xmax = x1_max or max(4 * d, 1.3 * float(l1s[-1]))
+    xmax = x1_max or zone_geometry_xlim(zone, cfg)
     lines = {}
     (lines["l1"],) = ax.plot(l1, -s, "k-", lw=1.5, label="l1, l2 (eqs. 9, 11)")
     ax.plot(-l1, s, "k-", lw=1.5)
@@ -756,25 +605,19 @@ def plot_zone_geometry(
     ax.fill_betweenx(-s, l1, l1s, color="tab:orange", alpha=0.15, label="zones S~_P, S~_N")
     ax.fill_betweenx(s, -l1s, -l1, color="tab:orange", alpha=0.15)
     # printed curve (19): a x1 + x2 + w ln(1 - x2/w) = -2 a w T
-    s19 = np.linspace(0.0, max(w, -zp.x20_tilde if np.isfinite(zp.x20_tilde) else w), 400)
+    top = -printed.x20_tilde if np.isfinite(printed.x20_tilde) else w
+    s19 = np.linspace(0.0, max(w, top), 400)
     x19 = (-2 * a * w * T + s19 - w * np.log1p(s19 / w)) / a
     (lines["eq19"],) = ax.plot(x19, -s19, ":", color="tab:purple", label="printed curve (19)")
     ax.axvspan(-d, d, color="tab:green", alpha=0.08, label=f"linear zone |x1| < {d:g} mm")
-    if starts is None:
-        x0 = np.linspace(1.2, 0.9 * xmax / max(d, 1e-9), 4) * d
-        starts = tuple((float(v), 0.0) for v in x0) + ((float(xmax * 0.9), -w),)
-        starts = starts + tuple((-x, -v) for x, v in starts)
-    res = simulate_batch(
-        make_law("pto", cfg), cfg.plant, [p[0] for p in starts], [p[1] for p in starts], steps
-    )
-    for j in range(len(starts)):
-        ax.plot(res.x1[:, j], res.x2[:, j], "-", color="0.6", lw=0.7)
+    traj = ax.plot(batch.x1, batch.x2, "-", color="0.6", lw=0.7)
+    lines["trajectories"] = traj[0]
     for reg, (mk, col) in _ZONE_MARKERS.items():
-        sel = res.region == reg
+        sel = batch.region == reg
         if sel.any():
             ax.plot(
-                res.x1[:-1][sel],
-                res.x2[:-1][sel],
+                batch.x1[:-1][sel],
+                batch.x2[:-1][sel],
                 mk,
                 color=col,
                 ms=3,
@@ -788,7 +631,7 @@ def plot_zone_geometry(
     ax.set_title(f"{cfg.name}: switching zone, T = {T * 1e3:g} ms, a = {a:.4g} rad/s")
     ax.legend(fontsize=7, loc="upper right")
     ax.grid(True, alpha=0.3)
-    return {"figure": fig, "ax": ax, "lines": lines, "zone": zc, "printed": zp}
+    return {"figure": fig, "ax": ax, "lines": lines, "zone": zone, "printed": printed}
 
 
 # ------------------------------------------------------------ collocation study
@@ -861,3 +704,201 @@ def plot_switch_profiles(study: ConvergenceStudy, state: int = 0, ax=None, windo
     ax.grid(True, lw=0.3)
     ax.legend(fontsize=7)
     return ax
+
+
+# ------------------------------------------------------------ files
+@dataclass(frozen=True)
+class FigureInputs:
+    """Everything Figs. 2-14 and the zone-geometry figure draw, computed by the caller.
+
+    Attributes
+    ----------
+    cfg : Config
+        Configuration the results were computed for.
+    open_loop : dict of str to tuple of ndarray
+        ``+w_max`` and ``-w_max``: open-loop trajectories (x1 [mm], x2 [mm/s]),
+        each of shape (n_t, n_traj) (Fig. 2).
+    to_batch : BatchResult
+        Sampled TO trajectories from the envelope's edge (Fig. 3).
+    zones : dict of str to PTOZone
+        ``corrected`` and ``printed``: the zones the PTO laws use (Figs. 4-6).
+    l1_image : tuple of ndarray
+        Points of l1 moved one sample under -w_max (x1 [mm], x2 [mm/s]) (Fig. 5).
+    fig6 : dict of str to BatchResult
+        ``pto`` and ``pto-printed``: a trajectory from the fourth quadrant (Fig. 6).
+    sims : dict of (str, bool) to dict of str to SimResult
+        (signal, feedforward) -> law name -> response (Figs. 7-14).
+    geometry : BatchResult
+        Sampled corrected-PTO trajectories for the zone-geometry figure.
+    """
+
+    cfg: Config
+    open_loop: dict[str, Arcs]
+    to_batch: BatchResult
+    zones: dict[str, PTOZone]
+    l1_image: Arcs
+    fig6: dict[str, BatchResult]
+    sims: dict[tuple[str, bool], dict[str, SimResult]]
+    geometry: BatchResult
+
+
+def save_figure(path: str | Path, draw: Callable, size: tuple[float, float] = SIZE) -> Path:
+    """Draw on a new figure, write it as a PNG (dpi 110), close it.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write (its folder must exist).
+    draw : callable
+        ``draw(ax)`` draws on the figure's axes.
+    size : tuple of float
+        Figure size [inch].
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    fig, ax = plt.subplots(figsize=size)
+    try:
+        draw(ax)
+        _write(fig, path)
+    finally:
+        plt.close(fig)
+    return Path(path)
+
+
+def _write(fig, path: str | Path) -> None:
+    """Tight layout once, then save without the layout engine's extra draw pass."""
+    fig.tight_layout()
+    fig.set_layout_engine(None)  # margins are set; a placeholder engine would redraw
+    fig.savefig(path, dpi=DPI)
+
+
+def _folder(outdir: str | Path) -> Path:
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    return outdir
+
+
+def save_sweep(res: SweepResult, outdir: str | Path) -> list[Path]:
+    """Write the sweep's heat maps (one PNG per denominator, a panel per law).
+
+    The panels of one PNG share their colour scale, so the laws compare by eye.
+
+    Parameters
+    ----------
+    res : SweepResult
+        Output of :func:`ptoverify.sweep.run_sweep`.
+    outdir : str or Path
+        Folder (created if missing).
+
+    Returns
+    -------
+    list of Path
+        ``sweep_ratio_tf.png`` and ``sweep_ratio_nt.png``.
+    """
+    outdir = _folder(outdir)
+    files: list[Path] = []
+    laws = list(res.laws)
+    cols = 2 if len(laws) > 1 else 1
+    rows = math.ceil(len(laws) / cols)
+    for which in ("tf", "nt"):
+        ratios = [r.ratio_tf if which == "tf" else r.ratio_nt for r in res.laws.values()]
+        finite = np.concatenate([r[np.isfinite(r)] for r in ratios])
+        vmax = max(2.0, float(np.percentile(finite, 99))) if finite.size else 2.0
+        fig, axes = plt.subplots(rows, cols, figsize=(5.6 * cols, 4.2 * rows), squeeze=False)
+        try:
+            for ax, law in zip(axes.flat, laws, strict=False):
+                plot_sweep(res, law, which, ax, vmax=vmax)
+            for ax in list(axes.flat)[len(laws) :]:
+                ax.set_visible(False)
+            _write(fig, outdir / f"sweep_ratio_{which}.png")
+        finally:
+            plt.close(fig)
+        files.append(outdir / f"sweep_ratio_{which}.png")
+    return files
+
+
+def save_all(inputs: FigureInputs, outdir: str | Path) -> list[Path]:
+    """Write Figs. 2-14 and the zone-geometry figure as PNGs; return their paths.
+
+    Zone figures come for both constructions; response figures for ramp and
+    sine for both feed-forward readings (suffix ``_noff`` without).
+
+    Parameters
+    ----------
+    inputs : FigureInputs
+        The results to draw.
+    outdir : str or Path
+        Folder (created if missing).
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
+    outdir = _folder(outdir)
+    cfg, fi = inputs.cfg, inputs
+    files: list[Path] = []
+
+    def one(name: str, draw: Callable, size: tuple[float, float] = SIZE) -> None:
+        files.append(save_figure(outdir / f"{name}.png", draw, size))
+
+    one("fig02_trajectories", lambda ax: plot_fig2(cfg.plant, *fi.open_loop.values(), ax))
+    one("fig03_saturation", lambda ax: plot_fig3(fi.to_batch, cfg.plant, ax))
+    for v in ("corrected", "printed"):
+        z = fi.zones[v]
+        one(f"fig04_zones_{v}", lambda ax, z=z: plot_zones(z, cfg, ax))
+        one(f"fig05_l1_image_{v}", lambda ax, z=z: plot_fig5(z, cfg, fi.l1_image, ax))
+    for law, v in (("pto", "corrected"), ("pto-printed", "printed")):
+        b, z = fi.fig6[law], fi.zones[v]
+        one(f"fig06_trajectory_{law}", lambda ax, z=z, b=b, law=law: plot_fig6(z, cfg, b, law, ax))
+    step = fi.sims[("step", True)]
+    one("fig07_step_position", lambda ax: plot_response(step, "position", ax, cfg=cfg))
+    one("fig08_step_error", lambda ax: plot_response(step, "error", ax, cfg=cfg))
+    for ff, sfx in ((True, ""), (False, "_noff")):
+        ramp, sine = fi.sims[("ramp", ff)], fi.sims[("sine", ff)]
+        for num, q in ((9, "position"), (10, "velocity"), (11, "error")):
+            one(
+                f"fig{num:02d}_ramp_{q}{sfx}",
+                lambda ax, q=q, s=ramp: plot_response(s, q, ax, cfg=cfg),
+            )
+        for num, q in ((12, "position"), (13, "velocity")):
+            one(
+                f"fig{num:02d}_sine_{q}{sfx}",
+                lambda ax, q=q, s=sine: plot_response(s, q, ax, cfg=cfg),
+            )
+        one(f"fig14_sine_states{sfx}", lambda ax, s=sine: plot_state_trajectories(s, ax))
+    one(
+        "zone_geometry",
+        lambda ax: plot_zone_geometry(
+            fi.zones["corrected"], fi.zones["printed"], cfg, fi.geometry, ax
+        ),
+        (7.5, 5.0),
+    )
+    return files
+
+
+def save_ground_truth(study: ConvergenceStudy, outdir: str | Path) -> list[Path]:
+    """Write the collocation convergence and switch-profile figures; return the paths.
+
+    Parameters
+    ----------
+    study : ConvergenceStudy
+        Output of :func:`ptoverify.ocp.convergence_study`.
+    outdir : str or Path
+        Folder (created if missing).
+
+    Returns
+    -------
+    list of Path
+        ``convergence.png`` and ``collocation_switch.png``.
+    """
+    outdir = _folder(outdir)
+    return [
+        save_figure(outdir / "convergence.png", lambda ax: plot_convergence(study, ax)),
+        save_figure(
+            outdir / "collocation_switch.png", lambda ax: plot_switch_profiles(study, 0, ax)
+        ),
+    ]

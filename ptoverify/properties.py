@@ -32,6 +32,7 @@ overshoot
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import asdict, dataclass
 
@@ -49,6 +50,7 @@ __all__ = [
     "default_steps",
     "law_properties",
     "all_properties",
+    "named_properties",
     "zone_outcome",
     "oscillating",
     "crossing_masks",
@@ -351,7 +353,31 @@ def all_properties(
     dict
         Law name -> :class:`LawProperties`.
     """
+    if not kwargs:
+        return {name: named_properties(cfg, name) for name in laws}
     return {name: law_properties(make_law(name, cfg), cfg, **kwargs) for name in laws}
+
+
+@functools.lru_cache(maxsize=16)
+def named_properties(cfg: Config, law: str) -> LawProperties:
+    """Properties of the law called ``law`` on the default grid, once per configuration.
+
+    Memoized on the frozen configuration: the report's properties section and
+    the ``no-stride-over`` / ``no-limit-cycle`` gates share one simulation.
+    ``named_properties.cache_clear()`` empties the memo.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+    law : str
+        Law name (:func:`ptoverify.laws.make_law`).
+
+    Returns
+    -------
+    LawProperties
+    """
+    return law_properties(make_law(law, cfg), cfg)
 
 
 def zone_outcome(cfg: Config, *, n1: int = 41, n2: int = 41, rest: int = 40) -> dict:

@@ -1,11 +1,19 @@
-"""The verification report: collect every result, render HTML + Markdown + JSON.
+"""The verification report: collect every result once, then draw and render it.
 
-``collect(cfg)`` runs the derivations, the ground truth, the zone, the poles,
-the closed-loop properties, the Section 6 claims, the sweep and the gates, and
-returns one JSON-able dict (``results.json``).  ``build_sections`` turns it into
-a list of sections made of neutral blocks (paragraphs, tables, figures, raw
-fragments) that ``render_html`` and ``render_markdown`` print.  Every text that
-reaches the HTML goes through :func:`html.escape`; equations are SymPy's MathML.
+``collect(cfg)`` is the one step that computes: the derivations, the ground
+truth, the zones, the poles, the closed-loop properties, the Section 6 claims,
+the sweep, the gates, and the responses and trajectories the figures draw
+(:func:`figure_inputs`).  It returns one dict: the JSON-able results
+(``results.json``) plus private keys (``_records``, ``_sweep``, ``_figures``,
+``ground_truth._study``) holding the objects that the figures and the
+derivation section need.  The figures (:mod:`ptoverify.plots`) and the sections
+(:mod:`ptoverify.report_sections`) only draw from it; the neutral blocks are
+printed by :mod:`ptoverify.render`.  Work shared with the gates (the corrected
+zone and its grid check, the corrected PTO's closed-loop properties, the
+claims) is memoized per frozen configuration in the numeric modules, so it runs
+once per report.  The SymPy derivations share nothing with the numerics and
+take about a third of the time, so they run in a separate Python process while
+the numerics run (in this process where no process can be started).
 
 ``write_report`` writes the folder atomically: everything goes to a temporary
 sibling folder that is renamed into place only when complete.
@@ -17,27 +25,29 @@ timings are not part of the results.
 from __future__ import annotations
 
 import datetime as _dt
-import html
 import json
 import math
 import platform
 import subprocess
-from collections.abc import Callable
-from dataclasses import dataclass
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ptoverify.config import Config
+from ptoverify.render import Section, render_html, render_markdown
 
 __all__ = [
     "collect",
+    "figure_inputs",
     "build_sections",
-    "render_html",
-    "render_markdown",
     "write_report",
+    "stderr_progress",
     "GROUND_TRUTH_STATES",
+    "STAGES",
 ]
 
 #: States of the ground-truth table [mm], [mm/s]: a step, moves with speed, on/near a
@@ -202,36 +212,136 @@ def _ipopt_version(casadi) -> str:
     return m.group(1).rstrip(",") if m else "bundled with casadi"
 
 
+# ------------------------------------------------------------------ figure inputs
+def figure_inputs(cfg: Config) -> Any:
+    """Simulate and construct everything the figures draw (plots only draw).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    ptoverify.plots.FigureInputs
+        Open-loop arcs under +-w_max (Fig. 2), sampled TO trajectories (Fig. 3),
+        the zones the PTO laws use (Figs. 4-6), the one-sample image of l1
+        (Fig. 5), a fourth-quadrant trajectory per PTO variant (Fig. 6), every
+        law's response to step, ramp and sine with and without feed-forward
+        (Figs. 7-14), and sampled PTO trajectories for the zone geometry.
+    """
+    from ptoverify.curves import level_curve_x1
+    from ptoverify.laws import LAW_NAMES, make_law
+    from ptoverify.plant import flow
+    from ptoverify.plots import FigureInputs, zone_geometry_xlim
+    from ptoverify.simulate import simulate, simulate_batch
+    from ptoverify.zones import zone_for_law
+
+    p, d = cfg.plant, cfg.pto.d
+    a, w, R = p.a, p.w_max, p.position_range
+    laws = {name: make_law(name, cfg) for name in LAW_NAMES}
+    zones = {v: zone_for_law(cfg, v) for v in ("corrected", "printed")}
+    # Fig. 2: seven starts on each side, 6 / a seconds of the exact flow under +-w_max
+    t = np.linspace(0, 6 / a, 200)[:, None]
+    x10 = np.linspace(-4 * w / a, 4 * w / a, 7)
+    open_loop = {
+        "+w_max": flow(x10, np.full(7, -0.95 * w), w, t, a),
+        "-w_max": flow(x10, np.full(7, 0.95 * w), -w, t, a),
+    }
+    # Fig. 3: from the envelope's edge, three times the farthest t_f*
+    s1 = np.array([R, R, 0.6 * R, -R, -0.6 * R, -R, 0.3 * R, -0.3 * R])
+    s2 = np.array([0.0, -0.8 * w, 0.9 * w, 0.0, -0.9 * w, 0.8 * w, 0.0, 0.0])
+    steps = int(math.ceil(3 * (2 * R / w + 3 / a) / p.T))
+    # Fig. 5: l1 moved one sample under -w_max
+    neg = np.linspace(-w, 0, 300)
+    l1_image = flow(level_curve_x1(neg, a, w), neg, -w, p.T, a)
+    # Fig. 6: from (4 d, -w_max / 3), 60 samples
+    fig6 = {
+        law: simulate_batch(laws[law], p, [4 * d], [-w / 3], 60) for law in ("pto", "pto-printed")
+    }
+    # zone geometry: starts at rest right of the linear zone, one at -w_max, and mirrors
+    xmax = zone_geometry_xlim(zones["corrected"], cfg)
+    g1 = np.append(np.linspace(1.2, 0.9 * xmax / max(d, 1e-9), 4) * d, 0.9 * xmax)
+    g2 = np.array([0.0, 0.0, 0.0, 0.0, -w])
+    sims = {
+        (signal, ff): {name: simulate(law, p, signal, feedforward=ff) for name, law in laws.items()}
+        for signal in ("step", "ramp", "sine")
+        for ff in (True, False)
+    }
+    return FigureInputs(
+        cfg=cfg,
+        open_loop=open_loop,
+        to_batch=simulate_batch(laws["to"], p, s1, s2, steps),
+        zones=zones,
+        l1_image=l1_image,
+        fig6=fig6,
+        sims=sims,
+        geometry=simulate_batch(
+            laws["pto"], p, np.concatenate([g1, -g1]), np.concatenate([g2, -g2]), 60
+        ),
+    )
+
+
+# ------------------------------------------------------------------ collect
+#: Stages of :func:`collect` and :func:`write_report`, in order (progress display).
+STAGES = (
+    "derivations",
+    "ground truth",
+    "switching zone",
+    "poles",
+    "closed-loop properties",
+    "Section 6 claims",
+    "suboptimality sweep",
+    "gates",
+    "figure data",
+    "figures",
+)
+
+
 def collect(cfg: Config, progress: Progress | None = None) -> dict[str, Any]:
-    """Compute every result of the report.
+    """Compute every result of the report, each once.
 
     Parameters
     ----------
     cfg : Config
         Configuration.
     progress : callable, optional
-        ``progress(stage)`` before each stage.
+        ``progress(stage)`` before each stage (:data:`STAGES`).
 
     Returns
     -------
     dict
-        JSON-able results, plus private keys (``_study``, ``_sweep``) with the
-        objects the figures need; :func:`write_report` drops those from the JSON.
+        JSON-able results, plus private keys with the objects the figures and
+        sections need: ``_records`` (derivation records), ``_sweep``
+        (SweepResult), ``_figures`` (:class:`ptoverify.plots.FigureInputs`) and
+        ``ground_truth._study`` (ConvergenceStudy); :func:`write_report` drops
+        them from the JSON.
     """
+    say = progress or (lambda stage: None)
+    out: dict[str, Any] = {"derivations": None}
+    say("derivations")
     import derivations
+
+    p = cfg.plant
+    plant = derivations.PlantNumbers(
+        a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
+    )
+    with _in_background("derivations", "all_records", plant) as records_later:
+        _numerics(cfg, out, say)
+        records = records_later()
+    out["derivations"] = [r.to_json() for r in records]
+    out["_records"] = records
+    out["summary"] = _summary(out, out.pop("_gates"))
+    return out
+
+
+def _numerics(cfg: Config, out: dict[str, Any], say: Callable[[str], None]) -> None:
+    """Run the numeric stages of :func:`collect` in order, into ``out``."""
     from ptoverify.checks import run_checks, summarize
     from ptoverify.claims import evaluate_claims
     from ptoverify.sweep import run_sweep
     from ptoverify.zones import zone_summary
 
-    say = progress or (lambda stage: None)
-    out: dict[str, Any] = {}
-    say("derivations")
-    p = cfg.plant
-    plant = derivations.PlantNumbers(
-        a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
-    )
-    out["derivations"] = [r.to_json() for r in derivations.all_records(plant)]
     say("ground truth")
     out["ground_truth"] = _ground_truth(cfg)
     say("switching zone")
@@ -256,9 +366,76 @@ def collect(cfg: Config, progress: Progress | None = None) -> dict[str, Any]:
     say("gates")
     checks = run_checks(cfg)
     out["checks"] = [c.to_json() for c in checks]
-    out["summary"] = _summary(out, summarize(checks))
+    out["_gates"] = summarize(checks)
     out["environment"] = _environment(cfg)
-    return out
+    say("figure data")
+    out["_figures"] = figure_inputs(cfg)
+
+
+_CHILD = (
+    "import importlib, pickle, sys\n"
+    "fn = getattr(importlib.import_module(sys.argv[1]), sys.argv[2])\n"
+    "with open(sys.argv[3], 'rb') as f:\n"
+    "    args = pickle.load(f)\n"
+    "with open(sys.argv[3], 'wb') as f:\n"
+    "    pickle.dump(fn(*args), f)\n"
+)
+
+
+@contextmanager
+def _in_background(module: str, name: str, *args: Any) -> Iterator[Callable[[], Any]]:
+    """Run ``module.name(*args)`` in a fresh Python process while the body runs.
+
+    Yields a getter of its result.  The SymPy derivations take about as long
+    as all the numerics together and share nothing with them, so on two cores
+    the report overlaps the two.  The worker is a new interpreter started with
+    ``sys.executable`` (no fork of solver or BLAS state, no re-import of the
+    caller's ``__main__``), with this process's ``sys.path``; it returns its
+    result pickled through a temporary file.  A failure in it raises
+    ``RuntimeError`` with its last lines of stderr.  Where no process can be
+    started, ``module.name()`` runs here when the result is asked for.
+    """
+    import importlib
+    import os
+    import pickle
+    import tempfile
+
+    fd, result = tempfile.mkstemp(suffix=".pickle")
+    with os.fdopen(fd, "wb") as f:  # the arguments go in; the child overwrites with its result
+        pickle.dump(args, f)
+    log = tempfile.TemporaryFile()
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+    try:
+        try:
+            child = subprocess.Popen(
+                [sys.executable, "-c", _CHILD, module, name, result],
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=log,
+                env=env,
+            )
+        except OSError:  # no process can be started here: compute in this process
+            fn = getattr(importlib.import_module(module), name)
+            yield lambda: fn(*args)
+            return
+
+        def get() -> Any:
+            if child.wait() != 0:
+                log.seek(0)
+                tail = log.read().decode(errors="replace").strip().splitlines()[-3:]
+                raise RuntimeError(f"{module}.{name} failed in its worker: {' | '.join(tail)}")
+            with open(result, "rb") as f:
+                return pickle.load(f)  # noqa: S301 - our own child's output
+
+        try:
+            yield get
+        finally:
+            if child.poll() is None:
+                child.kill()
+                child.wait()
+    finally:
+        log.close()
+        os.unlink(result)
 
 
 def _settings_json(settings: Any) -> dict[str, Any]:
@@ -291,40 +468,9 @@ def _summary(out: dict[str, Any], gates: dict[str, Any]) -> dict[str, Any]:
 
 
 # ------------------------------------------------------------------ sections
-@dataclass(frozen=True)
-class Block:
-    """A piece of a section: ``p`` text, ``table``, ``img``, or ``raw`` (html, md)."""
-
-    kind: str
-    text: str = ""
-    headers: tuple[str, ...] = ()
-    rows: tuple[tuple[str, ...], ...] = ()
-    html: str = ""
-
-
-def _fmt(v: Any, digits: int = 6) -> str:
-    if v is None:
-        return "n/a"
-    if isinstance(v, bool):
-        return "yes" if v else "no"
-    if isinstance(v, float):
-        if not math.isfinite(v):
-            return "n/a"
-        return f"{v:.{digits}g}"
-    if isinstance(v, (list, tuple)):
-        return "(" + ", ".join(_fmt(x, digits) for x in v) + ")"
-    return str(v)
-
-
-def _table(headers: list[str], rows: list[list[Any]]) -> Block:
-    return Block(
-        "table", headers=tuple(headers), rows=tuple(tuple(_fmt(c) for c in r) for r in rows)
-    )
-
-
 def build_sections(
-    res: dict[str, Any], figures: dict[str, str]
-) -> list[tuple[str, str, list[Block]]]:
+    res: dict[str, Any], figures: dict[str, str], records: list | None = None
+) -> list[Section]:
     """Turn the results into ordered sections ``(anchor, title, blocks)``.
 
     Parameters
@@ -333,6 +479,9 @@ def build_sections(
         Output of :func:`collect` (JSON part).
     figures : dict
         Figure key -> relative path (``figures/x.png``).
+    records : list of derivations.EquationRecord, optional
+        The derivation records :func:`collect` made (``res["_records"]``); when
+        None they are taken from ``res``.
 
     Returns
     -------
@@ -340,9 +489,10 @@ def build_sections(
     """
     from ptoverify import report_sections as rs
 
+    recs = records if records is not None else res["_records"]
     return [
         ("summary", "1. Summary", rs.summary(res)),
-        ("derivations", "2. Derivations: printed vs derived", rs.derivations(res)),
+        ("derivations", "2. Derivations: printed vs derived", rs.derivations(res, recs)),
         ("ground-truth", "3. Ground truth: minimum time", rs.ground_truth(res, figures)),
         ("zone", "4. Switching-zone geometry", rs.zone(res, figures)),
         ("poles", "5. Poles and stability", rs.poles(res)),
@@ -353,100 +503,14 @@ def build_sections(
     ]
 
 
-_CSS = """body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;
-color:#222;line-height:1.4}table{border-collapse:collapse;margin:1em 0;font-size:.9em}
-th,td{border:1px solid #ccc;padding:.3em .5em;vertical-align:top;text-align:left}
-th{background:#f0f0f0}.pass,.verified,.reproduced{background:#e6f4e6}
-.fail,.erratum,.not-reproduced{background:#fbe3e3}.unverified,.ambiguous,.unchecked{background:#fff4d6}
-img{max-width:100%;border:1px solid #ddd}figure{margin:1em 0}nav a{margin-right:1em}
-math{font-size:1.05em}code{font-size:.85em}
-table.derivations{table-layout:fixed;width:100%}table.derivations td{overflow-x:auto;
-overflow-wrap:anywhere}table.derivations td:nth-child(-n+2){width:6em}"""
-
-_STATUS_WORDS = {
-    "pass",
-    "fail",
-    "unverified",
-    "verified",
-    "erratum",
-    "unchecked",
-    "definition",
-    "reproduced",
-    "not reproduced",
-    "ambiguous",
-}
-
-
-def _html_block(b: Block) -> str:
-    if b.kind == "p":
-        return f"<p>{html.escape(b.text)}</p>"
-    if b.kind == "raw":
-        return b.html
-    if b.kind == "img":
-        return (
-            f'<figure><img src="{html.escape(b.html)}" alt="{html.escape(b.text)}">'
-            f"<figcaption>{html.escape(b.text)}</figcaption></figure>"
-        )
-    head = "".join(f"<th>{html.escape(h)}</th>" for h in b.headers)
-    body = []
-    for row in b.rows:
-        cells = []
-        for c in row:
-            cls = f' class="{c.replace(" ", "-")}"' if c in _STATUS_WORDS else ""
-            cells.append(f"<td{cls}>{html.escape(c)}</td>")
-        body.append("<tr>" + "".join(cells) + "</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
-
-
-def render_html(sections: list[tuple[str, str, list[Block]]], title: str) -> str:
-    """Render the sections as one offline HTML page (MathML, escaped text)."""
-    nav = "".join(f'<a href="#{a}">{html.escape(t)}</a>' for a, t, _ in sections)
-    parts = [
-        "<!DOCTYPE html>",
-        '<html lang="en"><head><meta charset="utf-8">',
-        f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
-        f"<h1>{html.escape(title)}</h1><nav>{nav}</nav>",
-    ]
-    for anchor, heading, blocks in sections:
-        parts.append(f'<section id="{anchor}"><h2>{html.escape(heading)}</h2>')
-        parts += [_html_block(b) for b in blocks]
-        parts.append("</section>")
-    parts.append("</body></html>")
-    return "\n".join(parts) + "\n"
-
-
-def _md_cell(text: str) -> str:
-    return text.replace("|", "\\|").replace("\n", " ")
-
-
-def render_markdown(sections: list[tuple[str, str, list[Block]]], title: str) -> str:
-    """Render the sections as Markdown (equations as plain text)."""
-    lines = [f"# {title}", ""]
-    for _anchor, heading, blocks in sections:
-        lines += [f"## {heading}", ""]
-        for b in blocks:
-            if b.kind == "p":
-                lines += [b.text, ""]
-            elif b.kind == "raw":
-                lines += [b.text, ""]
-            elif b.kind == "img":
-                lines += [f"![{b.text}]({b.html})", ""]
-            else:
-                lines.append("| " + " | ".join(_md_cell(h) for h in b.headers) + " |")
-                lines.append("|" + "---|" * len(b.headers))
-                lines += ["| " + " | ".join(_md_cell(c) for c in r) + " |" for r in b.rows]
-                lines.append("")
-    return "\n".join(lines) + "\n"
-
-
 # ------------------------------------------------------------------ writing
-def _figures(res: dict[str, Any], cfg: Config, figdir: Path) -> dict[str, str]:
+def _figures(res: dict[str, Any], figdir: Path) -> dict[str, str]:
+    """Draw every figure from the collected results; return key -> relative path."""
     from ptoverify import plots
 
-    files = plots.save_all(cfg, figdir)
+    files = plots.save_all(res["_figures"], figdir)
     files += plots.save_sweep(res["_sweep"], figdir)
     files += plots.save_ground_truth(res["ground_truth"]["_study"], figdir)
-    files += plots.save_zone_geometry(cfg, figdir)
     return {Path(f).stem: f"figures/{Path(f).name}" for f in files}
 
 
@@ -487,7 +551,7 @@ def write_report(
     try:
         if progress:
             progress("figures")
-        figures = _figures(res, cfg, tmp / "figures")
+        figures = _figures(res, tmp / "figures")
         public = _clean({k: v for k, v in res.items() if not k.startswith("_")})
         public["ground_truth"] = _clean(
             {k: v for k, v in res["ground_truth"].items() if not k.startswith("_")}
@@ -498,7 +562,7 @@ def write_report(
             "generated": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         }
         title = f"ptoverify verification report: {cfg.name}"
-        sections = build_sections(public, figures)
+        sections = build_sections(public, figures, res["_records"])
         (tmp / "results.json").write_text(
             json.dumps(public, indent=1, sort_keys=True, allow_nan=False) + "\n"
         )

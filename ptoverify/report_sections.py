@@ -1,16 +1,16 @@
 """The nine sections of the report, built from the JSON results as neutral blocks.
 
-Each function takes the results dict of :func:`ptoverify.report.collect` (and
-the figure paths) and returns a list of :class:`ptoverify.report.Block`.  No
-number is typed in here: every figure shown is read from the results.
+Each function takes the JSON results of :func:`ptoverify.report.collect` (and
+the figure paths) and returns a list of :class:`ptoverify.render.Block`.  No
+number is typed in here: every figure shown is read from the results.  Nothing
+here computes: the derivation section gets the records the collect step made.
 """
 
 from __future__ import annotations
 
-import html
 from typing import Any
 
-from ptoverify.report import Block, _fmt, _table
+from ptoverify.render import Block, fmt, image, link, table
 
 __all__ = [
     "summary",
@@ -23,18 +23,6 @@ __all__ = [
     "sweep",
     "environment",
 ]
-
-
-def _img(figures: dict[str, str], key: str, caption: str) -> list[Block]:
-    return [Block("img", text=caption, html=figures[key])] if key in figures else []
-
-
-def _link(anchor: str, text: str) -> Block:
-    return Block(
-        "raw",
-        text=f"{text} (section {anchor})",
-        html=f'<p><a href="#{html.escape(anchor)}">{html.escape(text)}</a></p>',
-    )
 
 
 def summary(res: dict[str, Any]) -> list[Block]:
@@ -58,30 +46,30 @@ def summary(res: dict[str, Any]) -> list[Block]:
         [c["name"], c["status"], c["measured"], c.get("comparison", "<="), c["limit"]]
         for c in res["checks"]
     ]
-    blocks.append(_table(["gate", "status", "measured", "must be", "limit"], rows))
+    blocks.append(table(["gate", "status", "measured", "must be", "limit"], rows))
     errata = [r for r in res["derivations"] if r["verdict"] == "erratum"]
     if errata:
         blocks.append(
             Block("p", text="Errata found in the paper (derived form disagrees with the print):")
         )
-        blocks.append(_table(["eq.", "what fails"], [[r["id"], r["note"][:300]] for r in errata]))
-        blocks.append(_link("derivations", "Details in the derivations section"))
+        blocks.append(table(["eq.", "what fails"], [[r["id"], r["note"][:300]] for r in errata]))
+        blocks.append(link("derivations", "Details in the derivations section"))
     z = res["zone"]
     blocks.append(
         Block(
             "p",
             text=(
                 f"Switching zone as printed: {'valid' if z['printed']['valid'] else 'invalid'} "
-                f"(omega0 = {_fmt(z['printed']['omega0'])} mm/s). Corrected: "
+                f"(omega0 = {fmt(z['printed']['omega0'])} mm/s). Corrected: "
                 f"{'valid' if z['corrected']['valid'] else 'invalid'} (omega0 = "
-                f"{_fmt(z['corrected']['omega0'])} mm/s, the largest level meeting the no-stride-over "
+                f"{fmt(z['corrected']['omega0'])} mm/s, the largest level meeting the no-stride-over "
                 f"principle; worst one-sample landing margin "
-                f"{_fmt(z['corrected'].get('margin_mm_s'), 3)} mm/s, i.e. it sits at the edge of the "
-                f"feasible interval {_fmt(z['corrected'].get('feasible_intervals'), 4)})."
+                f"{fmt(z['corrected'].get('margin_mm_s'), 3)} mm/s, i.e. it sits at the edge of the "
+                f"feasible interval {fmt(z['corrected'].get('feasible_intervals'), 4)})."
             ),
         )
     )
-    blocks.append(_link("zone", "Zone geometry and reasons"))
+    blocks.append(link("zone", "Zone geometry and reasons"))
     bad = [c for c in res["claims"] if c["verdict"] != "reproduced"]
     if bad:
         blocks.append(
@@ -109,7 +97,7 @@ def summary(res: dict[str, Any]) -> list[Block]:
                 ]
             )
         blocks.append(
-            _table(
+            table(
                 [
                     "claim",
                     "verdict",
@@ -121,7 +109,7 @@ def summary(res: dict[str, Any]) -> list[Block]:
                 rows,
             )
         )
-        blocks.append(_link("claims", "All claims with every reading"))
+        blocks.append(link("claims", "All claims with every reading"))
     sw = res["sweep"]["laws"]
     if sw:
         blocks.append(
@@ -131,21 +119,26 @@ def summary(res: dict[str, Any]) -> list[Block]:
                 "continuous minimum time t_f*): "
                 + "; ".join(
                     f"{law}: settles from {100 * v['fraction_settled']:.0f} % of states, median "
-                    f"{_fmt(v['median_ratio_tf'], 3)}, 95th percentile {_fmt(v.get('p95_ratio_tf'), 3)}"
+                    f"{fmt(v['median_ratio_tf'], 3)}, 95th percentile {fmt(v.get('p95_ratio_tf'), 3)}"
                     for law, v in sw.items()
                 )
                 + ".",
             )
         )
-        blocks.append(_link("sweep", "Suboptimality maps"))
+        blocks.append(link("sweep", "Suboptimality maps"))
     return blocks
 
 
-def derivations(res: dict[str, Any]) -> list[Block]:
-    """Section 2: printed next to derived (MathML), verdicts, errata."""
+def derivations(res: dict[str, Any], records: list) -> list[Block]:
+    """Section 2: printed next to derived (MathML), verdicts, errata.
+
+    ``records`` are the :class:`derivations.EquationRecord` objects the collect
+    step derived (their JSON form is ``res["derivations"]``); they carry the
+    SymPy expressions that render as MathML.
+    """
     import derivations as dv
 
-    recs = [dv.EquationRecord.from_json(r) for r in res["derivations"]]
+    recs = list(records)
     return [
         Block(
             "p",
@@ -187,7 +180,7 @@ def ground_truth(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             "the origin exactly, by linear programs). No sampled controller settles "
             "exactly in fewer than N* samples.",
         ),
-        _table(
+        table(
             [
                 "x0 [mm, mm/s]",
                 "t_f* closed [s]",
@@ -205,13 +198,13 @@ def ground_truth(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
         Block(
             "p",
             text=f"Collocation convergence over N = {conv['intervals']}: observed "
-            f"order {_fmt(conv['order'], 3)} (per state "
-            f"{_fmt(conv['order_per_state'], 3)}).",
+            f"order {fmt(conv['order'], 3)} (per state "
+            f"{fmt(conv['order_per_state'], 3)}).",
         ),
-        *_img(figures, "fig02_trajectories", "Fig. 2: trajectories under +-w_max, l1 and l2"),
-        *_img(figures, "fig03_saturation", "Fig. 3: trajectories with velocity saturation"),
-        *_img(figures, "convergence", "Collocation t_f error against N"),
-        *_img(figures, "collocation_switch", "Collocation input near the switch"),
+        *image(figures, "fig02_trajectories", "Fig. 2: trajectories under +-w_max, l1 and l2"),
+        *image(figures, "fig03_saturation", "Fig. 3: trajectories with velocity saturation"),
+        *image(figures, "convergence", "Collocation t_f error against N"),
+        *image(figures, "collocation_switch", "Collocation input near the switch"),
     ]
 
 
@@ -226,7 +219,7 @@ def zone(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 [key, v["omega0"], v.get("x20_tilde"), v["valid"], v.get("degenerate"), v["reason"]]
             )
     blocks = [
-        _table(
+        table(
             ["construction", "omega0 [mm/s]", "x20~ [mm/s]", "valid", "degenerate", "reason"], rows
         )
     ]
@@ -235,13 +228,13 @@ def zone(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             Block(
                 "p",
                 text=f"Closed-loop outcome of {name}: "
-                + ", ".join(f"{k} = {_fmt(v)}" for k, v in o.items()),
+                + ", ".join(f"{k} = {fmt(v)}" for k, v in o.items()),
             )
         )
-    blocks += _img(figures, "zone_geometry", "Zone geometry, sampled trajectories by region")
+    blocks += image(figures, "zone_geometry", "Zone geometry, sampled trajectories by region")
     for key in sorted(figures):
         if key.startswith(("fig04", "fig05", "fig06")):
-            blocks += _img(figures, key, key.replace("_", " "))
+            blocks += image(figures, key, key.replace("_", " "))
     return blocks
 
 
@@ -265,7 +258,7 @@ def poles(res: dict[str, Any]) -> list[Block]:
         )
     ce = res["poles"]["lyapunov_counterexample"]
     return [
-        _table(
+        table(
             [
                 "loop",
                 "gains",
@@ -285,7 +278,7 @@ def poles(res: dict[str, Any]) -> list[Block]:
             text="Section 5's conditions k1 > 0, 1 + k2 > 0 are a continuous-time "
             "statement; with sampling they do not imply stability: "
             + ", ".join(
-                f"{k} = {_fmt(v)}" for k, v in ce.items() if not isinstance(v, (dict, list))
+                f"{k} = {fmt(v)}" for k, v in ce.items() if not isinstance(v, (dict, list))
             ),
         ),
     ]
@@ -306,7 +299,7 @@ def properties(res: dict[str, Any]) -> list[Block]:
         "max_abs_u",
     ]
     rows = [[law, *[p.get(k) for k in keys]] for law, p in res["properties"].items()]
-    return [_table(["law", *keys], rows)]
+    return [table(["law", *keys], rows)]
 
 
 def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
@@ -330,7 +323,7 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
         for r in c["readings"]
     ]
     blocks = [
-        _table(
+        table(
             [
                 "sec.",
                 "signal",
@@ -344,11 +337,11 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             rows,
         ),
         Block("p", text="Every reading of an ambiguous point is run and reported:"),
-        _table(["claim", "reading", "measured", "verdict"], readings),
+        table(["claim", "reading", "measured", "verdict"], readings),
     ]
     for key in sorted(figures):
         if key.startswith(("fig07", "fig08", "fig09", "fig10", "fig11", "fig12", "fig13", "fig14")):
-            blocks += _img(figures, key, key.replace("_", " "))
+            blocks += image(figures, key, key.replace("_", " "))
     return blocks
 
 
@@ -375,7 +368,7 @@ def sweep(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             text=f"Grid {sw['grid']} of initial states, horizon {sw['steps']} "
             "samples; settling to the tight band and staying there.",
         ),
-        _table(
+        table(
             [
                 "law",
                 "settled",
@@ -392,7 +385,7 @@ def sweep(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     ]
     for key in sorted(figures):
         if key.startswith("sweep"):
-            blocks += _img(figures, key, key.replace("_", " "))
+            blocks += image(figures, key, key.replace("_", " "))
     return blocks
 
 
@@ -406,4 +399,4 @@ def environment(res: dict[str, Any]) -> list[Block]:
         for sec, vals in env["config"].items()
         for k, v in (vals.items() if isinstance(vals, dict) else [("", vals)])
     ]
-    return [_table(["item", "value"], rows), _table(["configuration key", "value"], cfg_rows)]
+    return [table(["item", "value"], rows), table(["configuration key", "value"], cfg_rows)]

@@ -72,6 +72,7 @@ __all__ = [
     "principle_margin",
     "principle_violations",
     "zone_for_law",
+    "clear_caches",
     "READINGS",
 ]
 
@@ -462,6 +463,7 @@ def _degenerate(cfg: Config, omega0: float) -> bool:
     return float(level_curve_x1(-w, a, omega0)) < d
 
 
+@functools.lru_cache(maxsize=16)
 def _feasible_intervals(cfg: Config, reading: str, scan: int) -> list[tuple[float, float]]:
     """Scan omega0 over (0, w_max], then bisect every edge of the feasible set."""
     w, tol = cfg.plant.w_max, _tol(cfg)
@@ -496,6 +498,7 @@ def _feasible_intervals(cfg: Config, reading: str, scan: int) -> list[tuple[floa
     return intervals
 
 
+@functools.lru_cache(maxsize=16)
 def smallest_d(cfg: Config, reading: str = "strict") -> float:
     """Smallest d [mm] for which some omega0 > 0 meets the principle (limit omega0 -> 0+).
 
@@ -557,6 +560,12 @@ def corrected_zone(
         The corrected zone; ``valid`` needs a feasible omega0 < w_max, a zone that
         acts outside |x1| < d, and no violation on the grid.
 
+    Notes
+    -----
+    The result is memoized per (cfg, reading, scan, verify), so the report's
+    zone section and the ``zone-corrected-valid`` gate share one grid check;
+    :func:`clear_caches` empties the memo (for tests that perturb the internals).
+
     Examples
     --------
     >>> from ptoverify.config import paper_config
@@ -564,6 +573,12 @@ def corrected_zone(
     >>> z.valid and 0 < z.omega0 < 300.0
     True
     """
+    return _corrected_zone(cfg, reading, scan, verify)
+
+
+@functools.lru_cache(maxsize=16)
+def _corrected_zone(cfg: Config, reading: str, scan: int, verify: bool) -> PTOZone:
+    """:func:`corrected_zone`, memoized on its normalised arguments (Config is frozen)."""
     a, w, d = cfg.plant.a, cfg.plant.w_max, cfg.pto.d
     intervals = _feasible_intervals(cfg, reading, scan)
     dmin = smallest_d(cfg, reading)
@@ -666,6 +681,12 @@ def zone_for_law(cfg: Config, variant: str) -> PTOZone:
 @functools.lru_cache(maxsize=256)
 def _zone_for_law(cfg: Config, variant: str) -> PTOZone:
     return corrected_zone(cfg, verify=False) if variant == "corrected" else printed_zone(cfg)
+
+
+def clear_caches() -> None:
+    """Empty the memos of this module (zones, feasible intervals, d_min per configuration)."""
+    for fn in (_corrected_zone, _feasible_intervals, smallest_d, _zone_for_law):
+        fn.cache_clear()
 
 
 def zone_summary(cfg: Config, *, verify: bool = True) -> dict:

@@ -63,8 +63,6 @@ ALLOWED: dict[str, str] = {
     "ptoverify.ocp.convergence_study": "parameter 'control' undocumented",
     "ptoverify.outdir.discard": "no Parameters section",
     "ptoverify.outdir.make_temp": "no Parameters section",
-    "ptoverify.plots.save_ground_truth": "no Parameters section",
-    "ptoverify.plots.save_sweep": "no Parameters section",
     "ptoverify.plots.save_zone_geometry": "no Parameters section",
     "ptoverify.report.Block": "no Parameters section",
     "ptoverify.report.render_html": "no Parameters section",

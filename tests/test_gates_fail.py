@@ -30,6 +30,20 @@ from ptoverify.checks import GATES, ROBUST_GATES, run_checks
 from ptoverify.config import Config, PDGains, Plant, PTOSettings, Robustness, paper_config
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED
 
+
+@pytest.fixture(autouse=True)
+def _fresh_memos():
+    """Zones and properties are memoized per configuration: a perturbation must not see
+    (or leave behind) a result computed without it."""
+    from ptoverify.properties import named_properties
+
+    zones_mod.clear_caches()
+    named_properties.cache_clear()
+    yield
+    zones_mod.clear_caches()
+    named_properties.cache_clear()
+
+
 #: gate name -> (perturb(monkeypatch, cfg) -> cfg, also check the unperturbed pass, slow)
 PERTURBATIONS: dict[str, tuple[Callable, bool, bool]] = {}
 

@@ -11,7 +11,8 @@ import pytest
 
 from ptoverify.cli import main
 from ptoverify.config import paper_config
-from ptoverify.report import Block, render_html, write_report
+from ptoverify.render import Block, render_html
+from ptoverify.report import write_report
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -1,0 +1,297 @@
+"""Rendering helpers of the report: neutral blocks, number formatting, HTML and Markdown.
+
+A report is a list of sections ``(anchor, title, blocks)``; a :class:`Block` is a
+paragraph, a table, a figure or a raw fragment (HTML with a plain-text twin
+for Markdown).  :func:`render_html` and :func:`render_markdown` print them.
+Every text that reaches the HTML goes through :func:`html.escape`; equations
+arrive as raw fragments of SymPy's presentation MathML (``derivations.render_html``).
+
+Used by :mod:`ptoverify.report` and :mod:`ptoverify.report_sections`, which
+both import it and not each other.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from dataclasses import dataclass
+from typing import Any
+
+__all__ = [
+    "Block",
+    "Section",
+    "fmt",
+    "table",
+    "paragraph",
+    "image",
+    "link",
+    "md_cell",
+    "render_html",
+    "render_markdown",
+    "STATUS_WORDS",
+]
+
+
+@dataclass(frozen=True)
+class Block:
+    """A piece of a section: ``p`` text, ``table``, ``img``, or ``raw`` (html, md).
+
+    Attributes
+    ----------
+    kind : {"p", "table", "img", "raw"}
+        What the block is.
+    text : str
+        Paragraph text, figure caption, or the Markdown twin of a raw fragment.
+    headers, rows : tuple of str
+        Table header and (already formatted) cells.
+    html : str
+        Raw HTML fragment, or the figure's relative path.
+    """
+
+    kind: str
+    text: str = ""
+    headers: tuple[str, ...] = ()
+    rows: tuple[tuple[str, ...], ...] = ()
+    html: str = ""
+
+
+Section = tuple[str, str, list[Block]]
+
+
+def fmt(v: Any, digits: int = 6) -> str:
+    """Format a value for a table cell: n/a for None and non-finite, yes/no, g-format.
+
+    Parameters
+    ----------
+    v : any
+        The value (None, bool, float, int, str, or a list/tuple of those).
+    digits : int
+        Significant digits of floats.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> fmt(0.123456789), fmt(None), fmt(True), fmt([1.0, float("nan")], 3)
+    ('0.123457', 'n/a', 'yes', '(1, n/a)')
+    """
+    if v is None:
+        return "n/a"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, float):
+        if not math.isfinite(v):
+            return "n/a"
+        return f"{v:.{digits}g}"
+    if isinstance(v, (list, tuple)):
+        return "(" + ", ".join(fmt(x, digits) for x in v) + ")"
+    return str(v)
+
+
+def table(headers: list[str], rows: list[list[Any]]) -> Block:
+    """Return a table block; every cell is formatted with :func:`fmt`.
+
+    Parameters
+    ----------
+    headers : list of str
+        Column titles.
+    rows : list of list
+        Cell values.
+
+    Returns
+    -------
+    Block
+    """
+    return Block(
+        "table", headers=tuple(headers), rows=tuple(tuple(fmt(c) for c in r) for r in rows)
+    )
+
+
+def paragraph(text: str) -> Block:
+    """Return a paragraph block (plain text; escaped when rendered).
+
+    Parameters
+    ----------
+    text : str
+        The paragraph.
+
+    Returns
+    -------
+    Block
+        A ``p`` block.
+    """
+    return Block("p", text=text)
+
+
+def image(figures: dict[str, str], key: str, caption: str) -> list[Block]:
+    """Return ``[figure block]`` when ``key`` is among the written figures, else ``[]``.
+
+    Parameters
+    ----------
+    figures : dict
+        Figure key -> relative path (``figures/x.png``).
+    key : str
+        The figure's key (file stem).
+    caption : str
+        Caption and alt text.
+
+    Returns
+    -------
+    list of Block
+    """
+    return [Block("img", text=caption, html=figures[key])] if key in figures else []
+
+
+def link(anchor: str, text: str) -> Block:
+    """Return a paragraph linking to a section of the same page.
+
+    Parameters
+    ----------
+    anchor : str
+        The section's anchor.
+    text : str
+        The link text.
+
+    Returns
+    -------
+    Block
+        A raw block with the link.
+    """
+    return Block(
+        "raw",
+        text=f"{text} (section {anchor})",
+        html=f'<p><a href="#{html.escape(anchor)}">{html.escape(text)}</a></p>',
+    )
+
+
+def md_cell(text: str) -> str:
+    """Escape a Markdown table cell (pipes, newlines).
+
+    Parameters
+    ----------
+    text : str
+        Cell content.
+
+    Returns
+    -------
+    str
+        The escaped cell.
+    """
+    return text.replace("|", "\\|").replace("\n", " ")
+
+
+CSS = """body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;
+color:#222;line-height:1.4}table{border-collapse:collapse;margin:1em 0;font-size:.9em}
+th,td{border:1px solid #ccc;padding:.3em .5em;vertical-align:top;text-align:left}
+th{background:#f0f0f0}.pass,.verified,.reproduced{background:#e6f4e6}
+.fail,.erratum,.not-reproduced{background:#fbe3e3}.unverified,.ambiguous,.unchecked{background:#fff4d6}
+img{max-width:100%;border:1px solid #ddd}figure{margin:1em 0}nav a{margin-right:1em}
+math{font-size:1.05em}code{font-size:.85em}
+table.derivations{table-layout:fixed;width:100%}table.derivations td{overflow-x:auto;
+overflow-wrap:anywhere}table.derivations td:nth-child(-n+2){width:6em}"""
+
+#: Cell texts that get a CSS class (colour) of their own.
+STATUS_WORDS = frozenset(
+    {
+        "pass",
+        "fail",
+        "unverified",
+        "verified",
+        "erratum",
+        "unchecked",
+        "definition",
+        "reproduced",
+        "not reproduced",
+        "ambiguous",
+    }
+)
+
+
+def _html_block(b: Block) -> str:
+    if b.kind == "p":
+        return f"<p>{html.escape(b.text)}</p>"
+    if b.kind == "raw":
+        return b.html
+    if b.kind == "img":
+        return (
+            f'<figure><img src="{html.escape(b.html)}" alt="{html.escape(b.text)}">'
+            f"<figcaption>{html.escape(b.text)}</figcaption></figure>"
+        )
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in b.headers)
+    body = []
+    for row in b.rows:
+        cells = []
+        for c in row:
+            cls = f' class="{c.replace(" ", "-")}"' if c in STATUS_WORDS else ""
+            cells.append(f"<td{cls}>{html.escape(c)}</td>")
+        body.append("<tr>" + "".join(cells) + "</tr>")
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+def render_html(sections: list[Section], title: str) -> str:
+    """Render the sections as one offline HTML page (MathML, escaped text).
+
+    Parameters
+    ----------
+    sections : list of (str, str, list of Block)
+        Anchor, heading and blocks of each section, in order.
+    title : str
+        Page title.
+
+    Returns
+    -------
+    str
+        The page.
+
+    Examples
+    --------
+    >>> page = render_html([("s", "A & B", [Block("p", text="<x>")])], "t")
+    >>> "&lt;x&gt;" in page and "A &amp; B" in page
+    True
+    """
+    nav = "".join(f'<a href="#{a}">{html.escape(t)}</a>' for a, t, _ in sections)
+    parts = [
+        "<!DOCTYPE html>",
+        '<html lang="en"><head><meta charset="utf-8">',
+        f"<title>{html.escape(title)}</title><style>{CSS}</style></head><body>",
+        f"<h1>{html.escape(title)}</h1><nav>{nav}</nav>",
+    ]
+    for anchor, heading, blocks in sections:
+        parts.append(f'<section id="{anchor}"><h2>{html.escape(heading)}</h2>')
+        parts += [_html_block(b) for b in blocks]
+        parts.append("</section>")
+    parts.append("</body></html>")
+    return "\n".join(parts) + "\n"
+
+
+def render_markdown(sections: list[Section], title: str) -> str:
+    """Render the sections as Markdown (equations as plain text).
+
+    Parameters
+    ----------
+    sections : list of (str, str, list of Block)
+        Anchor, heading and blocks of each section, in order.
+    title : str
+        Page title.
+
+    Returns
+    -------
+    str
+        The Markdown text.
+    """
+    lines = [f"# {title}", ""]
+    for _anchor, heading, blocks in sections:
+        lines += [f"## {heading}", ""]
+        for b in blocks:
+            if b.kind in ("p", "raw"):
+                lines += [b.text, ""]
+            elif b.kind == "img":
+                lines += [f"![{b.text}]({b.html})", ""]
+            else:
+                lines.append("| " + " | ".join(md_cell(h) for h in b.headers) + " |")
+                lines.append("|" + "---|" * len(b.headers))
+                lines += ["| " + " | ".join(md_cell(c) for c in r) + " |" for r in b.rows]
+                lines.append("")
+    return "\n".join(lines) + "\n"
