@@ -15,6 +15,10 @@ that the harness works.  At full size ``report_s`` times ``ptoverify report
 --quiet --out TMPDIR`` (a temporary folder, so the tracked reports/ is untouched),
 and ``sweep_s`` ``ptoverify sweep --quiet --json`` (200 x 200 states, 4 laws, settling
 between samples; ``--small``: ``--grid 4``).
+``robust_s`` times ``ptoverify robust --json`` at the paper's box and default sizes,
+``robust_gates_s`` the two gates of ``check --robust``; the robust maps' throughput
+is measured in-process and on a Dask LocalCluster side by side (the latter not with
+``--small``: cluster start-up would dominate).
 """
 
 from __future__ import annotations
@@ -69,6 +73,11 @@ TARGETS = {  # key: (target, ">=" or "<=")
     "sweep_s": (30.0, "<="),
     "tune_pd_s": (20.0, "<="),
     "tune_pto_s": (120.0, "<="),
+    "robust_s": (60.0, "<="),
+    "robust_gates_s": (60.0, "<="),
+    "robust_maps_state_cells_per_s": (None, ""),
+    "robust_maps_dask_local_state_cells_per_s": (None, ""),
+    "robust_maps_trajectory_steps_per_s": (None, ""),
 }
 
 FULL = {
@@ -354,6 +363,42 @@ def run_cli(args: list[str], repeat: int) -> tuple[float | None, str]:
     return statistics.median(times), note
 
 
+# ---------------------------------------------------------------- robustness
+def bench_robust_maps(cfg, small: bool) -> dict:
+    """Maps of ``ptoverify robust`` in-process and on a Dask LocalCluster, side by side.
+
+    The same maps (bit for bit, asserted); the Dask figure includes starting and
+    stopping its 2-process LocalCluster, as ``robust --dask local`` does.
+    """
+    from ptoverify.robust import RobustSettings, dask_runner, horizon_steps, robust_maps
+
+    s = RobustSettings(n1=5, n2=5, rest=4, n_a=3, n_w=2) if small else RobustSettings()
+    t0 = time.perf_counter()
+    here = robust_maps(cfg, s)
+    t_here = time.perf_counter() - t0
+    cells = here["states"] * sum(len(c) for c in here["laws"].values())
+    out = {
+        "state_cells": cells,
+        "in_process_s": t_here,
+        "state_cells_per_s": cells / t_here,
+        "trajectory_steps_per_s": cells * horizon_steps(cfg) / t_here,
+        "dask_local_s": None,
+        "dask_local_state_cells_per_s": None,
+        "dask_note": "",
+    }
+    if small:
+        out["dask_note"] = "not timed with --small (LocalCluster start-up dominates)"
+        return out
+    t0 = time.perf_counter()
+    there = robust_maps(cfg, s, runner=dask_runner("local"))
+    t_there = time.perf_counter() - t0
+    if there != here:
+        raise AssertionError("Dask local maps differ from the in-process maps")
+    out["dask_local_s"] = t_there
+    out["dask_local_state_cells_per_s"] = cells / t_there
+    return out
+
+
 # ---------------------------------------------------------------- machine
 def machine() -> dict:
     cpu = "unknown"
@@ -428,6 +473,20 @@ def run(small: bool) -> tuple[dict, dict]:
         out["report_s"], extra["report_note"] = run_cli(report, size["cli_repeat"])
     sweep = ["sweep", "--quiet", "--json"] + (["--grid", "4"] if small else [])
     out["sweep_s"], extra["sweep_note"] = run_cli(sweep, size["cli_repeat"])
+    rb = bench_robust_maps(cfg, small)
+    out["robust_maps_state_cells_per_s"] = rb["state_cells_per_s"]
+    out["robust_maps_dask_local_state_cells_per_s"] = rb["dask_local_state_cells_per_s"]
+    out["robust_maps_trajectory_steps_per_s"] = rb["trajectory_steps_per_s"]
+    extra["robust_maps"] = rb
+    robust = ["robust", "--quiet", "--json"]
+    if small:
+        robust += ["--grid", "3", "--law", "pd", "--generations", "1", "--population", "5"]
+    out["robust_s"], extra["robust_note"] = run_cli(robust, size["cli_repeat"])
+    gates = ["check", "--gate", "robust-no-limit-cycle", "--gate", "robust-settling"]
+    if small:
+        out["robust_gates_s"], extra["robust_gates_note"] = None, "not run with --small"
+    else:
+        out["robust_gates_s"], extra["robust_gates_note"] = run_cli(gates, size["cli_repeat"])
     extra["vector_vs_scalar"] = out["law_vector_evals_per_s"] * out["law_scalar_us"] * 1e-6
     return out, extra
 
@@ -466,7 +525,16 @@ def table(out: dict, extra: dict) -> str:
         f"settling {extra['tune']['pd_settling_ms']:.4g} ms; PTO "
         f"{extra['tune']['pto_evaluations']} evaluations, {extra['tune']['pto_settling_ms']:.4g} ms",
     ]
-    for k in ("check_note", "report_note", "sweep_note"):
+    rb = extra["robust_maps"]
+    dask = (
+        f"Dask LocalCluster {rb['dask_local_s']:.3g} s (with start-up)"
+        if rb["dask_local_s"] is not None
+        else f"Dask: {rb['dask_note']}"
+    )
+    rows.append(
+        f"robust maps: {rb['state_cells']} state-cells in-process {rb['in_process_s']:.3g} s; {dask}"
+    )
+    for k in ("check_note", "report_note", "sweep_note", "robust_note", "robust_gates_note"):
         if extra[k]:
             rows.append(f"{k}: {extra[k]}")
     return "\n".join(rows)
@@ -487,6 +555,9 @@ def main(argv: list[str] | None = None) -> int:
                 ("check_s", extra["check_note"]),
                 ("report_s", extra["report_note"]),
                 ("sweep_s", extra["sweep_note"]),
+                ("robust_s", extra["robust_note"]),
+                ("robust_gates_s", extra["robust_gates_note"]),
+                ("robust_maps_dask_local_state_cells_per_s", extra["robust_maps"]["dask_note"]),
             )
             if v
         }

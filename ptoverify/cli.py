@@ -29,7 +29,7 @@ from typing import Any
 
 from ptoverify import __version__
 from ptoverify.config import Config, load_config
-from ptoverify.errors import InputError, SolverError
+from ptoverify.errors import ClusterError, InputError, SolverError
 from ptoverify.outdir import (
     OutputBusy,
     Terminated,
@@ -281,7 +281,14 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     }
     if args.x0 is not None:
         return _simulate_regulation(args, cfg, {k: v for k, v in mismatch.items() if v is not None})
-    given = [k for k, v in mismatch.items() if v is not None]
+    flags = dict(
+        zip(
+            mismatch,
+            ("--a-ratio", "--w-max-ratio", "--delay", "--quantum", "--velocity-noise", "--seed"),
+            strict=True,
+        )
+    )
+    given = [flags[k] for k, v in mismatch.items() if v is not None]
     if given:
         raise InputError(f"the plant/measurement mismatch options need --x0 (got {given[0]})")
     run = run_simulation(
@@ -366,6 +373,27 @@ def _add_robust(sub) -> None:
     p.add_argument(
         "--grid", type=positive_int, default=15, metavar="N", help="N x N initial states (15)"
     )
+    p.add_argument(
+        "--law",
+        action="append",
+        choices=("to", "pd", "pto", "pto-printed"),
+        default=None,
+        help="study only this law (repeatable; default all four)",
+    )
+    p.add_argument(
+        "--generations",
+        type=int,
+        default=12,
+        metavar="N",
+        help="differential-evolution generations of the worst-case search (12; 0 to 500)",
+    )
+    p.add_argument(
+        "--population",
+        type=int,
+        default=24,
+        metavar="N",
+        help="candidates per generation of each search (24; 5 to 1000)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     p.set_defaults(handler=_cmd_robust)
 
@@ -377,7 +405,19 @@ def _cmd_robust(args: argparse.Namespace) -> int:
     cfg = _config(args)
     if not 3 <= args.grid <= 101:
         raise InputError(f"--grid must be in [3, 101], got {args.grid}")
-    res = run_robust_study(cfg, grid=args.grid, dask=args.dask, progress=stderr_bar(args.quiet))
+    if not 0 <= args.generations <= 500:
+        raise InputError(f"--generations must be in [0, 500], got {args.generations}")
+    if not 5 <= args.population <= 1000:
+        raise InputError(f"--population must be in [5, 1000], got {args.population}")
+    res = run_robust_study(
+        cfg,
+        grid=args.grid,
+        dask=args.dask,
+        laws=tuple(dict.fromkeys(args.law)) if args.law else None,
+        generations=args.generations,
+        population=args.population,
+        progress=stderr_bar(args.quiet),
+    )
     if args.json:
         print_json(res)
         return 0
@@ -538,7 +578,7 @@ def _add_check(sub) -> None:
         "--robust",
         action="store_true",
         help="also run the robustness gates over the [robustness] box "
-        "(robust-no-limit-cycle, robust-settling; about a minute)",
+        "(robust-no-limit-cycle, robust-settling; adds about 10 s)",
     )
     _add_junit(p)
     p.set_defaults(handler=_cmd_check)
@@ -994,7 +1034,7 @@ def main(argv: list[str] | None = None) -> int:
     except OutputBusy as exc:
         print(f"ptoverify: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 1
-    except SolverError as exc:
+    except (SolverError, ClusterError) as exc:  # the input was fine; the run could not be done
         print(f"ptoverify: error: {_one_line(exc)}", file=sys.stderr)
         return 1
     except InputError as exc:
