@@ -76,6 +76,7 @@ __all__ = [
     "RobustResult",
     "run_robust",
     "robust_gates",
+    "describe_case",
 ]
 
 LAWS = ("to", "pd", "pto", "pto-printed")
@@ -1094,6 +1095,40 @@ def run_robust(
 GATE_LAW = "pto"  #: the law the robustness gates judge (the corrected PTO)
 
 
+def describe_case(case: dict[str, Any]) -> str:
+    """Describe a worst case in words, with units (no Python repr).
+
+    Parameters
+    ----------
+    case : dict
+        A :func:`worst_case` entry (``state`` [mm, mm/s] and ``params``).
+
+    Returns
+    -------
+    str
+        E.g. "x0 = (48.01 mm, -87.3 mm/s), a_true/a = 1.25, drive limit 1 w_max, delay
+        1 sample, encoder 0.001 mm, velocity noise 0 mm/s (seed 0)".
+
+    Examples
+    --------
+    >>> describe_case({"state": [1.0, -2.0], "params": {"a_ratio": 1.25, "w_max_ratio": 1.0,
+    ...     "delay_samples": 1, "position_quantum": 0.001, "velocity_noise": 0.0, "seed": 0}})
+    'x0 = (1 mm, -2 mm/s), a_true/a = 1.25, drive limit 1 w_max, delay 1 sample(s), encoder 0.001 mm, velocity noise 0 mm/s (seed 0)'
+    """
+    x = case.get("state") or [float("nan"), float("nan")]
+    p = case.get("params") or {}
+
+    def g(v: Any) -> str:
+        return "?" if v is None else f"{float(v):.4g}"
+
+    return (
+        f"x0 = ({g(x[0])} mm, {g(x[1])} mm/s), a_true/a = {g(p.get('a_ratio'))}, "
+        f"drive limit {g(p.get('w_max_ratio'))} w_max, delay {p.get('delay_samples')} sample(s), "
+        f"encoder {g(p.get('position_quantum'))} mm, velocity noise "
+        f"{g(p.get('velocity_noise'))} mm/s (seed {p.get('seed')})"
+    )
+
+
 def robust_gates(result: RobustResult, law: str = GATE_LAW) -> list[Verdict]:
     """Judge the box: ``robust-no-limit-cycle`` and ``robust-settling`` for ``law``.
 
@@ -1118,7 +1153,7 @@ def robust_gates(result: RobustResult, law: str = GATE_LAW) -> list[Verdict]:
     out = []
     lc = worst.get("limit_cycle_mm", {})
     v = lc.get("searched")
-    where = f" at x0 = {lc.get('state')} with {lc.get('params')}" if v else ""
+    where = f" at {describe_case(lc)}" if v else ""
     if v is None:
         out.append(
             Verdict(
@@ -1168,7 +1203,7 @@ def robust_gates(result: RobustResult, law: str = GATE_LAW) -> list[Verdict]:
                 value,
                 limit,
                 f"{law}: worst settling time / N*T of the true plant found in the box "
-                f"(inf: never settles) at x0 = {st.get('state')} with {st.get('params')}; "
+                f"(inf: never settles) at {describe_case(st)}; "
                 f"limit from [robustness] settling_ratio_limit",
                 "<=",
                 "1",
