@@ -908,12 +908,21 @@ def save_robust(maps: Mapping, outdir: str | Path) -> list[Path]:
         finite = [v for v in vals if math.isfinite(v)]
         vmax = max(max(finite, default=1.0), 1.0)
         fig, axes = plt.subplots(
-            len(laws), len(delays), figsize=(3.6 * len(delays), 2.6 * len(laws)), squeeze=False
+            len(laws),
+            len(delays),
+            figsize=(3.8 * len(delays) + 1.2, 2.9 * len(laws)),
+            squeeze=False,
+            layout="constrained",
         )
         try:
             for r, law in enumerate(laws):
                 for c, dl in enumerate(delays):
-                    mesh = plot_robust_map(maps, law, key, dl, axes[r, c], vmax=vmax)["map"]
+                    ax = axes[r, c]
+                    mesh = plot_robust_map(maps, law, key, dl, ax, vmax=vmax)["map"]
+                    if r < len(laws) - 1:
+                        ax.set_xlabel("")
+                    if c > 0:
+                        ax.set_ylabel("")
             fig.colorbar(mesh, ax=axes, label=label, shrink=0.8)
             fig.savefig(outdir / f"{stem}.png", dpi=DPI)
         finally:

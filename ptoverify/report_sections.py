@@ -528,12 +528,14 @@ def _counterexample_rows(ce: dict[str, Any], unit: str) -> tuple[list[str], list
         u = "mm, mm/s" if isinstance(ce[n], list) and len(ce[n]) == 2 else ""
         rows.append([n.replace("_", " "), f"{fmt(ce[n])} {u}".strip(), *["" for _ in cols[1:]]])
     for which in ("printed", "derived"):
+        vals = [c.get(which) for _, c in cols]
+        vals = [v[0] if isinstance(v, list) and len(v) == 1 else v for v in vals]
         rows.append(
             [
                 f"{which} form, evaluated",
                 *[
-                    (qty(c.get(which), unit) if unit else fmt(c.get(which)) + " (residual)")
-                    for _, c in cols
+                    (qty(v, unit) if unit else fmt(v) + " (residual, unit as in the paper)")
+                    for v in vals
                 ],
             ]
         )
@@ -1076,10 +1078,10 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 else m.get("linear_loop_note") or "n/a",
                 _interval(m.get("linear_loop_a_ratio_stable_delay1"))
                 if m.get("linear_loop_a_ratio_stable_delay1")
-                else m.get("linear_loop_delay1_note") or "n/a",
+                else m.get("linear_loop_note_delay1") or "n/a",
                 _interval(m.get("no_limit_cycle_a_ratio"))
                 if m.get("no_limit_cycle_a_ratio")
-                else "n/a",
+                else m.get("no_limit_cycle_note") or "n/a",
             ]
         )
     best = rob.get("most_robust", {})
@@ -1224,10 +1226,15 @@ def tuning(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 "settling, best tuning",
                 "overshoot, best tuning",
                 "rise time, best tuning",
-                "settling / (N* T)",
+                "2 % settling / (N* T)",
                 "evaluated",
             ],
             rows,
+        ),
+        Block(
+            "p",
+            text="t_f* and N* T are the times to reach the origin exactly; a response enters "
+            "the 2 % band earlier, so a 2 % settling time can lie below them.",
         ),
         *image(
             figures,
