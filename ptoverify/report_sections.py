@@ -267,7 +267,19 @@ def _interval(iv: list | None) -> str:
 
 
 def headline(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
-    """Return the opening: the headline findings with the step responses beside them."""
+    """Return the opening: the headline findings with the step responses beside them.
+
+    Parameters
+    ----------
+    res : dict
+        Output of :func:`ptoverify.report.collect` (JSON part).
+    figures : dict
+        Figure key -> relative path (``figures/x.png``).
+
+    Returns
+    -------
+    list of Block
+    """
     key = "fig07_step_position"
     return [
         findings(
@@ -543,7 +555,19 @@ def _counterexample_rows(ce: dict[str, Any], unit: str) -> tuple[list[str], list
 
 
 def errata(res: dict[str, Any], records: list) -> list[Block]:
-    """Each erratum: printed and derived forms (MathML), counterexample, downstream links."""
+    """Each erratum: printed and derived forms (MathML), counterexample, downstream links.
+
+    Parameters
+    ----------
+    res : dict
+        Output of :func:`ptoverify.report.collect` (JSON part).
+    records : list of derivations.EquationRecord
+        The records the collect step derived (MathML of each form).
+
+    Returns
+    -------
+    list of Block
+    """
     recs = {r.id: r for r in records}
     ids = set(recs)
     err = [r for r in res["derivations"] if r["verdict"] == "erratum"]
@@ -850,7 +874,7 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
         differs = not _same(c["measured"], c.get("measured_grid"))
         rows.append(
             [
-                c["section"],
+                f"Sec. {c['section']}",
                 c["signal"],
                 c["claim"],
                 measured_quantity(c),
@@ -887,7 +911,7 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
         ),
         table(
             [
-                "sec.",
+                "paper section",
                 "signal",
                 "claim",
                 "what is measured",
@@ -1041,7 +1065,19 @@ def simulate_command(law: str, worst: dict[str, Any]) -> str:
 
 
 def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
-    """Show maps over the uncertainty box, margins, worst cases with reproducing commands."""
+    """Show maps over the uncertainty box, margins, worst cases with reproducing commands.
+
+    Parameters
+    ----------
+    res : dict
+        Output of :func:`ptoverify.report.collect` (JSON part).
+    figures : dict
+        Figure key -> relative path (``figures/x.png``).
+
+    Returns
+    -------
+    list of Block
+    """
     rob = res.get("robust")
     if not rob:
         return [
@@ -1172,7 +1208,19 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
 
 # ------------------------------------------------------------------ tuning
 def tuning(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
-    """PD and PTO each at their best tuning under the same overshoot bound."""
+    """PD and PTO each at their best tuning under the same overshoot bound.
+
+    Parameters
+    ----------
+    res : dict
+        Output of :func:`ptoverify.report.collect` (JSON part).
+    figures : dict
+        Figure key -> relative path (``figures/x.png``).
+
+    Returns
+    -------
+    list of Block
+    """
     t = res.get("tuning")
     if not t:
         return [
