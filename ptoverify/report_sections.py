@@ -1097,11 +1097,12 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             f"{fmt(box['a_ratio'])} [-], drive saturation / w_max in {fmt(box['w_max_ratio'])} "
             f"[-], computation delay {fmt(box['delay_samples'])} samples, encoder quantum "
             f"{qty(box['position_quantum'], 'mm')}, velocity noise {qty(box['velocity_noise'], 'mm/s')}. "
+            f"Laws: {', '.join(_law(k) for k in maps['laws'])}. "
             f"Maps: {len(maps['a_ratio'])} x {len(maps['w_max_ratio'])} perturbations per delay, "
             f"{maps['states']} initial states each (report settings: "
             f"{st.get('n1')} x {st.get('n2')} grid + {st.get('rest')} at rest, worst-case search "
             f"{st.get('search_iterations')} generations of {st.get('search_population')}; "
-            "`ptoverify robust` runs the full study).",
+            "`ptoverify robust` runs the full study on every law).",
         )
     ]
     rows = []
