@@ -1168,8 +1168,12 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 [
                     _law(law),
                     words,
-                    qty(w.get("grid"), unit),
-                    qty(w.get("searched"), unit),
+                    "unbounded (never settles)"
+                    if w.get("grid_unbounded")
+                    else qty(w.get("grid"), unit),
+                    "unbounded (never settles)"
+                    if w.get("unbounded")
+                    else qty(w.get("searched"), unit),
                     f"({fmt(w['state'][0])} mm, {fmt(w['state'][1])} mm/s)"
                     if w.get("state")
                     else "n/a",
