@@ -874,9 +874,13 @@ def plot_robust_map(
         z[wrs.index(c["w_max_ratio"]), ars.index(c["a_ratio"])] = _robust_cell_value(c, key)
     xi, yi = np.arange(len(ars) + 1) - 0.5, np.arange(len(wrs) + 1) - 0.5
     mesh = ax.pcolormesh(xi, yi, np.ma.masked_invalid(z), cmap="magma_r", vmin=0, vmax=vmax)
+    top = vmax if vmax is not None else (np.nanmax(z) if np.isfinite(z).any() else 1.0)
+    missing = "never" if key == "settling_ratio_nt" else "n/a"  # null max: some state never settles
+    ax.set_facecolor("0.85")
     for (i, j), v in np.ndenumerate(z):
-        text = "n/a" if not np.isfinite(v) else f"{v:.3g}"
-        ax.text(j, i, text, ha="center", va="center", fontsize=7, color="tab:blue")
+        text = missing if not np.isfinite(v) else f"{v:.3g}"
+        dark = np.isfinite(v) and v > 0.6 * top
+        ax.text(j, i, text, ha="center", va="center", fontsize=7, color="w" if dark else "k")
     ax.set_xticks(range(len(ars)), [f"{r:.3g}" for r in ars], fontsize=7)
     ax.set_yticks(range(len(wrs)), [f"{r:.3g}" for r in wrs], fontsize=7)
     ax.set_xlabel("a_true / a_design [-]")
