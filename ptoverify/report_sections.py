@@ -1156,7 +1156,9 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
         "(rows) and delay (columns), over a_true / a_design x w_max ratio",
     )
     pics += image(
-        figures, "robust_settling_nt", "Worst settling / (N* T) over the states, per law and delay"
+        figures,
+        "robust_settling_nt",
+        "Worst settling / (N* T) over the states, per law and delay (never: some state never settles)",
     )
     blocks += pics
     wrows, cmds = [], []
