@@ -12,7 +12,13 @@ With ``--small`` the sizes are cut so the whole run takes seconds; ``check_s``
 then times ``ptoverify check --gate roots-closed-form-vs-bisection`` (one cheap
 gate) and ``report_s`` ``ptoverify report --help``, so the figures only show
 that the harness works.  At full size ``report_s`` times ``ptoverify report
---quiet --out TMPDIR`` (a temporary folder, so the tracked reports/ is untouched).
+--quiet --out TMPDIR`` (a temporary folder, so the tracked reports/ is untouched),
+and ``sweep_s`` ``ptoverify sweep --quiet --json`` (200 x 200 states, 4 laws, settling
+between samples; ``--small``: ``--grid 4``).
+``robust_s`` times ``ptoverify robust --json`` at the paper's box and default sizes,
+``robust_gates_s`` the two gates of ``check --robust``; the robust maps' throughput
+is measured in-process and on a Dask LocalCluster side by side (the latter not with
+``--small``: cluster start-up would dominate).
 """
 
 from __future__ import annotations
@@ -64,6 +70,14 @@ TARGETS = {  # key: (target, ">=" or "<=")
     "discrete_batch_vs_lp_ratio": (None, ""),
     "check_s": (60.0, "<="),
     "report_s": (120.0, "<="),
+    "sweep_s": (30.0, "<="),
+    "tune_pd_s": (20.0, "<="),
+    "tune_pto_s": (120.0, "<="),
+    "robust_s": (60.0, "<="),
+    "robust_gates_s": (60.0, "<="),
+    "robust_maps_state_cells_per_s": (None, ""),
+    "robust_maps_dask_local_state_cells_per_s": (None, ""),
+    "robust_maps_trajectory_steps_per_s": (None, ""),
 }
 
 FULL = {
@@ -79,6 +93,7 @@ FULL = {
     "discrete_lp": 30,
     "repeat": 7,
     "cli_repeat": 3,
+    "tune": {},  # tune's defaults, as `ptoverify tune` runs it
 }
 SMALL = {
     "law": 2000,
@@ -93,6 +108,7 @@ SMALL = {
     "discrete_lp": 3,
     "repeat": 2,
     "cli_repeat": 1,
+    "tune": {"maxiter": 1, "popsize": 3, "d_grid": 2, "d_refine": 0},
 }
 
 
@@ -311,6 +327,23 @@ def bench_discrete_batch(cfg, size: dict) -> dict:
     }
 
 
+def bench_tune(cfg, size: dict) -> dict:
+    """Wall time [s] of one PD and one PTO tune on the step (no bound, seed 0), once each.
+
+    Tuning is seconds to a minute, so it is timed once, not as a median.
+    """
+    from ptoverify.tune import tune
+
+    out = {}
+    for law in ("pd", "pto"):
+        t0 = time.perf_counter()
+        r = tune(cfg, law, "step", **size["tune"])
+        out[f"{law}_s"] = time.perf_counter() - t0
+        out[f"{law}_evaluations"] = r.evaluations
+        out[f"{law}_settling_ms"] = 1e3 * r.best.settling_2pct_s
+    return out
+
+
 # ---------------------------------------------------------------- whole process
 def run_cli(args: list[str], repeat: int) -> tuple[float | None, str]:
     """Median wall time [s] of ``python -m ptoverify ARGS`` (cwd repo root)."""
@@ -328,6 +361,42 @@ def run_cli(args: list[str], repeat: int) -> tuple[float | None, str]:
         if p.returncode == 1:
             note = f"'ptoverify {' '.join(args)}' exited 1 (a gate did not pass)"
     return statistics.median(times), note
+
+
+# ---------------------------------------------------------------- robustness
+def bench_robust_maps(cfg, small: bool) -> dict:
+    """Maps of ``ptoverify robust`` in-process and on a Dask LocalCluster, side by side.
+
+    The same maps (bit for bit, asserted); the Dask figure includes starting and
+    stopping its 2-process LocalCluster, as ``robust --dask local`` does.
+    """
+    from ptoverify.robust import RobustSettings, dask_runner, horizon_steps, robust_maps
+
+    s = RobustSettings(n1=5, n2=5, rest=4, n_a=3, n_w=2) if small else RobustSettings()
+    t0 = time.perf_counter()
+    here = robust_maps(cfg, s)
+    t_here = time.perf_counter() - t0
+    cells = here["states"] * sum(len(c) for c in here["laws"].values())
+    out = {
+        "state_cells": cells,
+        "in_process_s": t_here,
+        "state_cells_per_s": cells / t_here,
+        "trajectory_steps_per_s": cells * horizon_steps(cfg) / t_here,
+        "dask_local_s": None,
+        "dask_local_state_cells_per_s": None,
+        "dask_note": "",
+    }
+    if small:
+        out["dask_note"] = "not timed with --small (LocalCluster start-up dominates)"
+        return out
+    t0 = time.perf_counter()
+    there = robust_maps(cfg, s, runner=dask_runner("local"))
+    t_there = time.perf_counter() - t0
+    if there != here:
+        raise AssertionError("Dask local maps differ from the in-process maps")
+    out["dask_local_s"] = t_there
+    out["dask_local_state_cells_per_s"] = cells / t_there
+    return out
 
 
 # ---------------------------------------------------------------- machine
@@ -394,11 +463,30 @@ def run(small: bool) -> tuple[dict, dict]:
     out["discrete_lp_states_per_s"] = db["lp_states_per_s"]
     out["discrete_batch_vs_lp_ratio"] = db["ratio"]
     extra["discrete_batch"] = db
+    tu = bench_tune(cfg, size)
+    out["tune_pd_s"], out["tune_pto_s"] = tu["pd_s"], tu["pto_s"]
+    extra["tune"] = tu
     check = ["check", "--gate", "roots-closed-form-vs-bisection"] if small else ["check"]
     out["check_s"], extra["check_note"] = run_cli(check, size["cli_repeat"])
     with tempfile.TemporaryDirectory() as tmp:  # never the tracked reports/ folder
         report = ["report", "--help"] if small else ["report", "--quiet", "--out", tmp]
         out["report_s"], extra["report_note"] = run_cli(report, size["cli_repeat"])
+    sweep = ["sweep", "--quiet", "--json"] + (["--grid", "4"] if small else [])
+    out["sweep_s"], extra["sweep_note"] = run_cli(sweep, size["cli_repeat"])
+    rb = bench_robust_maps(cfg, small)
+    out["robust_maps_state_cells_per_s"] = rb["state_cells_per_s"]
+    out["robust_maps_dask_local_state_cells_per_s"] = rb["dask_local_state_cells_per_s"]
+    out["robust_maps_trajectory_steps_per_s"] = rb["trajectory_steps_per_s"]
+    extra["robust_maps"] = rb
+    robust = ["robust", "--quiet", "--json"]
+    if small:
+        robust += ["--grid", "3", "--law", "pd", "--generations", "1", "--population", "5"]
+    out["robust_s"], extra["robust_note"] = run_cli(robust, size["cli_repeat"])
+    gates = ["check", "--gate", "robust-no-limit-cycle", "--gate", "robust-settling"]
+    if small:
+        out["robust_gates_s"], extra["robust_gates_note"] = None, "not run with --small"
+    else:
+        out["robust_gates_s"], extra["robust_gates_note"] = run_cli(gates, size["cli_repeat"])
     extra["vector_vs_scalar"] = out["law_vector_evals_per_s"] * out["law_scalar_us"] * 1e-6
     return out, extra
 
@@ -433,8 +521,20 @@ def table(out: dict, extra: dict) -> str:
         f"{extra['discrete_batch']['lp_states']} states",
         f"scalar law on switching-zone states only (omega_c by Newton): "
         f"{extra['law_scalar_zone_us']:.3g} us",
+        f"tune (step, no bound): PD {extra['tune']['pd_evaluations']} evaluations, best "
+        f"settling {extra['tune']['pd_settling_ms']:.4g} ms; PTO "
+        f"{extra['tune']['pto_evaluations']} evaluations, {extra['tune']['pto_settling_ms']:.4g} ms",
     ]
-    for k in ("check_note", "report_note"):
+    rb = extra["robust_maps"]
+    dask = (
+        f"Dask LocalCluster {rb['dask_local_s']:.3g} s (with start-up)"
+        if rb["dask_local_s"] is not None
+        else f"Dask: {rb['dask_note']}"
+    )
+    rows.append(
+        f"robust maps: {rb['state_cells']} state-cells in-process {rb['in_process_s']:.3g} s; {dask}"
+    )
+    for k in ("check_note", "report_note", "sweep_note", "robust_note", "robust_gates_note"):
         if extra[k]:
             rows.append(f"{k}: {extra[k]}")
     return "\n".join(rows)
@@ -451,7 +551,14 @@ def main(argv: list[str] | None = None) -> int:
         obj["machine"] = machine()
         notes = {
             k: v
-            for k, v in (("check_s", extra["check_note"]), ("report_s", extra["report_note"]))
+            for k, v in (
+                ("check_s", extra["check_note"]),
+                ("report_s", extra["report_note"]),
+                ("sweep_s", extra["sweep_note"]),
+                ("robust_s", extra["robust_note"]),
+                ("robust_gates_s", extra["robust_gates_note"]),
+                ("robust_maps_dask_local_state_cells_per_s", extra["robust_maps"]["dask_note"]),
+            )
             if v
         }
         if notes:  # reasons for a null (or a failing gate) ride with machine

@@ -65,9 +65,15 @@ verdicts and the rule texts read them from there.
 * A qualitative claim whose metric cannot be measured (a law never settles)
   is ``not reproduced`` under that reading, and the detail says why.
 
-"At the same overshoot" (Sec. 6.1): the laws are compared as configured (the
-paper's gains); both overshoots are measured and reported beside the time
-ratio, and the premise is not enforced by retuning.
+"At the same overshoot" (Sec. 6.1): under the paper-gain readings the laws are
+compared as configured (the paper's gains), both overshoots reported beside the
+time ratio.  With ``evaluate_claims(tuned=True)`` the claims of
+:data:`TUNED_CLAIMS` get three more readings (``Reading.gains``), each under the
+primary reading otherwise: the PD retuned (best 2 % settling of the step) to the
+PTO's paper-gain overshoot, the PTO at the paper's gains; and both laws at their
+best tuning (:func:`ptoverify.tune.fair_tunings`) under a shared overshoot bound,
+once the PTO's paper-gain overshoot and once the PD's.  Their common verdict is
+``verdict_tuned``; ``verdict`` stays that of the paper's gains.
 """
 
 from __future__ import annotations
@@ -75,16 +81,30 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
+from scipy.optimize import brentq
 
 from ptoverify import metrics as mt
 from ptoverify.config import Config
 from ptoverify.exact import Compared, ExactMetrics, exact_metrics
 from ptoverify.laws import Law, make_law
-from ptoverify.simulate import SimResult, simulate
+from ptoverify.metrics import STEP_FRACTION
+from ptoverify.mintime import discrete_min_steps_batch, min_time
+from ptoverify.simulate import SimResult, reference, simulate
+from ptoverify.tune import (
+    FAIR_BOUNDS,
+    Candidate,
+    FairTunings,
+    TuneBudget,
+    fair_tunings,
+    pareto_front,
+    worst_ratio_nt,
+)
+from ptoverify.tune import response_metrics as tune_response_metrics
 
 __all__ = [
     "Reading",
@@ -95,6 +115,8 @@ __all__ = [
     "response_metrics",
     "VERDICTS",
     "numeric_verdict",
+    "TUNED_CLAIMS",
+    "fair_comparison",
 ]
 
 VERDICTS = ("reproduced", "not reproduced", "ambiguous")
@@ -122,12 +144,21 @@ class Reading:
         ``corrected`` or ``printed`` (None: does not apply).
     band : float or None
         Settling band as a fraction of the step [-] (None: does not apply).
+    gains : str or None
+        None: the paper's gains.  ``pd-retuned``: the PD tuned to the PTO's
+        paper-gain overshoot, the PTO at the paper's gains.  ``best@pto-paper``,
+        ``best@pd-paper``: both laws at their best tuning under the shared
+        overshoot bound of that name (:data:`ptoverify.tune.FAIR_BOUNDS`).
+    bound_mm : float or None
+        The overshoot bound of a tuned reading [mm].
     """
 
     a: str = "given"
     tracking: str | None = None
     pto: str | None = None
     band: float | None = None
+    gains: str | None = None
+    bound_mm: float | None = None
 
     def label(self, cfg: Config) -> str:
         """Describe the reading in words, with the value of a."""
@@ -147,11 +178,25 @@ class Reading:
             parts.append(f"PTO {self.pto}")
         if self.band is not None:
             parts.append(f"band {100 * self.band:g} %")
+        if self.gains == "pd-retuned":
+            parts.append(
+                f"PD retuned to overshoot <= {self.bound_mm:.4g} mm (the PTO's), PTO paper gains"
+            )
+        elif self.gains is not None:
+            meaning = FAIR_BOUNDS[self.gains.removeprefix("best@")]
+            parts.append(f"both laws best-tuned, overshoot <= {self.bound_mm:.4g} mm ({meaning})")
         return ", ".join(parts)
 
     def to_json(self) -> dict:
         """Return the reading as a dict."""
-        return {"a": self.a, "tracking": self.tracking, "pto": self.pto, "band": self.band}
+        return {
+            "a": self.a,
+            "tracking": self.tracking,
+            "pto": self.pto,
+            "band": self.band,
+            "gains": self.gains,
+            "bound_mm": self.bound_mm,
+        }
 
 
 @dataclass(frozen=True)
@@ -249,6 +294,11 @@ class ClaimResult:
         Headline value under the primary reading, time metrics on the sample grid.
     verdict_grid : str
         Overall verdict from the readings' grid verdicts.
+    verdict_tuned : str
+        Common verdict of the tuned readings (``Reading.gains`` set), ``ambiguous``
+        when they differ; "" when they were not computed.  ``verdict`` and
+        ``verdict_grid`` are over the paper-gain readings only, so asking for
+        the tuned readings never changes them.
     """
 
     id: str
@@ -264,6 +314,7 @@ class ClaimResult:
     readings: tuple[ReadingResult, ...]
     measured_grid: float | None = None
     verdict_grid: str = ""
+    verdict_tuned: str = ""
 
     @property
     def differs_on_grid(self) -> bool:
@@ -287,6 +338,7 @@ class ClaimResult:
             "measured_grid": self.measured_grid,
             "verdict_grid": self.verdict_grid,
             "verdict_differs_on_grid": self.differs_on_grid,
+            "verdict_tuned": self.verdict_tuned,
         }
 
 
@@ -321,9 +373,15 @@ class _Ctx:
     """Access to the responses under one reading."""
 
     def __init__(
-        self, cfg: Config, reading: Reading, paper: dict[str, float | None], grid: bool = False
+        self,
+        cfg: Config,
+        reading: Reading,
+        paper: dict[str, float | None],
+        grid: bool = False,
+        law_cfg: dict[str, Config] | None = None,
     ):
         self.cfg = _cfg_for(cfg, reading)
+        self.law_cfg = law_cfg or {}  # law -> its (tuned) configuration, else self.cfg
         self.reading = reading
         self.paper = paper  # claim id -> the registry's paper value
         self.tracking = reading.tracking or "feed-forward"
@@ -334,7 +392,8 @@ class _Ctx:
 
     def sim(self, law: str, signal: str) -> SimResult:
         name = self.pto if law == "pto" else law
-        return _sim(self.cfg, name, signal, self.tracking if signal != "step" else "feed-forward")
+        cfg = self.law_cfg.get(law, self.cfg)
+        return _sim(cfg, name, signal, self.tracking if signal != "step" else "feed-forward")
 
     def tail(self, law: str, signal: str, what: str = "e") -> np.ndarray:
         r = self.sim(law, signal)
@@ -352,7 +411,8 @@ class _Ctx:
         name = self.pto if law == "pto" else law
         tracking = self.tracking if signal != "step" else "feed-forward"
         frac = self.reading.band if self.reading.band is not None else mt.STEP_FRACTION
-        return _metrics(self.cfg, name, signal, tracking, frac).values[key]
+        cfg = self.law_cfg.get(law, self.cfg)
+        return _metrics(cfg, name, signal, tracking, frac).values[key]
 
     def value(self, m: Compared) -> float:
         """Return the value this pass decides on: exact, or the grid value in the grid pass."""
@@ -801,12 +861,37 @@ def _overall(verdicts: set[str]) -> str:
     return verdicts.pop() if len(verdicts) == 1 else "ambiguous"
 
 
-def _evaluate(cfg: Config, cl: _Claim, paper: dict[str, float | None]) -> ClaimResult:
+def _tuned_readings(cfg: Config, cl: _Claim, ft: FairTunings) -> list[tuple[Reading, dict]]:
+    """Return the tuned readings of a claim, each with its laws' configurations."""
+    base = _readings(cfg, cl.dims)[0]
+    pto_bound = ft.bounds["pto-paper"]
+    out = [
+        (
+            replace(base, gains="pd-retuned", bound_mm=pto_bound),
+            {"pd": ft.config("pd", "pto-paper")},
+        )
+    ]
+    for name, bound in ft.bounds.items():
+        out.append(
+            (
+                replace(base, gains=f"best@{name}", bound_mm=bound),
+                {"pd": ft.config("pd", name), "pto": ft.config("pto", name)},
+            )
+        )
+    return out
+
+
+def _evaluate(
+    cfg: Config, cl: _Claim, paper: dict[str, float | None], ft: FairTunings | None = None
+) -> ClaimResult:
+    todo = [(rd, None) for rd in _readings(cfg, cl.dims)]
+    if ft is not None and cl.id in TUNED_CLAIMS:
+        todo += _tuned_readings(cfg, cl, ft)
     results = []
-    for rd in _readings(cfg, cl.dims):
-        exact = _Ctx(cfg, rd, paper)
+    for rd, law_cfg in todo:
+        exact = _Ctx(cfg, rd, paper, law_cfg=law_cfg)
         measured, values, ok, detail = cl.measure(exact, cl)
-        grid = _Ctx(cfg, rd, paper, grid=True)
+        grid = _Ctx(cfg, rd, paper, grid=True, law_cfg=law_cfg)
         measured_g, values_g, ok_g, _ = cl.measure(grid, cl)
         if exact.ties:
             detail += "; true tie between samples: " + ", ".join(exact.ties)
@@ -825,6 +910,8 @@ def _evaluate(cfg: Config, cl: _Claim, paper: dict[str, float | None]) -> ClaimR
             )
         )
     p = results[0]
+    plain = [r for r in results if r.reading.gains is None]
+    tuned = [r for r in results if r.reading.gains is not None]
     return ClaimResult(
         cl.id,
         cl.section,
@@ -833,23 +920,33 @@ def _evaluate(cfg: Config, cl: _Claim, paper: dict[str, float | None]) -> ClaimR
         cl.paper_value,
         cl.unit,
         cl.rule,
-        _overall({r.verdict for r in results}),
+        _overall({r.verdict for r in plain}),
         p.measured,
         p.detail,
         tuple(results),
         p.measured_grid,
-        _overall({r.verdict_grid for r in results}),
+        _overall({r.verdict_grid for r in plain}),
+        _overall({r.verdict for r in tuned}) if tuned else "",
     )
 
 
 @lru_cache(maxsize=8)
-def _evaluate_all(cfg: Config, claims: tuple[_Claim, ...]) -> tuple[ClaimResult, ...]:
+def _evaluate_all(
+    cfg: Config, claims: tuple[_Claim, ...], tuned: bool = False, budget: TuneBudget | None = None
+) -> tuple[ClaimResult, ...]:
     # paper values by id: the claims evaluated, over the registry's (a claim may quote another's)
     paper = {c.id: c.paper_value for c in CLAIMS} | {c.id: c.paper_value for c in claims}
-    return tuple(_evaluate(cfg, cl, paper) for cl in claims)
+    ft = fair_tunings(cfg, budget) if tuned else None
+    return tuple(_evaluate(cfg, cl, paper, ft) for cl in claims)
 
 
-def evaluate_claims(cfg: Config, claims: tuple[_Claim, ...] | None = None) -> list[ClaimResult]:
+def evaluate_claims(
+    cfg: Config,
+    claims: tuple[_Claim, ...] | None = None,
+    *,
+    tuned: bool = False,
+    budget: TuneBudget | None = None,
+) -> list[ClaimResult]:
     """Evaluate every claim under every reading (cached per configuration).
 
     Parameters
@@ -859,6 +956,13 @@ def evaluate_claims(cfg: Config, claims: tuple[_Claim, ...] | None = None) -> li
     claims : tuple of registry entries, optional
         The entries to evaluate; default :data:`CLAIMS`.  An entry with another
         ``paper_value`` (``dataclasses.replace``) is judged against that value.
+    tuned : bool
+        Also judge the claims of :data:`TUNED_CLAIMS` at the best tuning of
+        both laws (:func:`ptoverify.tune.fair_tunings`: minutes, memoized):
+        readings with ``gains`` set, summarized in ``verdict_tuned``.
+        ``ptoverify check`` leaves this off (see :data:`TUNED_CLAIMS`).
+    budget : TuneBudget, optional
+        Search effort of the tunings (default :class:`~ptoverify.tune.TuneBudget`).
 
     Returns
     -------
@@ -872,7 +976,68 @@ def evaluate_claims(cfg: Config, claims: tuple[_Claim, ...] | None = None) -> li
     >>> all(r.verdict in VERDICTS for r in res)
     True
     """
-    return list(_evaluate_all(cfg, CLAIMS if claims is None else tuple(claims)))
+    cl = CLAIMS if claims is None else tuple(claims)
+    return list(_evaluate_all(cfg, cl, tuned, budget))
+
+
+# ------------------------------------------------------------------ tuned sentences
+def _pct(x: float) -> str:
+    return "n/a" if not math.isfinite(x) else f"{x:+.2f} %"
+
+
+def _us(x: float) -> str:
+    """Milliseconds to the microsecond: tuned laws differ by tens of microseconds."""
+    return "never" if not math.isfinite(x) else f"{1e3 * x:.3f} ms"
+
+
+def _setting(r: ReadingResult) -> str:
+    if r.reading.gains == "pd-retuned":
+        return f"PD retuned to the PTO's overshoot ({r.reading.bound_mm:.3g} mm)"
+    return f"both laws best-tuned under overshoot <= {r.reading.bound_mm:.3g} mm"
+
+
+def _say_31(c: ClaimResult, rs: list[ReadingResult]) -> str:
+    parts = [
+        f"{_setting(r)}: PD {_us(r.values['settling_pd_s'])} vs PTO "
+        f"{_us(r.values['settling_pto_s'])}, PD takes {_pct(r.values['pd_more_percent'])} "
+        f"({r.verdict})"
+        for r in rs
+    ]
+    return f"31 % (paper {c.paper_value:g} %): " + "; ".join(parts) + "."
+
+
+def _say_settling(what: str) -> Callable[[ClaimResult, list[ReadingResult]], str]:
+    def say(c: ClaimResult, rs: list[ReadingResult]) -> str:
+        parts = []
+        for r in rs:
+            a, b = r.values["settling_pto_s"], r.values["settling_pd_s"]
+            holds = "holds" if a < b and "settling" not in " ".join(r.ties) else "does not hold"
+            parts.append(f"{_setting(r)}: PTO {_us(a)} vs PD {_us(b)} (2 % settling), {holds}")
+        return f"{what}: " + "; ".join(parts) + f"; claim verdict {c.verdict_tuned}."
+
+    return say
+
+
+def _say_rise(c: ClaimResult, rs: list[ReadingResult]) -> str:
+    parts = [
+        f"{_setting(r)}: 10-90 % rise PTO {_us(r.values['rise_time_pto_s'])} vs PD "
+        f"{_us(r.values['rise_time_pd_s'])} ({r.verdict})"
+        for r in rs
+    ]
+    return "Quicker dynamic response: " + "; ".join(parts) + "."
+
+
+#: Claims also judged at the best tuning of both laws (``evaluate_claims(tuned=True)``),
+#: with the sentence that states the result with its numbers.  ``ptoverify check``
+#: does not compute them: its claims-computed gate checks that every claim is
+#: measurable, which the paper-gain readings already show in seconds, while the
+#: tunings take minutes (the report computes them once, memoized).
+TUNED_CLAIMS: dict[str, Callable[[ClaimResult, list[ReadingResult]], str]] = {
+    "step-pd-31-percent": _say_31,
+    "step-pto-steadier-quicker": _say_settling("Quicker dynamic process (Sec. 6.1)"),
+    "conclusion-vs-to-and-pd": _say_settling("Shorter adjustment time"),
+    "conclusion-quicker-response": _say_rise,
+}
 
 
 @lru_cache(maxsize=8)
@@ -917,4 +1082,104 @@ def response_metrics(cfg: Config) -> dict[str, dict[str, dict[str, float]]]:
     return {
         law: {sig: dict(v) for sig, v in by_sig.items()}
         for law, by_sig in _response_metrics(cfg).items()
+    }
+
+
+# ------------------------------------------------------------------ fair comparison
+def _cand_json(c: Candidate) -> dict[str, Any]:
+    j = c.to_json()
+    keys = ("gains", "omega0", "settling_2pct_s", "overshoot_mm", "verified", "feasible")
+    return {k: j[k] for k in keys}
+
+
+def fair_comparison(cfg: Config, budget: TuneBudget | None = None) -> dict[str, Any]:
+    """Everything the report section "Can any tuning reproduce the paper?" shows.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (plant and the paper's gains).
+    budget : TuneBudget, optional
+        Search effort of the tunings; default :class:`~ptoverify.tune.TuneBudget`.
+
+    Returns
+    -------
+    dict
+        ``bounds_mm`` (name -> [mm]) and ``bound_meaning`` (name -> words);
+        ``floor``: the step's ``nt_s`` (N* T) and ``tf_s`` (t_f*) [s], the
+        least times to reach the target exactly, and ``band_entry_s`` [s], the
+        least time to reach the 2 % band at all (full input from rest: a lower
+        bound of any 2 % settling time, which can lie below t_f* since the band
+        is entered before the target is reached); ``paper``: law -> the step's metrics at
+        the paper's gains plus ``worst_ratio_nt``; ``fronts``: law -> the Pareto
+        front of 2 % settling [s] vs overshoot [mm] over every candidate the
+        tunings evaluated (cheap constraints; ``verified`` marks those checked on
+        the gate grid), by increasing overshoot; ``best``: bound name -> law ->
+        the best tuned gains with ``settling_2pct_s``, ``overshoot_mm``,
+        ``rise_time_s``, ``settling_0p01mm_s`` and ``worst_ratio_nt`` (over the
+        :data:`~ptoverify.tune.WORST_GRID` envelope grid); ``claims``: one entry per claim
+        judged at the best tuning (``id``, ``verdict``, ``sentence``,
+        ``readings``); ``evaluations``, ``seconds``, ``budget``.
+    """
+    ft = fair_tunings(cfg, budget)
+    step = reference("step").amplitude
+    a, w = cfg.plant.a, cfg.plant.w_max
+    dist = (1.0 - STEP_FRACTION) * abs(step)  # to the edge of the 2 % band, from rest
+    floor = {
+        "nt_s": float(discrete_min_steps_batch([-step], [0.0], cfg.plant).time_s[0]),
+        "tf_s": float(min_time(np.array([-step]), np.array([0.0]), cfg.plant).t_f[0]),
+        "band_entry_s": float(
+            brentq(
+                lambda t: w * (t - (1.0 - math.exp(-a * t)) / a) - dist,
+                0.0,
+                dist / w + 1.0,
+                xtol=1e-15,
+            )
+        ),
+    }
+    paper = {law: dict(m, worst_ratio_nt=worst_ratio_nt(cfg, law)) for law, m in ft.paper.items()}
+    fronts = {}
+    for law in ("pd", "pto"):
+        pool = [c for (lw, _), r in ft.results.items() if lw == law for c in r.front]
+        uniq = {tuple(sorted(c.gains.items())): c for c in pool}
+        fronts[law] = [_cand_json(c) for c in pareto_front(list(uniq.values()))]
+    best: dict[str, dict[str, Any]] = {}
+    for name in ft.bounds:
+        best[name] = {}
+        for law in ("pd", "pto"):
+            r = ft.results[(law, name)]
+            m = tune_response_metrics(r.config, law, "step")
+            best[name][law] = _cand_json(r.best) | {
+                "rise_time_s": m["rise_time_s"],
+                "settling_0p01mm_s": m["settling_0p01mm_s"],
+                "worst_ratio_nt": worst_ratio_nt(r.config, law),
+                "evaluations": r.evaluations,
+            }
+    results = evaluate_claims(cfg, tuned=True, budget=budget)
+    claims = []
+    for c in results:
+        if c.id not in TUNED_CLAIMS:
+            continue
+        tuned = [r for r in c.readings if r.reading.gains is not None]
+        claims.append(
+            {
+                "id": c.id,
+                "claim": c.claim,
+                "verdict": c.verdict_tuned,
+                "sentence": TUNED_CLAIMS[c.id](c, tuned),
+                "readings": [r.to_json() for r in tuned],
+            }
+        )
+    uniq_runs = {id(r): r for r in ft.results.values()}.values()
+    return {
+        "bounds_mm": dict(ft.bounds),
+        "bound_meaning": dict(FAIR_BOUNDS),
+        "floor": floor,
+        "paper": paper,
+        "fronts": fronts,
+        "best": best,
+        "claims": claims,
+        "evaluations": sum(r.evaluations for r in uniq_runs),
+        "seconds": ft.seconds,
+        "budget": asdict(ft.budget),
     }

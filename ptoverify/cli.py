@@ -29,7 +29,7 @@ from typing import Any
 
 from ptoverify import __version__
 from ptoverify.config import Config, load_config
-from ptoverify.errors import InputError, SolverError
+from ptoverify.errors import ClusterError, InputError, SolverError
 from ptoverify.outdir import (
     OutputBusy,
     Terminated,
@@ -281,7 +281,14 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     }
     if args.x0 is not None:
         return _simulate_regulation(args, cfg, {k: v for k, v in mismatch.items() if v is not None})
-    given = [k for k, v in mismatch.items() if v is not None]
+    flags = dict(
+        zip(
+            mismatch,
+            ("--a-ratio", "--w-max-ratio", "--delay", "--quantum", "--velocity-noise", "--seed"),
+            strict=True,
+        )
+    )
+    given = [flags[k] for k, v in mismatch.items() if v is not None]
     if given:
         raise InputError(f"the plant/measurement mismatch options need --x0 (got {given[0]})")
     run = run_simulation(
@@ -366,6 +373,27 @@ def _add_robust(sub) -> None:
     p.add_argument(
         "--grid", type=positive_int, default=15, metavar="N", help="N x N initial states (15)"
     )
+    p.add_argument(
+        "--law",
+        action="append",
+        choices=("to", "pd", "pto", "pto-printed"),
+        default=None,
+        help="study only this law (repeatable; default all four)",
+    )
+    p.add_argument(
+        "--generations",
+        type=int,
+        default=12,
+        metavar="N",
+        help="differential-evolution generations of the worst-case search (12; 0 to 500)",
+    )
+    p.add_argument(
+        "--population",
+        type=int,
+        default=24,
+        metavar="N",
+        help="candidates per generation of each search (24; 5 to 1000)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     p.set_defaults(handler=_cmd_robust)
 
@@ -377,7 +405,19 @@ def _cmd_robust(args: argparse.Namespace) -> int:
     cfg = _config(args)
     if not 3 <= args.grid <= 101:
         raise InputError(f"--grid must be in [3, 101], got {args.grid}")
-    res = run_robust_study(cfg, grid=args.grid, dask=args.dask, progress=stderr_bar(args.quiet))
+    if not 0 <= args.generations <= 500:
+        raise InputError(f"--generations must be in [0, 500], got {args.generations}")
+    if not 5 <= args.population <= 1000:
+        raise InputError(f"--population must be in [5, 1000], got {args.population}")
+    res = run_robust_study(
+        cfg,
+        grid=args.grid,
+        dask=args.dask,
+        laws=tuple(dict.fromkeys(args.law)) if args.law else None,
+        generations=args.generations,
+        population=args.population,
+        progress=stderr_bar(args.quiet),
+    )
     if args.json:
         print_json(res)
         return 0
@@ -418,9 +458,17 @@ def _add_tune(sub) -> None:
         "--objective",
         choices=("settling_2pct", "settling_0p01mm", "worst_ratio_nt"),
         default="settling_2pct",
-        help="what to minimize (default settling_2pct)",
+        help="what to minimize (default settling_2pct); worst_ratio_nt: the worst settling / "
+        "N*T over a 20 x 20 grid of the envelope",
     )
     p.add_argument("--seed", type=int, default=0, help="search seed (default 0)")
+    p.add_argument(
+        "--maxiter",
+        type=int,
+        default=30,
+        metavar="N",
+        help="differential-evolution generations (default 30; the PTO uses max(N/2, 5) per d)",
+    )
     p.set_defaults(handler=_cmd_tune)
 
 
@@ -435,6 +483,7 @@ def _cmd_tune(args: argparse.Namespace) -> int:
         max_overshoot=args.max_overshoot,
         objective=args.objective,
         seed=args.seed,
+        maxiter=args.maxiter,
     )
     if args.json:
         print_json(res.to_json())
@@ -442,7 +491,8 @@ def _cmd_tune(args: argparse.Namespace) -> int:
     b = res.best
     print(
         f"# best {args.law} on the {args.signal}: settling (2 %) {b.settling_2pct_s * 1e3:.4g} ms, "
-        f"overshoot {b.overshoot_mm:.4g} mm, {res.evaluations} evaluations, "
+        f"overshoot {b.overshoot_mm:.4g} mm, {args.objective} {b.objective:.6g}, "
+        f"{res.evaluations} evaluations, "
         f"{res.seconds:.1f} s"
     )
     print(res.toml(), end="")
@@ -528,7 +578,7 @@ def _add_check(sub) -> None:
         "--robust",
         action="store_true",
         help="also run the robustness gates over the [robustness] box "
-        "(robust-no-limit-cycle, robust-settling; about a minute)",
+        "(robust-no-limit-cycle, robust-settling; adds about 10 s)",
     )
     _add_junit(p)
     p.set_defaults(handler=_cmd_check)
@@ -776,6 +826,11 @@ E_ref the reference's worst. Table: agreement and |u| <= w_max at its points onl
 reference is evaluated at the table's x1, x2, so firmware that rounds the state (float32) must
 write back the state it actually evaluated.
 
+--report DIR also writes a report for a review (verdict, properties with units, heat maps of
+|u - u_ref| with l1, l2, l1*, l2* and |x1| < d, closed loop, settling / N*T, step/ramp/sine
+responses of a --law next to the reference); DIR is checked before anything runs and written
+atomically.
+
 Exit codes: 0 conforms, 1 does not (each failing property named with the first state that
 shows it; a law that raises, returns NaN/inf, or has memory is a finding), 2 bad input
 (import error, missing attribute, not callable, wrong signature, a non-number or wrong
@@ -785,7 +840,8 @@ examples:
   ptoverify conform --law ptoverify.conform:reference_law
   ptoverify conform --law examples/my_pto.py:pto --json
   ptoverify conform --emit-grid grid.csv      # fill in column u, then:
-  ptoverify conform --table grid_with_u.csv"""
+  ptoverify conform --table grid_with_u.csv
+  ptoverify conform --law examples/my_pto.py:pto --report review    # HTML/Markdown/JSON report"""
 
 
 def _add_conform(sub) -> None:
@@ -823,6 +879,14 @@ def _add_conform(sub) -> None:
         help="budget for the whole conformance of a --law [s] (default 120); the law runs "
         "in a child process, and a hang, crash or exit of it is a finding",
     )
+    p.add_argument(
+        "--report",
+        metavar="DIR",
+        default=None,
+        help="also write a report folder for a review (index.html, report.md, results.json, "
+        "figures/): verdict, properties, map of |u - u_ref| with the region boundaries, "
+        "closed loop, step/ramp/sine responses; checked before computing, written atomically",
+    )
     _add_junit(p)
     p.set_defaults(handler=_cmd_conform)
 
@@ -835,6 +899,13 @@ def _cmd_conform(args: argparse.Namespace) -> int:
     if not 0 < rtol < 1:
         raise InputError(f"--tolerance must be in (0, 1), got {rtol:g}")
     _check_junit(args)
+    target = None
+    if args.report is not None:
+        from ptoverify.conform_report import check_report_target
+
+        if args.emit_grid:
+            raise InputError("--report needs --law or --table, not --emit-grid")
+        target = check_report_target(args.report, cfg)
     if args.emit_grid:
         text = conform.grid_csv(cfg)
         write_atomic(args.emit_grid, text)
@@ -849,12 +920,19 @@ def _cmd_conform(args: argparse.Namespace) -> int:
         return 0
     if not 0 < args.timeout <= 86400:
         raise InputError(f"--timeout must be in (0, 86400] s, got {args.timeout:g}")
-    if args.table:
+    evidence = None
+    if target is not None:
+        from ptoverify.conform_evidence import conform_with_evidence
+
+        result, evidence = conform_with_evidence(
+            cfg, law=args.law, table=args.table, rtol=rtol, timeout=args.timeout
+        )
+    elif args.table:
         result = conform.conform_table(args.table, cfg, rtol=rtol)
     else:  # the law runs in a child process; what it prints goes to stderr afterwards
         result = conform.conform_spec(args.law, cfg, rtol=rtol, timeout=args.timeout)
-        if result.law_output:
-            print(result.law_output, end="", file=sys.stderr)
+    if args.law and result.law_output:
+        print(result.law_output, end="", file=sys.stderr)
     if args.junit:
         from ptoverify.junit import conform_verdicts, junit_xml
 
@@ -862,10 +940,19 @@ def _cmd_conform(args: argparse.Namespace) -> int:
         props = {"config": cfg.name, "target": result.target, "mode": result.mode}
         xml = junit_xml(verdicts, "ptoverify.conform", states, props, result.conforms)
         write_atomic(args.junit, xml)
+    if target is not None:
+        from ptoverify.conform_report import write_conform_report
+
+        write_conform_report(result, evidence, cfg, target)
     if args.json:
-        print_json(result.to_json())
+        out = result.to_json()
+        if target is not None:
+            out["report"] = str(target / "index.html")
+        print_json(out)
     else:
         print(conform.format_result(result))
+        if target is not None:
+            print(f"wrote report {target}/index.html, report.md, results.json, figures/")
     return 0 if result.conforms else 1
 
 
@@ -961,7 +1048,7 @@ def main(argv: list[str] | None = None) -> int:
     except OutputBusy as exc:
         print(f"ptoverify: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 1
-    except SolverError as exc:
+    except (SolverError, ClusterError) as exc:  # the input was fine; the run could not be done
         print(f"ptoverify: error: {_one_line(exc)}", file=sys.stderr)
         return 1
     except InputError as exc:

@@ -326,6 +326,9 @@ def run_robust_study(
     *,
     grid: int = 15,
     dask: str | None = None,
+    laws: tuple[str, ...] | None = None,
+    generations: int = 12,
+    population: int = 24,
     progress: Callable[[str, float], None] | None = None,
 ) -> dict[str, Any]:
     """Return the ``ptoverify robust --json`` object.
@@ -338,6 +341,11 @@ def run_robust_study(
         Initial states per axis of the maps.
     dask : str, optional
         Scheduler address or ``local`` (None: in-process).
+    laws : tuple of str, optional
+        Laws studied (default: to, pd, pto, pto-printed).
+    generations, population : int
+        Differential-evolution generations and candidates per generation of
+        each worst-case search.
     progress : callable, optional
         ``progress(stage, fraction)``.
 
@@ -346,7 +354,13 @@ def run_robust_study(
     dict
         ``box``, ``margins``, ``worst``, ``maps``, ``most_robust``, ``timings_s``, ``backend``.
     """
-    from ptoverify.robust import RobustSettings, run_robust
+    from ptoverify.robust import LAWS, RobustSettings, run_robust
 
-    settings = RobustSettings(n1=grid, n2=grid)
+    settings = RobustSettings(
+        n1=grid,
+        n2=grid,
+        laws=laws or LAWS,
+        search_iterations=generations,
+        search_population=population,
+    )
     return run_robust(cfg, settings, dask=dask, progress=progress).to_json()

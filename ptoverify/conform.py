@@ -115,6 +115,8 @@ __all__ = [
     "read_table",
     "agreement",
     "closed_loop",
+    "as_law",
+    "settling_states",
     "determinism",
     "ConformResult",
     "conform_callable",
@@ -254,8 +256,21 @@ def _differs(first, other, x1, x2, how: str) -> list[dict]:
 
 
 # ------------------------------------------------------------------ closed loop
-def _as_law(user, cfg: Config) -> Law:
-    """Wrap a user law as a :class:`Law` whose regions are the reference's (geometry)."""
+def as_law(user, cfg: Config) -> Law:
+    """Wrap a user law as a :class:`Law` whose regions are the reference's (geometry).
+
+    Parameters
+    ----------
+    user : UserLaw or IsolatedLaw
+        The wrapped law (an isolated law is called through its child process).
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    Law
+        Named ``user``; ``vector`` and ``scalar`` return (u [mm/s], region code).
+    """
     ref = reference(cfg)
 
     def vector(x1, x2):
@@ -357,6 +372,36 @@ def _settling(law: Law, cfg: Config, visited: list) -> tuple[Verdict, list[dict]
     return v, fails
 
 
+def settling_states(cfg: Config, x1_user: NDArray) -> dict:
+    """Per-state settling of the settling sweep: the user law, the reference and N*.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+    x1_user : ndarray, shape (steps + 1, n)
+        Positions [mm] of the user law's settling sweep (the second
+        :class:`~ptoverify.simulate.BatchResult` that :func:`closed_loop` visits).
+
+    Returns
+    -------
+    dict
+        ``x1``, ``x2`` initial states [mm], [mm/s]; ``n_star`` (N*, -1 where
+        unknown), ``s_user`` and ``s_ref`` (settling samples, |x1| <= ``band_mm``
+        for good; inf if never); ``band_mm`` [mm]; ``sample_time_s`` [s].
+    """
+    ref = _settling_reference(cfg)
+    return {
+        "x1": ref["x1"],
+        "x2": ref["x2"],
+        "n_star": ref["n_star"],
+        "s_user": _settle_steps(np.asarray(x1_user, dtype=float), _BAND_MM),
+        "s_ref": ref["s_ref"],
+        "band_mm": _BAND_MM,
+        "sample_time_s": cfg.plant.sample_time,
+    }
+
+
 def _grid_sizes(mode: str, sweep: tuple[int, int, int] | None) -> tuple[int, int, int]:
     if sweep is not None:
         return sweep
@@ -397,7 +442,7 @@ def closed_loop(
     from ptoverify.simulate import simulate_batch
 
     visited = [] if visited is None else visited
-    law = _as_law(user, cfg)
+    law = as_law(user, cfg)
     n1, n2, rest = _grid_sizes(user.mode, sweep)
     x1, x2, _ = initial_grid(cfg, n1, n2, rest)
     steps = default_steps(cfg)
@@ -608,8 +653,12 @@ def _random_states(cfg: Config, n: int) -> tuple[NDArray, NDArray]:
     return rng.uniform(-R, R, n), rng.uniform(-w, w, n)
 
 
-def _judge(user, failures: list[dict], cfg: Config, rtol, sweep, grid, n_random) -> tuple:
-    """Evaluate every property in order; returns (props, agreement, timings)."""
+def _judge(user, failures: list[dict], cfg: Config, rtol, sweep, grid, n_random, keep=None):
+    """Evaluate every property in order; returns (props, agreement, timings).
+
+    ``keep`` (a dict) receives the judged states ``states`` = (x1, x2, u) and the
+    per-state ``settling`` (:func:`settling_states`) when they were computed.
+    """
     props: dict[str, Verdict] = {}
     agree: dict = {"pass": False, "detail": "not run"}
     timings: dict[str, float] = {}
@@ -661,6 +710,9 @@ def _judge(user, failures: list[dict], cfg: Config, rtol, sweep, grid, n_random)
     props.update(cl)
     failures += f
     timings["closed_loop"] = time.perf_counter() - t
+    n_settle = _settling_reference(cfg)["x1"].size
+    if keep is not None and len(visited) == 2 and visited[1].x1.shape[1] == n_settle:
+        keep["settling"] = settling_states(cfg, visited[1].x1)
     t = time.perf_counter()
     if us:
         for res, label in zip(visited, ("sweep", "settling")):
@@ -669,6 +721,8 @@ def _judge(user, failures: list[dict], cfg: Config, rtol, sweep, grid, n_random)
             us.append(res.u.ravel())
             sources[label] = res.u.size
         x1, x2, u = np.concatenate(xs), np.concatenate(ys), np.concatenate(us)
+        if keep is not None:
+            keep["states"] = (x1, x2, u)
         agree, f = agreement(x1, x2, u, cfg, rtol)
         agree["sources"] = sources
         agree["gap"] = largest_gap(x1, x2, cfg)
@@ -768,6 +822,8 @@ def conform_spec(
     sweep: tuple[int, int, int] | None = None,
     grid: tuple[NDArray, NDArray] | None = None,
     n_random: int = N_RANDOM,
+    keep: dict | None = None,
+    after: Callable | None = None,
 ) -> ConformResult:
     """Judge ``MODULE:FUNCTION`` or ``file.py:FUNCTION`` isolated in a child process.
 
@@ -784,6 +840,15 @@ def conform_spec(
         per state).
     sweep, grid, n_random
         As :func:`conform_callable`.
+    keep : dict, optional
+        Receives the evidence behind the verdict: ``states`` (x1, x2, u of every
+        judged state), ``settling`` (:func:`settling_states`), and what ``after``
+        returned (``after``) or why it could not run (``after_error``).
+    after : callable, optional
+        ``after(law)`` is called with the live isolated law once every property
+        is judged (inside the same child process and ``timeout``), e.g. to
+        simulate responses for a report.  A fault or an abort there is recorded
+        in ``keep["after_error"]`` and changes no property.
 
     Returns
     -------
@@ -805,10 +870,16 @@ def conform_spec(
     timings = {"detect": time.perf_counter() - t0}
     props: dict[str, Verdict] = {}
     try:
-        props, agree, t = _judge(user, failures, cfg, rtol, sweep, grid, n_random)
+        props, agree, t = _judge(user, failures, cfg, rtol, sweep, grid, n_random, keep)
         timings.update(t)
     except LawAborted as ab:
         return _aborted(user, props, failures, ab, timings, t0, cfg, spec, user.close())
+    if after is not None:
+        keep = {} if keep is None else keep
+        try:
+            keep["after"] = after(user)
+        except (LawFault, LawAborted) as exc:
+            keep["after_error"] = exc.message
     return _finish(user, props, failures, agree, timings, t0, cfg, spec, user.close())
 
 
@@ -862,7 +933,9 @@ def _coverage(agree: dict, cfg: Config) -> Verdict:
     return Verdict("coverage", FAIL if short else PASS, worst, MIN_PER_REGION, detail, ">=", "1")
 
 
-def conform_table(path: str | Path, cfg: Config, *, rtol: float = DEFAULT_RTOL) -> ConformResult:
+def conform_table(
+    path: str | Path, cfg: Config, *, rtol: float = DEFAULT_RTOL, keep: dict | None = None
+) -> ConformResult:
     """Judge a table x1, x2, u (CSV) against the reference where it has points.
 
     Parameters
@@ -873,6 +946,8 @@ def conform_table(path: str | Path, cfg: Config, *, rtol: float = DEFAULT_RTOL) 
         Configuration.
     rtol : float
         Agreement tolerance relative to w_max.
+    keep : dict, optional
+        Receives ``states`` = (x1, x2, u), the table's states and values.
 
     Returns
     -------
@@ -883,6 +958,8 @@ def conform_table(path: str | Path, cfg: Config, *, rtol: float = DEFAULT_RTOL) 
     t0 = time.perf_counter()
     x1, x2, u = read_table(path, cfg)
     t_read = time.perf_counter() - t0
+    if keep is not None:
+        keep["states"] = (x1, x2, u)
     agree, failures = agreement(x1, x2, u, cfg, rtol)
     agree["sources"] = {"table": int(x1.size)}
     props = {"coverage": _coverage(agree, cfg), "agreement": _agreement_verdict(agree)}

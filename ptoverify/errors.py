@@ -22,3 +22,7 @@ class ConfigError(InputError):
 
 class SolverError(PtoverifyError, RuntimeError):
     """A numerical reference could not be computed (solver failure)."""
+
+
+class ClusterError(PtoverifyError, RuntimeError):
+    """A compute cluster (a Dask scheduler) could not be reached (exit code 1, not bad input)."""

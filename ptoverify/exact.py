@@ -75,6 +75,8 @@ __all__ = [
     "sine_phase",
     "exact_metrics",
     "metrics_from_arrays",
+    "BatchSettling",
+    "settling_times_batch",
 ]
 
 TIGHT_BAND = 0.01
@@ -1248,3 +1250,206 @@ def _infer(res: Any) -> Signal:
         rd = np.asarray(res.r_dot, dtype=float)
         return Signal("ramp", float(r[np.argmax(np.abs(r))]), float(np.max(np.abs(rd))))
     raise InputError(f"pass the reference of this '{name}' response explicitly")
+
+
+@dataclass(frozen=True)
+class BatchSettling:
+    """Settling times of many regulation records, between samples and on the grid.
+
+    Attributes
+    ----------
+    time : ndarray, shape (n,)
+        Exact settling time [s] from the record's start: the last exit of the
+        continuous trajectory from the box |x1| <= band_x1, |x2| <= band_x2
+        (0 if never outside); NaN when the record ends outside or the settled
+        tail is shorter than ``hold``.
+    grid : ndarray, shape (n,)
+        Sample-grid settling time [s]: k T for the first sample k after the last
+        sample outside the box (``ptoverify.sweep.settle_steps``); NaN likewise,
+        with the hold counted in whole samples, ceil(hold / T).
+    accuracy : float
+        Bound on the error of :attr:`time` [s] (see :func:`settling_times_batch`).
+    """
+
+    time: NDArray[np.float64]
+    grid: NDArray[np.float64]
+    accuracy: float
+
+
+def settling_times_batch(
+    x1: ArrayLike,
+    x2: ArrayLike,
+    u: ArrayLike,
+    a: float,
+    T: float,  # noqa: N803
+    band_x1: float,
+    band_x2: float,
+    hold: float = 0.0,
+) -> BatchSettling:
+    """Exact last exit from a band box for many ZOH records at once (regulation).
+
+    The box is |x1| <= band_x1 and |x2| <= band_x2.  The last time outside the
+    box is the later of the last exits of x1 and of x2 from their own bands,
+    found separately:
+
+    * x2(s) = u + (x2k - u) e^{-a s} is monotone on each sample, so it leaves its
+      band between samples only if a sample is outside: its last exit is in the
+      interval after the last sample outside, at the closed-form
+      s = ln((x2k - u)/(L - u)) / a, L = +-band_x2.
+    * x1 is convex or concave on each sample (x1'' = x2' has one sign), with an
+      interior extremum only where x2 changes sign, at s* = ln((u - x2k)/u) / a.
+      Its last exit is in the latest interval that has a point outside -- its
+      first sample, or an excursion x1(s*) outside the band between two samples
+      that are both inside -- on the monotone piece after that point, found by
+      safeguarded Newton on eq. (7) to 4 ulps of T.
+
+    Parameters
+    ----------
+    x1, x2 : array_like, shape (steps + 1, n) or (steps + 1,)
+        Position [mm] and velocity [mm/s] at the samples t_k = k T.
+    u : array_like, shape (steps, n) or (steps,)
+        Input held on [t_k, t_k+1) [mm/s].
+    a : float
+        Bandwidth [rad/s].
+    T : float
+        Sample period [s].
+    band_x1 : float
+        Position band [mm], > 0.
+    band_x2 : float
+        Velocity band [mm/s], > 0.
+    hold : float
+        Shortest settled tail that counts [s]: settled only if
+        t_end - time >= hold - 1e-9 T (the grid value: whole samples,
+        ceil(hold / T - 1e-9), as ``ptoverify.sweep``).
+
+    Returns
+    -------
+    BatchSettling
+        ``time`` (between samples) and ``grid`` (on the samples), shape (n,),
+        and ``accuracy`` = 4 eps T (Newton's stopping width) + 4 eps t_end
+        (round-off of k T + s) [s]; the x1 crossing also moves with the
+        round-off of eq. (7), about 8 eps X / |x2| for X the size of its terms.
+        Where both are finite, grid - T < time (the sample before the grid
+        value is outside the box) and grid <= T ceil(time / T) (every sample
+        from the exact time on is inside); time > grid only when the
+        trajectory leaves the box between samples after the grid value.
+
+    Examples
+    --------
+    >>> a, T = 10.0, 0.1
+    >>> t = np.arange(11) * T
+    >>> x2 = 5.0 * np.exp(-a * t)  # u = 0: x1 = 0.5 (1 - e^{-a t}) - 0.5
+    >>> x1 = -0.5 * np.exp(-a * t)
+    >>> st = settling_times_batch(x1, x2, np.zeros(10), a, T, 0.01, 1.0)
+    >>> round(float(st.time[0]), 6), float(st.grid[0])  # ln(50) / 10, then the sample after
+    (0.391202, 0.4)
+    """
+    x1, x2, u = _arr(x1), _arr(x2), _arr(u)
+    if x1.ndim == 1:
+        x1, x2, u = x1[:, None], x2[:, None], u[:, None]
+    steps = x1.shape[0] - 1
+    if steps < 1 or x2.shape != x1.shape or u.shape != (steps, x1.shape[1]):
+        raise InputError("x1, x2 must be (steps + 1, n) and u (steps, n), steps >= 1")
+    if not (band_x1 > 0 and band_x2 > 0 and a > 0 and T > 0 and hold >= 0):
+        raise InputError("bands, a and T must be positive and hold >= 0")
+    cols = np.arange(x1.shape[1])
+    L1, L2, E1 = _scan_back(x1, x2, u, a, T, band_x1, band_x2)
+    ended = (L1 == steps) | (L2 == steps)
+    # the piece of x1's last exit: after the excursion of E1, or from the sample L1
+    from_exc = (E1 >= 0) & (E1 >= L1) & ~ended
+    from_smp = (L1 >= 0) & ~from_exc & ~ended
+    t1 = np.zeros(cols.size)
+    tol = 4.0 * np.finfo(float).eps * T
+    for sel, after in ((from_exc, True), (from_smp, False)):
+        c = cols[sel]
+        k = (E1 if after else L1)[c]
+        xk, vk, uk = x1[k, c], x2[k, c], u[k, c]
+        s_star, y_star = _x1_extremum(xk, vk, uk, a, T)
+        if after:  # from the excursion's extremum (outside) to the next sample (inside)
+            lo, hi, level = s_star, np.full(c.size, T), np.copysign(band_x1, y_star)
+        else:  # from the sample outside to the extremum (inside) or the next sample
+            lo, hi = np.zeros(c.size), np.where(np.isfinite(s_star), s_star, T)
+            level = np.copysign(band_x1, xk)
+        t1[c] = k * T + _x1_crossing(xk, vk, uk, a, level, lo, hi, tol)
+    # x2: closed form in the interval after its last sample outside
+    t2 = np.zeros(cols.size)
+    c = cols[(L2 >= 0) & ~ended]
+    k = L2[c]
+    vk, uk = x2[k, c], u[k, c]
+    lvl = np.copysign(band_x2, vk)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s2 = np.log1p((vk - lvl) / (lvl - uk)) / a
+    t2[c] = k * T + np.clip(np.nan_to_num(s2, nan=T), 0.0, T)
+    t_end = steps * T
+    ts = np.maximum(t1, t2)
+    ts = np.where(ended | (t_end - ts < hold - 1e-9 * T), np.nan, ts)
+    kg = np.maximum(L1, L2) + 1
+    hold_steps = math.ceil(hold / T - 1e-9)
+    grid = np.where(steps - kg >= hold_steps, kg * T, np.nan)
+    eps = float(np.finfo(float).eps)
+    return BatchSettling(ts, grid, 4.0 * eps * T + 4.0 * eps * t_end)
+
+
+def _scan_back(x1, x2, u, a: float, T: float, b1: float, b2: float):  # noqa: N803
+    """Last samples outside each band (L1, L2) and last x1 excursion at or after L1 (E1).
+
+    Scans blocks of samples from the record's end backwards (blocks of about
+    32k values stay in cache) and stops once every column's L1 and L2 are
+    known.  -1 where none.  An excursion in interval k needs an interior zero of
+    x2 (x2k x2k+1 < 0) and |x1k| + T |x2k| > b1 (on [0, s*] |x2| <= |x2k|, so
+    |x1(s*) - x1k| < T |x2k|); only those candidates get the closed-form s*.
+    """
+    steps, n = x1.shape[0] - 1, x1.shape[1]
+    L1 = np.where(np.abs(x1[steps]) > b1, steps, -1)
+    L2 = np.where(np.abs(x2[steps]) > b2, steps, -1)
+    kk, cc = [], []
+    rows = max(1, 32768 // max(n, 1))
+    for hi in range(steps, 0, -rows):
+        if (L1 >= 0).all() and (L2 >= 0).all():
+            break
+        lo = max(0, hi - rows)
+        y1, y2 = x1[lo:hi], x2[lo:hi]  # samples lo..hi-1: the intervals' starts
+        idx = np.arange(lo + 1, hi + 1, dtype=np.int32)[:, None]  # row + 1
+        ax1, ax2 = np.abs(y1), np.abs(y2)
+        for L, ay, b in ((L1, ax1, b1), (L2, ax2, b2)):
+            r = ((ay > b) * idx).max(axis=0)  # last row outside + 1, 0 if none
+            if r.any():
+                np.copyto(L, r - 1, where=(L < 0) & (r > 0))
+        ax2 *= T
+        ax2 += ax1
+        c = ax2 > b1
+        with np.errstate(invalid="ignore"):
+            c &= (y2 * x2[lo + 1 : hi + 1]) < 0.0
+        if c.any():
+            k, j = np.nonzero(c)
+            k += lo
+            keep = k >= L1[j]  # L1 found in an earlier row later on is < lo <= k
+            kk.append(k[keep])
+            cc.append(j[keep])
+    kk = np.concatenate(kk) if kk else np.zeros(0, dtype=np.int64)
+    cc = np.concatenate(cc) if cc else np.zeros(0, dtype=np.int64)
+    _, y_ex = _x1_extremum(x1[kk, cc], x2[kk, cc], u[kk, cc], a, T)
+    exc = np.abs(y_ex) > b1  # NaN (no interior extremum) compares False
+    E1 = np.full(n, -1)
+    np.maximum.at(E1, cc[exc], kk[exc])
+    return L1, L2, E1
+
+
+def _x1_extremum(x1k, x2k, uk, a: float, T: float):  # noqa: N803
+    """Interior extremum (s*, x1(s*)) of x1 on each sample, NaN where none in (0, T)."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        s = np.log1p(-x2k / uk) / a
+    s = np.where((s > 0.0) & (s < T), s, np.nan)
+    return s, _flow(x1k, x2k, uk, s, a)[0]
+
+
+def _x1_crossing(x1k, x2k, uk, a: float, level, lo, hi, tol: float):
+    """Offset s in [lo, hi] where the monotone x1(s) of eq. (7) equals level (Newton)."""
+    if np.size(x1k) == 0:
+        return np.zeros(0)
+    dv = x2k - uk
+
+    def fdf(s):
+        return x1k + uk * s + dv * -np.expm1(-a * s) / a - level, uk + dv * np.exp(-a * s)
+
+    return _newton(fdf, lo, hi, fdf(lo)[0], tol)

@@ -25,15 +25,17 @@ settling_ratio_nt, settling_ratio_tf
 
 Maps evaluate a grid of perturbations (a_ratio x w_max_ratio x each delay)
 times a grid of initial states.  Margins bisect a_true / a_design around 1.
-The worst-case search runs ``scipy.optimize.differential_evolution`` (seeded,
-its initial population seeded with the grid's worst cells) and a bounded
-Nelder-Mead polish, so the searched value is never below the grid's worst.
+The worst-case search is a seeded differential evolution (scipy's default
+strategy, all searches of a law in lockstep so each generation is one batch
+simulation) started from the grid's worst cells, then a batched local polish,
+so the searched value is never below the grid's worst.
 """
 
 from __future__ import annotations
 
 import functools
 import math
+import re
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -41,10 +43,10 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import differential_evolution, minimize
+from scipy.stats import qmc
 
 from ptoverify.config import Config, Plant
-from ptoverify.errors import InputError
+from ptoverify.errors import ClusterError, InputError
 from ptoverify.laws import Law, make_law
 from ptoverify.mintime import discrete_min_steps_batch, min_time
 from ptoverify.plant import zoh_matrices
@@ -65,8 +67,11 @@ __all__ = [
     "linear_loop_margin",
     "no_limit_cycle_margin",
     "worst_case",
+    "worst_cases",
     "grid_worst",
     "dask_runner",
+    "check_dask_address",
+    "DASK_CONNECT_TIMEOUT_S",
     "most_robust",
     "RobustResult",
     "run_robust",
@@ -176,7 +181,7 @@ def trajectory_properties(
     mismatch: Mismatch,
     *,
     steps: int | None = None,
-    with_settling: bool = True,
+    with_settling: bool | NDArray[np.bool_] = True,
 ) -> dict[str, NDArray[np.float64]]:
     """Simulate ``law_name`` (nominal design) on a mismatched plant and measure each state.
 
@@ -192,8 +197,9 @@ def trajectory_properties(
         The plant and measurement (a_ratio and w_max_ratio may be arrays of shape (n,)).
     steps : int, optional
         Horizon [samples]; default covers the slowest plant of the box.
-    with_settling : bool
-        Also compute the settling ratios (needs t_f* and N* of each true plant).
+    with_settling : bool or ndarray of bool, shape (n,)
+        Also compute the settling ratios (needs t_f* and N* of each true plant),
+        for every state or for the states of a mask (nan elsewhere).
 
     Returns
     -------
@@ -229,7 +235,8 @@ def trajectory_properties(
         "limit_cycle_mm": amp,
         "overshoot_mm": over,
     }
-    if not with_settling:
+    need = np.broadcast_to(np.asarray(with_settling, dtype=bool), (n,))
+    if not need.any():
         return out
     T = cfg.plant.sample_time
     hold = math.ceil(SETTLE_HOLD_S / T - 1e-9)
@@ -237,16 +244,18 @@ def trajectory_properties(
     settle = np.where(k >= 0, k * T, np.inf)
     ar = np.broadcast_to(np.asarray(mismatch.a_ratio, dtype=float), (n,))
     wr = np.broadcast_to(np.asarray(mismatch.w_max_ratio, dtype=float), (n,))
-    t_f, n_star = np.empty(n), np.empty(n)
-    for key in set(zip(ar.tolist(), wr.tolist(), strict=True)):
-        sel = (ar == key[0]) & (wr == key[1])
+    t_f, n_star = np.full(n, np.nan), np.full(n, np.nan)
+    for key in set(zip(ar[need].tolist(), wr[need].tolist(), strict=True)):
+        sel = (ar == key[0]) & (wr == key[1]) & need
         true = _true_plant(cfg.plant, *key)
         t_f[sel] = min_time(x1[sel], x2[sel], true).t_f
         n_star[sel] = _n_star(x1[sel], x2[sel], true)
     with np.errstate(divide="ignore", invalid="ignore"):
-        out["settling_s"] = settle
-        out["settling_ratio_nt"] = np.where(n_star > 0, settle / (n_star * T), 0.0)
-        out["settling_ratio_tf"] = np.where(t_f > 0, settle / t_f, 0.0)
+        out["settling_s"] = np.where(need, settle, np.nan)
+        ratio_nt = np.where(n_star > 0, settle / (n_star * T), 0.0)
+        ratio_tf = np.where(t_f > 0, settle / t_f, 0.0)
+        out["settling_ratio_nt"] = np.where(need & ~np.isnan(n_star), ratio_nt, np.nan)
+        out["settling_ratio_tf"] = np.where(need & ~np.isnan(t_f), ratio_tf, np.nan)
     return out
 
 
@@ -289,21 +298,9 @@ def map_states(cfg: Config, s: RobustSettings | None = None) -> tuple[NDArray, N
     return x1, x2
 
 
-def _cell_task(
-    law: LawSpec, cfg: Config, x1: NDArray, x2: NDArray, ar: float, wr: float, delay: int
-) -> dict[str, Any]:
-    """One map cell: every grid state on one perturbed plant (a picklable task)."""
-    box = cfg.robustness
-    m = Mismatch(
-        a_ratio=ar,
-        w_max_ratio=wr,
-        delay_samples=delay,
-        position_quantum=box.position_quantum,
-        velocity_noise=box.velocity_noise,
-        seed=box.seed,
-    )
-    props = trajectory_properties(law, cfg, x1, x2, m)
-    summary: dict[str, Any] = {"a_ratio": ar, "w_max_ratio": wr, "delay_samples": delay}
+def _summarize(props: dict[str, NDArray], x1: NDArray, x2: NDArray) -> dict[str, Any]:
+    """One map cell's summary of the per-state properties."""
+    summary: dict[str, Any] = {}
     for key in PROPERTIES:
         v = props[key]
         fin = v[~np.isnan(v)]
@@ -321,11 +318,62 @@ def _cell_task(
     return summary
 
 
+def _map_task(
+    law: LawSpec,
+    cfg: Config,
+    x1: NDArray,
+    x2: NDArray,
+    ars: list[float],
+    wrs: list[float],
+    delay: int,
+) -> list[dict[str, Any]]:
+    """Every cell of one law and one delay: all (w, a) cells times all states in one batch.
+
+    A picklable task (the unit :func:`dask_runner` distributes); cells in the
+    order w_max_ratio, a_ratio.  One batch simulation, since the per-sample cost
+    of a small batch is mostly fixed overhead.
+    """
+    box = cfg.robustness
+    cells = [(float(wr), float(ar)) for wr in wrs for ar in ars]
+    n = x1.size
+    out = []
+    for group in _groups(len(cells), n):
+        part = [cells[i] for i in group]
+        m = Mismatch(
+            a_ratio=np.repeat([ar for _, ar in part], n),
+            w_max_ratio=np.repeat([wr for wr, _ in part], n),
+            delay_samples=delay,
+            position_quantum=box.position_quantum,
+            velocity_noise=box.velocity_noise,
+            seed=box.seed,
+        )
+        props = trajectory_properties(law, cfg, np.tile(x1, len(part)), np.tile(x2, len(part)), m)
+        for i, (wr, ar) in enumerate(part):
+            cell = {k: v[i * n : (i + 1) * n] for k, v in props.items()}
+            out.append(
+                {"a_ratio": ar, "w_max_ratio": wr, "delay_samples": delay}
+                | _summarize(cell, x1, x2)
+            )
+    return out
+
+
+BATCH_STATES = 16384  #: largest batch simulated at once (memory: ~4 x 8 bytes x states x horizon)
+
+
+def _groups(items: int, per_item: int) -> list[range]:
+    """Split ``items`` blocks of ``per_item`` states into batches of <= BATCH_STATES states."""
+    size = max(1, BATCH_STATES // max(per_item, 1))
+    return [range(i, min(i + size, items)) for i in range(0, items, size)]
+
+
+Runner = Callable[[list[tuple]], list[Any]]
+
+
 def robust_maps(
     cfg: Config,
     settings: RobustSettings | None = None,
     *,
-    runner: Callable[[list[tuple]], list[dict]] | None = None,
+    runner: Runner | None = None,
 ) -> dict[str, Any]:
     """Evaluate every law on a grid of perturbations times a grid of initial states.
 
@@ -336,14 +384,17 @@ def robust_maps(
     settings : RobustSettings, optional
         Grid sizes and laws.
     runner : callable, optional
-        ``runner(tasks) -> results`` evaluating ``_cell_task(*task)`` for each task,
-        in order (in-process by default; :func:`dask_runner` distributes them).
+        ``runner(tasks) -> results`` evaluating ``_map_task(*task)`` for each task
+        (one per law and delay), in order: in-process by default;
+        :func:`dask_runner` distributes them.  Each task is deterministic, so
+        the maps do not depend on where or in which order the tasks ran.
 
     Returns
     -------
     dict
-        ``a_ratio``, ``w_max_ratio``, ``delay_samples`` (the grid axes) and per law a
-        list of cell summaries (``cells``), in the order delay, w_max_ratio, a_ratio.
+        ``a_ratio``, ``w_max_ratio``, ``delay_samples`` (the grid axes), ``states``
+        (initial states per cell) and per law a list of cell summaries (``laws``),
+        in the order delay, w_max_ratio, a_ratio.
     """
     s = settings or RobustSettings()
     box = cfg.robustness
@@ -352,16 +403,15 @@ def robust_maps(
     delays = list(range(box.delay_samples[0], box.delay_samples[1] + 1))
     x1, x2 = map_states(cfg, s)
     tasks = [
-        (law, cfg, x1, x2, float(ar), float(wr), int(dl))
-        for law in s.laws
-        for dl in delays
-        for wr in wrs
-        for ar in ars
+        (law, cfg, x1, x2, ars.tolist(), wrs.tolist(), int(dl)) for law in s.laws for dl in delays
     ]
-    run = runner or (lambda ts: [_cell_task(*t) for t in ts])
+    run = runner or (lambda ts: [_map_task(*t) for t in ts])
     results = run(tasks)
-    per = len(delays) * len(wrs) * len(ars)
-    laws = {law: results[i * per : (i + 1) * per] for i, law in enumerate(s.laws)}
+    per = len(delays)
+    laws = {
+        law: [c for r in results[i * per : (i + 1) * per] for c in r]
+        for i, law in enumerate(s.laws)
+    }
     return {
         "a_ratio": ars.tolist(),
         "w_max_ratio": wrs.tolist(),
@@ -371,31 +421,85 @@ def robust_maps(
     }
 
 
-def dask_runner(address: str) -> Callable[[list[tuple]], list[dict]]:
+DASK_CONNECT_TIMEOUT_S = 10.0  #: how long to wait for a Dask scheduler [s]
+_ADDRESS = re.compile(r"^(tcp|tls|ucx|inproc|ws|wss)://[^\s/:]+(:\d{1,5})?$|^local$")
+
+
+def check_dask_address(address: str) -> str:
+    """Validate ``--dask``: ``local`` or ``PROTOCOL://HOST:PORT``.
+
+    Parameters
+    ----------
+    address : str
+        The address given.
+
+    Returns
+    -------
+    str
+        The address, unchanged.
+
+    Raises
+    ------
+    InputError
+        A malformed address (exit 2); an unreachable one is a
+        :class:`ptoverify.errors.ClusterError` when the run connects.
+
+    Examples
+    --------
+    >>> check_dask_address("tcp://127.0.0.1:8786")
+    'tcp://127.0.0.1:8786'
+    """
+    if not _ADDRESS.match(address):
+        raise InputError(
+            f"--dask must be 'local' or a scheduler address like tcp://HOST:PORT, got {address!r}"
+        )
+    return address
+
+
+def dask_runner(address: str) -> Runner:
     """Return a runner for :func:`robust_maps` on a ``dask.distributed`` cluster.
 
     Parameters
     ----------
     address : str
         Scheduler address (``tcp://host:port``), or ``local`` to start a
-        LocalCluster on this machine for the run.
+        LocalCluster of 2 worker processes on this machine for the run.
 
     Returns
     -------
     callable
         ``runner(tasks) -> results`` in task order.
-    """
-    from dask.distributed import Client, LocalCluster
 
-    def run(tasks: list[tuple]) -> list[dict]:
+    Raises
+    ------
+    InputError
+        A malformed address.
+    ClusterError
+        (When the runner runs) the scheduler could not be reached within
+        :data:`DASK_CONNECT_TIMEOUT_S`.
+    """
+    check_dask_address(address)
+
+    def run(tasks: list[tuple]) -> list[Any]:
+        from dask.distributed import Client, LocalCluster
+
         if address == "local":
             with (
-                LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster,
+                LocalCluster(
+                    n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+                ) as cluster,
                 Client(cluster) as client,
             ):
-                return client.gather(client.map(_cell_task, *zip(*tasks, strict=True), pure=False))
-        with Client(address, timeout=30) as client:
-            return client.gather(client.map(_cell_task, *zip(*tasks, strict=True), pure=False))
+                return client.gather(client.map(_map_task, *zip(*tasks, strict=True), pure=False))
+        try:
+            client = Client(address, timeout=DASK_CONNECT_TIMEOUT_S)
+        except OSError as exc:  # TimeoutError and refused connections
+            raise ClusterError(
+                f"cannot reach the Dask scheduler at {address} within "
+                f"{DASK_CONNECT_TIMEOUT_S:g} s ({type(exc).__name__}); start it, or use --dask local"
+            ) from None
+        with client:
+            return client.gather(client.map(_map_task, *zip(*tasks, strict=True), pure=False))
 
     return run
 
@@ -497,8 +601,8 @@ def no_limit_cycle_margin(
     Saturation, delay and measurement stay nominal (ratio 1, no delay, exact
     measurement) so the interval isolates the bandwidth error.  The property is
     checked on the map's state grid; the endpoints come from a 40-point
-    geometric scan then bisection to ``rtol`` relative (each evaluation is one
-    batch simulation).
+    geometric scan of each side then a 16-section of the bracket to ``rtol``
+    relative, every ratio of a round in one batch simulation.
 
     Parameters
     ----------
@@ -520,15 +624,66 @@ def no_limit_cycle_margin(
     s = settings or RobustSettings()
     x1, x2 = map_states(cfg, s)
 
-    def clean(r: float) -> bool:
-        props = trajectory_properties(law, cfg, x1, x2, Mismatch(a_ratio=r), with_settling=False)
-        return not bool((props["limit_cycle_mm"] > 0).any())
+    def clean(ratios: NDArray) -> NDArray[np.bool_]:
+        """No limit cycle from any grid state, for each ratio: few batches for all."""
+        out = np.empty(ratios.size, dtype=bool)
+        for g in _groups(ratios.size, x1.size):
+            r = ratios[g.start : g.stop]
+            props = trajectory_properties(
+                law,
+                cfg,
+                np.tile(x1, r.size),
+                np.tile(x2, r.size),
+                Mismatch(a_ratio=np.repeat(r, x1.size)),
+                with_settling=False,
+            )
+            lc = props["limit_cycle_mm"].reshape(r.size, x1.size)
+            out[g.start : g.stop] = ~(lc > 0).any(axis=1)
+        return out
 
-    if not clean(1.0):
+    if not clean(np.array([1.0]))[0]:
         return {"no_limit_cycle_a_ratio": None, "no_limit_cycle_note": "limit cycles nominally"}
-    lo = _edge(clean, MARGIN_RANGE[0], grid=40, rtol=rtol)
-    hi = _edge(clean, MARGIN_RANGE[1], grid=40, rtol=rtol)
+    lo, hi = _edges_batched(clean, grid=40, rtol=rtol)
     return {"no_limit_cycle_a_ratio": [lo, hi], "no_limit_cycle_note": ""}
+
+
+def _edges_batched(
+    ok: Callable[[NDArray], NDArray[np.bool_]], *, grid: int, rtol: float, split: int = 16
+) -> tuple[float | None, float | None]:
+    """Both edges of ``ok`` around 1 within :data:`MARGIN_RANGE`, a batch per round.
+
+    The same edge as :func:`_edge` (the first failing point of a ``grid``-point
+    geometric scan from 1 outward, then the bracket narrowed to ``rtol``), but
+    the scan of both sides is one call of ``ok`` and each narrowing round tests
+    ``split - 1`` interior points of both brackets at once (the bracket shrinks
+    ``split``-fold per round instead of 2-fold per call).
+    """
+    sides = [np.geomspace(1.0, end, grid)[1:] for end in MARGIN_RANGE]
+    flags = ok(np.concatenate(sides))
+    brackets: list[list[float] | None] = []
+    for i, pts in enumerate(sides):
+        f = flags[i * pts.size : (i + 1) * pts.size]
+        bad = np.flatnonzero(~f)
+        if bad.size == 0:
+            brackets.append(None)
+            continue
+        j = int(bad[0])
+        brackets.append([1.0 if j == 0 else float(pts[j - 1]), float(pts[j])])
+    live = [b for b in brackets if b is not None]
+    while any(abs(b[1] - b[0]) > rtol * min(abs(b[0]), abs(b[1])) for b in live):
+        # geometric interior points of each bracket, from its ok end to its failing end
+        inner = [b[0] * (b[1] / b[0]) ** (np.arange(1, split) / split) for b in live]
+        f = ok(np.concatenate(inner))
+        for k, b in enumerate(live):
+            fk = f[k * (split - 1) : (k + 1) * (split - 1)]
+            bad = np.flatnonzero(~fk)
+            pts = inner[k]
+            if bad.size == 0:
+                b[0] = float(pts[-1])
+            else:
+                j = int(bad[0])
+                b[0], b[1] = (b[0] if j == 0 else float(pts[j - 1])), float(pts[j])
+    return tuple(None if b is None else b[0] for b in brackets)  # type: ignore[return-value]
 
 
 # -- worst-case search ---------------------------------------------------------
@@ -543,12 +698,7 @@ def worst_case(
 ) -> dict[str, Any]:
     """Search the box for the worst value of ``prop`` under ``law``.
 
-    Variables: x1_0 [mm], x2_0 [mm/s] (for ``overshoot_mm`` x2_0 = 0 and
-    d <= |x1_0|), a_ratio, w_max_ratio; each delay of the box is searched
-    separately.  Differential evolution (seed ``box.seed``) starts from a
-    population holding the grid's worst cells, then a bounded Nelder-Mead
-    polish from the best; the value returned is the best found, so it is never
-    below the grid's worst.
+    One property of :func:`worst_cases` (see there).
 
     Parameters
     ----------
@@ -568,104 +718,195 @@ def worst_case(
         ``grid`` (the best starting value), ``searched``, ``state`` and ``params``
         (with the full mismatch: quantum, noise, seed), ``evaluations``.
     """
-    s = settings or RobustSettings()
+    return worst_cases(law, cfg, {prop: grid_worst}, settings)[prop]
+
+
+DE_MUTATION = (0.5, 1.0)  #: differential weight F, dithered per generation (scipy's default)
+DE_STRATEGY = "rand1bin"
+DE_CROSSOVER = 0.7  #: crossover probability CR (scipy's default)
+POLISH_ROUNDS = 4  #: rounds of the batched local polish
+POLISH_STEP = 0.05  #: first polish step, as a fraction of each variable's range (halved per round)
+
+
+def _box_bounds(cfg: Config, prop: str) -> tuple[NDArray, NDArray]:
+    """Bounds of (x1 [mm], x2 [mm/s], a_ratio, w_max_ratio) searched for ``prop``."""
     box, p = cfg.robustness, cfg.plant
     R, w, d = p.position_range, p.w_max, cfg.pto.d
-    rest = prop == "overshoot_mm"
-    bounds = [
-        (max(d, 1e-3 * R), R) if rest else (-R, R),
-        (0.0, 0.0) if rest else (-w, w),
-        tuple(box.a_ratio),
-        tuple(box.w_max_ratio),
-    ]
-    rng = np.random.default_rng(box.seed)
-    evaluations = 0
-    best = {"value": -math.inf, "z": None, "delay": box.delay_samples[0]}
+    if prop == "overshoot_mm":  # from rest, d <= x1_0 (odd laws: the sign is symmetric)
+        lo = [max(d, 1e-3 * R), 0.0, box.a_ratio[0], box.w_max_ratio[0]]
+        hi = [R, 0.0, box.a_ratio[1], box.w_max_ratio[1]]
+    else:
+        lo = [-R, -w, box.a_ratio[0], box.w_max_ratio[0]]
+        hi = [R, w, box.a_ratio[1], box.w_max_ratio[1]]
+    return np.array(lo, dtype=float), np.array(hi, dtype=float)
 
-    def evaluate(Z: NDArray, delay: int) -> NDArray:  # noqa: N803 - Z is (4, S)
-        nonlocal evaluations
-        Z = np.atleast_2d(Z)
-        evaluations += Z.shape[1]
+
+def worst_cases(
+    law: LawSpec,
+    cfg: Config,
+    starts: dict[str, list[dict[str, Any]]],
+    settings: RobustSettings | None = None,
+) -> dict[str, dict[str, Any]]:
+    """Search the box for the worst value of each property in ``starts`` under ``law``.
+
+    Variables: x1_0 [mm], x2_0 [mm/s] (for ``overshoot_mm`` x2_0 = 0 and
+    d <= x1_0 <= position_range), a_ratio, w_max_ratio; each delay of the box is
+    searched separately.  Per property and delay, a differential evolution
+    (strategy best/1/bin, F dithered in [0.5, 1], CR 0.7, as scipy's
+    ``differential_evolution`` defaults; out-of-bounds trials resampled
+    uniformly; deferred updating) whose initial population holds the grid's
+    worst cells of that delay and uniform samples (seed ``box.seed``), then a
+    batched local polish (:data:`POLISH_ROUNDS` rounds of Gaussian and compass
+    steps around the best, the step halving each round).  All the
+    (property, delay) searches advance in lockstep and each generation is one
+    batch simulation; every trajectory simulated counts toward every
+    property's worst (the settling ratio only where it was computed: in the
+    settling searches), so a property's value is the worst over all evaluated
+    points of the box, never below the grid's worst (the grid's cells are in
+    the first population).
+
+    Parameters
+    ----------
+    law : str or callable
+        Law name, or a factory ``f(cfg) -> Law``.
+    cfg : Config
+        Nominal configuration with its box.
+    starts : dict
+        Property (of :data:`PROPERTIES`) -> starting points (:func:`grid_worst`):
+        each ``state`` [x1 mm, x2 mm/s], ``params`` (``a_ratio``, ``w_max_ratio``,
+        ``delay_samples``) and ``value``.
+    settings : RobustSettings, optional
+        Population and generations.
+
+    Returns
+    -------
+    dict
+        Per property: ``grid`` (the best starting value), ``searched``, ``state``
+        and ``params`` (with the full mismatch: quantum, noise, seed),
+        ``evaluations`` (trajectories simulated by this search, all properties).
+    """
+    s = settings or RobustSettings()
+    box = cfg.robustness
+    props = list(starts)
+    delays = list(range(box.delay_samples[0], box.delay_samples[1] + 1))
+    problems = [(prop, dl) for prop in props for dl in delays]
+    bounds = [_box_bounds(cfg, prop) for prop, _ in problems]
+    rng = np.random.default_rng(box.seed)
+    best = {prop: {"value": -math.inf, "z": None, "delay": delays[0]} for prop in props}
+    count = 0
+
+    def evaluate(pops: list[NDArray]) -> list[NDArray]:
+        """Each problem's population (S_i, 4) -> its values (S_i,), larger is worse."""
+        nonlocal count
+        Z = np.concatenate(pops)  # noqa: N806
+        sizes = [len(z) for z in pops]
+        owner = np.repeat(np.arange(len(pops)), sizes)
+        delay = np.array([problems[i][1] for i in owner], dtype=np.int64)
+        settle = np.array([problems[i][0].startswith("settling") for i in owner])
         m = Mismatch(
-            a_ratio=Z[2],
-            w_max_ratio=Z[3],
+            a_ratio=Z[:, 2],
+            w_max_ratio=Z[:, 3],
             delay_samples=delay,
             position_quantum=box.position_quantum,
             velocity_noise=box.velocity_noise,
             seed=box.seed,
         )
-        v = trajectory_properties(
-            law, cfg, Z[0], Z[1], m, with_settling=prop.startswith("settling")
-        )[prop]
-        v = np.where(np.isnan(v), -np.inf, v)
-        k = int(np.argmax(v))
-        if v[k] > best["value"]:
-            best.update(value=float(v[k]), z=Z[:, k].copy(), delay=delay)
-        return v
+        out = trajectory_properties(law, cfg, Z[:, 0], Z[:, 1], m, with_settling=settle)
+        count += len(Z)
+        for prop in props:  # every trajectory counts toward every property's worst
+            v = np.where(np.isnan(out[prop]), -np.inf, out[prop])
+            k = int(np.argmax(v))
+            if v[k] > best[prop]["value"]:
+                best[prop].update(value=float(v[k]), z=Z[k].copy(), delay=int(delay[k]))
+        edges = np.cumsum([0, *sizes])
+        res = []
+        for i, (prop, _) in enumerate(problems):
+            v = out[prop][edges[i] : edges[i + 1]]
+            res.append(np.where(np.isnan(v), -np.inf, v))
+        return res
 
-    starts: list[tuple[NDArray, int]] = []
-    grid_value = -math.inf
-    for g in grid_worst:
-        z = np.array([*g["state"], g["params"]["a_ratio"], g["params"]["w_max_ratio"]])
-        if rest:
-            z[0], z[1] = abs(z[0]), 0.0
-        starts.append((z, int(g["params"]["delay_samples"])))
-        grid_value = max(grid_value, float(g["value"]))
-    for delay in range(box.delay_samples[0], box.delay_samples[1] + 1):
-        lo = np.array([b[0] for b in bounds])
-        hi = np.array([b[1] for b in bounds])
-        pop = lo + (hi - lo) * rng.random((s.search_population, 4))
-        mine = [z for z, dl in starts if dl == delay]
-        for i, z in enumerate(mine[: s.search_population]):
+    # initial populations: the grid's worst cells of the problem's delay, then uniform
+    pops, grid_value = [], {}
+    for (prop, dl), (lo, hi) in zip(problems, bounds, strict=True):
+        lhs = qmc.LatinHypercube(d=4, seed=rng).random(s.search_population)
+        pop = lo + (hi - lo) * lhs
+        mine = [g for g in starts[prop] if int(g["params"]["delay_samples"]) == dl]
+        for i, g in enumerate(mine[: s.search_population]):
+            z = np.array([*g["state"], g["params"]["a_ratio"], g["params"]["w_max_ratio"]])
+            if prop == "overshoot_mm":
+                z[0], z[1] = abs(z[0]), 0.0
             pop[i] = np.clip(z, lo, hi)
-        free = [i for i in range(4) if hi[i] > lo[i]]
-        if mine:  # the grid's worst cells, evaluated as the map evaluated them
-            evaluate(np.clip(np.array(mine), lo, hi).T, delay)
-
-        def objective(x: NDArray, delay: int = delay, free: list[int] = free) -> NDArray:
-            x = np.atleast_2d(x.T).T if x.ndim == 1 else x
-            Z = np.tile(lo[:, None], (1, x.shape[1]))  # noqa: N806
-            Z[free] = x
-            return -evaluate(Z, delay)
-
-        res = differential_evolution(
-            objective,
-            [bounds[i] for i in free],
-            init=pop[:, free],
-            maxiter=s.search_iterations,
-            seed=box.seed,
-            polish=False,
-            vectorized=True,
-            updating="deferred",
-            tol=0.0,
-        )
-        x0 = res.x
-        minimize(
-            lambda x, delay=delay, free=free: float(objective(x[:, None], delay, free)[0]),
-            x0,
-            method="Nelder-Mead",
-            bounds=[bounds[i] for i in free],
-            options={"maxfev": 60, "xatol": 1e-6, "fatol": 0.0},
-        )
-    z = best["z"]
-    # the grid's worst cells were evaluated first, so best >= the grid's worst
-    searched = best["value"]
-    return {
-        "grid": grid_value if grid_value > -math.inf else None,
-        "grid_unbounded": grid_value == math.inf,
-        "searched": searched if searched > -math.inf else None,
-        "unbounded": searched == math.inf,  # e.g. never settles: JSON shows searched null
-        "state": [float(z[0]), float(z[1])] if z is not None else None,
-        "params": {
-            "a_ratio": float(z[2]) if z is not None else None,
-            "w_max_ratio": float(z[3]) if z is not None else None,
-            "delay_samples": int(best["delay"]),
-            "position_quantum": box.position_quantum,
-            "velocity_noise": box.velocity_noise,
-            "seed": box.seed,
-        },
-        "evaluations": evaluations,
-    }
+        pops.append(pop)
+    for prop in props:
+        vals = [float(g["value"]) for g in starts[prop]]
+        grid_value[prop] = max(vals) if vals else -math.inf
+    fit = evaluate(pops)
+    for _ in range(s.search_iterations):
+        f_weight = rng.uniform(*DE_MUTATION)
+        trials = []
+        for pop, f, (lo, hi) in zip(pops, fit, bounds, strict=True):
+            n_pop = len(pop)
+            b = pop[int(np.argmax(f))] if DE_STRATEGY == "best1bin" else None
+            r = np.array(
+                [rng.choice(np.delete(np.arange(n_pop), i), 2, replace=False) for i in range(n_pop)]
+            )
+            if b is None:
+                r = np.array(
+                    [
+                        rng.choice(np.delete(np.arange(n_pop), i), 3, replace=False)
+                        for i in range(n_pop)
+                    ]
+                )
+                mutant = pop[r[:, 2]] + f_weight * (pop[r[:, 0]] - pop[r[:, 1]])
+            else:
+                mutant = b + f_weight * (pop[r[:, 0]] - pop[r[:, 1]])
+            cross = rng.random(pop.shape) < DE_CROSSOVER
+            cross[np.arange(n_pop), rng.integers(0, 4, n_pop)] = True
+            trial = np.where(cross, mutant, pop)
+            outside = (trial < lo) | (trial > hi)
+            trial = np.where(outside, lo + (hi - lo) * rng.random(pop.shape), trial)
+            trials.append(trial)
+        tfit = evaluate(trials)
+        for i in range(len(pops)):
+            better = tfit[i] >= fit[i]
+            pops[i][better], fit[i][better] = trials[i][better], tfit[i][better]
+    # batched polish around each problem's best
+    centre = [pop[int(np.argmax(f))].copy() for pop, f in zip(pops, fit, strict=True)]
+    cval = [float(np.max(f)) for f in fit]
+    for rnd in range(POLISH_ROUNDS):
+        step = POLISH_STEP * 0.5**rnd
+        cands = []
+        for c, (lo, hi) in zip(centre, bounds, strict=True):
+            span = (hi - lo) * step
+            compass = c + np.concatenate([np.diag(span), -np.diag(span)])
+            gauss = c + span * rng.standard_normal((max(s.search_population - 8, 1), 4))
+            cands.append(np.clip(np.concatenate([compass, gauss]), lo, hi))
+        cfit = evaluate(cands)
+        for i in range(len(centre)):
+            k = int(np.argmax(cfit[i]))
+            if cfit[i][k] > cval[i]:
+                centre[i], cval[i] = cands[i][k].copy(), float(cfit[i][k])
+    out: dict[str, dict[str, Any]] = {}
+    for prop in props:
+        g, z = grid_value[prop], best[prop]["z"]
+        searched = best[prop]["value"]
+        out[prop] = {
+            "grid": g if g > -math.inf else None,
+            "grid_unbounded": g == math.inf,
+            "searched": searched if searched > -math.inf else None,
+            "unbounded": searched == math.inf,  # e.g. never settles: JSON shows searched null
+            "state": [float(z[0]), float(z[1])] if z is not None else None,
+            "params": {
+                "a_ratio": float(z[2]) if z is not None else None,
+                "w_max_ratio": float(z[3]) if z is not None else None,
+                "delay_samples": int(best[prop]["delay"]),
+                "position_quantum": box.position_quantum,
+                "velocity_noise": box.velocity_noise,
+                "seed": box.seed,
+            },
+            "evaluations": count,
+        }
+    return out
 
 
 def grid_worst(cells: list[dict[str, Any]], prop: str, k: int = 4) -> list[dict[str, Any]]:
@@ -841,10 +1082,8 @@ def run_robust(
     worst: dict[str, Any] = {}
     for i, law in enumerate(s.laws):
         report(f"worst case {law}", 0.5 + 0.5 * i / len(s.laws))
-        worst[law] = {
-            prop: worst_case(law, prop, cfg, grid_worst(maps["laws"][law], prop), s)
-            for prop in s.properties
-        }
+        starts = {prop: grid_worst(maps["laws"][law], prop) for prop in s.properties}
+        worst[law] = worst_cases(law, cfg, starts, s)
     timings["worst_case"] = time.perf_counter() - t2
     timings["total"] = time.perf_counter() - t0
     return RobustResult(cfg, s, maps, margins, worst, timings, dask or "in-process")

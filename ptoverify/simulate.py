@@ -456,9 +456,9 @@ class Mismatch:
     w_max_ratio : float or ndarray, shape (n,)
         The drive saturates at ``w_max_ratio * w_max`` [-] (at or below what the
         law assumes); the commanded input is recorded unclipped.
-    delay_samples : int
-        Computation delay: the input computed from x_k is applied from sample
-        k + delay.  Before the first computed input acts, the loop holds the
+    delay_samples : int or ndarray of int, shape (n,)
+        Computation delay, per state or shared: the input computed from x_k is
+        applied from sample k + delay.  Before the first computed input acts, the loop holds the
         input computed from the initial state (the controller was already running).
     position_quantum : float
         Encoder resolution [mm]: the law sees ``q round(x1 / q)`` (0: exact).
@@ -472,7 +472,7 @@ class Mismatch:
 
     a_ratio: float | NDArray[np.float64] = 1.0
     w_max_ratio: float | NDArray[np.float64] = 1.0
-    delay_samples: int = 0
+    delay_samples: int | NDArray[np.int64] = 0
     position_quantum: float = 0.0
     velocity_noise: float = 0.0
     seed: int = 0
@@ -483,7 +483,7 @@ class Mismatch:
         return (
             np.all(np.asarray(self.a_ratio) == 1.0)
             and np.all(np.asarray(self.w_max_ratio) == 1.0)
-            and self.delay_samples == 0
+            and np.all(np.asarray(self.delay_samples) == 0)
             and self.position_quantum == 0.0
             and self.velocity_noise == 0.0
         )
@@ -498,7 +498,7 @@ class Mismatch:
         return {
             "a_ratio": num(self.a_ratio),
             "w_max_ratio": num(self.w_max_ratio),
-            "delay_samples": int(self.delay_samples),
+            "delay_samples": np.asarray(self.delay_samples, dtype=int).tolist(),
             "position_quantum": float(self.position_quantum),
             "velocity_noise": float(self.velocity_noise),
             "seed": int(self.seed),
@@ -602,7 +602,8 @@ def _simulate_mismatch(
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     x2 = np.atleast_1d(np.asarray(x2, dtype=float))
     n = x1.shape[0]
-    if m.delay_samples < 0 or m.position_quantum < 0 or m.velocity_noise < 0:
+    delay = np.broadcast_to(np.asarray(m.delay_samples), (n,))
+    if np.any(delay < 0) or m.position_quantum < 0 or m.velocity_noise < 0:
         raise InputError("mismatch: delay, quantum and noise must be >= 0")
     X1, X2 = np.empty((steps + 1, n)), np.empty((steps + 1, n))
     U, R = np.empty((steps, n)), np.empty((steps, n), dtype=np.int8)
@@ -617,17 +618,18 @@ def _simulate_mismatch(
         if m.velocity_noise > 0
         else np.zeros(steps)
     )
-    pending: list[np.ndarray] = []  # commanded inputs not yet applied (the delay line)
-    applied = None
+    # the delay line: sample k applies U[k - delay] (U[0] before it: the controller
+    # was running and held what x_0 commands)
+    shared = int(delay[0]) if n and np.all(delay == delay[0]) else None
+    cols = np.arange(n)
     for k in range(steps):
         y1 = q * np.round(X1[k] / q) if q > 0 else X1[k]
         y2 = X2[k] + noise[k]
         U[k], R[k] = law(y1, y2)
-        pending.append(U[k])
-        if applied is None:  # the controller was running: hold what x_0 commands
-            applied = U[0]
-        if len(pending) > m.delay_samples:
-            applied = pending.pop(0)
+        if shared is not None:
+            applied = U[max(k - shared, 0)]
+        else:
+            applied = U[np.maximum(k - delay, 0), cols]
         uk = np.clip(applied, -w_true, w_true)
         dv = (X2[k] - uk) * g
         X2[k + 1] = X2[k] - dv

@@ -19,21 +19,30 @@ Decisions (the issue is silent on them):
   held in memory, never the whole grid's).
 * Settled: |x1| <= ``band`` (0.01 mm, :data:`~ptoverify.metrics.TIGHT_BAND`)
   and |x2| <= ``velocity_band`` (default a * band: a state coasting with
-  u = 0 from the velocity band moves at most x2 / a = band further), from a
-  sample on until the end of the horizon.  The settling time is that sample's
-  time (not the exact crossing between samples, so a ratio can fall slightly
-  below 1: settling to a band is easier than reaching the origin exactly).
+  u = 0 from the velocity band moves at most x2 / a = band further) on the
+  continuous trajectory, from some time on until the end of the horizon.  The
+  settling time is the last exit from that box, found exactly between samples
+  on the ZOH flow (:func:`ptoverify.exact.settling_times_batch`), including
+  excursions out of the box between two samples that are both inside it.  A
+  ratio can fall slightly below 1: settling to a band is easier than reaching
+  the origin exactly.
+* The sample-grid reading (the first sample from which every later sample is
+  in the box) is kept alongside: ``LawSweep.grid`` and ``sample_grid`` in the
+  JSON.  The exact time is within one sample before the grid time
+  (grid - T < exact), and later than it only where the trajectory leaves the
+  box between samples after the grid's settled sample (``excursions_after_grid``).
 * A state counts as settled only if it stays settled for at least ``hold``
-  (default 0.05 s = 25 samples at T = 2 ms) before the horizon ends; the
-  horizon is 4 max t_f* + hold over the grid, rounded up to whole samples.
+  (default 0.05 s = 25 samples at T = 2 ms) before the horizon ends (the grid
+  reading counts whole samples); the horizon is 4 max t_f* + hold over the
+  grid, rounded up to whole samples.
 * N* is computed for every grid state (a fraction of a second at 40,000).
 * Statistics per law: the fraction of states that settle, the median of the
   ratio over the settled states, the worst (largest) ratio with its state, the
   percentiles 50/95/99/max of both ratios, and the five worst states of each
   (the worst states lie next to the origin, where t_f* is a few samples and a
   fixed settling tail weighs most).
-* The settling times come from one call, :func:`settling_times` (sample-grid
-  reading); an exact between-sample reading replaces that one function.
+* The settling times come from one call, :func:`settling_times`, which returns
+  both readings.
 """
 
 from __future__ import annotations
@@ -48,6 +57,7 @@ from numpy.typing import NDArray
 
 from ptoverify.config import Config, Plant
 from ptoverify.errors import InputError
+from ptoverify.exact import BatchSettling, settling_times_batch
 from ptoverify.laws import LAW_NAMES, make_law
 from ptoverify.metrics import TIGHT_BAND
 from ptoverify.mintime import discrete_min_steps_batch, min_time
@@ -105,7 +115,8 @@ class LawSweep:
     law : str
         Law name.
     settle_time : ndarray
-        Settling time [s]; NaN where the law does not settle.
+        Settling time between samples (exact last exit from the box) [s]; NaN
+        where the law does not settle.  Every statistic below is of this reading.
     ratio_tf : ndarray
         settle_time / t_f* [-].
     ratio_nt : ndarray
@@ -127,6 +138,12 @@ class LawSweep:
         The five largest ratios, worst first, as [x1 [mm], x2 [mm/s], ratio].
     seconds : float
         Wall time of this law's simulation [s].
+    grid : LawSweep or None
+        The same statistics of the sample-grid reading (settling at the first
+        sample from which every later sample is in the box); None inside it.
+    excursions_after_grid : int
+        States whose trajectory leaves the box between samples after the grid's
+        settled sample (exact time > grid time) [-].
     """
 
     law: str
@@ -146,9 +163,23 @@ class LawSweep:
     percentiles_nt: dict = field(default_factory=dict)
     worst_states_tf: list = field(default_factory=list)
     worst_states_nt: list = field(default_factory=list)
+    grid: LawSweep | None = None
+    excursions_after_grid: int = 0
 
     def to_json(self) -> dict:
-        """Return the statistics (not the arrays) as a JSON-able dict."""
+        """Return the statistics (not the arrays) as a JSON-able dict.
+
+        The top-level keys are the between-samples reading; ``sample_grid`` holds
+        the same keys for the sample-grid reading (without ``seconds``).
+        """
+        out = self._stats_json()
+        out["seconds"] = self.seconds
+        if self.grid is not None:
+            out["excursions_after_grid"] = self.excursions_after_grid
+            out["sample_grid"] = self.grid._stats_json()
+        return out
+
+    def _stats_json(self) -> dict:
         return {
             "law": self.law,
             "fraction_settled": self.fraction_settled,
@@ -163,7 +194,6 @@ class LawSweep:
             "percentiles_ratio_nt": self.percentiles_nt,
             "worst_states_tf": self.worst_states_tf,
             "worst_states_nt": self.worst_states_nt,
-            "seconds": self.seconds,
         }
 
 
@@ -221,6 +251,7 @@ class SweepResult:
             "band_mm": s.band,
             "velocity_band_mm_s": self.velocity_band,
             "hold_s": s.hold,
+            "settling": "between samples (exact ZOH flow); sample_grid: on the samples",
             "horizon_s": self.steps * self.sample_time,
             "horizon_steps": self.steps,
             "n_star_computed": int(np.count_nonzero(self.n_star >= 0)),
@@ -284,10 +315,10 @@ def settling_times(
     steps: int,
     band: float,
     velocity_band: float,
-    hold_steps: int,
+    hold: float,
     chunk: int = 4096,
-) -> NDArray[np.float64]:
-    """Settling time of ``law`` from each state, read on the sample grid.
+) -> BatchSettling:
+    """Settling times of ``law`` from each state, between samples and on the grid.
 
     Parameters
     ----------
@@ -301,21 +332,26 @@ def settling_times(
         Horizon [samples].
     band, velocity_band : float
         Half-widths of the settled box [mm], [mm/s].
-    hold_steps : int
-        Shortest settled tail [samples].
+    hold : float
+        Shortest settled tail [s] (the grid reading: ceil(hold / T) samples).
     chunk : int
         States simulated at once (memory: about 25 bytes x chunk x steps).
 
     Returns
     -------
-    ndarray, shape (n,)
-        Settling time [s] (:func:`settle_steps` times T); NaN where not settled.
+    BatchSettling
+        ``time``: exact last exit from the box [s]; ``grid``: :func:`settle_steps`
+        times T [s]; NaN where not settled (see
+        :func:`ptoverify.exact.settling_times_batch`).
     """
-    k = np.empty(x1.size, dtype=np.int64)
+    ts, tg = np.empty(x1.size), np.empty(x1.size)
+    acc = 0.0
+    T = plant.sample_time
     for i in range(0, x1.size, chunk):
         b = simulate_batch(law, plant, x1[i : i + chunk], x2[i : i + chunk], steps)
-        k[i : i + chunk] = settle_steps(b.x1, b.x2, band, velocity_band, hold_steps)
-    return np.where(k >= 0, k * plant.sample_time, np.nan)
+        st = settling_times_batch(b.x1, b.x2, b.u, plant.a, T, band, velocity_band, hold)
+        ts[i : i + chunk], tg[i : i + chunk], acc = st.time, st.grid, max(acc, st.accuracy)
+    return BatchSettling(ts, tg, acc)
 
 
 def discrete_limit(plant: Plant, x1: NDArray, x2: NDArray) -> NDArray[np.int64]:
@@ -356,6 +392,36 @@ def _worst(ratio: NDArray, x1: NDArray, x2: NDArray, count: int = 5) -> list:
     r = np.where(np.isfinite(ratio), ratio, -np.inf).ravel()
     top = np.argsort(-r, kind="stable")[:count]
     return [[float(x1.flat[i]), float(x2.flat[i]), float(r[i])] for i in top if np.isfinite(r[i])]
+
+
+def _law_sweep(name, st, t_f, nt, X1, X2, seconds, grid=None, later=0) -> LawSweep:
+    """Statistics of one law's settling times ``st`` (one reading)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        r_tf, r_nt = st / t_f, st / nt
+    med_tf, worst_tf, at_tf = _stats(r_tf, X1, X2)
+    med_nt, worst_nt, at_nt = _stats(r_nt, X1, X2)
+    pct_tf = _percentiles(r_tf)
+    return LawSweep(
+        name,
+        st,
+        r_tf,
+        r_nt,
+        float(np.mean(np.isfinite(st))),
+        med_tf,
+        med_nt,
+        worst_tf,
+        worst_nt,
+        at_tf,
+        at_nt,
+        seconds,
+        pct_tf["p95"],
+        pct_tf,
+        _percentiles(r_nt),
+        _worst(r_tf, X1, X2),
+        _worst(r_nt, X1, X2),
+        grid,
+        later,
+    )
 
 
 def run_sweep(
@@ -401,7 +467,7 @@ def run_sweep(
     t1 = time.perf_counter()
     n_star = discrete_limit(plant, X1, X2).reshape(X1.shape)
     timings["discrete_limit"] = time.perf_counter() - t1
-    settle: dict[str, NDArray] = {}
+    settle: dict[str, BatchSettling] = {}
     secs: dict[str, float] = {}
     skipped: dict[str, str] = {}
     for i, name in enumerate(s.laws):
@@ -412,37 +478,19 @@ def run_sweep(
             skipped[name] = str(exc)
             continue
         t1 = time.perf_counter()
-        st = settling_times(law, plant, X1.ravel(), X2.ravel(), steps, s.band, vband, hold_steps)
-        settle[name] = st.reshape(X1.shape)
+        settle[name] = settling_times(
+            law, plant, X1.ravel(), X2.ravel(), steps, s.band, vband, s.hold
+        )
         secs[name] = time.perf_counter() - t1
         timings[f"simulate_{name}"] = secs[name]
     nt = np.where(n_star > 0, n_star * T, np.nan)
     laws = {}
     for name, st in settle.items():
-        with np.errstate(invalid="ignore", divide="ignore"):
-            r_tf, r_nt = st / t_f, st / nt
-        med_tf, worst_tf, at_tf = _stats(r_tf, X1, X2)
-        med_nt, worst_nt, at_nt = _stats(r_nt, X1, X2)
-        pct_tf = _percentiles(r_tf)
-        laws[name] = LawSweep(
-            name,
-            st,
-            r_tf,
-            r_nt,
-            float(np.mean(np.isfinite(st))),
-            med_tf,
-            med_nt,
-            worst_tf,
-            worst_nt,
-            at_tf,
-            at_nt,
-            secs[name],
-            pct_tf["p95"],
-            pct_tf,
-            _percentiles(r_nt),
-            _worst(r_tf, X1, X2),
-            _worst(r_nt, X1, X2),
-        )
+        exact, grid = st.time.reshape(X1.shape), st.grid.reshape(X1.shape)
+        with np.errstate(invalid="ignore"):
+            later = int(np.count_nonzero(exact > grid))
+        on_grid = _law_sweep(name, grid, t_f, nt, X1, X2, secs[name])
+        laws[name] = _law_sweep(name, exact, t_f, nt, X1, X2, secs[name], on_grid, later)
     timings["total"] = time.perf_counter() - t0
     report("done", 1.0)
     return SweepResult(X1, X2, t_f, n_star, laws, s, vband, steps, T, timings, skipped)

@@ -30,6 +30,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -39,9 +40,11 @@ from ptoverify.config import Config, PDGains, PTOSettings
 from ptoverify.errors import InputError
 from ptoverify.exact import exact_metrics
 from ptoverify.laws import make_law
+from ptoverify.mintime import discrete_min_steps_batch, min_time
 from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import law_properties
 from ptoverify.simulate import reference, simulate
+from ptoverify.sweep import SweepSettings, grid_states, settling_times
 
 __all__ = [
     "OBJECTIVES",
@@ -52,6 +55,11 @@ __all__ = [
     "evaluate",
     "tune",
     "pareto_front",
+    "worst_ratio_nt",
+    "WORST_GRID",
+    "TuneBudget",
+    "FairTunings",
+    "fair_tunings",
 ]
 
 OBJECTIVES = ("settling_2pct", "settling_0p01mm", "worst_ratio_nt")
@@ -164,6 +172,79 @@ def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:
     return {k: math.nan if v is None else float(v) for k, v in m.items()}
 
 
+#: Default state grid of :func:`worst_ratio_nt` (n1 x n2 over the envelope).  Even
+#: counts keep the origin (N* = 0) off the grid, as the sweep's.
+WORST_GRID = (20, 20)
+
+
+@lru_cache(maxsize=16)
+def _envelope(plant, n1: int, n2: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, int]:
+    """States, N* T [s], horizon and hold [samples] of the grid; once per plant and grid."""
+    s = SweepSettings()
+    X1, X2 = grid_states(plant, n1, n2)
+    T = plant.sample_time
+    t_f = min_time(X1, X2, plant).t_f
+    hold = math.ceil(s.hold / T - 1e-9)
+    steps = math.ceil(s.horizon_factor * float(t_f.max()) / T) + hold
+    n_star = discrete_min_steps_batch(X1.ravel(), X2.ravel(), plant).steps
+    nt = np.where(n_star > 0, n_star * T, np.nan)
+    return X1.ravel(), X2.ravel(), nt, steps, hold
+
+
+def worst_ratio_nt(
+    cfg: Config, law: str, *, n1: int = WORST_GRID[0], n2: int = WORST_GRID[1]
+) -> float:
+    """Worst settling time / (N* T) of ``law`` over an n1 x n2 grid of the envelope.
+
+    The suboptimality the paper is about, with the sweep's definitions
+    (:mod:`ptoverify.sweep`): settled = |x1| <= 0.01 mm and |x2| <= a 0.01 mm/s
+    from a sample on, for at least the hold (0.05 s), read on the sample grid
+    (:func:`~ptoverify.sweep.settling_times`); N* the fewest ZOH samples to the
+    origin (:func:`~ptoverify.mintime.discrete_min_steps_batch`, computed once
+    per plant and grid).  A law that does not settle from some grid state has
+    an infinite worst ratio (the tuner treats it as infeasible).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration the law is built from.
+    law : str
+        Law name.
+    n1, n2 : int
+        Grid points along x1 [mm] and x2 [mm/s] over |x1| <= position_range,
+        |x2| <= w_max.
+
+    Returns
+    -------
+    float
+        max over the grid of settling / (N* T) [-]; inf if a state never settles.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> worst_ratio_nt(paper_config(), "pd", n1=4, n2=4) >= 1.0
+    True
+    """
+    if n1 < 2 or n2 < 2:
+        raise InputError("worst_ratio_nt: the grid needs at least 2 points per axis")
+    p = cfg.plant
+    x1, x2, nt, steps, hold = _envelope(p, n1, n2)
+    st = settling_times(
+        make_law(law, cfg),
+        p,
+        x1,
+        x2,
+        steps,
+        SweepSettings().band,
+        p.a * SweepSettings().band,
+        hold * p.sample_time,
+    ).grid  # the sweep's sample-grid reading (its between-samples twin differs by < T)
+    ok = np.isfinite(nt)
+    if not np.isfinite(st[ok]).all():
+        return math.inf
+    return float(np.max(st[ok] / nt[ok]))
+
+
 def evaluate(
     cfg: Config,
     law: str,
@@ -172,7 +253,7 @@ def evaluate(
     signal: str = "step",
     objective: str = "settling_2pct",
     max_overshoot: float | None = None,
-    worst_ratio: Callable[[Config], float] | None = None,
+    worst_ratio: Callable[[Config, str], float] | None = None,
 ) -> Candidate:
     """Evaluate one set of gains under the cheap constraints (not the grid properties).
 
@@ -191,7 +272,8 @@ def evaluate(
     max_overshoot : float, optional
         Overshoot bound [mm].
     worst_ratio : callable, optional
-        ``f(cfg) -> worst settling / N*T`` for ``objective="worst_ratio_nt"``.
+        ``f(cfg, law) -> worst settling / N*T`` for ``objective="worst_ratio_nt"``;
+        default :func:`worst_ratio_nt` on its default grid.
 
     Returns
     -------
@@ -221,7 +303,7 @@ def evaluate(
     else:
         reason = ""
         if objective == "worst_ratio_nt":
-            value = worst_ratio(tcfg) if worst_ratio else math.nan
+            value = (worst_ratio or worst_ratio_nt)(tcfg, law)
         else:
             value = m[f"{objective}_s"]
         if not math.isfinite(value):
@@ -296,8 +378,9 @@ class TuneResult:
     runner_up : Candidate or None
         The best verified candidate at least 0.2 (normalized search units) from ``best``.
     front : list of Candidate
-        Pareto front of settling vs overshoot among the evaluated candidates
-        (cheap constraints; ``verified`` says which were checked on the grid).
+        Pareto front of settling vs overshoot among the evaluated candidates,
+        whatever their overshoot (stable, settling; those the grid check
+        rejected are left out; ``verified`` says which were checked on the grid).
     evaluations : int
         Candidates evaluated.
     seconds : float
@@ -392,7 +475,8 @@ def tune(
     maxiter: int = 30,
     popsize: int = 10,
     d_grid: int = 9,
-    worst_ratio: Callable[[Config], float] | None = None,
+    d_refine: int = 4,
+    worst_ratio: Callable[[Config, str], float] | None = None,
 ) -> TuneResult:
     """Search the law's gains for the best response under the constraints.
 
@@ -414,8 +498,11 @@ def tune(
         Differential-evolution generations and population factor.
     d_grid : int
         PTO: points of the geometric d grid.
+    d_refine : int
+        PTO: golden-section steps refining d between the best grid point's neighbours.
     worst_ratio : callable, optional
-        ``f(cfg) -> worst settling / N*T`` (needed for ``worst_ratio_nt``).
+        ``f(cfg, law) -> worst settling / N*T`` for ``worst_ratio_nt``; default
+        :func:`worst_ratio_nt` over the :data:`WORST_GRID` grid.
 
     Returns
     -------
@@ -435,8 +522,11 @@ def tune(
         )
     if max_overshoot is not None and not (max_overshoot >= 0 and math.isfinite(max_overshoot)):
         raise InputError(f"tune: --max-overshoot must be a finite number >= 0, got {max_overshoot}")
-    if objective == "worst_ratio_nt" and worst_ratio is None:
-        raise InputError("tune: objective worst_ratio_nt needs a worst-ratio function")
+    if maxiter < 1 or popsize < 1 or d_grid < 2 or d_refine < 0:
+        raise InputError(
+            f"tune: maxiter and popsize must be >= 1, d_grid >= 2 and d_refine >= 0 (got "
+            f"{maxiter}, {popsize}, {d_grid}, {d_refine})"
+        )
     reference(signal)  # names the signal or raises InputError
     t0 = time.perf_counter()
     seen: dict[tuple, Candidate] = {}
@@ -470,7 +560,7 @@ def tune(
         i = int(np.argmin([score[float(d)] for d in ds]))
         a, b = float(ds[max(i - 1, 0)]), float(ds[min(i + 1, len(ds) - 1)])
         gr = (math.sqrt(5.0) - 1.0) / 2.0
-        for _ in range(4):
+        for _ in range(d_refine):
             c1, c2 = b - gr * (b - a), a + gr * (b - a)
             for d in (c1, c2):
                 if d not in score:
@@ -503,7 +593,8 @@ def tune(
         if v.feasible:
             runner_up = v
             break
-    front = pareto_front(list(seen.values()))
+    # the front over the evaluated candidates, less those the grid check rejected
+    front = pareto_front([c for c in seen.values() if c.feasible or not c.verified])
     return TuneResult(
         law=law,
         signal=signal,
@@ -518,3 +609,117 @@ def tune(
             tuned_config(cfg, law, best.gains), name=f"{cfg.name}-tuned-{law}"
         ),
     )
+
+
+# ---------------------------------------------------------------- fair comparison
+@dataclass(frozen=True)
+class TuneBudget:
+    """Search effort of the fair-comparison tunings (:func:`fair_tunings`).
+
+    Attributes
+    ----------
+    maxiter, popsize : int
+        Differential-evolution generations and population factor.
+    d_grid : int
+        PTO: points of the geometric d grid.
+    d_refine : int
+        PTO: golden-section steps on d.
+    seed : int
+        Seed (fixed, so the comparison is reproducible).
+    """
+
+    maxiter: int = 30
+    popsize: int = 10
+    d_grid: int = 9
+    d_refine: int = 4
+    seed: int = 0
+
+
+#: The shared overshoot bounds of the fair comparison, by name, with their meaning.
+FAIR_BOUNDS = {
+    "pto-paper": "the PTO's overshoot at the paper's gains",
+    "pd-paper": "the PD's overshoot at the paper's gains",
+}
+
+
+@dataclass(frozen=True)
+class FairTunings:
+    """Both laws tuned on the step under each shared overshoot bound.
+
+    Attributes
+    ----------
+    bounds : dict
+        Bound name (:data:`FAIR_BOUNDS`) -> overshoot bound [mm], measured between
+        samples on the paper-gain response of that law.
+    paper : dict
+        ``pd``, ``pto`` -> response metrics of the step at the paper's gains
+        (:func:`response_metrics`).
+    results : dict
+        (law, bound name) -> :class:`TuneResult` (settling_2pct objective).
+    budget : TuneBudget
+        The search effort used.
+    seconds : float
+        Wall time of the tunings [s].
+    """
+
+    bounds: dict[str, float]
+    paper: dict[str, dict[str, float]]
+    results: dict[tuple[str, str], TuneResult]
+    budget: TuneBudget
+    seconds: float
+
+    def config(self, law: str, bound: str) -> Config:
+        """Return the configuration of ``law`` tuned under the bound named ``bound``."""
+        return self.results[(law, bound)].config
+
+
+@lru_cache(maxsize=8)
+def _fair_tunings(cfg: Config, budget: TuneBudget) -> FairTunings:
+    t0 = time.perf_counter()
+    paper = {law: response_metrics(cfg, law, "step") for law in ("pd", "pto")}
+    bounds = {"pto-paper": paper["pto"]["overshoot_mm"], "pd-paper": paper["pd"]["overshoot_mm"]}
+    by_value: dict[tuple[str, float], TuneResult] = {}
+    results = {}
+    for name, bound in bounds.items():
+        for law in ("pd", "pto"):
+            key = (law, bound)
+            if key not in by_value:
+                by_value[key] = tune(
+                    cfg,
+                    law,
+                    "step",
+                    max_overshoot=bound,
+                    seed=budget.seed,
+                    maxiter=budget.maxiter,
+                    popsize=budget.popsize,
+                    d_grid=budget.d_grid,
+                    d_refine=budget.d_refine,
+                )
+            results[(law, name)] = by_value[key]
+    return FairTunings(bounds, paper, results, budget, time.perf_counter() - t0)
+
+
+def fair_tunings(cfg: Config, budget: TuneBudget | None = None) -> FairTunings:
+    """Tune PD and PTO on the step under each shared overshoot bound (memoized).
+
+    The bounds (:data:`FAIR_BOUNDS`) are the overshoots, between samples, of the
+    PTO and of the PD at the paper's gains: under the first, "the same overshoot"
+    is the PTO's (the paper's premise for the 31 %), under the second the PD's.
+    Each law minimizes its 2 % settling time of the step under the bound
+    (:func:`tune`, fixed seed); a tuning shared by two bounds of equal value is
+    run once.  Results are cached per (configuration, budget): four tunings
+    cost about 2-3 minutes on the paper's plant.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (plant and the paper's gains).
+    budget : TuneBudget, optional
+        Search effort; default :class:`TuneBudget`.
+
+    Returns
+    -------
+    FairTunings
+        Bounds, paper-gain metrics and the tuned results.
+    """
+    return _fair_tunings(cfg, budget or TuneBudget())

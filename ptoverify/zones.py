@@ -685,7 +685,7 @@ def _zone_for_law(cfg: Config, variant: str) -> PTOZone:
 
 def clear_caches() -> None:
     """Empty the memos of this module (zones, feasible intervals, d_min per configuration)."""
-    for fn in (_corrected_zone, _feasible_intervals, smallest_d, zone_for_law):
+    for fn in (_corrected_zone, _feasible_intervals, smallest_d, _zone_for_law):
         fn.cache_clear()
 
 

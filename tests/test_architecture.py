@@ -21,6 +21,7 @@ PACKAGES = ("ptoverify", "derivations")
 
 #: The output layer: everything else in ptoverify is numeric.
 OUTPUT = {
+    "ptoverify.conform_report",
     "ptoverify.cli",
     "ptoverify.__main__",
     "ptoverify.report",

@@ -35,6 +35,14 @@ KEYS = {
     "discrete_batch_vs_lp_ratio",
     "check_s",
     "report_s",
+    "sweep_s",
+    "tune_pd_s",
+    "tune_pto_s",
+    "robust_s",
+    "robust_gates_s",
+    "robust_maps_state_cells_per_s",
+    "robust_maps_dask_local_state_cells_per_s",
+    "robust_maps_trajectory_steps_per_s",
 }
 
 
@@ -60,7 +68,13 @@ def test_values_finite_positive(small_run, key):
     v = small_run[key]
     if v is None:
         # only the whole-process figures may be missing, and then with a reason
-        assert key in ("report_s", "check_s"), f"{key} is null"
+        assert key in (
+            "report_s",
+            "check_s",
+            "robust_s",
+            "robust_gates_s",
+            "robust_maps_dask_local_state_cells_per_s",
+        ), f"{key} is null"
         assert small_run["machine"]["notes"][key], f"{key} is null without a reason"
         return
     assert isinstance(v, float | int) and math.isfinite(v) and v > 0, f"{key} = {v!r}"

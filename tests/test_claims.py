@@ -17,6 +17,7 @@ from ptoverify.metrics import settling_time
 from ptoverify.plant import flow as plant_flow
 from ptoverify.plant import step as plant_step
 from ptoverify.simulate import simulate
+from ptoverify.tune import TuneBudget, fair_tunings
 
 REQUIRED = {
     "step-to-oscillation",
@@ -240,16 +241,18 @@ def test_exact_overshoot_is_at_least_the_grid_overshoot_everywhere(results):
 
 
 def test_claims_json_is_backward_compatible(results):
-    """The grid values, grid verdicts and ties are added beside the old keys, none renamed."""
+    """Grid values and verdicts, ties and the tuned keys are added beside the old ones."""
     old_claim = {"id", "section", "signal", "claim", "paper_value", "unit", "rule", "verdict"}
     old_claim |= {"measured", "detail", "readings"}
     old_reading = {"reading", "label", "measured", "values", "verdict", "detail"}
     for r in results:
         j = r.to_json()
-        assert old_claim | {"measured_grid", "verdict_grid", "verdict_differs_on_grid"} == set(j)
+        added = {"measured_grid", "verdict_grid", "verdict_differs_on_grid", "verdict_tuned"}
+        assert old_claim | added == set(j)
         for x in j["readings"]:
             new = {"measured_grid", "values_grid", "verdict_grid", "verdict_differs_on_grid"}
             assert old_reading | new | {"ties"} == set(x)
+            assert {"a", "tracking", "pto", "band", "gains", "bound_mm"} == set(x["reading"])
             assert set(x["values_grid"]) == set(x["values"]), r.id
 
 
@@ -352,3 +355,87 @@ def test_response_metrics_show_exact_and_grid_for_every_section6_response():
                 assert m["linear_zone_s_grid"] - T < m["linear_zone_s"] <= m["linear_zone_s_grid"]
     assert got["pd"]["step"]["linear_zone_s"] == 0.0
     assert math.isnan(got["to"]["step"]["linear_zone_s"])
+
+
+# ---------------------------------------------------------------- at the best tuning
+#: the smallest search that exercises every step (the same value as test_tune's: memoized once)
+SMALL = TuneBudget(maxiter=2, popsize=5, d_grid=2, d_refine=0)
+TUNED_GAINS = ("pd-retuned", "best@pto-paper", "best@pd-paper")
+
+
+@pytest.fixture(scope="module")
+def tuned():
+    return cl.evaluate_claims(paper_config(), tuned=True, budget=SMALL)
+
+
+def _tuned_reading(claim, gains):
+    return next(r for r in claim.readings if r.reading.gains == gains)
+
+
+def _step_exact(cfg, law):
+    res = simulate(make_law(law, cfg), cfg.plant, "step")
+    return exact.exact_metrics(res, cfg.plant).exact()
+
+
+@pytest.mark.slow
+def test_tuned_readings_sit_beside_the_paper_gain_ones(results, tuned):
+    assert [c.id for c in tuned] == [c.id for c in results]
+    for plain, t in zip(results, tuned, strict=True):
+        # asking for the tuned readings never changes the paper-gain verdicts
+        assert (t.verdict, t.verdict_grid, t.measured) == (
+            plain.verdict,
+            plain.verdict_grid,
+            plain.measured,
+        )
+        assert plain.verdict_tuned == ""
+        extra = [r for r in t.readings if r.reading.gains is not None]
+        if t.id in cl.TUNED_CLAIMS:
+            assert [r.reading.gains for r in extra] == list(TUNED_GAINS), t.id
+            agree = {r.verdict for r in extra}
+            assert t.verdict_tuned == (agree.pop() if len(agree) == 1 else "ambiguous")
+            assert all(r.reading.bound_mm is not None and "overshoot <=" in r.label for r in extra)
+        else:
+            assert not extra and t.verdict_tuned == "", t.id
+        json.dumps(t.to_json(), allow_nan=True)
+
+
+@pytest.mark.slow
+def test_tuned_31_percent_measured_independently(tuned):
+    cfg = paper_config()
+    ft = fair_tunings(cfg, SMALL)
+    c31 = next(c for c in tuned if c.id == "step-pd-31-percent")
+    pto_paper = _step_exact(cfg, "pto")
+    for gains, (pd_cfg, pto_cfg, bound) in {
+        "pd-retuned": (ft.config("pd", "pto-paper"), cfg, pto_paper["overshoot_mm"]),
+        "best@pto-paper": (
+            ft.config("pd", "pto-paper"),
+            ft.config("pto", "pto-paper"),
+            ft.bounds["pto-paper"],
+        ),
+        "best@pd-paper": (
+            ft.config("pd", "pd-paper"),
+            ft.config("pto", "pd-paper"),
+            _step_exact(cfg, "pd")["overshoot_mm"],
+        ),
+    }.items():
+        pd, pto = _step_exact(pd_cfg, "pd"), _step_exact(pto_cfg, "pto")
+        r = _tuned_reading(c31, gains)
+        more = 100.0 * (pd["settling_2pct_s"] / pto["settling_2pct_s"] - 1.0)
+        assert r.measured == pytest.approx(more, rel=1e-12), gains
+        # the premise "with the same overshoot" holds: each law within the shared bound
+        assert pd["overshoot_mm"] <= bound and pto["overshoot_mm"] <= bound, gains
+        assert r.reading.bound_mm == bound
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("gains", TUNED_GAINS)
+def test_tuned_31_verdict_follows_the_registry_paper_value(tuned, gains):
+    cfg = paper_config()
+    measured = _tuned_reading(
+        next(c for c in tuned if c.id == "step-pd-31-percent"), gains
+    ).measured
+    entry = next(c for c in cl.CLAIMS if c.id == "step-pd-31-percent")
+    for value, expect in ((measured, "reproduced"), (measured + 100.0, "not reproduced")):
+        moved = (dataclasses.replace(entry, paper_value=value),)
+        (res,) = cl.evaluate_claims(cfg, moved, tuned=True, budget=SMALL)
+        assert _tuned_reading(res, gains).verdict == expect, (value, gains)

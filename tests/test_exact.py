@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.integrate import solve_ivp
-from scipy.optimize import curve_fit
+from scipy.optimize import brentq, curve_fit
 
 from ptoverify import exact
 from ptoverify.config import paper_config
@@ -340,3 +340,186 @@ def test_trajectory_state_is_the_flow_between_samples():
     z1, z2 = tr.state(mid)
     assert_allclose(z1, y1, rtol=1e-15, atol=1e-15, err_msg="x1 between samples")
     assert_allclose(z2, y2, rtol=1e-15, atol=1e-12, err_msg="x2 between samples")
+
+
+# ------------------------------------------------- settling of many records at once
+BAND1, BAND2 = 0.01, PLANT.a * 0.01  # the sweep's box [mm], [mm/s]
+PER_SWEEP = 2_000  # dense points per sample for the batch settling
+
+
+def dense_last_out(x1, x2, u, a, T, b1, b2, per=PER_SWEEP):
+    """Time of the last dense point outside the box per record (-1 if none; NaN if the end is out).
+
+    plant.flow at ``per`` uniform points per sample.  Intervals are skipped only
+    when an elementary bound certifies them inside: x2(s) is a convex combination
+    of x2k and u, so |x2(s)| <= V = max(|x2k|, |u|), and x1 is V-Lipschitz from
+    both ends, so |x1(s)| <= (|x1k| + |x1k+1| + T V) / 2.
+    """
+    steps, n = u.shape
+    v = np.maximum(np.abs(x2[:-1]), np.abs(u))
+    sure = (v <= b2) & (0.5 * (np.abs(x1[:-1]) + np.abs(x1[1:]) + T * v) <= b1)
+    end_out = (np.abs(x1[-1]) > b1) | (np.abs(x2[-1]) > b2)
+    sure[:, end_out] = True  # nothing to evaluate: the record ends outside
+    kk, cc = np.nonzero(~sure)
+    s = T * np.arange(per) / per
+    last = np.full(n, -1.0)
+    for i in range(0, kk.size, 256):
+        k, c = kk[i : i + 256], cc[i : i + 256]
+        y1, y2 = flow(x1[k, c][:, None], x2[k, c][:, None], u[k, c][:, None], s[None, :], a)
+        out = (np.abs(y1) > b1) | (np.abs(y2) > b2)
+        j = per - 1 - out[:, ::-1].argmax(axis=1)
+        tt = np.where(out.any(axis=1), k * T + s[j], -1.0)
+        np.maximum.at(last, c, tt)
+    return np.where(end_out, np.nan, last)
+
+
+@pytest.fixture(scope="module")
+def sweep_records():
+    """400 states of the sweep's grid (20 x 20), and 6 states of its 200 x 200 grid with
+    excursions between in-band samples; the sweep's horizon; every law's records."""
+    from ptoverify.simulate import simulate_batch
+    from ptoverify.sweep import SweepSettings, grid_states, run_sweep
+
+    res = run_sweep(CFG, SweepSettings(n1=20, n2=20))
+    G1, G2 = grid_states(PLANT, 200, 200)
+    pick = [(86, 99), (87, 99), (88, 99), (44, 95), (98, 91), (155, 108)]  # (x2 index, x1 index)
+    x1 = np.concatenate([res.x1.ravel(), [G1[i, j] for i, j in pick]])
+    x2 = np.concatenate([res.x2.ravel(), [G2[i, j] for i, j in pick]])
+    recs = {law: simulate_batch(make_law(law, CFG), PLANT, x1, x2, res.steps) for law in res.laws}
+    return res, recs
+
+
+@pytest.mark.parametrize("law", ["pd", "pto", "pto-printed", "to"])
+def test_batch_settling_matches_dense_flow_on_sweep_records(sweep_records, law):
+    """Last exit from the box vs the last dense point outside it (2,000 per sample).
+
+    The true last exit lies after the last dense point outside and, unless an
+    excursion is shorter than the dense spacing, before the next dense point.
+    With the sweep's hold, both readings agree on which states settle, and the
+    sweep's own values are these.
+    """
+    res, recs = sweep_records
+    b, T = recs[law], PLANT.sample_time
+    dt = T / PER_SWEEP
+    st0 = exact.settling_times_batch(b.x1, b.x2, b.u, PLANT.a, T, BAND1, BAND2)
+    ref = dense_last_out(b.x1, b.x2, b.u, PLANT.a, T, BAND1, BAND2)
+    assert np.array_equal(np.isnan(st0.time), np.isnan(ref)), f"{law}: which records end outside"
+    ok = np.isfinite(ref)
+    got, lo = st0.time[ok], np.maximum(ref[ok], 0.0)
+    assert np.all(got >= lo - 1e-12), f"{law}: exact exit before a dense point outside"
+    hi = np.where(ref[ok] < 0, 0.0, ref[ok] + dt)
+    assert_allclose(got, hi, rtol=0, atol=dt * 1.001, err_msg=f"{law}: settling vs dense flow")
+    # with the hold, as the sweep reads it
+    hold = res.settings.hold
+    st = exact.settling_times_batch(b.x1, b.x2, b.u, PLANT.a, T, BAND1, BAND2, hold)
+    tail = res.steps * T - np.where(ref < 0, 0.0, ref + dt)
+    clear = np.abs(tail - hold) > 2 * dt  # not decided within the dense spacing
+    assert np.array_equal(np.isnan(st.time)[clear], ~(tail >= hold)[clear]), "hold rule"
+    n = res.x1.size
+    assert np.array_equal(res.laws[law].settle_time.ravel(), st.time[:n], equal_nan=True)
+    assert np.array_equal(res.laws[law].grid.settle_time.ravel(), st.grid[:n], equal_nan=True)
+    if law == "pd":  # the picked 200 x 200 states leave the box between in-band samples
+        later = st0.time[n : n + 3] > st0.grid[n : n + 3]
+        dense_later = ref[n : n + 3] > st0.grid[n : n + 3]
+        assert later.all() and dense_later.all(), "PD excursions after the grid's settled sample"
+    if law == "pto-printed":
+        assert (ref[n + 3 : n + 5] > st0.grid[n + 3 : n + 5]).all(), "dense sees the excursions"
+        assert (st0.time[n + 3 : n + 5] > st0.grid[n + 3 : n + 5]).all()
+
+
+def test_batch_settling_grid_bounds_on_sweep_records(sweep_records):
+    """grid - T < exact (the sample before the grid value is outside) and grid <= T ceil(exact / T)
+    (every sample from the exact time on is inside); exact > grid only with an excursion
+    between samples, which the dense reference confirms."""
+    _, recs = sweep_records
+    T = PLANT.sample_time
+    for law, b in recs.items():
+        st = exact.settling_times_batch(b.x1, b.x2, b.u, PLANT.a, T, BAND1, BAND2)
+        ok = np.isfinite(st.time)
+        assert np.array_equal(ok, np.isfinite(st.grid)), f"{law}: same records settle (no hold)"
+        ex, gr = st.time[ok], st.grid[ok]
+        assert np.all((ex > gr - T) | (gr == 0.0)), f"{law}: exact more than a sample early"
+        assert np.all(gr <= T * np.ceil(ex / T - 1e-9) + 1e-15), f"{law}: grid after exact's sample"
+        from ptoverify.sweep import settle_steps
+
+        k = settle_steps(b.x1, b.x2, BAND1, BAND2, 0)
+        assert np.array_equal(np.where(k >= 0, k * T, np.nan), st.grid, equal_nan=True)
+
+
+def _excursion_record(x11):
+    """Sample 0 outside (x2), samples 1.. inside from (x11, 1.8); -9.66 mm/s on interval 1."""
+    a, T = PLANT.a, PLANT.sample_time
+    x1, x2 = np.empty(6), np.empty(6)
+    x1[1], x2[1] = x11, 1.8
+    x1[0], x2[0] = flow(x1[1], x2[1], 0.0, -T, a)  # backward flow under u = 0
+    u = np.array([0.0, -9.66, 0.0, 0.0, 0.0])
+    for k in range(1, 5):
+        x1[k + 1], x2[k + 1] = flow(x1[k], x2[k], u[k], T, a)
+    return x1, x2, u
+
+
+def test_batch_settling_constructed_excursion_between_in_band_samples():
+    """x1 peaks above the band inside interval 1 while samples 1 and 2 are inside:
+    the exact settling is the re-entry on x1's falling side (brentq on plant.flow),
+    later than the grid's (sample 1); from x1 = 0 there is no excursion."""
+    a, T = PLANT.a, PLANT.sample_time
+    x1, x2, u = _excursion_record(0.0095)
+    assert abs(x2[0]) > BAND2 and np.all(np.abs(x1[1:]) <= BAND1), "construction"
+    assert np.all(np.abs(x2[1:]) <= BAND2), "construction: samples 1.. inside"
+    s_dense = T * np.linspace(0, 1, 20001)
+    y1 = flow(x1[1], x2[1], u[1], s_dense, a)[0]
+    assert y1.max() > BAND1 * 1.01, "construction: the excursion leaves the band"
+    i = int(np.argmax(y1))
+    s_ref = brentq(lambda s: flow(x1[1], x2[1], u[1], s, a)[0] - BAND1, s_dense[i], T, xtol=1e-18)
+    st = exact.settling_times_batch(x1, x2, u, a, T, BAND1, BAND2)
+    assert st.grid[0] == T
+    assert_allclose(st.time[0], T + s_ref, rtol=0, atol=1e-15, err_msg="re-entry time")
+    assert st.time[0] > st.grid[0]
+    x1m, x2m, um = _excursion_record(0.0)  # the same, 0.0095 mm lower: no excursion
+    assert np.all(np.abs(x1m[1:]) <= BAND1) and np.all(np.abs(x2m[1:]) <= BAND2)
+    assert flow(x1m[1], x2m[1], um[1], s_dense, a)[0].max() <= BAND1
+    st = exact.settling_times_batch(x1m, x2m, um, a, T, BAND1, BAND2)
+    x2_cross = brentq(lambda s: flow(x1m[0], x2m[0], 0.0, s, a)[1] - BAND2, 0.0, T, xtol=1e-18)
+    assert_allclose(st.time[0], x2_cross, rtol=0, atol=1e-15, err_msg="x2 re-entry")
+    assert st.grid[0] == T and st.time[0] < T
+
+
+def test_batch_settling_agrees_with_single_record_settling_time():
+    """Position band only (velocity band huge): the batch equals ``settling_time`` of the
+    regulation error e = 0 - x1 (pieces and brentq, another path) on PD and PTO records."""
+    from ptoverify.simulate import simulate_batch
+
+    rng = np.random.default_rng(3)
+    x1s, x2s = rng.uniform(-50, 50, 30), rng.uniform(-300, 300, 30)
+    T = PLANT.sample_time
+    for law in ("pd", "pto"):
+        b = simulate_batch(make_law(law, CFG), PLANT, x1s, x2s, 300)
+        st = exact.settling_times_batch(b.x1, b.x2, b.u, PLANT.a, T, BAND1, 1e300)
+        t = T * np.arange(301)
+        for j in range(x1s.size):
+            tr = exact.Trajectory.from_samples(t, b.x1[:, j], b.x2[:, j], b.u[:, j], PLANT.a)
+            one = exact.settling_time(tr, exact.Signal("step", 0.0), BAND1)
+            close_or_both_nan(st.time[j], one, 1e-13, f"{law} record {j}")
+
+
+def test_batch_settling_hold_and_bad_input():
+    """A free decay: closed-form exits; the hold rule in seconds (exact) and samples (grid)."""
+    a, T = 10.0, 0.1
+    t = np.arange(11) * T
+    x1, x2 = -0.5 * np.exp(-a * t), 5.0 * np.exp(-a * t)
+    st = exact.settling_times_batch(x1, x2, np.zeros(10), a, T, 0.01, 1.0, hold=0.6)
+    assert_allclose(st.time[0], math.log(50) / a, rtol=1e-14, err_msg="x1 exit ln(50)/a")
+    assert st.grid[0] == pytest.approx(0.4) and math.isnan(
+        exact.settling_times_batch(x1, x2, np.zeros(10), a, T, 0.01, 1.0, hold=0.61).time[0]
+    ), "tail 1.0 - 0.391 = 0.609 s < 0.61 s"
+    assert math.isnan(
+        exact.settling_times_batch(x1, x2, np.zeros(10), a, T, 0.01, 1.0, hold=0.61).grid[0]
+    ), "grid: 6 samples of tail < 7"
+    end_out = exact.settling_times_batch(x1, x2, np.zeros(10), a, T, 1e-9, 1.0)
+    assert math.isnan(end_out.time[0]) and math.isnan(end_out.grid[0])
+    inside = exact.settling_times_batch(x1, x2, np.zeros(10), a, T, 1.0, 10.0)
+    assert inside.time[0] == 0.0 == inside.grid[0]
+    with pytest.raises(InputError):
+        exact.settling_times_batch(x1, x2, np.zeros(11), a, T, 0.01, 1.0)
+    with pytest.raises(InputError):
+        exact.settling_times_batch(x1, x2, np.zeros(10), a, T, 0.0, 1.0)

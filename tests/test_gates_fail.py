@@ -1,6 +1,6 @@
 """Every gate of ``ptoverify check`` is shown failing.
 
-For each gate, its subject (the flow, a root, a law, a solver's answer, the zone
+For each gate (the nominal ones and the robustness gates of ``check --robust``), its subject (the flow, a root, a law, a solver's answer, the zone
 construction, the loop gains, the claims) is perturbed with monkeypatch, and the
 gate must report ``fail`` or ``unverified``, never ``pass``.  Where the run is
 cheap the same gate also passes unperturbed on the same configuration, so the
@@ -24,10 +24,25 @@ import ptoverify.mintime as mintime_mod
 import ptoverify.ocp as ocp_mod
 import ptoverify.plant as plant_mod
 import ptoverify.poles as poles_mod
+import ptoverify.robust as robust_mod
 import ptoverify.zones as zones_mod
-from ptoverify.checks import GATES
-from ptoverify.config import Config, PDGains, Plant, PTOSettings, paper_config
+from ptoverify.checks import GATES, ROBUST_GATES, run_checks
+from ptoverify.config import Config, PDGains, Plant, PTOSettings, Robustness, paper_config
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED
+
+
+@pytest.fixture(autouse=True)
+def _fresh_memos():
+    """Zones and properties are memoized per configuration: a perturbation must not see
+    (or leave behind) a result computed without it."""
+    from ptoverify.properties import named_properties
+
+    zones_mod.clear_caches()
+    named_properties.cache_clear()
+    yield
+    zones_mod.clear_caches()
+    named_properties.cache_clear()
+
 
 #: gate name -> (perturb(monkeypatch, cfg) -> cfg, also check the unperturbed pass, slow)
 PERTURBATIONS: dict[str, tuple[Callable, bool, bool]] = {}
@@ -234,10 +249,81 @@ def _(monkeypatch, cfg):
     return cfg
 
 
+#: A box where the corrected PTO passes both robustness gates (no delay; the settling
+#: limit above the ratio of the states next to the origin, where N* is a few samples), so
+#: that their failures below are the perturbations' doing.  At the paper's box (delay 0..1)
+#: the PTO fails both: a finding, reported by ``check --robust``.
+ROBUST_CFG = dataclasses.replace(
+    paper_config(), robustness=Robustness(delay_samples=(0, 0), settling_ratio_limit=20.0)
+)
+
+
+def _pto_replaced_in_robust(monkeypatch, law):
+    """The robustness study builds ``law(cfg)`` where it would build the PTO."""
+    real = robust_mod.make_law
+    monkeypatch.setattr(
+        robust_mod, "make_law", lambda name, c: law(c) if name == "pto" else real(name, c)
+    )
+
+
+@perturbation("robust-no-limit-cycle")
+def _(monkeypatch, cfg):
+    """The sampled time-optimal law in place of PTO: it chatters around the origin."""
+    _pto_replaced_in_robust(monkeypatch, lambda c: laws_mod.make_law("to", c))
+    return ROBUST_CFG
+
+
+@perturbation("robust-settling")
+def _(monkeypatch, cfg):
+    """PTO with a dead band (u = 0) at 10 <= |x1| <= 30 mm, |x2| < 100 mm/s: it never settles."""
+
+    def trapped(c):
+        pto = laws_mod.make_law("pto", c)
+
+        def vector(x1, x2):
+            u, r = pto(x1, x2)
+            trap = (np.abs(x1) >= 10.0) & (np.abs(x1) <= 30.0) & (np.abs(x2) < 100.0)
+            return np.where(trap, 0.0, u), r
+
+        def scalar(x1, x2):
+            u, r = vector(np.array([x1]), np.array([x2]))
+            return float(u[0]), int(r[0])
+
+        return laws_mod.Law("trapped", vector, scalar, c.plant.w_max, "PTO with a dead band")
+
+    _pto_replaced_in_robust(monkeypatch, trapped)
+    return ROBUST_CFG
+
+
+def _judge(name: str, cfg: Config):
+    """The verdict of gate ``name`` (a robustness gate through ``run_checks``)."""
+    if name in GATES:
+        return GATES[name](cfg)
+    (verdict,) = run_checks(cfg, [name])
+    return verdict
+
+
 def test_every_gate_has_a_failing_perturbation():
-    missing = sorted(set(GATES) - set(PERTURBATIONS))
+    gates = {*GATES, *ROBUST_GATES}
+    missing = sorted(gates - set(PERTURBATIONS))
     assert not missing, f"gates without a failing-perturbation test: {missing}"
-    assert not set(PERTURBATIONS) - set(GATES), "perturbation of a gate that does not exist"
+    assert not set(PERTURBATIONS) - gates, "perturbation of a gate that does not exist"
+
+
+def test_robust_gates_fail_at_the_paper_box_and_fail_closed(monkeypatch):
+    """At the paper's box the PTO fails both (delay 1); a study that raises is unverified."""
+    cfg = paper_config()
+    verdicts = run_checks(cfg, list(ROBUST_GATES))
+    assert [v.name for v in verdicts] == list(ROBUST_GATES)
+    assert all(v.status == FAIL for v in verdicts), verdicts
+    assert verdicts[0].measured > 0.0, "limit cycle amplitude [mm]"
+
+    def broken(*args, **kwargs):
+        raise FloatingPointError("injected")
+
+    monkeypatch.setattr(robust_mod, "run_robust", broken)
+    verdicts = run_checks(cfg, list(ROBUST_GATES))
+    assert all(v.status == UNVERIFIED and "injected" in v.detail for v in verdicts), verdicts
 
 
 def _params():
@@ -251,9 +337,9 @@ def test_gate_fails_when_its_subject_is_perturbed(monkeypatch, name):
     cfg = paper_config()
     with monkeypatch.context() as m:
         cfg = perturb(m, cfg)
-        r = GATES[name](cfg)
+        r = _judge(name, cfg)
     assert r.status in (FAIL, UNVERIFIED), r
     assert r.name == name and r.unit, r
     if baseline:
-        clean = GATES[name](cfg)
+        clean = _judge(name, cfg)
         assert clean.status == PASS, clean

@@ -80,13 +80,13 @@ def test_every_option_the_readme_names_exists():
         else:
             assert cmd in subs, f"README names unknown command {cmd!r} in `{snip}`"
             options = {o for a in subs[cmd]._actions for o in a.option_strings}
-        for opt in re.findall(r"(?<![\w-])(--[a-z][a-z-]*)", snip):
+        for opt in re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*)", snip):
             assert opt in options, f"`{snip}`: {cmd} has no option {opt}"
             checked += 1
     # bare options in prose, e.g. `--no-feedforward`, exist in some command
     every = {o for p in subs.values() for a in p._actions for o in a.option_strings}
     every |= {o for a in parser._actions for o in a.option_strings}
-    for opt in re.findall(r"`(--[a-z][a-z-]*)", README):
+    for opt in re.findall(r"`(--[a-z][a-z0-9-]*)", README):
         assert opt in every, opt
     assert checked > 20
 

@@ -11,6 +11,7 @@ from numpy.testing import assert_allclose
 
 from ptoverify.cli import main
 from ptoverify.config import paper_config
+from ptoverify.exact import settling_times_batch
 from ptoverify.laws import make_law
 from ptoverify.mintime import discrete_min_steps, min_time
 from ptoverify.ocp import TwoPhaseOCP
@@ -33,7 +34,9 @@ def test_settle_steps_definition():
 
 
 def test_small_sweep_agrees_with_single_state_runs(small):
-    """Each grid state's settling time equals a one-state batch run; ratios use t_f*, N*."""
+    """Each grid state's settling times equal a one-state run's: the exact reading
+    (``settling_times_batch`` on that one record), the grid reading (``settle_steps``);
+    ratios use t_f* and N* (LP reference)."""
     cfg = paper_config()
     p = cfg.plant
     vband = p.a * SMALL.band
@@ -44,26 +47,23 @@ def test_small_sweep_agrees_with_single_state_runs(small):
             x1, x2 = small.x1.flat[j], small.x2.flat[j]
             b = simulate_batch(make_law(law, cfg), p, [x1], [x2], small.steps)
             k = int(settle_steps(b.x1, b.x2, SMALL.band, vband, hold)[0])
-            ts = small.laws[law].settle_time.flat[j]
+            one = settling_times_batch(b.x1, b.x2, b.u, p.a, p.T, SMALL.band, vband, SMALL.hold)
+            ts, tg = small.laws[law].settle_time.flat[j], small.laws[law].grid.settle_time.flat[j]
+            assert ts == one.time[0] or (math.isnan(ts) and math.isnan(one.time[0])), law
             if k < 0:
-                assert math.isnan(ts), f"{law} at ({x1}, {x2}) should not settle"
+                assert math.isnan(tg), f"{law} at ({x1}, {x2}) should not settle on the grid"
                 continue
-            assert ts == pytest.approx(k * p.T, abs=1e-12), f"{law} settle time at ({x1},{x2})"
+            assert tg == pytest.approx(k * p.T, abs=1e-12), f"{law} grid time at ({x1},{x2})"
+            if math.isnan(ts):
+                continue
             tf = float(min_time(x1, x2, p).t_f)
-            assert_allclose(
-                small.laws[law].ratio_tf.flat[j],
-                ts / tf,
-                rtol=1e-12,
-                err_msg=f"{law}: ratio to t_f*",
-            )
             ns = discrete_min_steps(x1, x2, p).steps
             assert small.n_star.flat[j] == ns, "N* (zonotope) equals the LP reference"
-            assert_allclose(
-                small.laws[law].ratio_nt.flat[j],
-                ts / (ns * p.T),
-                rtol=1e-12,
-                err_msg=f"{law}: ratio to N* T",
-            )
+            for r, t in ((small.laws[law], ts), (small.laws[law].grid, tg)):
+                assert_allclose(r.ratio_tf.flat[j], t / tf, rtol=1e-12, err_msg=f"{law}: / t_f*")
+                assert_allclose(
+                    r.ratio_nt.flat[j], t / (ns * p.T), rtol=1e-12, err_msg=f"{law}: / N* T"
+                )
 
 
 def test_discrete_limit_bounds(small):
@@ -141,11 +141,16 @@ def test_sweep_json_keys(capsys):
             "worst_states_nt",
         } <= set(r)
         assert set(r["percentiles_ratio_nt"]) == {"p50", "p95", "p99", "max"}
+        assert {"fraction_settled", "median_ratio_tf", "percentiles_ratio_tf"} <= set(
+            r["sample_grid"]
+        ), "the sample-grid reading alongside"
+        assert isinstance(r["excursions_after_grid"], int)
+    assert "between samples" in out["settling"]
 
 
 def test_percentiles_and_worst_states(small):
     """p50 <= p95 <= p99 <= max = the worst ratio; worst states listed worst first."""
-    for r in small.laws.values():
+    for r in [*small.laws.values(), *(v.grid for v in small.laws.values())]:
         for pct, worst, states, ratio in (
             (r.percentiles_tf, r.worst_ratio_tf, r.worst_states_tf, r.ratio_tf),
             (r.percentiles_nt, r.worst_ratio_nt, r.worst_states_nt, r.ratio_nt),
@@ -166,9 +171,26 @@ def test_settling_chunks_do_not_change_results():
     p = cfg.plant
     x1, x2 = np.linspace(-20, 20, 11), np.linspace(300, -300, 11)
     law = make_law("pto", cfg)
-    a = settling_times(law, p, x1, x2, 200, 0.01, p.a * 0.01, 25, chunk=3)
-    b = settling_times(law, p, x1, x2, 200, 0.01, p.a * 0.01, 25)
-    assert np.array_equal(a, b, equal_nan=True)
+    a = settling_times(law, p, x1, x2, 200, 0.01, p.a * 0.01, 0.05, chunk=3)
+    b = settling_times(law, p, x1, x2, 200, 0.01, p.a * 0.01, 0.05)
+    assert np.array_equal(a.time, b.time, equal_nan=True)
+    assert np.array_equal(a.grid, b.grid, equal_nan=True)
+
+
+def test_exact_and_grid_readings_side_by_side(small):
+    """Both readings are kept; grid - T < exact wherever both settle; exact > grid only
+    for the counted excursions; the statistics of the grid reading are its own."""
+    T = small.sample_time
+    for name, r in small.laws.items():
+        ex, gr = r.settle_time, r.grid.settle_time
+        both = np.isfinite(ex) & np.isfinite(gr)
+        assert np.all(ex[both] > gr[both] - T), f"{name}: exact more than a sample early"
+        assert r.excursions_after_grid == int(np.count_nonzero(ex[both] > gr[both]))
+        assert r.grid.grid is None
+        if both.any():
+            assert r.grid.median_ratio_tf == pytest.approx(np.median(r.grid.ratio_tf[both]))
+    pd = small.laws["pd"]
+    assert pd.median_ratio_tf < pd.grid.median_ratio_tf, "PD: exact exits precede the samples"
 
 
 def test_grid_limit(capsys):

@@ -1,19 +1,35 @@
 """Tuning: a brute-force reference, constraints re-checked independently, TOML round trip."""
 
 import dataclasses
+import functools
+import json
 import math
 
 import numpy as np
 import pytest
+from scipy.linalg import expm
 from scipy.signal import cont2discrete
 
+from ptoverify import cli
+from ptoverify.claims import fair_comparison
 from ptoverify.config import config_from_mapping, load_config, paper_config
 from ptoverify.errors import InputError
 from ptoverify.exact import exact_metrics
 from ptoverify.laws import make_law
+from ptoverify.mintime import discrete_min_steps, min_time
 from ptoverify.properties import law_properties
 from ptoverify.simulate import simulate
-from ptoverify.tune import BOUNDS, pareto_front, tune
+from ptoverify.tune import (
+    BOUNDS,
+    TuneBudget,
+    fair_tunings,
+    pareto_front,
+    tune,
+    worst_ratio_nt,
+)
+
+#: the smallest search that still exercises every step (shared, memoized, with test_claims)
+SMALL = TuneBudget(maxiter=2, popsize=5, d_grid=2, d_refine=0)
 
 CFG = paper_config()
 # a slower, coarser plant: few samples per response, so a brute-force grid is cheap
@@ -114,3 +130,142 @@ def test_pareto_front_is_nondominated():
 def test_bad_arguments_are_input_errors(kwargs, word):
     with pytest.raises(InputError, match=word):
         tune(CFG, **kwargs)
+
+
+# ---------------------------------------------------------------- worst_ratio_nt
+def _worst_ratio_reference(cfg, law_name, n1, n2):
+    """The same definition, evaluated independently: a scalar ZOH loop and LP N*."""
+    p = cfg.plant
+    T, a, band = p.sample_time, p.a, 0.01
+    M = np.zeros((3, 3))
+    M[:2, :2] = [[0.0, 1.0], [0.0, -a]]
+    M[1, 2] = a
+    E = expm(M * T)
+    Ad, Bd = E[:2, :2], E[:2, 2]
+    law = make_law(law_name, cfg)
+    xs = np.linspace(-p.position_range, p.position_range, n1)
+    vs = np.linspace(-p.w_max, p.w_max, n2)
+    t_f = max(float(min_time(x, v, p).t_f) for x in xs for v in vs)
+    hold = math.ceil(0.05 / T - 1e-9)
+    steps = math.ceil(4.0 * t_f / T) + hold
+    worst = 0.0
+    for v in vs:
+        for x in xs:
+            n_star = discrete_min_steps(x, v, p).steps
+            s, last_out = np.array([x, v]), 0
+            for k in range(steps + 1):
+                if abs(s[0]) > band or abs(s[1]) > a * band:
+                    last_out = k + 1
+                u, _ = law.scalar(float(s[0]), float(s[1]))
+                s = Ad @ s + Bd * u
+            if steps - last_out < hold:
+                return math.inf
+            worst = max(worst, last_out / n_star)
+    return worst
+
+
+@pytest.mark.parametrize("law", ["pd", "pto"])
+def test_worst_ratio_nt_matches_an_independent_evaluation(law):
+    got = worst_ratio_nt(CFG, law, n1=4, n2=4)
+    assert got == pytest.approx(_worst_ratio_reference(CFG, law, 4, 4), rel=1e-12)
+    assert got >= 1.0 - 1e-12  # no law beats the discrete-time limit by a whole sample
+
+
+def test_worst_ratio_nt_is_infinite_when_a_state_never_settles():
+    # kd = 0 with a large kp: the sampled loop is unstable and never settles
+    bad = dataclasses.replace(CFG, pd=dataclasses.replace(CFG.pd, kp=2000.0, kd=0.0))
+    assert _spectral_radius(CFG.plant.a, CFG.plant.T, 2000.0, 0.0) > 1.0
+    assert worst_ratio_nt(bad, "pd", n1=4, n2=4) == math.inf
+
+
+def test_tune_worst_ratio_objective_is_that_of_its_gains():
+    small = functools.partial(worst_ratio_nt, n1=6, n2=6)
+    r = tune(CFG, "pd", "step", objective="worst_ratio_nt", maxiter=2, popsize=5, worst_ratio=small)
+    assert r.best.feasible and r.best.verified
+    assert r.best.objective == worst_ratio_nt(r.config, "pd", n1=6, n2=6)
+    # the search's best is no worse than any feasible candidate it evaluated
+    for c in r.front:
+        if c.feasible:
+            assert r.best.objective <= c.objective
+
+
+# ---------------------------------------------------------------- CLI round trip
+def _cli(capsys, *argv):
+    code = cli.main(list(argv))
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    return out
+
+
+def test_cli_tune_config_reproduced_by_simulate(capsys, tmp_path):
+    bound = 0.02
+    out = _cli(
+        capsys, "tune", "--law", "pd", "--max-overshoot", str(bound), "--maxiter", "3", "--json"
+    )
+    res = json.loads(out)
+    path = tmp_path / "tuned.toml"
+    path.write_text(res["config_toml"])
+    sim = json.loads(
+        _cli(capsys, "simulate", "--config", str(path), "--law", "pd", "--signal", "step", "--json")
+    )
+    m = sim["metrics"]
+    assert m["settling_2pct_s"] == res["best"]["settling_2pct_s"]
+    assert m["overshoot_mm"] == res["best"]["overshoot_mm"] <= bound
+    # the text form prints the same configuration after one comment line
+    text = _cli(capsys, "tune", "--law", "pd", "--max-overshoot", str(bound), "--maxiter", "3")
+    assert text.split("\n", 1)[1] == res["config_toml"]
+
+
+@pytest.mark.slow
+def test_tuned_pto_config_reproduced_by_simulate(capsys, tmp_path):
+    ft = fair_tunings(CFG, SMALL)
+    r = ft.results[("pto", "pd-paper")]
+    path = tmp_path / "pto.toml"
+    path.write_text(r.toml())
+    assert load_config(path).pto == r.config.pto
+    sim = json.loads(
+        _cli(
+            capsys, "simulate", "--config", str(path), "--law", "pto", "--signal", "step", "--json"
+        )
+    )
+    assert sim["metrics"]["settling_2pct_s"] == r.best.settling_2pct_s
+    assert sim["metrics"]["overshoot_mm"] == r.best.overshoot_mm <= ft.bounds["pd-paper"]
+
+
+# ---------------------------------------------------------------- fair comparison
+@pytest.mark.slow
+def test_fair_comparison_bounds_constraints_and_floor():
+    fc = fair_comparison(CFG, SMALL)
+    # the bounds are the paper-gain overshoots, measured independently here
+    for law, name in (("pto", "pto-paper"), ("pd", "pd-paper")):
+        res = simulate(make_law(law, CFG), CFG.plant, "step")
+        assert fc["bounds_mm"][name] == exact_metrics(res, CFG.plant).exact()["overshoot_mm"]
+    step = abs(simulate(make_law("pd", CFG), CFG.plant, "step").reference.amplitude)
+    assert fc["floor"]["nt_s"] == discrete_min_steps(-step, 0.0, CFG.plant).steps * CFG.plant.T
+    assert fc["floor"]["band_entry_s"] < fc["floor"]["tf_s"] <= fc["floor"]["nt_s"]
+    # band entry: full input from rest reaches 98 % of the step exactly then (closed form)
+    a, w, tb = CFG.plant.a, CFG.plant.w_max, fc["floor"]["band_entry_s"]
+    assert w * (tb - (1 - math.exp(-a * tb)) / a) == pytest.approx(0.98 * step, abs=1e-9)
+    for name, bound in fc["bounds_mm"].items():
+        for law in ("pd", "pto"):
+            b = fc["best"][name][law]
+            cfg = fair_tunings(CFG, SMALL).config(law, name)
+            res = simulate(make_law(law, cfg), cfg.plant, "step")
+            m = exact_metrics(res, cfg.plant).exact()
+            assert m["overshoot_mm"] <= bound  # the constraint, re-simulated
+            assert m["settling_2pct_s"] == b["settling_2pct_s"] >= fc["floor"]["band_entry_s"]
+            assert b["worst_ratio_nt"] == worst_ratio_nt(cfg, law)
+            assert b["verified"]
+    for law, front in fc["fronts"].items():
+        o = [c["overshoot_mm"] for c in front]
+        s = [c["settling_2pct_s"] for c in front]
+        assert o == sorted(o) and s == sorted(s, reverse=True), law
+    assert {c["id"] for c in fc["claims"]} == {
+        "step-pd-31-percent",
+        "step-pto-steadier-quicker",
+        "conclusion-vs-to-and-pd",
+        "conclusion-quicker-response",
+    }
+    for c in fc["claims"]:
+        assert c["sentence"] and len(c["readings"]) == 3, c["id"]
+    json.dumps(fc, allow_nan=True)
