@@ -936,14 +936,16 @@ def save_robust(maps: Mapping, outdir: str | Path) -> list[Path]:
 
 
 def plot_pareto(tuning: Mapping, ax=None) -> dict:
-    """Settling-vs-overshoot Pareto fronts of the tuned laws, with the time-optimal floor.
+    """Settling-vs-overshoot Pareto fronts of PD and PTO on the step, with the floor.
 
     Parameters
     ----------
     tuning : mapping
-        ``laws``: law -> ``front`` (candidates with ``overshoot_mm`` [mm] and
-        ``settling_2pct_s`` [s]), ``best`` and ``paper`` (the paper's gains);
-        ``floor``: ``t_f_s`` and ``n_star_t_s`` [s] of the step; ``max_overshoot_mm``.
+        :func:`ptoverify.claims.fair_comparison`: ``fronts`` (law -> candidates
+        with ``overshoot_mm`` [mm] and ``settling_2pct_s`` [s]), ``best`` (bound
+        -> law -> candidate), ``paper`` (law -> metrics at the paper's gains),
+        ``bounds_mm`` (bound -> [mm]) and ``floor`` (``tf_s``, ``nt_s``,
+        ``band_entry_s`` [s]).
     ax : matplotlib Axes, optional
         Where to draw.
 
@@ -955,29 +957,36 @@ def plot_pareto(tuning: Mapping, ax=None) -> dict:
     ax = _ax(ax)
     drawn: dict = {}
     colors = {"pd": "tab:orange", "pto": "tab:green"}
-    for law, r in tuning["laws"].items():
+    for law, front in tuning["fronts"].items():
+        col = colors.get(law, "tab:blue")
         pts = sorted(
             (c["overshoot_mm"], 1e3 * c["settling_2pct_s"])
-            for c in r["front"]
+            for c in front
             if c.get("settling_2pct_s") is not None and c.get("overshoot_mm") is not None
         )
-        col = colors.get(law, "tab:blue")
         if pts:
             x, y = np.array(pts).T
-            (drawn[f"{law} front"],) = ax.step(x, y, where="post", color=col, marker=".")
-        b, p = r["best"], r.get("paper") or {}
-        drawn[f"{law} best"] = ax.scatter(
-            [b["overshoot_mm"]], [1e3 * b["settling_2pct_s"]], color=col, marker="*", s=120
+            (drawn[f"{law} front"],) = ax.step(x, y, where="post", color=col, marker=".", ms=3)
+        bests = [b[law] for b in tuning["best"].values() if law in b]
+        drawn[f"{law} best per bound"] = ax.scatter(
+            [b["overshoot_mm"] for b in bests],
+            [1e3 * b["settling_2pct_s"] for b in bests],
+            color=col,
+            marker="*",
+            s=140,
+            zorder=3,
         )
+        p = tuning["paper"].get(law, {})
         if p.get("settling_2pct_s") is not None:
             drawn[f"{law} paper gains"] = ax.scatter(
-                [p["overshoot_mm"]], [1e3 * p["settling_2pct_s"]], color=col, marker="s"
+                [p["overshoot_mm"]], [1e3 * p["settling_2pct_s"]], color=col, marker="s", zorder=3
             )
     fl = tuning["floor"]
-    drawn["t_f* (continuous)"] = ax.axhline(1e3 * fl["t_f_s"], color="k", ls="--", lw=1)
-    drawn["N* T (sampled)"] = ax.axhline(1e3 * fl["n_star_t_s"], color="k", ls=":", lw=1)
-    if tuning.get("max_overshoot_mm") is not None:
-        drawn["overshoot bound"] = ax.axvline(tuning["max_overshoot_mm"], color="grey", lw=0.8)
+    drawn["t_f* (exact arrival)"] = ax.axhline(1e3 * fl["tf_s"], color="k", ls="--", lw=1)
+    drawn["N* T (sampled arrival)"] = ax.axhline(1e3 * fl["nt_s"], color="k", ls=":", lw=1)
+    drawn["least 2 % band entry"] = ax.axhline(1e3 * fl["band_entry_s"], color="0.5", lw=1)
+    for name, bound in tuning["bounds_mm"].items():
+        drawn[f"bound: {name}"] = ax.axvline(bound, color="0.6", lw=0.8, ls="-.")
     ax.set_xlabel("overshoot, between samples [mm]")
     ax.set_ylabel("2 % settling time of the step [ms]")
     ax.set_ylim(bottom=0)
@@ -992,7 +1001,7 @@ def save_tuning(tuning: Mapping, outdir: str | Path) -> list[Path]:
     Parameters
     ----------
     tuning : mapping
-        As :func:`plot_pareto`.
+        :func:`ptoverify.claims.fair_comparison` (as :func:`plot_pareto`).
     outdir : str or Path
         Folder (created if missing).
 
