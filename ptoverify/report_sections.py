@@ -1101,10 +1101,10 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             f"{qty(box['position_quantum'], 'mm')}, velocity noise {qty(box['velocity_noise'], 'mm/s')}. "
             f"Laws: {', '.join(_law(k) for k in maps['laws'])}. "
             f"Maps: {len(maps['a_ratio'])} x {len(maps['w_max_ratio'])} perturbations per delay, "
-            f"{maps['states']} initial states each (report settings: "
+            f"{maps['states']} initial states each (settings: "
             f"{st.get('n1')} x {st.get('n2')} grid + {st.get('rest')} at rest, worst-case search "
             f"{st.get('search_iterations')} generations of {st.get('search_population')}; "
-            "`ptoverify robust` runs the full study on every law).",
+            "as `ptoverify robust` with this configuration).",
         )
     ]
     rows = []
