@@ -199,9 +199,10 @@ def _finding_claims(res: dict[str, Any]) -> tuple[str, str, str] | None:
         best = [r["measured"] for r in c31["readings"] if "best-tuned" in r["label"]]
         if best:
             tuned = (
-                "; with both laws at their best tuning under a shared overshoot bound PD takes "
+                "; with both laws at their best tuning under a shared overshoot bound, PD's "
+                "settling time exceeds the PTO's by "
                 + " and ".join(qty(v, "%") for v in best)
-                + f" more time than the PTO ({c31['verdict']})"
+                + f" (paper: {qty(c31_paper(res), '%')}; {c31['verdict']})"
             )
     return (
         f"{len(fail)} of {len(cl)} Section 6 claims fail under every reading tried "
@@ -209,6 +210,22 @@ def _finding_claims(res: dict[str, Any]) -> tuple[str, str, str] | None:
         "claims",
         "claims with every reading",
     )
+
+
+def c31_paper(res: dict[str, Any]) -> float | None:
+    """Return the paper's value of the 31 % claim [%] from the claims results.
+
+    Parameters
+    ----------
+    res : dict
+        Output of :func:`ptoverify.report.collect` (JSON part).
+
+    Returns
+    -------
+    float or None
+    """
+    c = next((c for c in res["claims"] if c["id"] == "step-pd-31-percent"), None)
+    return None if c is None else c["paper_value"]
 
 
 def _claim_value_sentence(c: dict[str, Any]) -> str:
