@@ -412,6 +412,18 @@ def test_headline_findings_follow_the_results():
     res = copy.deepcopy(base)
     res["robust"] = None
     assert all(a != "robustness" for _, a, _ in headline_findings(res))
+    res["claims"][0]["id"] = "step-pd-31-percent"
+    res["tuning"] = {
+        "claims": [
+            {
+                "id": "step-pd-31-percent",
+                "verdict": "not reproduced",
+                "readings": [{"label": "both laws best-tuned", "measured": -1.5}],
+            }
+        ]
+    }
+    claims_sentence = next(s for s, a, _ in headline_findings(res) if a == "claims")
+    assert "-1.5 %" in claims_sentence and "paper: 31 %" in claims_sentence
 
 
 def test_unknown_skip_stage_is_an_input_error(tmp_path, capsys):
