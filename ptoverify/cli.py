@@ -765,6 +765,13 @@ def _add_report(sub) -> None:
     p.add_argument(
         "--out", metavar="DIR", default=None, help="report folder (default reports/<config name>)"
     )
+    p.add_argument(
+        "--skip",
+        metavar="STAGES",
+        default="",
+        help="comma-separated expensive stages to leave out for a quick report: robust, "
+        "tuning (their sections then say so)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     p.set_defaults(handler=_cmd_report)
 
@@ -775,7 +782,14 @@ def _cmd_report(args: argparse.Namespace) -> int:
     cfg = _config(args)
     if args.out is not None and Path(args.out).exists() and not Path(args.out).is_dir():
         raise InputError(f"--out '{args.out}' exists and is not a directory")
-    out = write_report(cfg, args.out, stderr_progress(args.quiet))
+    skip = tuple(x.strip() for x in args.skip.split(",") if x.strip())
+    timings: dict[str, float] = {}
+    out = write_report(cfg, args.out, stderr_progress(args.quiet), skip=skip, timings=timings)
+    if not args.quiet:
+        print(
+            "stage timings: " + ", ".join(f"{k} {v:.1f} s" for k, v in timings.items()),
+            file=sys.stderr,
+        )
     res = json.loads((out / "results.json").read_text())
     if args.json:
         print_json({"out": str(out), "summary": res["summary"]})

@@ -67,6 +67,10 @@ __all__ = [
     "save_all",
     "save_sweep",
     "save_ground_truth",
+    "plot_robust_map",
+    "save_robust",
+    "plot_pareto",
+    "save_tuning",
 ]
 
 DPI = 110
@@ -818,6 +822,196 @@ def save_sweep(res: SweepResult, outdir: str | Path) -> list[Path]:
             plt.close(fig)
         files.append(outdir / f"sweep_ratio_{which}.png")
     return files
+
+
+#: Quantities of the robustness heat maps: cell key, colour-bar label, file stem.
+ROBUST_MAPS = (
+    ("limit_cycle_states", "states ending in a limit cycle [count]", "robust_limit_cycles"),
+    ("settling_ratio_nt", "worst settling / (N* T) [-]", "robust_settling_nt"),
+)
+
+
+def _robust_cell_value(cell: Mapping, key: str) -> float:
+    v = cell.get(key)
+    if isinstance(v, Mapping):
+        v = v.get("max")
+    return math.nan if v is None else float(v)
+
+
+def plot_robust_map(
+    maps: Mapping, law: str, key: str, delay: int, ax=None, *, vmax: float | None = None
+) -> dict:
+    """Heat map of one property over a_ratio x w_max_ratio at one computation delay.
+
+    Parameters
+    ----------
+    maps : mapping
+        The ``maps`` of :meth:`ptoverify.robust.RobustResult.to_json`: axes
+        ``a_ratio``, ``w_max_ratio``, ``delay_samples`` and per law the cells
+        (order delay, w_max_ratio, a_ratio).
+    law : str
+        Law name.
+    key : str
+        Cell key: a count (``limit_cycle_states``) or a property with ``max``
+        (``settling_ratio_nt``).
+    delay : int
+        Computation delay [samples].
+    ax : matplotlib Axes, optional
+        Where to draw.
+    vmax : float, optional
+        Top of the colour scale.
+
+    Returns
+    -------
+    dict
+        ``{"map": QuadMesh}``.
+    """
+    ax = _ax(ax)
+    ars, wrs = list(maps["a_ratio"]), list(maps["w_max_ratio"])
+    cells = [c for c in maps["laws"][law] if c["delay_samples"] == delay]
+    z = np.full((len(wrs), len(ars)), np.nan)
+    for c in cells:
+        z[wrs.index(c["w_max_ratio"]), ars.index(c["a_ratio"])] = _robust_cell_value(c, key)
+    xi, yi = np.arange(len(ars) + 1) - 0.5, np.arange(len(wrs) + 1) - 0.5
+    mesh = ax.pcolormesh(xi, yi, np.ma.masked_invalid(z), cmap="magma_r", vmin=0, vmax=vmax)
+    top = vmax if vmax is not None else (np.nanmax(z) if np.isfinite(z).any() else 1.0)
+    missing = "never" if key == "settling_ratio_nt" else "n/a"  # null max: some state never settles
+    ax.set_facecolor("0.85")
+    for (i, j), v in np.ndenumerate(z):
+        text = missing if not np.isfinite(v) else f"{v:.3g}"
+        dark = np.isfinite(v) and v > 0.6 * top
+        ax.text(j, i, text, ha="center", va="center", fontsize=7, color="w" if dark else "k")
+    ax.set_xticks(range(len(ars)), [f"{r:.3g}" for r in ars], fontsize=7)
+    ax.set_yticks(range(len(wrs)), [f"{r:.3g}" for r in wrs], fontsize=7)
+    ax.set_xlabel("a_true / a_design [-]")
+    ax.set_ylabel("w_max,true / w_max [-]")
+    ax.set_title(f"{law}, delay {delay} sample{'s' if delay != 1 else ''}", fontsize=9)
+    return {"map": mesh}
+
+
+def save_robust(maps: Mapping, outdir: str | Path) -> list[Path]:
+    """Write the robustness heat maps: one PNG per quantity, a panel per law and delay.
+
+    Parameters
+    ----------
+    maps : mapping
+        The ``maps`` of :meth:`ptoverify.robust.RobustResult.to_json`.
+    outdir : str or Path
+        Folder (created if missing).
+
+    Returns
+    -------
+    list of Path
+        ``robust_limit_cycles.png`` and ``robust_settling_nt.png``.
+    """
+    outdir = _folder(outdir)
+    laws, delays = list(maps["laws"]), list(maps["delay_samples"])
+    files = []
+    for key, label, stem in ROBUST_MAPS:
+        vals = [_robust_cell_value(c, key) for law in laws for c in maps["laws"][law]]
+        finite = [v for v in vals if math.isfinite(v)]
+        vmax = max(max(finite, default=1.0), 1.0)
+        fig, axes = plt.subplots(
+            len(laws),
+            len(delays),
+            figsize=(3.8 * len(delays) + 1.2, 2.9 * len(laws)),
+            squeeze=False,
+            layout="constrained",
+        )
+        try:
+            for r, law in enumerate(laws):
+                for c, dl in enumerate(delays):
+                    ax = axes[r, c]
+                    mesh = plot_robust_map(maps, law, key, dl, ax, vmax=vmax)["map"]
+                    if r < len(laws) - 1:
+                        ax.set_xlabel("")
+                    if c > 0:
+                        ax.set_ylabel("")
+            fig.colorbar(mesh, ax=axes, label=label, shrink=0.8)
+            fig.savefig(outdir / f"{stem}.png", dpi=DPI)
+        finally:
+            plt.close(fig)
+        files.append(outdir / f"{stem}.png")
+    return files
+
+
+def plot_pareto(tuning: Mapping, ax=None) -> dict:
+    """Settling-vs-overshoot Pareto fronts of PD and PTO on the step, with the floor.
+
+    Parameters
+    ----------
+    tuning : mapping
+        :func:`ptoverify.claims.fair_comparison`: ``fronts`` (law -> candidates
+        with ``overshoot_mm`` [mm] and ``settling_2pct_s`` [s]), ``best`` (bound
+        -> law -> candidate), ``paper`` (law -> metrics at the paper's gains),
+        ``bounds_mm`` (bound -> [mm]) and ``floor`` (``tf_s``, ``nt_s``,
+        ``band_entry_s`` [s]).
+    ax : matplotlib Axes, optional
+        Where to draw.
+
+    Returns
+    -------
+    dict
+        Legend label -> artist.
+    """
+    ax = _ax(ax)
+    drawn: dict = {}
+    colors = {"pd": "tab:orange", "pto": "tab:green"}
+    for law, front in tuning["fronts"].items():
+        col = colors.get(law, "tab:blue")
+        pts = sorted(
+            (c["overshoot_mm"], 1e3 * c["settling_2pct_s"])
+            for c in front
+            if c.get("settling_2pct_s") is not None and c.get("overshoot_mm") is not None
+        )
+        if pts:
+            x, y = np.array(pts).T
+            (drawn[f"{law} front"],) = ax.step(x, y, where="post", color=col, marker=".", ms=3)
+        bests = [b[law] for b in tuning["best"].values() if law in b]
+        drawn[f"{law} best per bound"] = ax.scatter(
+            [b["overshoot_mm"] for b in bests],
+            [1e3 * b["settling_2pct_s"] for b in bests],
+            color=col,
+            marker="*",
+            s=140,
+            zorder=3,
+        )
+        p = tuning["paper"].get(law, {})
+        if p.get("settling_2pct_s") is not None:
+            drawn[f"{law} paper gains"] = ax.scatter(
+                [p["overshoot_mm"]], [1e3 * p["settling_2pct_s"]], color=col, marker="s", zorder=3
+            )
+    fl = tuning["floor"]
+    drawn["t_f* (exact arrival)"] = ax.axhline(1e3 * fl["tf_s"], color="k", ls="--", lw=1)
+    drawn["N* T (sampled arrival)"] = ax.axhline(1e3 * fl["nt_s"], color="k", ls=":", lw=1)
+    drawn["least 2 % band entry"] = ax.axhline(1e3 * fl["band_entry_s"], color="0.5", lw=1)
+    for name, bound in tuning["bounds_mm"].items():
+        drawn[f"bound: {name}"] = ax.axvline(bound, color="0.6", lw=0.8, ls="-.")
+    ax.set_xlabel("overshoot, between samples [mm]")
+    ax.set_ylabel("2 % settling time of the step [ms]")
+    ax.set_ylim(bottom=0)
+    ax.legend(list(drawn.values()), list(drawn), fontsize=7)
+    ax.grid(alpha=0.3)
+    return drawn
+
+
+def save_tuning(tuning: Mapping, outdir: str | Path) -> list[Path]:
+    """Write ``tuning_pareto.png`` (:func:`plot_pareto`).
+
+    Parameters
+    ----------
+    tuning : mapping
+        :func:`ptoverify.claims.fair_comparison` (as :func:`plot_pareto`).
+    outdir : str or Path
+        Folder (created if missing).
+
+    Returns
+    -------
+    list of Path
+        The file written.
+    """
+    outdir = _folder(outdir)
+    return [save_figure(outdir / "tuning_pareto.png", lambda ax: plot_pareto(tuning, ax))]
 
 
 def save_all(inputs: FigureInputs, outdir: str | Path) -> list[Path]:

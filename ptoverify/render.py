@@ -23,7 +23,11 @@ __all__ = [
     "fmt",
     "table",
     "paragraph",
+    "qty",
     "image",
+    "figure_beside",
+    "findings",
+    "code",
     "link",
     "md_cell",
     "render_html",
@@ -58,13 +62,17 @@ class Block:
 Section = tuple[str, str, list[Block]]
 
 
-def fmt(v: Any, digits: int = 6) -> str:
+def fmt(v: Any, digits: int = 4) -> str:
     """Format a value for a table cell: n/a for None and non-finite, yes/no, g-format.
+
+    Readable precision: 4 significant digits by default (the full values stay in
+    ``results.json``).  Lists print as ``(a, b)`` and mappings as ``k = v; ...``:
+    never a Python ``repr``.
 
     Parameters
     ----------
     v : any
-        The value (None, bool, float, int, str, or a list/tuple of those).
+        The value (None, bool, float, int, str, or a list/tuple/dict of those).
     digits : int
         Significant digits of floats.
 
@@ -75,7 +83,9 @@ def fmt(v: Any, digits: int = 6) -> str:
     Examples
     --------
     >>> fmt(0.123456789), fmt(None), fmt(True), fmt([1.0, float("nan")], 3)
-    ('0.123457', 'n/a', 'yes', '(1, n/a)')
+    ('0.1235', 'n/a', 'yes', '(1, n/a)')
+    >>> fmt({"a": 1.0, "b": [2, 3]})
+    'a = 1; b = (2, 3)'
     """
     if v is None:
         return "n/a"
@@ -87,7 +97,39 @@ def fmt(v: Any, digits: int = 6) -> str:
         return f"{v:.{digits}g}"
     if isinstance(v, (list, tuple)):
         return "(" + ", ".join(fmt(x, digits) for x in v) + ")"
+    if isinstance(v, dict):
+        return "; ".join(f"{k} = {fmt(x, digits)}" for k, x in v.items())
     return str(v)
+
+
+def qty(v: Any, unit: str, digits: int = 4) -> str:
+    """Format a number with its unit: ``0.2409 mm``; ``[-]`` marks a dimensionless one.
+
+    Parameters
+    ----------
+    v : any
+        The value (as :func:`fmt`).
+    unit : str
+        Its unit (``mm``, ``mm/s``, ``%``, ``deg``...); ``""`` or ``"1"`` or ``"-"``
+        for a dimensionless number.
+    digits : int
+        Significant digits.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> qty(0.240891, "mm"), qty(1.5, ""), qty(None, "s"), qty(12.0, "%")
+    ('0.2409 mm', '1.5 [-]', 'n/a', '12 %')
+    """
+    text = fmt(v, digits)
+    if text == "n/a":
+        return text
+    if unit in ("", "1", "-"):
+        return f"{text} [-]"
+    return f"{text} {unit}"
 
 
 def table(headers: list[str], rows: list[list[Any]]) -> Block:
@@ -123,6 +165,83 @@ def paragraph(text: str) -> Block:
         A ``p`` block.
     """
     return Block("p", text=text)
+
+
+def code(text: str) -> Block:
+    """Return a preformatted block (a command line to copy).
+
+    Parameters
+    ----------
+    text : str
+        The text, shown verbatim.
+
+    Returns
+    -------
+    Block
+        A raw block: ``<pre><code>`` in HTML, an indented code block in Markdown.
+    """
+    md = "\n".join("    " + line for line in text.splitlines())
+    return Block("raw", text=md, html=f"<pre><code>{html.escape(text)}</code></pre>")
+
+
+def findings(items: list[tuple[str, str, str]], figure: str = "", caption: str = "") -> Block:
+    """Return the headline findings as a numbered list, with a figure beside them.
+
+    Parameters
+    ----------
+    items : list of (str, str, str)
+        ``(sentence, anchor, link text)``: each finding with the section holding
+        its evidence.
+    figure : str
+        Relative path of the overview figure ("" for none).
+    caption : str
+        The figure's caption and alt text.
+
+    Returns
+    -------
+    Block
+        A raw block (HTML ``<ol class="findings">``; Markdown numbered list).
+
+    Examples
+    --------
+    >>> b = findings([("3 of 5 pass.", "summary", "gates")])
+    >>> 'id="finding-1"' in b.html and b.text.startswith("1. 3 of 5 pass.")
+    True
+    """
+    lis = "".join(
+        f'<li id="finding-{i}">{html.escape(s)} <a href="#{html.escape(a)}">'
+        f"({html.escape(t)})</a></li>"
+        for i, (s, a, t) in enumerate(items, 1)
+    )
+    md = "\n".join(f"{i}. {s} ({t}: section {a})" for i, (s, a, t) in enumerate(items, 1))
+    fig = ""
+    if figure:
+        fig = (
+            f'<figure class="overview"><img src="{html.escape(figure)}" '
+            f'alt="{html.escape(caption)}"><figcaption>{html.escape(caption)}</figcaption></figure>'
+        )
+        md += f"\n\n![{caption}]({figure})"
+    return Block(
+        "raw", text=md, html=f'<div class="headline"><ol class="findings">{lis}</ol>{fig}</div>'
+    )
+
+
+def figure_beside(blocks: list[Block]) -> Block:
+    """Return figures side by side (a row of small multiples; one per line in Markdown).
+
+    Parameters
+    ----------
+    blocks : list of Block
+        ``img`` blocks.
+
+    Returns
+    -------
+    Block
+        A raw block.
+    """
+    inner = "".join(_html_block(b) for b in blocks)
+    md = "\n\n".join(f"![{b.text}]({b.html})" for b in blocks)
+    return Block("raw", text=md, html=f'<div class="row">{inner}</div>')
 
 
 def image(figures: dict[str, str], key: str, caption: str) -> list[Block]:
@@ -188,7 +307,11 @@ th,td{border:1px solid #ccc;padding:.3em .5em;vertical-align:top;text-align:left
 th{background:#f0f0f0}.pass,.verified,.reproduced{background:#e6f4e6}
 .fail,.erratum,.not-reproduced{background:#fbe3e3}.unverified,.ambiguous,.unchecked{background:#fff4d6}
 img{max-width:100%;border:1px solid #ddd}figure{margin:1em 0}nav a{margin-right:1em}
-math{font-size:1.05em}code{font-size:.85em}
+math{font-size:1.05em}code{font-size:.85em}pre{background:#f6f6f6;padding:.5em;overflow-x:auto}
+.headline{display:flex;gap:1.5em;align-items:flex-start;flex-wrap:wrap}
+.headline ol{flex:1 1 28em;font-size:1.05em}.headline li{margin:.4em 0}
+.headline figure{flex:1 1 24em;margin:0}.row{display:flex;gap:1em;flex-wrap:wrap}
+.row figure{flex:1 1 22em}.erratum-block{border-left:4px solid #d88;padding:.2em 1em;margin:1em 0}
 table.derivations{table-layout:fixed;width:100%}table.derivations td{overflow-x:auto;
 overflow-wrap:anywhere}table.derivations td:nth-child(-n+2){width:6em}"""
 

@@ -15,6 +15,15 @@ once per report.  The SymPy derivations share nothing with the numerics and
 take about a third of the time, so they run in a separate Python process while
 the numerics run (in this process where no process can be started).
 
+Two stages cost more than the rest together and are optional: the robustness
+study (:func:`ptoverify.robust.run_robust` at :data:`ROBUST_SETTINGS`, the
+command's defaults) and the tuning comparison (:func:`tuning_results`: PD and
+PTO tuned on the step under shared overshoot bounds, at the reduced search
+effort :data:`TUNE_SETTINGS`).  ``skip`` (the
+command's ``--skip robust,tuning``) leaves them out for a quick report; their
+sections then say so.  Each stage's wall time is kept in ``res["_timings"]``
+(not in ``results.json``, which stays reproducible).
+
 ``write_report`` writes the folder atomically: everything goes to a temporary
 sibling folder that is renamed into place only when complete.
 
@@ -30,6 +39,7 @@ import math
 import platform
 import subprocess
 import sys
+import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -48,7 +58,24 @@ __all__ = [
     "stderr_progress",
     "GROUND_TRUTH_STATES",
     "STAGES",
+    "SKIPPABLE",
+    "ROBUST_SETTINGS",
+    "TUNE_SETTINGS",
+    "tuning_results",
 ]
+
+#: Stages ``--skip`` can leave out (the expensive ones).
+SKIPPABLE = ("robust", "tuning")
+
+#: Sizes of the report's robustness study: overrides of
+#: :class:`ptoverify.robust.RobustSettings`.  Empty: the report runs the same study as
+#: ``ptoverify robust`` on its defaults (all four laws; about 20-25 s on 2 cores).
+ROBUST_SETTINGS: dict[str, Any] = {}
+
+#: Search effort of the report's tunings (:class:`ptoverify.tune.TuneBudget`, fixed seed),
+#: reduced from ``ptoverify tune``'s defaults (30 generations, population factor 10, 9 d
+#: points, 4 refinements) so the four tunings take about a minute.
+TUNE_SETTINGS = {"maxiter": 15, "popsize": 8, "d_grid": 5, "d_refine": 2, "seed": 0}
 
 #: States of the ground-truth table [mm], [mm/s]: a step, moves with speed, on/near a
 #: curve, beyond saturation, and near the origin.
@@ -283,22 +310,11 @@ def figure_inputs(cfg: Config) -> Any:
 
 
 # ------------------------------------------------------------------ collect
-#: Stages of :func:`collect` and :func:`write_report`, in order (progress display).
-STAGES = (
-    "derivations",
-    "ground truth",
-    "switching zone",
-    "poles",
-    "closed-loop properties",
-    "Section 6 claims",
-    "suboptimality sweep",
-    "gates",
-    "figure data",
-    "figures",
-)
 
 
-def collect(cfg: Config, progress: Progress | None = None) -> dict[str, Any]:
+def collect(
+    cfg: Config, progress: Progress | None = None, skip: tuple[str, ...] = ()
+) -> dict[str, Any]:
     """Compute every result of the report, each once.
 
     Parameters
@@ -307,6 +323,8 @@ def collect(cfg: Config, progress: Progress | None = None) -> dict[str, Any]:
         Configuration.
     progress : callable, optional
         ``progress(stage)`` before each stage (:data:`STAGES`).
+    skip : tuple of str
+        Stages of :data:`SKIPPABLE` to leave out (their results are None).
 
     Returns
     -------
@@ -317,8 +335,23 @@ def collect(cfg: Config, progress: Progress | None = None) -> dict[str, Any]:
         ``ground_truth._study`` (ConvergenceStudy); :func:`write_report` drops
         them from the JSON.
     """
-    say = progress or (lambda stage: None)
-    out: dict[str, Any] = {"derivations": None}
+    from ptoverify.errors import InputError
+
+    bad = sorted(set(skip) - set(SKIPPABLE))
+    if bad:
+        raise InputError(f"--skip: unknown stage '{bad[0]}' (choose from {', '.join(SKIPPABLE)})")
+    timings: dict[str, float] = {}
+    clock = {"stage": None, "t": time.perf_counter()}
+
+    def say(stage: str) -> None:
+        now = time.perf_counter()
+        if clock["stage"] is not None:
+            timings[clock["stage"]] = now - clock["t"]
+        clock.update(stage=stage, t=now)
+        if progress and stage:
+            progress(stage)
+
+    out: dict[str, Any] = {"derivations": None, "skipped": sorted(set(skip))}
     say("derivations")
     import derivations
 
@@ -327,18 +360,22 @@ def collect(cfg: Config, progress: Progress | None = None) -> dict[str, Any]:
         a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
     )
     with _in_background("derivations", "all_records", plant) as records_later:
-        _numerics(cfg, out, say)
+        _numerics(cfg, out, say, set(skip))
+        say("waiting for the derivations")
         records = records_later()
+    say("")
+    timings.pop("", None)
+    out["_timings"] = timings
     out["derivations"] = [r.to_json() for r in records]
     out["_records"] = records
     out["summary"] = _summary(out, out.pop("_gates"))
     return out
 
 
-def _numerics(cfg: Config, out: dict[str, Any], say: Callable[[str], None]) -> None:
+def _numerics(cfg: Config, out: dict[str, Any], say: Callable[[str], None], skip: set[str]) -> None:
     """Run the numeric stages of :func:`collect` in order, into ``out``."""
     from ptoverify.checks import run_checks, summarize
-    from ptoverify.claims import evaluate_claims
+    from ptoverify.claims import evaluate_claims, response_metrics
     from ptoverify.sweep import run_sweep
     from ptoverify.zones import zone_summary
 
@@ -352,6 +389,7 @@ def _numerics(cfg: Config, out: dict[str, Any], say: Callable[[str], None]) -> N
     out["properties"] = _properties(cfg)
     say("Section 6 claims")
     out["claims"] = [c.to_json() for c in evaluate_claims(cfg)]
+    out["responses"] = response_metrics(cfg)
     say("suboptimality sweep")
     sweep = run_sweep(cfg)
     out["sweep"] = {
@@ -368,8 +406,51 @@ def _numerics(cfg: Config, out: dict[str, Any], say: Callable[[str], None]) -> N
     out["checks"] = [c.to_json() for c in checks]
     out["_gates"] = summarize(checks)
     out["environment"] = _environment(cfg)
+    say("robustness")
+    out["robust"] = None if "robust" in skip else _robust(cfg)
+    say("tuning")
+    out["tuning"] = None if "tuning" in skip else tuning_results(cfg)
     say("figure data")
     out["_figures"] = figure_inputs(cfg)
+
+
+def _robust(cfg: Config) -> dict[str, Any]:
+    """Run the robustness study at :data:`ROBUST_SETTINGS` (JSON, settings included)."""
+    from dataclasses import asdict
+
+    from ptoverify.robust import RobustSettings, run_robust
+
+    settings = RobustSettings(**ROBUST_SETTINGS)
+    res = run_robust(cfg, settings).to_json()
+    res.pop("timings_s", None)
+    res["settings"] = asdict(settings)
+    return res
+
+
+def tuning_results(cfg: Config) -> dict[str, Any]:
+    """Both laws at their best tuning: :func:`ptoverify.claims.fair_comparison`.
+
+    PD and PTO tuned on the step under each shared overshoot bound (the PTO's
+    and the PD's own overshoot at the paper's gains), with the floor (t_f*,
+    N* T, the least 2 % band entry), the Pareto fronts and the claims judged at
+    the best tuning, at the report's search effort :data:`TUNE_SETTINGS`.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (plant and the paper's gains).
+
+    Returns
+    -------
+    dict
+        The keys of :func:`ptoverify.claims.fair_comparison` less its wall time.
+    """
+    from ptoverify.claims import fair_comparison
+    from ptoverify.tune import TuneBudget
+
+    res = fair_comparison(cfg, TuneBudget(**TUNE_SETTINGS))
+    res.pop("seconds", None)
+    return res
 
 
 _CHILD = (
@@ -464,6 +545,11 @@ def _summary(out: dict[str, Any], gates: dict[str, Any]) -> dict[str, Any]:
         "corrected_zone_valid": bool(out["zone"]["corrected"]["valid"]),
         "corrected_omega0": out["zone"]["corrected"]["omega0"],
         "corrected_zone_margin_mm_s": out["zone"]["corrected"].get("margin_mm_s"),
+        "claims_failing_every_reading": [
+            c["id"]
+            for c in out["claims"]
+            if c["readings"] and all(r["verdict"] == "not reproduced" for r in c["readings"])
+        ],
     }
 
 
@@ -490,17 +576,22 @@ def build_sections(
     from ptoverify import report_sections as rs
 
     recs = records if records is not None else res["_records"]
-    return [
-        ("summary", "1. Summary", rs.summary(res)),
-        ("derivations", "2. Derivations: printed vs derived", rs.derivations(res, recs)),
-        ("ground-truth", "3. Ground truth: minimum time", rs.ground_truth(res, figures)),
-        ("zone", "4. Switching-zone geometry", rs.zone(res, figures)),
-        ("poles", "5. Poles and stability", rs.poles(res)),
-        ("properties", "6. Closed-loop properties over the grid", rs.properties(res)),
-        ("claims", "7. Section 6 claims", rs.claims(res, figures)),
-        ("sweep", "8. Suboptimality maps", rs.sweep(res, figures)),
-        ("environment", "9. Environment", rs.environment(res)),
+    parts = [
+        ("findings", "Headline findings", rs.headline(res, figures)),
+        ("summary", "Summary: gates, errata, claims", rs.summary(res)),
+        ("errata", "Errata in the paper", rs.errata(res, recs)),
+        ("derivations", "Derivations: printed vs derived", rs.derivations(res, recs)),
+        ("ground-truth", "Ground truth: minimum time", rs.ground_truth(res, figures)),
+        ("zone", "Switching-zone geometry", rs.zone(res, figures)),
+        ("poles", "Poles and stability", rs.poles(res)),
+        ("properties", "Closed-loop properties over the grid", rs.properties(res)),
+        ("claims", "Section 6 claims", rs.claims(res, figures)),
+        ("sweep", "Suboptimality maps", rs.sweep(res, figures)),
+        ("robustness", "Robustness under model mismatch", rs.robustness(res, figures)),
+        ("tuning", "Can any tuning reproduce the paper?", rs.tuning(res, figures)),
+        ("environment", "Environment", rs.environment(res)),
     ]
+    return [(a, t if i == 0 else f"{i}. {t}", b) for i, (a, t, b) in enumerate(parts)]
 
 
 # ------------------------------------------------------------------ writing
@@ -511,11 +602,19 @@ def _figures(res: dict[str, Any], figdir: Path) -> dict[str, str]:
     files = plots.save_all(res["_figures"], figdir)
     files += plots.save_sweep(res["_sweep"], figdir)
     files += plots.save_ground_truth(res["ground_truth"]["_study"], figdir)
+    if res.get("robust"):
+        files += plots.save_robust(res["robust"]["maps"], figdir)
+    if res.get("tuning"):
+        files += plots.save_tuning(res["tuning"], figdir)
     return {Path(f).stem: f"figures/{Path(f).name}" for f in files}
 
 
 def write_report(
-    cfg: Config, out: str | Path | None = None, progress: Progress | None = None
+    cfg: Config,
+    out: str | Path | None = None,
+    progress: Progress | None = None,
+    skip: tuple[str, ...] = (),
+    timings: dict[str, float] | None = None,
 ) -> Path:
     """Compute and write the report folder atomically.
 
@@ -528,6 +627,10 @@ def write_report(
         the report of another configuration (see :mod:`ptoverify.outdir`).
     progress : callable, optional
         Called with each stage's name.
+    skip : tuple of str
+        Stages of :data:`SKIPPABLE` to leave out (a quick report).
+    timings : dict, optional
+        Filled with the wall time of each stage [s] (figures included).
 
     Returns
     -------
@@ -546,12 +649,15 @@ def write_report(
     out = check_target(
         Path("reports") / cfg.name if default else out, config_hash=cfg.digest(), default=default
     )
-    res = collect(cfg, progress)  # nothing is written before this ends
+    res = collect(cfg, progress, skip)  # nothing is written before this ends
     tmp = make_temp(out)
     try:
         if progress:
             progress("figures")
+        t0 = time.perf_counter()
         figures = _figures(res, tmp / "figures")
+        if timings is not None:
+            timings.update(res["_timings"], figures=time.perf_counter() - t0)
         public = _clean({k: v for k, v in res.items() if not k.startswith("_")})
         public["ground_truth"] = _clean(
             {k: v for k, v in res["ground_truth"].items() if not k.startswith("_")}
@@ -585,6 +691,10 @@ STAGES = (
     "Section 6 claims",
     "suboptimality sweep",
     "gates",
+    "robustness",
+    "tuning",
+    "figure data",
+    "waiting for the derivations",
     "figures",
 )
 

@@ -3,6 +3,7 @@
 
 import json
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -12,22 +13,31 @@ import pytest
 from ptoverify.cli import main
 from ptoverify.config import paper_config
 from ptoverify.render import Block, render_html
-from ptoverify.report import write_report
+from ptoverify.report import SKIPPABLE, write_report
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture(scope="module")
 def two_reports(tmp_path_factory):
+    """A full report and a quick one (``skip`` robust, tuning): the second checks that
+    everything else is reproducible without paying twice for the expensive stages."""
     base = tmp_path_factory.mktemp("rep")
     cfg = paper_config()
-    return write_report(cfg, base / "one"), write_report(cfg, base / "two")
+    return write_report(cfg, base / "one"), write_report(cfg, base / "two", skip=SKIPPABLE)
 
 
 def _without_meta(path: Path) -> dict:
     data = json.loads((path / "results.json").read_text())
     data["meta"].pop("generated")
     return data
+
+
+def _shared(data: dict) -> dict:
+    """The results both fixture runs compute (the skipped stages and figures left out)."""
+    out = {k: v for k, v in data.items() if k not in SKIPPABLE + ("skipped",)}
+    out["meta"] = {k: v for k, v in data["meta"].items() if k != "figures"}
+    return out
 
 
 @pytest.mark.slow
@@ -37,8 +47,10 @@ def test_report_folder_complete_and_reproducible(two_reports):
         assert (one / f).stat().st_size > 1000, f
     figs = sorted((one / "figures").glob("*.png"))
     assert len(figs) >= 20 and all(f.stat().st_size > 5000 for f in figs)
-    assert _without_meta(one) == _without_meta(two), "two runs differ beyond the timestamp"
-    data = _without_meta(one)
+    a, b = _without_meta(one), _without_meta(two)
+    assert _shared(a) == _shared(b), "two runs differ beyond the timestamp"
+    assert b["skipped"] == sorted(SKIPPABLE) and b["robust"] is None and b["tuning"] is None
+    data = a
     for key in (
         "derivations",
         "ground_truth",
@@ -50,8 +62,11 @@ def test_report_folder_complete_and_reproducible(two_reports):
         "checks",
         "summary",
         "environment",
+        "responses",
+        "robust",
+        "tuning",
     ):
-        assert key in data, key
+        assert data.get(key) is not None, key
     html_text = (one / "index.html").read_text()
     assert html_text.count("<math") > 30 and "<script" not in html_text
     for rel in data["meta"]["figures"]:
@@ -167,7 +182,11 @@ def test_report_renders_in_headless_chromium(two_reports, tmp_path):
         "const m=[...document.querySelectorAll('math')];"
         "const mh=m.filter(e=>e.getBoundingClientRect().height>0).length;"
         "const rows=document.querySelectorAll('#summary table tr').length;"
-        "document.title=`IMAGES ${ok}/${imgs.length} MATH ${mh}/${m.length} ROWS ${rows}`;"
+        "const li=[...document.querySelectorAll('#findings ol.findings li')];"
+        "const fv=li.filter(e=>e.getBoundingClientRect().height>0&&e.innerText.length>40).length;"
+        "const raw=/\\{'|np\\.float64|array\\(|\\[np\\./.test(document.body.innerText)?1:0;"
+        "document.title=`IMAGES ${ok}/${imgs.length} MATH ${mh}/${m.length} ROWS ${rows} "
+        "FINDINGS ${fv}/${li.length} RAW ${raw}`;"
         "}</script>"
     )
     probe_page = index.parent / "probe.html"
@@ -197,6 +216,9 @@ def test_report_renders_in_headless_chromium(two_reports, tmp_path):
     assert total >= 20 and loaded == total, title
     assert math_n > 30 and math_h == math_n, title
     assert int(parts[5]) >= 12, title
+    shown, n_findings = map(int, parts[7].split("/"))
+    assert 4 <= n_findings <= 6 and shown == n_findings, f"headline findings not rendered: {title}"
+    assert parts[9] == "0", f"raw Python text on the page: {title}"
     png = shot.read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 50_000, "blank screenshot"
     # a non-blank page: many distinct pixel rows (decode via matplotlib, already a dependency)
@@ -206,3 +228,244 @@ def test_report_renders_in_headless_chromium(two_reports, tmp_path):
     img = mpimg.imread(shot)
     assert np.std(img[..., :3]) > 0.05, "screenshot is blank"
     assert os.path.getsize(shot) > 0
+
+
+# ---------------------------------------------------------------- readability
+#: Text that only a Python repr would put on the page.
+REPR_MARKERS = ("{'", "[np.", "np.float64", "np.int64", "array(", "object at 0x", "<built-in")
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return token == "n/a"
+    return True
+
+
+def _bare_number(cell: str) -> bool:
+    """A cell of numbers only (no unit word): '1.5', '(0.25, -200.5)', 'n/a' does not count."""
+    tokens = [t for t in re.split(r"[(),;\s]+", cell) if t]
+    return any(t != "n/a" for t in tokens) and all(_is_number(t) for t in tokens)
+
+
+def unit_problems(sections) -> list[str]:
+    """Table cells holding a bare number in a column whose header names no unit."""
+    bad = []
+    for anchor, _title, blocks in sections:
+        for b in blocks:
+            if b.kind != "table":
+                continue
+            for row in b.rows:
+                for head, cell in zip(b.headers, row, strict=True):
+                    if _bare_number(cell) and not re.search(r"\[[^\]]+\]", head):
+                        bad.append(f"{anchor}: column '{head}' cell '{cell}'")
+    return bad
+
+
+def _sections(folder: Path):
+    """The sections of a written report rebuilt from its results.json and records."""
+    import derivations
+    from ptoverify.report import build_sections
+
+    data = json.loads((folder / "results.json").read_text())
+    records = [derivations.EquationRecord.from_json(r) for r in data["derivations"]]
+    figures = {Path(f).stem: f for f in data["meta"]["figures"]}
+    return build_sections(data, figures, records)
+
+
+@pytest.mark.slow
+def test_no_python_repr_anywhere(two_reports):
+    for folder in two_reports:
+        for name in ("index.html", "report.md"):
+            text = (folder / name).read_text()
+            found = [m for m in REPR_MARKERS if m in text]
+            assert not found, f"{folder.name}/{name} shows Python reprs: {found}"
+
+
+@pytest.mark.slow
+def test_every_number_in_every_table_has_a_unit(two_reports):
+    for folder in two_reports:
+        problems = unit_problems(_sections(folder))
+        assert not problems, "numbers without a unit:\n" + "\n".join(problems[:20])
+
+
+@pytest.mark.slow
+def test_report_sections_present_and_findings_first(two_reports):
+    full, quick = (f / "index.html" for f in two_reports)
+    html_text = full.read_text()
+    assert html_text.index('id="findings"') < html_text.index('id="summary"')
+    assert html_text.count('<li id="finding-') in range(4, 7)
+    for anchor in ("errata", "robustness", "tuning"):
+        assert f'id="{anchor}"' in html_text, anchor
+    assert "robust_limit_cycles.png" in html_text and "tuning_pareto.png" in html_text
+    assert "ptoverify simulate --law" in html_text or "counterexample" not in html_text
+    q = quick.read_text()
+    assert "report --skip robust" in q and "report --skip tuning" in q
+
+
+def test_unit_check_catches_a_bare_number():
+    """The units check is not vacuous: a unitless numeric column is reported."""
+    from ptoverify.render import table
+
+    ok = table(["t [s]", "x"], [[1.5, "1.5 mm"]])
+    bad = table(["t", "x"], [[1.5, "(1, 2)"]])
+    assert unit_problems([("s", "", [ok])]) == []
+    assert len(unit_problems([("s", "", [bad])])) == 2
+
+
+def _fake_results() -> dict:
+    """The results keys the headline reads, with made-up values (inputs, not expectations)."""
+    sweep = {
+        law: {
+            "fraction_settled": 1.0,
+            "percentiles_ratio_nt": {"p50": p50, "p95": 2 * p50, "p99": 3 * p50, "max": 4 * p50},
+        }
+        for law, p50 in (("pd", 1.2), ("pto", 1.5))
+    }
+    sweep["to"] = {"fraction_settled": 0.0, "percentiles_ratio_nt": {"p50": None}}
+    claim = {
+        "id": "c1",
+        "unit": "%",
+        "measured": -12.0,
+        "paper_value": 31.0,
+        "verdict": "not reproduced",
+        "readings": [{"verdict": "not reproduced"}],
+    }
+    return {
+        "derivations": [
+            {"id": "1", "verdict": "verified", "inherits": []},
+            {"id": "16", "verdict": "erratum", "inherits": ["17: changes", "20-27: also"]},
+        ],
+        "zone": {
+            "printed": {"omega0": 1969.0, "valid": False},
+            "corrected": {"omega0": 10.04, "valid": True, "grid_violations": 0, "grid_points": 99},
+        },
+        "environment": {"config": {"plant": {"w_max": 300.0}}},
+        "responses": {
+            "pd": {"step": {"settling_2pct_s": 0.0236}},
+            "pto": {"step": {"settling_2pct_s": 0.0371}},
+            "to": {"step": {"settling_2pct_s": None}},
+        },
+        "sweep": {"grid": [200, 200], "laws": sweep},
+        "claims": [claim, {**claim, "id": "c2", "readings": [{"verdict": "reproduced"}]}],
+        "robust": {
+            "margins": {"pto": {"linear_loop_a_ratio_stable_delay1": None}},
+            "most_robust": {"law": "pd", "log_width": {"pd": 3.0, "pto": 1.0}},
+        },
+        "tuning": None,
+        "summary": {"gates": {"pass": 14, "total": 15, "fail": 1, "unverified": 0}},
+        "checks": [{"name": "g1", "status": "fail"}],
+    }
+
+
+def test_headline_findings_follow_the_results():
+    """Each sentence is generated: perturb a result and its sentence changes with it."""
+    import copy
+
+    from ptoverify.report_sections import headline_findings
+
+    base = _fake_results()
+    found = headline_findings(base)
+    assert 1 <= len(found) <= 6
+    text = " ".join(s for s, _, _ in found)
+    for piece in (
+        "1 of 2",
+        "1969 mm/s",
+        "10.04 mm/s",
+        "300 mm/s",
+        "23.6 ms",
+        "1.2 [-]",
+        "1 of 2 Section 6 claims",
+        "-12 %",
+        "unstable",
+        "14 of 15",
+        "g1",
+    ):
+        assert piece in text, piece
+    anchors = {a for _, a, _ in found}
+    assert {"errata", "zone", "sweep", "claims", "robustness", "summary"} <= anchors
+
+    def changed(edit) -> set[str]:
+        res = copy.deepcopy(base)
+        edit(res)
+        before = {s for s, _, _ in found}
+        return {s for s, _, _ in headline_findings(res)} - before
+
+    def faster_pto(r):
+        r["responses"]["pto"]["step"]["settling_2pct_s"] = 0.01
+        r["sweep"]["laws"]["pto"]["percentiles_ratio_nt"]["p50"] = 1.1
+
+    new = changed(faster_pto)
+    assert len(new) == 1 and next(iter(new)).startswith("PTO (corrected) settles fastest")
+    assert "10 ms" in next(iter(new)) and "median 1.1 [-]" in next(iter(new))
+    new = changed(lambda r: r["zone"]["corrected"].update(omega0=12.5))
+    assert len(new) == 1 and "12.5 mm/s" in next(iter(new))
+    new = changed(
+        lambda r: r["robust"]["margins"]["pto"].update(linear_loop_a_ratio_stable_delay1=[0.5, 2.0])
+    )
+    assert len(new) == 1 and "[0.5, 2] [-]" in next(iter(new))
+    new = changed(
+        lambda r: r["derivations"].append({"id": "18", "verdict": "erratum", "inherits": []})
+    )
+    assert len(new) == 1 and "2 of 3" in next(iter(new))
+    res = copy.deepcopy(base)
+    res["robust"] = None
+    assert all(a != "robustness" for _, a, _ in headline_findings(res))
+    res["claims"][0]["id"] = "step-pd-31-percent"
+    res["tuning"] = {
+        "claims": [
+            {
+                "id": "step-pd-31-percent",
+                "verdict": "not reproduced",
+                "readings": [{"label": "both laws best-tuned", "measured": -1.5}],
+            }
+        ]
+    }
+    claims_sentence = next(s for s, a, _ in headline_findings(res) if a == "claims")
+    assert "-1.5 %" in claims_sentence and "paper: 31 %" in claims_sentence
+
+
+def test_unknown_skip_stage_is_an_input_error(tmp_path, capsys):
+    assert main(["report", "--out", str(tmp_path / "r"), "--skip", "robust,bogus"]) == 2
+    err = capsys.readouterr().err
+    assert "bogus" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "r").exists()
+
+
+def test_worst_case_command_line_runs(capsys):
+    """The command the robustness section prints is one `ptoverify simulate` accepts."""
+    import shlex
+
+    from ptoverify.report_sections import simulate_command
+
+    cmd = simulate_command(
+        "pto",
+        {
+            "state": [3.25, -120.5],
+            "params": {"a_ratio": 0.85, "w_max_ratio": 0.95, "delay_samples": 1, "seed": 0},
+        },
+    )
+    argv = shlex.split(cmd)
+    assert argv[:2] == ["ptoverify", "simulate"]
+    assert main([*argv[1:], "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["x0"] == [3.25, -120.5]
+
+
+def test_robust_map_places_each_cell():
+    """The heat map's cell (w_max ratio i, a ratio j) holds that cell's value."""
+    import numpy as np
+
+    from ptoverify.plots import plot_robust_map
+
+    ars, wrs = [0.8, 1.0, 1.25], [0.9, 1.0]
+    cells = [
+        {"a_ratio": a, "w_max_ratio": w, "delay_samples": 0, "limit_cycle_states": 10 * i + j}
+        for i, w in enumerate(wrs)
+        for j, a in enumerate(ars)
+    ]
+    maps = {"a_ratio": ars, "w_max_ratio": wrs, "delay_samples": [0], "laws": {"pd": cells}}
+    mesh = plot_robust_map(maps, "pd", "limit_cycle_states", 0)["map"]
+    z = np.asarray(mesh.get_array()).reshape(len(wrs), len(ars))
+    np.testing.assert_array_equal(z, [[0, 1, 2], [10, 11, 12]], err_msg="cell placement")
