@@ -314,16 +314,18 @@ def grid_csv(cfg: Config) -> str:
     return "\n".join(lines) + "\n"
 
 
-_OFF = 1 << 22  #: offset of lattice indices (|s| <= 3 is within +-3e6 steps)
 _HALF = round(1.0 / MATCH_TOL)  #: lattice steps from 0 to the envelope's edge
+_OFF = round(1.5 / MATCH_TOL) + 1  #: offset of lattice indices (|s| clipped to 1.5: >= 1)
 _FINE = 9  #: the near-probe bitmap's cells are 2^9 lattice steps wide
+_M = ((2 * _OFF + 1) >> _FINE) + 1  #: bitmap cells per axis
 
 
-def _lattice(s: NDArray) -> NDArray[np.int64]:
-    """Lattice index (step MATCH_TOL, offset _OFF) of scaled coordinates (|s| clipped to 3)."""
-    q = np.clip(s, -3.0, 3.0) / MATCH_TOL
+def _lattice(s: NDArray) -> NDArray[np.int32]:
+    """Lattice index (step MATCH_TOL, offset _OFF) of scaled coordinates (|s| clipped to 1.5)."""
+    q = np.clip(s, -1.5, 1.5)
+    q *= 1.0 / MATCH_TOL
     np.rint(q, out=q)
-    out = q.astype(np.int64)
+    out = q.astype(np.int32)
     out += _OFF
     return out
 
@@ -331,14 +333,12 @@ def _lattice(s: NDArray) -> NDArray[np.int64]:
 _NEIGHBOURS = [(d1, d2) for d1 in (0, -1, 1) for d2 in (0, -1, 1)]
 
 
-def _bitmap_cell(q1: NDArray, q2: NDArray) -> tuple[NDArray, NDArray, int]:
-    """Near-probe bitmap cell of lattice indices; valid where inside the envelope (+1 step)."""
-    c1 = q1 - (_OFF - _HALF - 1)
-    c2 = q2 - (_OFF - _HALF - 1)
-    top = 2 * _HALF + 2
-    ok = (c1 >= 0) & (c1 <= top) & (c2 >= 0) & (c2 <= top)
-    m = (top >> _FINE) + 1
-    return np.where(ok, (c1 >> _FINE) * m + (c2 >> _FINE), 0), ok, m
+def _bitmap_cell(q1: NDArray, q2: NDArray) -> NDArray[np.int32]:
+    """Near-probe bitmap cell of lattice indices (_M x _M cells)."""
+    c = q1 >> _FINE
+    c *= _M
+    c += q2 >> _FINE
+    return c
 
 
 def _match(x1, x2, q1, q2, p1, p2, n_grid: int, R: float, w: float) -> NDArray[np.intp]:
@@ -348,16 +348,13 @@ def _match(x1, x2, q1, q2, p1, p2, n_grid: int, R: float, w: float) -> NDArray[n
     cells near some probe keeps the sorted search to the few table rows near one.
     """
     pq1, pq2 = _lattice(p1 / R), _lattice(p2 / w)
-    e1 = np.concatenate([pq1 + d1 for d1, _ in _NEIGHBOURS])
-    e2 = np.concatenate([pq2 + d2 for _, d2 in _NEIGHBOURS])
+    e1 = np.concatenate([pq1 + d1 for d1, _ in _NEIGHBOURS]).astype(np.int64)
+    e2 = np.concatenate([pq2 + d2 for _, d2 in _NEIGHBOURS]).astype(np.int64)
     uk, inv = np.unique((e1 << 23) | e2, return_inverse=True)
-    cell, ok, m = _bitmap_cell(e1, e2)
-    near = np.zeros(m * m, dtype=bool)
-    near[cell[ok]] = True
-    cell, ok, _ = _bitmap_cell(q1, q2)
-    cand = np.flatnonzero(ok & near[cell])
-    del cell, ok
-    tk = (q1[cand] << 23) | q2[cand]
+    near = np.zeros(_M * _M, dtype=bool)
+    near[_bitmap_cell(e1, e2)] = True
+    cand = np.flatnonzero(near[_bitmap_cell(q1, q2)])
+    tk = (q1[cand].astype(np.int64) << 23) | q2[cand]
     pos = np.minimum(np.searchsorted(uk, tk), uk.size - 1)
     hit = uk[pos] == tk
     cand, pos = cand[hit], pos[hit]  # table rows near some probe
@@ -423,10 +420,15 @@ def table_coverage(x1: NDArray, x2: NDArray, cfg: Config) -> dict:
     q1 -= _OFF - _HALF
     q2 -= _OFF - _HALF
     inside = (q1 >= 0) & (q1 <= 2 * _HALF) & (q2 >= 0) & (q2 <= 2 * _HALF)
-    i1 = np.minimum(q1[inside] // per, L - 1)
-    i2 = np.minimum(q2[inside] // per, L - 1)
+    i1, i2 = q1[inside], q2[inside]
     del q1, q2, inside
-    empty = np.bincount(i1 * L + i2, minlength=L * L) == 0
+    i1 //= per
+    i2 //= per
+    np.minimum(i1, L - 1, out=i1)
+    np.minimum(i2, L - 1, out=i2)
+    i1 *= L
+    i1 += i2
+    empty = np.bincount(i1, minlength=L * L) == 0
     first_empty = None
     if empty.any():
         c = int(np.argmax(empty))
