@@ -822,9 +822,13 @@ of a computed curve outside |x1| < d are excluded and counted (a float tie may f
 region there); odd symmetry; |u| <= w_max; closed loop as `check` gates it: no stride-over,
 no limit cycle (and settled within 1e-3 mm), |u| <= w_max, and settling against the
 discrete-time limit N*T: worst (settling samples - N*) <= E_ref + max(2, ceil(E_ref/2)),
-E_ref the reference's worst. Table: agreement and |u| <= w_max at its points only; the
-reference is evaluated at the table's x1, x2, so firmware that rounds the state (float32) must
-write back the state it actually evaluated.
+E_ref the reference's worst. Both routes probe the same set, which --emit-grid writes: the
+grid, 100,000 seeded random states and 80,000 states around the curves and |x1| = d (a --law
+also at every state its closed loop visits). Table: agreement, |u| <= w_max and odd symmetry
+(mirrored grid states) at its points only; it must hold every emitted state (within 1e-6 of
+the range and w_max), or else a state in each of 200 x 200 cells and 100 per region, otherwise
+"insufficient coverage" (exit 1). The reference is evaluated at the table's x1, x2, so
+firmware that rounds the state (float32) must write back the state it actually evaluated.
 
 --report DIR also writes a report for a review (verdict, properties with units, heat maps of
 |u - u_ref| with l1, l2, l1*, l2* and |x1| < d, closed loop, settling / N*T, step/ramp/sine
@@ -862,7 +866,7 @@ def _add_conform(sub) -> None:
     src.add_argument(
         "--emit-grid",
         metavar="FILE.csv",
-        help="write the conformance grid (columns x1, x2) and exit",
+        help="write the probe set (columns x1, x2; grid, random and curve-band states) and exit",
     )
     p.add_argument(
         "--tolerance",

@@ -37,10 +37,13 @@ Determinism (``pure-function``, every mode)
     calls.  A latch, a cache, a debounce, a delay or a call counter shows here;
     after this finding the other properties are ``not_run``.
 Agreement (:mod:`ptoverify.agreement`) where the law is used
-    |u - u_ref| <= ``rtol`` w_max (default 1e-6) at the conformance grid
-    (``--emit-grid``), at ``N_RANDOM`` = 100000 seeded uniform states over the
-    envelope, and at every state the closed-loop and settling sweeps visit
-    (their u is the law's, already computed).  Points outside |x1| < d within
+    |u - u_ref| <= ``rtol`` w_max (default 1e-6) at the probe set
+    (:func:`ptoverify.agreement.probe_set`, what ``--emit-grid`` writes): the
+    conformance grid, ``N_RANDOM`` = 100000 seeded random states (one jittered
+    state in each cell of a 200 x 200 lattice over the envelope, the rest
+    uniform) and ``N_BAND`` = 80000 seeded states in a band around l1/l2,
+    l1*/l2* and |x1| = d; for a callable also at every state the closed-loop
+    and settling sweeps visit (their u is the law's, already computed).  Points outside |x1| < d within
     ``verdict.tie_band`` of l1/l2 or l1*/l2* are excluded and counted.  The
     largest disc of the envelope with no probed state is reported (``gap``).
 Odd symmetry
@@ -54,11 +57,18 @@ Closed loop (callable only)
     samples, E_ref the reference's worst; ``unverified`` if N* is unknown).
 Tables
     Regular files only, parsed in chunks.  States beyond 1000 x the envelope
-    are bad input (as ``mintime``).  ``coverage``: every region the reference
-    has on the conformance grid needs ``MIN_PER_REGION`` judged table states
-    (100; the origin 1), else "insufficient coverage".  Agreement and
-    |u| <= w_max are judged at the table's states; the closed-loop properties
-    need a callable and are ``not_run``.  The reference is evaluated at the
+    are bad input (as ``mintime``).  ``coverage``: the table must hold every
+    state of the probe set (each within ``MATCH_TOL`` = 1e-6 of position_range
+    and w_max per axis, so a state rounded to float32 still counts), or else
+    fill the envelope: a state in every cell of the 200 x 200 lattice
+    (0.5 mm x 3 mm/s for the paper) and ``MIN_PER_REGION`` judged states (100;
+    the origin 1) in every region the reference has on the grid; otherwise
+    "insufficient coverage" (exit 1).  Either way a fault confined to a band
+    two lattice cells wide (1 mm of x1 or 6 mm/s of x2 for the paper) holds
+    probed states.  Agreement and |u| <= w_max are judged at the table's
+    states; odd symmetry at the grid states whose exact mirror the table also
+    holds (``not_run`` if none); the closed-loop properties need a callable
+    and are ``not_run``.  The reference is evaluated at the
     table's x1, x2 as written: firmware that rounds the state must write back
     the state it evaluated.
 """
@@ -77,14 +87,21 @@ from numpy.typing import NDArray
 
 from ptoverify.agreement import (
     DEFAULT_RTOL,
+    LATTICE,
+    MATCH_TOL,
+    N_BAND,
+    N_RANDOM,
+    RANDOM_SEED,
     agreement,
     conformance_grid,
     failure,
     grid_csv,
     largest_gap,
+    probe_set,
     read_table,
     reference,
     region_counts,
+    table_coverage,
     ties,
 )
 from ptoverify.config import Config
@@ -126,14 +143,13 @@ __all__ = [
     "DEFAULT_RTOL",
     "DEFAULT_TIMEOUT_S",
     "N_RANDOM",
+    "N_BAND",
     "N_DETERMINISM",
     "MIN_PER_REGION",
     "PROPERTIES",
 ]
 
 _BAND_MM = 1e-3  #: settling / oscillation band [mm], as properties
-N_RANDOM = 100_000  #: seeded uniform agreement states over the envelope
-RANDOM_SEED = 15  #: seed of those states (issue 15)
 N_DETERMINISM = 2000  #: states of the determinism check
 _CHUNKS = (1, 2, 3, 5, 8, 13, 21, 34)  #: chunk sizes of the determinism check, cycled
 MIN_PER_REGION = 100  #: judged table states per reference region (the origin: 1)
@@ -647,13 +663,7 @@ class ConformResult:
         return list(dict.fromkeys(f["property"] for f in self.failures))
 
 
-def _random_states(cfg: Config, n: int) -> tuple[NDArray, NDArray]:
-    rng = np.random.default_rng(RANDOM_SEED)
-    R, w = cfg.plant.position_range, cfg.plant.w_max
-    return rng.uniform(-R, R, n), rng.uniform(-w, w, n)
-
-
-def _judge(user, failures: list[dict], cfg: Config, rtol, sweep, grid, n_random, keep=None):
+def _judge(user, failures: list[dict], cfg: Config, rtol, sweep, grid, n_random, n_band, keep=None):
     """Evaluate every property in order; returns (props, agreement, timings).
 
     ``keep`` (a dict) receives the judged states ``states`` = (x1, x2, u) and the
@@ -687,13 +697,14 @@ def _judge(user, failures: list[dict], cfg: Config, rtol, sweep, grid, n_random,
         "1",
     )
     t = time.perf_counter()
-    g1, g2 = grid
-    r1, r2 = _random_states(cfg, n_random)
-    xs, us, sources = [g1, r1], [], {"grid": g1.size, "random": r1.size}
+    probes = probe_set(cfg, grid=grid, n_random=n_random, n_band=n_band)
+    g1, g2 = probes["grid"]
+    xs = [p[0] for p in probes.values()]
+    us, sources = [], {k: int(p[0].size) for k, p in probes.items()}
     try:
         u_grid = user(g1, g2)
-        us = [u_grid, user(r1, r2)]
-        ys = [g2, r2]
+        us = [u_grid] + [user(*probes[k]) for k in ("random", "band")]
+        ys = [p[1] for p in probes.values()]
         props["input-bound-grid"], f = _input_bound(g1, g2, u_grid, cfg, "on the grid")
         failures += f
         props["odd-symmetry"], f = _odd_symmetry(user, g1, g2, u_grid, cfg, rtol)
@@ -772,6 +783,7 @@ def conform_callable(
     sweep: tuple[int, int, int] | None = None,
     grid: tuple[NDArray, NDArray] | None = None,
     n_random: int = N_RANDOM,
+    n_band: int = N_BAND,
 ) -> ConformResult:
     """Judge a law ``u = f(x1, x2, cfg)`` in this process (no isolation).
 
@@ -789,8 +801,9 @@ def conform_callable(
         Closed-loop sweep grid (see :func:`closed_loop`).
     grid : (x1, x2), optional
         Agreement grid; default :func:`conformance_grid`.
-    n_random : int
-        Seeded random agreement states over the envelope.
+    n_random, n_band : int
+        Seeded random states over the envelope, and around the curves and
+        |x1| = d (:func:`ptoverify.agreement.probe_set`).
 
     Returns
     -------
@@ -808,7 +821,7 @@ def conform_callable(
     user, failures = wrap_callable(fn, cfg)
     timings = {"detect": time.perf_counter() - t0}
     grid = conformance_grid(cfg) if grid is None else grid
-    props, agree, t = _judge(user, failures, cfg, rtol, sweep, grid, n_random)
+    props, agree, t = _judge(user, failures, cfg, rtol, sweep, grid, n_random, n_band)
     timings.update(t)
     return _finish(user, props, failures, agree, timings, t0, cfg, target)
 
@@ -822,6 +835,7 @@ def conform_spec(
     sweep: tuple[int, int, int] | None = None,
     grid: tuple[NDArray, NDArray] | None = None,
     n_random: int = N_RANDOM,
+    n_band: int = N_BAND,
     keep: dict | None = None,
     after: Callable | None = None,
 ) -> ConformResult:
@@ -838,7 +852,7 @@ def conform_spec(
     timeout : float
         Budget for the whole conformance [s] (each batch also gets 10 s + 1 ms
         per state).
-    sweep, grid, n_random
+    sweep, grid, n_random, n_band
         As :func:`conform_callable`.
     keep : dict, optional
         Receives the evidence behind the verdict: ``states`` (x1, x2, u of every
@@ -870,7 +884,7 @@ def conform_spec(
     timings = {"detect": time.perf_counter() - t0}
     props: dict[str, Verdict] = {}
     try:
-        props, agree, t = _judge(user, failures, cfg, rtol, sweep, grid, n_random, keep)
+        props, agree, t = _judge(user, failures, cfg, rtol, sweep, grid, n_random, n_band, keep)
         timings.update(t)
     except LawAborted as ab:
         return _aborted(user, props, failures, ab, timings, t0, cfg, spec, user.close())
@@ -914,8 +928,8 @@ def _clip(text: str, n: int = 2000) -> str:
     return f"{text[:n]}\n[... {len(text) - 2 * n} characters left out ...]\n{text[-n:]}"
 
 
-def _coverage(agree: dict, cfg: Config) -> Verdict:
-    """Every region the reference has on the grid needs MIN_PER_REGION judged states."""
+def _coverage(agree: dict, cov: dict, cfg: Config) -> Verdict:
+    """Judge coverage: the probe set held, or the lattice filled and every region populated."""
     need = region_counts(*conformance_grid(cfg), cfg)
     have = {k: v["points"] - v["excluded"] for k, v in agree["regions"].items()}
     short = []
@@ -923,14 +937,67 @@ def _coverage(agree: dict, cfg: Config) -> Verdict:
         want = 1 if name == Region.ORIGIN.name else MIN_PER_REGION
         if have.get(name, 0) < want:
             short.append(f"{name} {have.get(name, 0)} < {want}")
-    worst = min((have.get(n, 0) for n in need if n != Region.ORIGIN.name), default=0)
-    detail = (
-        f"judged table states per reference region (need {MIN_PER_REGION} in each of "
-        f"{', '.join(need)}; the origin 1)"
+    rule = (
+        f"the table must hold the {cov['probes']} states of --emit-grid (within "
+        f"{MATCH_TOL:g} of position_range and w_max), or else a state in each of the "
+        f"{LATTICE} x {LATTICE} cells of the envelope and {MIN_PER_REGION} judged states in "
+        f"each region of {', '.join(need)} (the origin 1)"
     )
+    if cov["missing"] == 0:
+        detail = f"holds all {cov['probes']} states of --emit-grid"
+        return Verdict("coverage", PASS, 0, 0, detail, "<=", "states missing")
+    m = cov["first_missing"]
+    held = (
+        f"{cov['missing']} of {cov['probes']} states of --emit-grid missing (first "
+        f"({m[0]:.10g}, {m[1]:.10g}))"
+    )
+    if cov["empty_cells"] == 0 and not short:
+        detail = f"{held}, but the table fills all {cov['cells']} cells and every region"
+        return Verdict("coverage", PASS, 0, 0, detail, "<=", "cells empty")
+    gaps = []
+    if cov["empty_cells"]:
+        e = cov["first_empty"]
+        gaps.append(
+            f"{cov['empty_cells']} of {cov['cells']} cells empty (first centred at "
+            f"({e[0]:.4g}, {e[1]:.4g}))"
+        )
     if short:
-        detail = f"insufficient coverage: {'; '.join(short)}; " + detail
-    return Verdict("coverage", FAIL if short else PASS, worst, MIN_PER_REGION, detail, ">=", "1")
+        gaps.append("too few states in " + ", ".join(short))
+    detail = f"insufficient coverage: {held}; {'; '.join(gaps)}; {rule}"
+    return Verdict("coverage", FAIL, cov["missing"], 0, detail, "<=", "states missing")
+
+
+def _table_symmetry(x1, x2, u, rows, cfg: Config, rtol: float) -> tuple[Verdict, list[dict]]:
+    """u(-x) = -u(x) at the grid states whose exact mirror the table also holds."""
+    name = "odd-symmetry"
+    tol = rtol * cfg.plant.w_max
+    mirror = rows[::-1]  # the grid is sorted and symmetric: state i mirrors state n-1-i
+    ok = (rows >= 0) & (mirror >= 0)
+    i, j = rows[ok], mirror[ok]
+    exact = (x1[i] == -x1[j]) & (x2[i] == -x2[j])
+    i, j = i[exact], j[exact]
+    if not i.size:
+        why = "no grid state and its exact mirror in the table (needs the --emit-grid states)"
+        return Verdict(name, NOT_RUN, None, None, why), []
+    err = np.abs(u[i] + u[j])
+    bad = err > tol
+    tie = ties(x1[i], x2[i], cfg)
+    v = Verdict(
+        name,
+        FAIL if bad.any() else PASS,
+        float(err.max()),
+        tol,
+        f"max |u(x) + u(-x)| over {i.size} table states whose mirror the table holds, "
+        f"{int(tie.sum())} of them curve ties (a mirrored tie must take the mirrored branch)",
+        "<=",
+        "mm/s",
+    )
+    if not bad.any():
+        return v, []
+    k = int(np.argmax(bad))
+    on = " (a curve tie)" if tie[k] else ""
+    a, b = int(i[k]), int(j[k])
+    return v, [failure(name, (x1[a], x2[a]), f"u(x) = {u[a]:.10g}, u(-x) = {u[b]:.10g} mm/s{on}")]
 
 
 def conform_table(
@@ -952,8 +1019,8 @@ def conform_table(
     Returns
     -------
     ConformResult
-        ``coverage``, ``agreement`` and ``input-bound-grid``; closed-loop
-        properties ``not_run``.
+        ``coverage``, ``agreement``, ``input-bound-grid`` and ``odd-symmetry``
+        (at mirrored grid states); closed-loop properties ``not_run``.
     """
     t0 = time.perf_counter()
     x1, x2, u = read_table(path, cfg)
@@ -962,14 +1029,18 @@ def conform_table(
         keep["states"] = (x1, x2, u)
     agree, failures = agreement(x1, x2, u, cfg, rtol)
     agree["sources"] = {"table": int(x1.size)}
-    props = {"coverage": _coverage(agree, cfg), "agreement": _agreement_verdict(agree)}
+    cov = table_coverage(x1, x2, cfg)
+    agree["coverage"] = {k: v for k, v in cov.items() if k != "grid_rows"}
+    props = {"coverage": _coverage(agree, cov, cfg), "agreement": _agreement_verdict(agree)}
     if not props["coverage"].passed:
         failures.insert(
             0, {"property": "coverage", "state": None, "detail": props["coverage"].detail}
         )
     props["input-bound-grid"], f = _input_bound(x1, x2, u, cfg, "at the table's states")
     failures += f
-    for name in ("odd-symmetry",) + _CLOSED:
+    props["odd-symmetry"], f = _table_symmetry(x1, x2, u, cov["grid_rows"], cfg, rtol)
+    failures += f
+    for name in _CLOSED:
         props[name] = Verdict(name, NOT_RUN, None, None, "needs a callable law (--law)")
     ok = not failures and agree["pass"] and props["coverage"].passed
     total = time.perf_counter() - t0

@@ -7,7 +7,9 @@ a flag that makes one small edit.  ``make_law(faults)`` returns a callable
 ``u = f(x1, x2, cfg)`` for ``ptoverify conform``.  Only omega0 is taken from
 ``ptoverify.zones`` (a design parameter a team reads from ``ptoverify zone``).
 
-``mutation_score()`` runs ``conform`` on every mutant and returns the score;
+``mutation_score()`` runs ``conform`` on every mutant and returns the score
+(``tests/test_conform_table_probes.py`` also evaluates each mutant at the
+states of ``conform --emit-grid`` and gates the table);
 ``python tests/pto_mutants.py`` prints it (the tests only assert).
 """
 

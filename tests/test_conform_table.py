@@ -14,7 +14,6 @@ from ptoverify.agreement import read_table
 from ptoverify.cli import main
 from ptoverify.conform import MIN_PER_REGION, conformance_grid, reference_law
 from ptoverify.errors import InputError
-from ptoverify.laws import Region, make_law
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -64,18 +63,21 @@ def test_one_row_table_is_insufficient_coverage(capsys, tmp_path):
     assert "insufficient coverage" in data["failures"][0]["detail"]
 
 
-def test_coverage_counts_each_region(capsys, tmp_path, paper_cfg):
-    """The grid covers every region; dropping one region's states fails coverage."""
+def test_small_grid_is_insufficient_coverage(capsys, tmp_path, paper_cfg):
+    """An 11 x 11 grid covers every region with 100 states but not the probe set or the cells."""
     x1, x2 = conformance_grid(paper_cfg, n=11, n_curve=11)
     u = reference_law(x1, x2, paper_cfg)
-    code, out, _ = run(capsys, "conform", "--table", str(write(tmp_path / "a.csv", x1, x2, u)))
-    assert code == 0, out
-    keep = make_law("pto", paper_cfg)(x1, x2)[1] != Region.ZONE_P
-    table = write(tmp_path / "b.csv", x1[keep], x2[keep], u[keep])
+    table = write(tmp_path / "a.csv", x1, x2, u)
     code, out, _ = run(capsys, "conform", "--table", str(table), "--json")
     data = json.loads(out)
-    assert code == 1 and data["properties"]["coverage"]["limit"] == MIN_PER_REGION
-    assert "ZONE_P" in data["properties"]["coverage"]["detail"]
+    assert data["agreement"]["pass"] and data["properties"]["agreement"]["status"] == "pass"
+    regions = data["agreement"]["regions"]
+    assert all(
+        e["points"] - e["excluded"] >= MIN_PER_REGION for k, e in regions.items() if k != "ORIGIN"
+    )
+    assert code == 1 and data["properties"]["coverage"]["status"] == "fail"
+    assert "insufficient coverage" in data["failures"][0]["detail"]
+    assert "cells empty" in data["properties"]["coverage"]["detail"]
 
 
 @pytest.mark.parametrize("value", ["1e308", "-5.1e4"])
