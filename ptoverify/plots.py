@@ -483,6 +483,7 @@ def plot_sweep(
     -------
     dict
         ``mesh`` (ratio), ``unsettled`` (grey cells where the law never settles),
+        ``contours`` (iso-ratio lines at 1.5, 2 and 4 where in range),
         ``worst`` (marker at the worst state), ``colorbar``.
     """
     ax = _ax(ax)
@@ -510,6 +511,17 @@ def plot_sweep(
         shading="nearest",
         cmap=ListedColormap(["0.6"]),
     )
+    levels = [v for v in (1.5, 2.0, 4.0) if finite.size and finite.min() < v < finite.max()]
+    if levels:  # iso-ratio lines: where the law is within 50 %, 2x, 4x of the floor
+        drawn["contours"] = ax.contour(
+            res.x1,
+            res.x2,
+            np.ma.masked_invalid(ratio),
+            levels=levels,
+            colors="white",
+            linewidths=0.6,
+        )
+        ax.clabel(drawn["contours"], fmt="%g", fontsize=6)
     wr = ls.worst_state_tf if which == "tf" else ls.worst_state_nt
     worst = ls.worst_ratio_tf if which == "tf" else ls.worst_ratio_nt
     if math.isfinite(wr[0]):
