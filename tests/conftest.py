@@ -5,6 +5,7 @@ they live here once.
 """
 
 import dataclasses
+import functools
 
 import matplotlib
 
@@ -65,15 +66,19 @@ def random_states(plant: Plant, n: int, seed: int) -> np.ndarray:
     return np.column_stack([x1, x2])
 
 
+@functools.lru_cache(maxsize=64)
 def zoh_reference(a: float, T: float) -> tuple[np.ndarray, np.ndarray]:  # noqa: N803
     """(Ad, Bd) of eq. (1) by ``scipy.signal.cont2discrete(method="zoh")``.
 
     Independent of ``ptoverify.plant`` (scipy builds it from expm of the
-    augmented matrix): the reference for every one-sample map.
+    augmented matrix): the reference for every one-sample map.  Computed once
+    per (a, T) and returned read-only (the same matrices every call; the
+    sample-by-sample reference simulations call this per sample).
     """
     A = np.array([[0.0, 1.0], [0.0, -a]])
     B = np.array([[0.0], [a]])
     Ad, Bd, *_ = cont2discrete((A, B, np.eye(2), np.zeros((2, 1))), T, method="zoh")
+    Ad.flags.writeable = Bd.flags.writeable = False
     return Ad, Bd
 
 

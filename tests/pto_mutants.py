@@ -309,7 +309,7 @@ def faithful(x1, x2, cfg):
     return make_law()(x1, x2, cfg)
 
 
-def mutation_score(cfg=None, sweep=(11, 11, 20)):
+def mutation_score(cfg=None, sweep=(11, 11, 20), grid=None):
     """Run ``conform`` on every mutant; return (killed, total, {name: failed properties}).
 
     Parameters
@@ -318,6 +318,9 @@ def mutation_score(cfg=None, sweep=(11, 11, 20)):
         Configuration (default: the paper's).
     sweep : (n1, n2, rest)
         Closed-loop sweep grid.
+    grid : (x1, x2), optional
+        Agreement grid [mm], [mm/s]; default ``conformance_grid(cfg)``, built once for
+        all mutants (what ``conform_callable`` would build for each).
 
     Returns
     -------
@@ -326,13 +329,15 @@ def mutation_score(cfg=None, sweep=(11, 11, 20)):
     detail : dict
         Mutant -> list of the properties that failed (empty: survived).
     """
+    from ptoverify.agreement import conformance_grid
     from ptoverify.config import paper_config
     from ptoverify.conform import conform_callable
 
     cfg = paper_config() if cfg is None else cfg
+    grid = conformance_grid(cfg) if grid is None else grid
     detail = {}
     for name in MUTANTS:
-        r = conform_callable(make_law([name]), cfg, target=name, sweep=sweep)
+        r = conform_callable(make_law([name]), cfg, target=name, sweep=sweep, grid=grid)
         detail[name] = [] if r.conforms else r.failed_properties()
     killed = sum(bool(v) for v in detail.values())
     return killed, len(detail), detail
