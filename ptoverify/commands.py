@@ -301,7 +301,9 @@ def run_regulation(
     )
     fn = make_law(law, cfg)
     b = simulate_batch(fn, p, [x0[0]], [x0[1]], steps, mismatch=m)
-    props = trajectory_properties(law, cfg, np.array([x0[0]]), np.array([x0[1]]), m, steps=steps)
+    props = trajectory_properties(
+        law, cfg, np.array([x0[0]]), np.array([x0[1]]), m, steps=steps, batch=b
+    )
     t = np.arange(steps + 1) * p.sample_time
     return {
         "law": law,

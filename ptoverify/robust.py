@@ -22,6 +22,9 @@ settling_ratio_nt, settling_ratio_tf
     Settling time (|x1| <= 0.01 mm and |x2| <= 0.01 a mm/s, held 0.05 s, the
     sweep's band) over N*T and over t_f* of the *true* plant (true a, true
     saturation) [-]; inf when the trajectory does not settle in the horizon.
+    Read on the samples, unlike the sweep: under a delay or a weaker drive the
+    input the plant receives is not the commanded one the batch records, so the
+    sweep's between-samples reconstruction does not apply here.
 
 Maps evaluate a grid of perturbations (a_ratio x w_max_ratio x each delay)
 times a grid of initial states.  Margins bisect a_true / a_design around 1.
@@ -52,7 +55,7 @@ from ptoverify.mintime import discrete_min_steps_batch, min_time
 from ptoverify.plant import zoh_matrices
 from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import crossing_masks, oscillating
-from ptoverify.simulate import Mismatch, simulate_batch
+from ptoverify.simulate import BatchResult, Mismatch, simulate_batch
 from ptoverify.sweep import settle_steps
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED, Verdict
 
@@ -183,6 +186,7 @@ def trajectory_properties(
     *,
     steps: int | None = None,
     with_settling: bool | NDArray[np.bool_] = True,
+    batch: BatchResult | None = None,
 ) -> dict[str, NDArray[np.float64]]:
     """Simulate ``law_name`` (nominal design) on a mismatched plant and measure each state.
 
@@ -201,6 +205,9 @@ def trajectory_properties(
     with_settling : bool or ndarray of bool, shape (n,)
         Also compute the settling ratios (needs t_f* and N* of each true plant),
         for every state or for the states of a mask (nan elsewhere).
+    batch : BatchResult, optional
+        The simulation of exactly these states, mismatch and horizon, when the
+        caller already has it (it is measured, not simulated again).
 
     Returns
     -------
@@ -221,8 +228,9 @@ def trajectory_properties(
     x2 = np.atleast_1d(np.asarray(x2, dtype=float))
     n = x1.size
     steps = horizon_steps(cfg) if steps is None else steps
-    law = _law(law_name, cfg)
-    b = simulate_batch(law, cfg.plant, x1, x2, steps, mismatch=mismatch)
+    if batch is None:
+        batch = simulate_batch(_law(law_name, cfg), cfg.plant, x1, x2, steps, mismatch=mismatch)
+    b = batch
     stride, _ = crossing_masks(b.x1, b.x2, b.region, cfg)
     window = max(20, steps // 4)
     tail = b.x1[-window:]

@@ -38,12 +38,11 @@ from scipy.optimize import differential_evolution
 
 from ptoverify.config import Config, PDGains, PTOSettings
 from ptoverify.errors import InputError
-from ptoverify.exact import exact_metrics
 from ptoverify.laws import make_law
 from ptoverify.mintime import discrete_min_steps_batch, min_time
 from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import law_properties
-from ptoverify.simulate import reference, simulate
+from ptoverify.simulate import reference
 from ptoverify.sweep import SweepSettings, grid_states, settling_times
 
 __all__ = [
@@ -167,8 +166,9 @@ def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:
         ``settling_2pct_s`` [s], ``settling_0p01mm_s`` [s], ``overshoot_mm`` [mm],
         ``rise_time_s`` [s]; NaN where undefined (never settles).
     """
-    res = simulate(make_law(law, cfg), cfg.plant, signal)
-    m = exact_metrics(res, cfg.plant).json_metrics()
+    from ptoverify.commands import run_simulation
+
+    m, _ = run_simulation(cfg, law, signal).metrics()  # the very path of simulate --json
     return {k: math.nan if v is None else float(v) for k, v in m.items()}
 
 
