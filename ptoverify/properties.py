@@ -242,15 +242,21 @@ def crossing_masks(
     p = cfg.plant
     a, w, d = p.a, p.w_max, cfg.pto.d
     tol = tie_band(w, a, p.position_range)
-    sig = switching_function(X1, X2, a, w)
     out = np.abs(X1) >= d
     R = R[: X1.shape[0] - 1]
     zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
+    src = out[:-1] & ~zone
+    # sigma only at the samples a transition from outside the zones reads (k and k + 1
+    # of each such k); it is elementwise, so these values are those of the whole grid
+    need = np.zeros(X1.shape, dtype=bool)
+    need[:-1] = src
+    need[1:] |= src
+    sig = np.zeros(X1.shape)
+    sig[need] = switching_function(X1[need], X2[need], a, w)
     s0, s1 = sig[:-1], sig[1:]
     n_side = (s0 > 0) | ((s0 == 0) & (X2[:-1] > 0))
     p_side = (s0 < 0) | ((s0 == 0) & (X2[:-1] < 0))
     cross = (n_side & (s1 < -tol)) | (p_side & (s1 > tol))
-    src = out[:-1] & ~zone
     return src & cross & out[1:], src & cross & ~out[1:]
 
 

@@ -63,7 +63,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Plant
 
-__all__ = ["MARGIN", "DiscreteLimit", "ZonotopeTable", "zonotope_table", "zonotope_steps"]
+__all__ = [
+    "MARGIN",
+    "DiscreteLimit",
+    "ZonotopeTable",
+    "zonotope_table",
+    "zonotope_steps",
+    "zonotope_steps_each",
+]
 
 MARGIN = 1e-9  # relative: |u_k| <= (1 + MARGIN) w_max counts as within the bound
 _BLOCK = 8192  # states per block (temporaries stay in the heap and the cache)
@@ -313,3 +320,150 @@ def _search(x1: NDArray, x2: NDArray, n0: NDArray, plant: Plant, n_max: int):
     steps = np.where(found, hi, -1)
     steps[origin] = 0
     return steps, below, tests
+
+
+def _contains_each(z1: NDArray, z2: NDArray, n: NDArray, c: NDArray) -> NDArray[np.bool_]:
+    """:meth:`ZonotopeTable.contains` with a plant per state (c = a T per state).
+
+    The table's entries at the indices a state needs, in closed form from its own
+    c (the same formulas as :class:`ZonotopeTable`); the segment of each state by
+    a bisection on k between two bounds from cx_k = c k - (1 - r^k) in [c k - 1, c k].
+    """
+    s = 1.0 / (1.0 + MARGIN)
+    nf = n.astype(float)
+    cyn = -np.expm1(-c * nf)
+    cxn = c * nf - cyn
+    rn = np.exp(-c * nf)
+    g = -np.expm1(-c)
+    c_minus_g = c + np.expm1(-c)
+    px = (z1 + cyn * z2) * s  # Ad^n z, scaled by the margin
+    py = (rn * z2) * s
+    ok = np.abs(px) <= cxn
+    top = n - 1
+    for sign in (1.0, -1.0):
+        qx = 0.5 * (sign * px + cxn)
+        qy = 0.5 * (sign * py + cyn)
+        # the largest k in [0, n - 1] with cx_k <= qx (0 if none), as the table's
+        # searchsorted: cx_k <= c k gives k >= floor(qx / c), cx_k >= c k - 1 gives
+        # k <= (qx + 1) / c; one sample of slack on each side for the roundings
+        with np.errstate(invalid="ignore", over="ignore"):
+            lo = np.floor(np.clip(qx / c - 1.0, 0.0, top)).astype(np.int64)
+            hi = np.floor(np.clip((qx + 1.0) / c + 1.0, 0.0, top)).astype(np.int64)
+        lo = np.minimum(lo, top)
+        live = np.flatnonzero(lo < hi)
+        while live.size:
+            mid = (lo[live] + hi[live] + 1) // 2
+            cm = c[live]
+            mf = mid.astype(float)
+            at = cm * mf + np.expm1(-cm * mf) <= qx[live]  # cx_mid = c mid - (1 - r^mid)
+            lo[live[at]] = mid[at]
+            hi[live[~at]] = mid[~at] - 1
+            live = live[lo[live] < hi[live]]
+        kf = lo.astype(float)
+        rk = np.exp(-c * kf)
+        cyk = -np.expm1(-c * kf)
+        cxk = c * kf - cyk
+        gxk = c_minus_g + g * (1.0 - rk)
+        ok &= gxk * (qy - cyk) - (g * rk) * (qx - cxk) <= 0.0
+    one = np.flatnonzero(n == 1)
+    if one.size:  # Z_1 is a segment: colinear within the margin (angle)
+        x, y = px[one] / s, py[one] / s
+        gx, gy = c_minus_g[one], g[one]
+        ok[one] = (np.abs(gx * y - gy * x) <= MARGIN * np.hypot(gx, gy) * np.hypot(x, y)) & (
+            np.abs(x) <= (1.0 + MARGIN) * gx
+        )
+    return ok
+
+
+def zonotope_steps_each(
+    x1: ArrayLike,
+    x2: ArrayLike,
+    n0: ArrayLike,
+    a: ArrayLike,
+    w_max: ArrayLike,
+    sample_time: float,
+    n_max: int = 20000,
+) -> NDArray[np.int64]:
+    """N* of many states, each for its own plant (a, w_max), by zonotope membership.
+
+    :func:`zonotope_steps` when every state has a different plant (e.g. a
+    robustness search over the true bandwidth and drive limit): the same
+    membership test, margin and search, with the generator table of each state
+    evaluated in closed form at the few indices the state needs instead of
+    tabulated per plant.  Vectorized over states whatever the mix of plants.
+
+    Parameters
+    ----------
+    x1, x2 : array_like
+        Initial positions [mm] and velocities [mm/s], finite; broadcast, flattened.
+    n0 : array_like of int
+        Per-state first candidate [samples], >= 1 (e.g. ceil(t_f* / T); any
+        value >= 1 gives the same N*, only the number of tests changes).
+    a : array_like
+        Bandwidth of each state's plant [rad/s], > 0.
+    w_max : array_like
+        Saturation of each state's plant [mm/s], > 0.
+    sample_time : float
+        Sampling period T [s].
+    n_max : int
+        Largest N tried [samples].
+
+    Returns
+    -------
+    ndarray of int64
+        N* [samples] (0 at the origin, -1 where N* > n_max), flattened order.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> p = paper_config().plant
+    >>> one = zonotope_steps([5.0], [0.0], [1], p).steps
+    >>> each = zonotope_steps_each([5.0, 5.0], [0.0, 0.0], [1, 1], [p.a, 2 * p.a], p.w_max, p.T)
+    >>> bool(each[0] == one[0]), bool(each[1] < each[0])
+    (True, True)
+    """
+    x1, x2, n0, a, w = np.broadcast_arrays(
+        np.asarray(x1, dtype=float),
+        np.asarray(x2, dtype=float),
+        np.asarray(n0),
+        np.asarray(a, dtype=float),
+        np.asarray(w_max, dtype=float),
+    )
+    x1, x2, a, w = x1.ravel(), x2.ravel(), a.ravel(), w.ravel()
+    n0 = np.clip(n0.ravel(), 1, n_max + 1).astype(np.int64)
+    z1, z2, c = a * x1 / w, x2 / w, a * sample_time
+
+    def inside(idx: NDArray, n: NDArray) -> NDArray[np.bool_]:
+        return _contains_each(z1[idx], z2[idx], n, c[idx])
+
+    # the search of :func:`_search`, per state
+    origin = (x1 == 0.0) & (x2 == 0.0)
+    lo = n0 - 1
+    hi = n0.copy()
+    found = np.zeros(x1.size, dtype=bool)
+    idx = np.flatnonzero(~origin & (lo >= 1))
+    if idx.size:
+        bad = idx[inside(idx, lo[idx])]
+        lo[bad] = 0
+        hi[bad] = n0[bad] - 1
+        found[bad] = True
+    step = np.ones(x1.size, dtype=np.int64)
+    act = np.flatnonzero(~origin & ~found & (n0 <= n_max))
+    while act.size:  # exponential search for an N inside
+        ok = inside(act, hi[act])
+        found[act[ok]] = True
+        out = act[~ok]
+        lo[out] = hi[out]
+        step[out] *= 2
+        hi[out] = np.minimum(lo[out] + step[out], n_max)
+        act = out[lo[out] < n_max]
+    act = np.flatnonzero(found & (hi - lo > 1))
+    while act.size:  # bisection: lo outside, hi inside
+        mid = (lo[act] + hi[act]) // 2
+        ok = inside(act, mid)
+        hi[act[ok]] = mid[ok]
+        lo[act[~ok]] = mid[~ok]
+        act = act[hi[act] - lo[act] > 1]
+    steps = np.where(found, hi, -1)
+    steps[origin] = 0
+    return steps

@@ -36,11 +36,10 @@ so the searched value is never below the grid's worst.
 
 from __future__ import annotations
 
-import functools
 import math
 import re
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Generator
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -51,11 +50,12 @@ from scipy.stats import qmc
 from ptoverify.config import Config, Plant
 from ptoverify.errors import ClusterError, InputError
 from ptoverify.laws import Law, make_law
-from ptoverify.mintime import discrete_min_steps_batch, min_time
+from ptoverify.mintime import min_time
 from ptoverify.plant import zoh_matrices
 from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import crossing_masks, oscillating
-from ptoverify.simulate import BatchResult, Mismatch, simulate_batch
+from ptoverify.reach import zonotope_steps_each
+from ptoverify.simulate import BatchResult, Mismatch, simulate_batch, simulate_laws
 from ptoverify.sweep import settle_steps
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED, Verdict
 
@@ -154,19 +154,21 @@ def _true_plant(plant: Plant, a_ratio: float, w_ratio: float) -> Plant:
     return replace(plant, a=plant.a * a_ratio, w_max=plant.w_max * w_ratio)
 
 
-def _n_star(x1: NDArray, x2: NDArray, plant: Plant) -> NDArray[np.float64]:
-    """N* of each state for ``plant`` (nan where it could not be computed), memoized."""
-    x1, x2 = np.ascontiguousarray(x1, dtype=float), np.ascontiguousarray(x2, dtype=float)
-    return _n_star_memo(plant, x1.tobytes(), x2.tobytes())
+def _n_star(x1: NDArray, x2: NDArray, a_ratio: NDArray, w_ratio: NDArray, plant: Plant) -> NDArray:
+    """N* of each state for its own true plant (a_ratio, w_max_ratio), nan where not found.
 
-
-@functools.lru_cache(maxsize=256)
-def _n_star_memo(plant: Plant, b1: bytes, b2: bytes) -> NDArray[np.float64]:
-    x1, x2 = np.frombuffer(b1), np.frombuffer(b2)
-    steps = discrete_min_steps_batch(x1, x2, plant).steps
-    out = np.where(steps >= 0, steps, np.nan).astype(float)
-    out.setflags(write=False)
-    return out
+    One vectorized zonotope search for every mix of plants
+    (:func:`ptoverify.reach.zonotope_steps_each`), started from the continuous
+    bound ceil(t_f* / T) of the true plant (t_f* in the plant's dimensionless time,
+    min_time of the unit plant; the start only changes the number of tests).
+    """
+    a, w = plant.a * a_ratio, plant.w_max * w_ratio
+    unit = replace(plant, a=1.0, w_max=1.0)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        tau = min_time(a * x1 / w, x2 / w, unit).t_f  # a t_f* [-]
+        n0 = np.nan_to_num(np.ceil(tau / (a * plant.sample_time) - 1e-9), nan=1.0, posinf=1.0)
+    steps = zonotope_steps_each(x1, x2, np.maximum(n0, 1.0), a, w, plant.sample_time)
+    return np.where(steps >= 0, steps, np.nan).astype(float)
 
 
 LawSpec = str | Callable[[Config], Law]
@@ -226,11 +228,29 @@ def trajectory_properties(
     """
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     x2 = np.atleast_1d(np.asarray(x2, dtype=float))
-    n = x1.size
     steps = horizon_steps(cfg) if steps is None else steps
     if batch is None:
         batch = simulate_batch(_law(law_name, cfg), cfg.plant, x1, x2, steps, mismatch=mismatch)
-    b = batch
+    return _measure(batch, cfg, x1, x2, mismatch, with_settling, with_tf=True)
+
+
+def _measure(
+    b: BatchResult,
+    cfg: Config,
+    x1: NDArray,
+    x2: NDArray,
+    mismatch: Mismatch,
+    with_settling: bool | NDArray[np.bool_],
+    *,
+    with_tf: bool,
+) -> dict[str, NDArray[np.float64]]:
+    """Measure the properties of :func:`trajectory_properties` on a simulated batch.
+
+    ``with_tf`` False leaves ``settling_ratio_tf`` out (the study reads only the
+    ratio to N*T; t_f* of each true plant is then not computed).
+    """
+    n = x1.size
+    steps = b.x1.shape[0] - 1
     stride, _ = crossing_masks(b.x1, b.x2, b.region, cfg)
     window = max(20, steps // 4)
     tail = b.x1[-window:]
@@ -253,18 +273,21 @@ def trajectory_properties(
     settle = np.where(k >= 0, k * T, np.inf)
     ar = np.broadcast_to(np.asarray(mismatch.a_ratio, dtype=float), (n,))
     wr = np.broadcast_to(np.asarray(mismatch.w_max_ratio, dtype=float), (n,))
-    t_f, n_star = np.full(n, np.nan), np.full(n, np.nan)
-    for key in set(zip(ar[need].tolist(), wr[need].tolist(), strict=True)):
-        sel = (ar == key[0]) & (wr == key[1]) & need
-        true = _true_plant(cfg.plant, *key)
-        t_f[sel] = min_time(x1[sel], x2[sel], true).t_f
-        n_star[sel] = _n_star(x1[sel], x2[sel], true)
+    n_star = np.full(n, np.nan)
+    sel = np.flatnonzero(need)
+    n_star[sel] = _n_star(x1[sel], x2[sel], ar[sel], wr[sel], cfg.plant)
     with np.errstate(divide="ignore", invalid="ignore"):
         out["settling_s"] = np.where(need, settle, np.nan)
         ratio_nt = np.where(n_star > 0, settle / (n_star * T), 0.0)
-        ratio_tf = np.where(t_f > 0, settle / t_f, 0.0)
         out["settling_ratio_nt"] = np.where(need & ~np.isnan(n_star), ratio_nt, np.nan)
-        out["settling_ratio_tf"] = np.where(need & ~np.isnan(t_f), ratio_tf, np.nan)
+    if with_tf:
+        t_f = np.full(n, np.nan)
+        for key in set(zip(ar[need].tolist(), wr[need].tolist(), strict=True)):
+            on = (ar == key[0]) & (wr == key[1]) & need
+            t_f[on] = min_time(x1[on], x2[on], _true_plant(cfg.plant, *key)).t_f
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio_tf = np.where(t_f > 0, settle / t_f, 0.0)
+            out["settling_ratio_tf"] = np.where(need & ~np.isnan(t_f), ratio_tf, np.nan)
     return out
 
 
@@ -334,34 +357,39 @@ def _map_task(
     x2: NDArray,
     ars: list[float],
     wrs: list[float],
-    delay: int,
+    delays: list[int],
 ) -> list[dict[str, Any]]:
-    """Every cell of one law and one delay: all (w, a) cells times all states in one batch.
+    """Every cell of one law: all (delay, w, a) cells times all states in one batch.
 
     A picklable task (the unit :func:`dask_runner` distributes); cells in the
-    order w_max_ratio, a_ratio.  One batch simulation, since the per-sample cost
-    of a small batch is mostly fixed overhead.
+    order delay, w_max_ratio, a_ratio.  One batch simulation (per
+    :data:`BATCH_STATES` states), each state with its cell's a_ratio,
+    w_max_ratio and delay, since the per-sample cost of a small batch is mostly
+    fixed overhead.
     """
     box = cfg.robustness
-    cells = [(float(wr), float(ar)) for wr in wrs for ar in ars]
+    cells = [(int(dl), float(wr), float(ar)) for dl in delays for wr in wrs for ar in ars]
     n = x1.size
+    fn = _law(law, cfg)
+    steps = horizon_steps(cfg)
     out = []
     for group in _groups(len(cells), n):
         part = [cells[i] for i in group]
         m = Mismatch(
-            a_ratio=np.repeat([ar for _, ar in part], n),
-            w_max_ratio=np.repeat([wr for wr, _ in part], n),
-            delay_samples=delay,
+            a_ratio=np.repeat([ar for _, _, ar in part], n),
+            w_max_ratio=np.repeat([wr for _, wr, _ in part], n),
+            delay_samples=np.repeat([dl for dl, _, _ in part], n),
             position_quantum=box.position_quantum,
             velocity_noise=box.velocity_noise,
             seed=box.seed,
         )
-        props = trajectory_properties(law, cfg, np.tile(x1, len(part)), np.tile(x2, len(part)), m)
-        for i, (wr, ar) in enumerate(part):
+        b1, b2 = np.tile(x1, len(part)), np.tile(x2, len(part))
+        batch = simulate_batch(fn, cfg.plant, b1, b2, steps, mismatch=m)
+        props = _measure(batch, cfg, b1, b2, m, True, with_tf=False)
+        for i, (dl, wr, ar) in enumerate(part):
             cell = {k: v[i * n : (i + 1) * n] for k, v in props.items()}
             out.append(
-                {"a_ratio": ar, "w_max_ratio": wr, "delay_samples": delay}
-                | _summarize(cell, x1, x2)
+                {"a_ratio": ar, "w_max_ratio": wr, "delay_samples": dl} | _summarize(cell, x1, x2)
             )
     return out
 
@@ -394,7 +422,7 @@ def robust_maps(
         Grid sizes and laws.
     runner : callable, optional
         ``runner(tasks) -> results`` evaluating ``_map_task(*task)`` for each task
-        (one per law and delay), in order: in-process by default;
+        (one per law, every delay in it), in order: in-process by default;
         :func:`dask_runner` distributes them.  Each task is deterministic, so
         the maps do not depend on where or in which order the tasks ran.
 
@@ -411,16 +439,9 @@ def robust_maps(
     wrs = _ratio_grid(*box.w_max_ratio, s.n_w)
     delays = list(range(box.delay_samples[0], box.delay_samples[1] + 1))
     x1, x2 = map_states(cfg, s)
-    tasks = [
-        (law, cfg, x1, x2, ars.tolist(), wrs.tolist(), int(dl)) for law in s.laws for dl in delays
-    ]
+    tasks = [(law, cfg, x1, x2, ars.tolist(), wrs.tolist(), delays) for law in s.laws]
     run = runner or (lambda ts: [_map_task(*t) for t in ts])
-    results = run(tasks)
-    per = len(delays)
-    laws = {
-        law: [c for r in results[i * per : (i + 1) * per] for c in r]
-        for i, law in enumerate(s.laws)
-    }
+    laws = dict(zip(s.laws, run(tasks), strict=True))
     return {
         "a_ratio": ars.tolist(),
         "w_max_ratio": wrs.tolist(),
@@ -656,28 +677,47 @@ def no_limit_cycle_margin(
     return {"no_limit_cycle_a_ratio": [lo, hi], "no_limit_cycle_note": ""}
 
 
+SCAN_FIRST = 8  #: points of each side's scan tested in the first call of :func:`_edges_batched`
+
+
 def _edges_batched(
-    ok: Callable[[NDArray], NDArray[np.bool_]], *, grid: int, rtol: float, split: int = 16
+    ok: Callable[[NDArray], NDArray[np.bool_]],
+    *,
+    grid: int,
+    rtol: float,
+    split: int = 16,
+    first: int = SCAN_FIRST,
 ) -> tuple[float | None, float | None]:
     """Both edges of ``ok`` around 1 within :data:`MARGIN_RANGE`, a batch per round.
 
     The same edge as :func:`_edge` (the first failing point of a ``grid``-point
     geometric scan from 1 outward, then the bracket narrowed to ``rtol``), but
-    the scan of both sides is one call of ``ok`` and each narrowing round tests
-    ``split - 1`` interior points of both brackets at once (the bracket shrinks
-    ``split``-fold per round instead of 2-fold per call).
+    the scan of both sides takes two calls of ``ok``: the ``first`` points of
+    each side nearest 1, then the rest of each side that has not failed yet (a
+    point beyond a side's first failure cannot change its edge, so it is not
+    tested); and each narrowing round tests ``split - 1`` interior points of
+    both brackets at once (the bracket shrinks ``split``-fold per round instead
+    of 2-fold per call).
     """
     sides = [np.geomspace(1.0, end, grid)[1:] for end in MARGIN_RANGE]
-    flags = ok(np.concatenate(sides))
+    bad_at: list[int | None] = [None, None]
+    for lo_i, hi_i in ((0, first), (first, None)):
+        todo = [i for i in (0, 1) if bad_at[i] is None and sides[i][lo_i:hi_i].size]
+        if not todo:
+            break
+        chunks = [sides[i][lo_i:hi_i] for i in todo]
+        flags = ok(np.concatenate(chunks))
+        at = 0
+        for i, c in zip(todo, chunks, strict=True):
+            bad = np.flatnonzero(~flags[at : at + c.size])
+            at += c.size
+            if bad.size:
+                bad_at[i] = lo_i + int(bad[0])
     brackets: list[list[float] | None] = []
-    for i, pts in enumerate(sides):
-        f = flags[i * pts.size : (i + 1) * pts.size]
-        bad = np.flatnonzero(~f)
-        if bad.size == 0:
-            brackets.append(None)
-            continue
-        j = int(bad[0])
-        brackets.append([1.0 if j == 0 else float(pts[j - 1]), float(pts[j])])
+    for pts, j in zip(sides, bad_at, strict=True):
+        brackets.append(
+            None if j is None else [1.0 if j == 0 else float(pts[j - 1]), float(pts[j])]
+        )
     live = [b for b in brackets if b is not None]
     while any(abs(b[1] - b[0]) > rtol * min(abs(b[0]), abs(b[1])) for b in live):
         # geometric interior points of each bracket, from its ok end to its failing end
@@ -794,7 +834,67 @@ def worst_cases(
         and ``params`` (with the full mismatch: quantum, noise, seed),
         ``evaluations`` (trajectories simulated by this search, all properties).
     """
+    return _worst_cases_lockstep(cfg, [(law, starts)], settings)[0]
+
+
+#: A search coroutine: yields (candidates (S, 4), delays (S,), settle mask (S,)), is sent
+#: the measured properties of those candidates, returns the per-property worst cases.
+_Search = Generator[tuple[NDArray, NDArray, NDArray], dict[str, NDArray], dict[str, Any]]
+
+
+def _worst_cases_lockstep(
+    cfg: Config,
+    searches: list[tuple[LawSpec, dict[str, list[dict[str, Any]]]]],
+    settings: RobustSettings | None = None,
+) -> list[dict[str, dict[str, Any]]]:
+    """:func:`worst_cases` of several laws, advanced together.
+
+    Each law's search is its own coroutine (:func:`_de_search`, its own seeded
+    generator, so its result does not depend on the other searches); at each
+    step every law's candidates run in one simulation
+    (:func:`ptoverify.simulate.simulate_laws`) and one measurement, so the
+    per-sample overhead of a small batch is paid once for all laws.
+    """
     s = settings or RobustSettings()
+    box = cfg.robustness
+    steps = horizon_steps(cfg)
+    laws = [_law(spec, cfg) for spec, _ in searches]
+    gens = [_de_search(cfg, starts, s) for _, starts in searches]
+    results: list[dict[str, dict[str, Any]] | None] = [None] * len(gens)
+    asks: list[Any] = [None] * len(gens)
+
+    def advance(i: int, sent: dict[str, NDArray] | None) -> None:
+        try:
+            asks[i] = next(gens[i]) if sent is None else gens[i].send(sent)
+        except StopIteration as done:
+            results[i], asks[i] = done.value, None
+
+    for i in range(len(gens)):
+        advance(i, None)
+    while live := [i for i in range(len(gens)) if asks[i] is not None]:
+        Z = np.concatenate([asks[i][0] for i in live])  # noqa: N806
+        counts = [len(asks[i][0]) for i in live]
+        m = Mismatch(
+            a_ratio=Z[:, 2],
+            w_max_ratio=Z[:, 3],
+            delay_samples=np.concatenate([asks[i][1] for i in live]),
+            position_quantum=box.position_quantum,
+            velocity_noise=box.velocity_noise,
+            seed=box.seed,
+        )
+        batch = simulate_laws(
+            [laws[i] for i in live], counts, cfg.plant, Z[:, 0], Z[:, 1], steps, mismatch=m
+        )
+        settle = np.concatenate([asks[i][2] for i in live])
+        out = _measure(batch, cfg, Z[:, 0], Z[:, 1], m, settle, with_tf=False)
+        edges = np.cumsum([0, *counts])
+        for j, i in enumerate(live):
+            advance(i, {k: v[edges[j] : edges[j + 1]] for k, v in out.items()})
+    return results  # type: ignore[return-value]
+
+
+def _de_search(cfg: Config, starts: dict[str, list[dict[str, Any]]], s: RobustSettings) -> _Search:
+    """Run the search of :func:`worst_cases` for one law as a coroutine (see :data:`_Search`)."""
     box = cfg.robustness
     props = list(starts)
     delays = list(range(box.delay_samples[0], box.delay_samples[1] + 1))
@@ -804,7 +904,7 @@ def worst_cases(
     best = {prop: {"value": -math.inf, "z": None, "delay": delays[0]} for prop in props}
     count = 0
 
-    def evaluate(pops: list[NDArray]) -> list[NDArray]:
+    def evaluate(pops: list[NDArray]) -> _Search:
         """Each problem's population (S_i, 4) -> its values (S_i,), larger is worse."""
         nonlocal count
         Z = np.concatenate(pops)  # noqa: N806
@@ -812,15 +912,7 @@ def worst_cases(
         owner = np.repeat(np.arange(len(pops)), sizes)
         delay = np.array([problems[i][1] for i in owner], dtype=np.int64)
         settle = np.array([problems[i][0].startswith("settling") for i in owner])
-        m = Mismatch(
-            a_ratio=Z[:, 2],
-            w_max_ratio=Z[:, 3],
-            delay_samples=delay,
-            position_quantum=box.position_quantum,
-            velocity_noise=box.velocity_noise,
-            seed=box.seed,
-        )
-        out = trajectory_properties(law, cfg, Z[:, 0], Z[:, 1], m, with_settling=settle)
+        out = yield Z, delay, settle  # the driver simulates and measures them
         count += len(Z)
         for prop in props:  # every trajectory counts toward every property's worst
             v = np.where(np.isnan(out[prop]), -np.inf, out[prop])
@@ -849,7 +941,7 @@ def worst_cases(
     for prop in props:
         vals = [float(g["value"]) for g in starts[prop]]
         grid_value[prop] = max(vals) if vals else -math.inf
-    fit = evaluate(pops)
+    fit = yield from evaluate(pops)
     for _ in range(s.search_iterations):
         f_weight = rng.uniform(*DE_MUTATION)
         trials = []
@@ -875,7 +967,7 @@ def worst_cases(
             outside = (trial < lo) | (trial > hi)
             trial = np.where(outside, lo + (hi - lo) * rng.random(pop.shape), trial)
             trials.append(trial)
-        tfit = evaluate(trials)
+        tfit = yield from evaluate(trials)
         for i in range(len(pops)):
             better = tfit[i] >= fit[i]
             pops[i][better], fit[i][better] = trials[i][better], tfit[i][better]
@@ -890,7 +982,7 @@ def worst_cases(
             compass = c + np.concatenate([np.diag(span), -np.diag(span)])
             gauss = c + span * rng.standard_normal((max(s.search_population - 8, 1), 4))
             cands.append(np.clip(np.concatenate([compass, gauss]), lo, hi))
-        cfit = evaluate(cands)
+        cfit = yield from evaluate(cands)
         for i in range(len(centre)):
             k = int(np.argmax(cfit[i]))
             if cfit[i][k] > cval[i]:
@@ -1088,11 +1180,12 @@ def run_robust(
     )
     timings["margins"] = time.perf_counter() - t1
     t2 = time.perf_counter()
-    worst: dict[str, Any] = {}
-    for i, law in enumerate(s.laws):
-        report(f"worst case {law}", 0.5 + 0.5 * i / len(s.laws))
-        starts = {prop: grid_worst(maps["laws"][law], prop) for prop in s.properties}
-        worst[law] = worst_cases(law, cfg, starts, s)
+    report("worst cases", 0.5)
+    searches = [
+        (law, {prop: grid_worst(maps["laws"][law], prop) for prop in s.properties})
+        for law in s.laws
+    ]
+    worst = dict(zip(s.laws, _worst_cases_lockstep(cfg, searches, s), strict=True))
     timings["worst_case"] = time.perf_counter() - t2
     timings["total"] = time.perf_counter() - t0
     return RobustResult(cfg, s, maps, margins, worst, timings, dask or "in-process")

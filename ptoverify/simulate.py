@@ -48,6 +48,7 @@ __all__ = [
     "BatchResult",
     "Mismatch",
     "simulate_batch",
+    "simulate_laws",
 ]
 
 
@@ -572,7 +573,8 @@ def simulate_batch(
     (True, True)
     """
     if mismatch is not None and not mismatch.is_identity:
-        return _simulate_mismatch(law, plant, x1, x2, steps, mismatch)
+        x1 = np.atleast_1d(np.asarray(x1, dtype=float))
+        return _simulate_mismatch([(law, slice(None))], plant, x1, x2, steps, mismatch)
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     x2 = np.atleast_1d(np.asarray(x2, dtype=float))
     n = x1.shape[0]
@@ -595,10 +597,94 @@ def simulate_batch(
     return BatchResult(X1, X2, U, R, mismatch)
 
 
-def _simulate_mismatch(
-    law: Law, plant: Plant, x1: ArrayLike, x2: ArrayLike, steps: int, m: Mismatch
+def simulate_laws(
+    laws: list[Law],
+    counts: list[int],
+    plant: Plant,
+    x1: ArrayLike,
+    x2: ArrayLike,
+    steps: int,
+    *,
+    mismatch: Mismatch | None = None,
 ) -> BatchResult:
-    """Run the loop of :func:`simulate_batch` with a true plant and a measurement model."""
+    """:func:`simulate_batch` of several laws in one run: law i drives the next counts[i] states.
+
+    Each state's trajectory is the one :func:`simulate_batch` gives for its own law
+    (bit for bit): the laws are evaluated on their own states at each sample and
+    the true plant is advanced for all states at once, so many small batches of
+    different laws cost one run's per-sample overhead.
+
+    Parameters
+    ----------
+    laws : list of Law
+        Feedback laws (their vectorized paths).
+    counts : list of int
+        States per law, in order; they sum to the number of states.
+    plant : Plant
+        Design plant and sample time (the laws').
+    x1, x2 : array_like, shape (n,)
+        Initial states [mm], [mm/s], the states of ``laws[0]`` first.
+    steps : int
+        Number of samples.
+    mismatch : Mismatch, optional
+        True plant and measurement (per-state arrays of shape (n,) allowed).
+
+    Returns
+    -------
+    BatchResult
+        The trajectories of all states, in the order given.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> from ptoverify.laws import pd_law, to_law
+    >>> cfg = paper_config()
+    >>> m = Mismatch(a_ratio=0.9, delay_samples=1)
+    >>> both = simulate_laws([pd_law(cfg), to_law(cfg)], [1, 1], cfg.plant, [5.0, 5.0],
+    ...                      [0.0, 0.0], 100, mismatch=m)
+    >>> one = simulate_batch(to_law(cfg), cfg.plant, [5.0], [0.0], 100, mismatch=m)
+    >>> bool((both.x1[:, 1] == one.x1[:, 0]).all())
+    True
+    """
+    x1 = np.atleast_1d(np.asarray(x1, dtype=float))
+    x2 = np.atleast_1d(np.asarray(x2, dtype=float))
+    if len(laws) != len(counts) or sum(counts) != x1.size or min(counts, default=0) < 0:
+        raise ValueError("simulate_laws: one count per law, summing to the number of states")
+    edges = np.cumsum([0, *counts]).tolist()
+    if mismatch is None or mismatch.is_identity:  # the nominal loop, law by law
+        parts = [
+            simulate_batch(law, plant, x1[i:j], x2[i:j], steps)
+            for law, i, j in zip(laws, edges[:-1], edges[1:], strict=True)
+        ]
+        return BatchResult(
+            *(
+                np.concatenate([getattr(b, f) for b in parts], axis=1)
+                for f in ("x1", "x2", "u", "region")
+            ),
+            mismatch,
+        )
+    segments = [
+        (law, slice(i, j)) for law, i, j in zip(laws, edges[:-1], edges[1:], strict=True) if j > i
+    ]
+    return _simulate_mismatch(segments, plant, x1, x2, steps, mismatch)
+
+
+def _simulate_mismatch(
+    segments: list[tuple[Law, slice]],
+    plant: Plant,
+    x1: ArrayLike,
+    x2: ArrayLike,
+    steps: int,
+    m: Mismatch,
+) -> BatchResult:
+    """Run the loop of :func:`simulate_batch` with a true plant and a measurement model.
+
+    ``segments`` pairs each law with the slice of states it drives.  Vectorized
+    over states, each with its own a_ratio, w_max_ratio and delay; the per-sample
+    work is a fixed sequence of in-place array operations (the same roundings as
+    ``plant.flow`` and ``np.clip``), so a state's trajectory does not depend on
+    the batch it runs in.
+    """
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     x2 = np.atleast_1d(np.asarray(x2, dtype=float))
     n = x1.shape[0]
@@ -611,27 +697,67 @@ def _simulate_mismatch(
     T = plant.sample_time
     a = plant.a * np.broadcast_to(np.asarray(m.a_ratio, dtype=float), (n,))
     w_true = plant.w_max * np.broadcast_to(np.asarray(m.w_max_ratio, dtype=float), (n,))
+    w_neg = -w_true
     g = -np.expm1(-a * T)
     q = float(m.position_quantum)
-    noise = (
-        np.random.default_rng(m.seed).normal(0.0, m.velocity_noise, steps)
-        if m.velocity_noise > 0
-        else np.zeros(steps)
-    )
+    noisy = m.velocity_noise > 0
+    noise = np.random.default_rng(m.seed).normal(0.0, m.velocity_noise, steps) if noisy else None
+    # without noise the law sees x2 + 0.0, which is x2 bit for bit unless x2 is -0.0;
+    # and x2 - dv is -0.0 only where x2 is, so checking the initial states suffices
+    add_zero = not noisy and bool(np.any((x2 == 0.0) & np.signbit(x2)))
     # the delay line: sample k applies U[k - delay] (U[0] before it: the controller
-    # was running and held what x_0 commands)
-    shared = int(delay[0]) if n and np.all(delay == delay[0]) else None
-    cols = np.arange(n)
+    # was running and held what x_0 commands); per distinct delay, a mask of its states
+    values = np.unique(delay).tolist() if n else [0]
+    base, others = int(values[0]), [(int(d), delay == d) for d in values[1:]]
+    if len(others) > 3:  # many delays: a gather
+        cols = np.arange(n, dtype=np.intp)
+        delay_i = delay.astype(np.intp)
+        flat_u = U.reshape(-1)
+        pick = np.empty(n, dtype=np.intp)
+        gathered = np.empty(n)
+    parts = [(law.vector, sl) for law, sl in segments]
+    y1, y2 = np.empty(n), np.empty(n)
+    uk, dv = np.empty(n), np.empty(n)
     for k in range(steps):
-        y1 = q * np.round(X1[k] / q) if q > 0 else X1[k]
-        y2 = X2[k] + noise[k]
-        U[k], R[k] = law(y1, y2)
-        if shared is not None:
-            applied = U[max(k - shared, 0)]
+        x1k, x2k = X1[k], X2[k]
+        if q > 0:  # q * round(x1 / q)
+            np.divide(x1k, q, out=y1)
+            np.rint(y1, out=y1)
+            y1 *= q
+            meas1 = y1
         else:
-            applied = U[np.maximum(k - delay, 0), cols]
-        uk = np.clip(applied, -w_true, w_true)
-        dv = (X2[k] - uk) * g
-        X2[k + 1] = X2[k] - dv
-        X1[k + 1] = X1[k] + uk * T + dv / a
+            meas1 = x1k
+        if noisy:
+            np.add(x2k, noise[k], out=y2)
+            meas2 = y2
+        elif add_zero:
+            np.add(x2k, 0.0, out=y2)
+            meas2 = y2
+        else:
+            meas2 = x2k
+        uk_row, rk_row = U[k], R[k]
+        for vector, sl in parts:
+            uk_row[sl], rk_row[sl] = vector(meas1[sl], meas2[sl])
+        # uk = np.clip(applied, -w_true, w_true), the applied input picked per delay
+        if len(others) > 3:  # U[max(k - delay, 0), state]
+            np.subtract(k, delay_i, out=pick)
+            np.maximum(pick, 0, out=pick)
+            pick *= n
+            pick += cols
+            np.take(flat_u, pick, out=gathered)
+            np.maximum(gathered, w_neg, out=uk)
+        else:
+            np.maximum(U[max(k - base, 0)], w_neg, out=uk)
+            for d, mask in others:
+                np.maximum(U[max(k - d, 0)], w_neg, out=uk, where=mask)
+        np.minimum(uk, w_true, out=uk)
+        # plant.flow of the true plant: x2 - (x2 - u) g,  x1 + u T + (x2 - u) g / a
+        np.subtract(x2k, uk, out=dv)
+        dv *= g
+        np.subtract(x2k, dv, out=X2[k + 1])
+        x1n = X1[k + 1]
+        np.multiply(uk, T, out=x1n)
+        x1n += x1k
+        dv /= a
+        x1n += dv
     return BatchResult(X1, X2, U, R, m)
