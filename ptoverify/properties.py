@@ -54,6 +54,7 @@ __all__ = [
     "zone_outcome",
     "oscillating",
     "crossing_masks",
+    "stride_over_counts",
 ]
 
 
@@ -214,6 +215,38 @@ def oscillating(x1: np.ndarray, band: float) -> np.ndarray:
     return (changes >= 4) & (second > band) & (second >= 0.5 * first)
 
 
+def _crossings(
+    X1: np.ndarray,  # noqa: N803
+    X2: np.ndarray,  # noqa: N803
+    R: np.ndarray,  # noqa: N803
+    cfg: Config,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Find the transitions that cross l1 - o - l2 (see :func:`crossing_masks`), compressed.
+
+    Returns the flat indices f into the (steps, n) transition grid of the
+    transitions that start outside the zones and the linear zone, whether each
+    crosses, and whether it lands outside the linear zone.  sigma is evaluated
+    only at the two ends of these transitions (it is elementwise, so the values
+    are those of the whole grid).
+    """
+    p = cfg.plant
+    a, w, d = p.a, p.w_max, cfg.pto.d
+    tol = tie_band(w, a, p.position_range)
+    n = X1.shape[1]
+    out = np.abs(X1) >= d
+    R = R[: X1.shape[0] - 1]
+    zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
+    f = np.flatnonzero(out[:-1] & ~zone)
+    x1, x2 = np.ravel(X1), np.ravel(X2)
+    ends = np.concatenate([f, f + n])
+    sig = switching_function(x1[ends], x2[ends], a, w)
+    s0, s1, v0 = sig[: f.size], sig[f.size :], x2[f]
+    n_side = (s0 > 0) | ((s0 == 0) & (v0 > 0))
+    p_side = (s0 < 0) | ((s0 == 0) & (v0 < 0))
+    cross = (n_side & (s1 < -tol)) | (p_side & (s1 > tol))
+    return f, cross, np.ravel(out)[f + n]
+
+
 def crossing_masks(
     X1: np.ndarray,
     X2: np.ndarray,
@@ -239,25 +272,50 @@ def crossing_masks(
     -------
     stride, into_linear : ndarray of bool, shape (steps, n)
     """
-    p = cfg.plant
-    a, w, d = p.a, p.w_max, cfg.pto.d
-    tol = tie_band(w, a, p.position_range)
-    out = np.abs(X1) >= d
-    R = R[: X1.shape[0] - 1]
-    zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
-    src = out[:-1] & ~zone
-    # sigma only at the samples a transition from outside the zones reads (k and k + 1
-    # of each such k); it is elementwise, so these values are those of the whole grid
-    need = np.zeros(X1.shape, dtype=bool)
-    need[:-1] = src
-    need[1:] |= src
-    sig = np.zeros(X1.shape)
-    sig[need] = switching_function(X1[need], X2[need], a, w)
-    s0, s1 = sig[:-1], sig[1:]
-    n_side = (s0 > 0) | ((s0 == 0) & (X2[:-1] > 0))
-    p_side = (s0 < 0) | ((s0 == 0) & (X2[:-1] < 0))
-    cross = (n_side & (s1 < -tol)) | (p_side & (s1 > tol))
-    return src & cross & out[1:], src & cross & ~out[1:]
+    f, cross, lands_out = _crossings(X1, X2, R, cfg)
+    shape = (X1.shape[0] - 1, X1.shape[1])
+    stride, into = np.zeros(shape, dtype=bool), np.zeros(shape, dtype=bool)
+    stride.ravel()[f[cross & lands_out]] = True
+    into.ravel()[f[cross & ~lands_out]] = True
+    return stride, into
+
+
+def stride_over_counts(
+    X1: np.ndarray,
+    X2: np.ndarray,
+    R: np.ndarray,  # noqa: N803
+    cfg: Config,
+) -> np.ndarray:
+    """Stride-overs of each trajectory: ``crossing_masks(...)[0].sum(axis=0)``, without the masks.
+
+    Parameters
+    ----------
+    X1, X2 : ndarray, shape (steps + 1, n)
+        States at the samples [mm], [mm/s].
+    R : ndarray, shape (steps, n) or (steps + 1, n)
+        Region codes of the samples.
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    ndarray of int, shape (n,)
+        Stride-overs per trajectory [-].
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> from ptoverify.laws import make_law
+    >>> from ptoverify.simulate import simulate_batch
+    >>> cfg = paper_config()
+    >>> b = simulate_batch(make_law("to", cfg), cfg.plant, [40.0, 5.0], [0.0, 0.0], 100)
+    >>> counts = stride_over_counts(b.x1, b.x2, b.region, cfg)
+    >>> counts.tolist() == crossing_masks(b.x1, b.x2, b.region, cfg)[0].sum(axis=0).tolist()
+    True
+    """
+    f, cross, lands_out = _crossings(X1, X2, R, cfg)
+    n = X1.shape[1]
+    return np.bincount(f[cross & lands_out] % n, minlength=n)
 
 
 def law_properties(

@@ -53,7 +53,7 @@ from ptoverify.laws import Law, make_law
 from ptoverify.mintime import min_time
 from ptoverify.plant import zoh_matrices
 from ptoverify.poles import sampled_spectral_radius
-from ptoverify.properties import crossing_masks, oscillating
+from ptoverify.properties import oscillating, stride_over_counts
 from ptoverify.reach import zonotope_steps_each
 from ptoverify.simulate import BatchResult, Mismatch, simulate_batch, simulate_laws
 from ptoverify.sweep import settle_steps
@@ -251,16 +251,17 @@ def _measure(
     """
     n = x1.size
     steps = b.x1.shape[0] - 1
-    stride, _ = crossing_masks(b.x1, b.x2, b.region, cfg)
     window = max(20, steps // 4)
     tail = b.x1[-window:]
     osc = oscillating(tail, 1e-3)
     amp = np.where(osc, np.abs(tail).max(axis=0), 0.0)
-    rest = (x2 == 0.0) & (np.abs(x1) >= cfg.pto.d) & (x1 != 0.0)
-    over = (-np.sign(x1)[None, :] * b.x1).max(axis=0)
-    over = np.where(rest, np.maximum(over, 0.0), np.nan)
+    rest = np.flatnonzero((x2 == 0.0) & (np.abs(x1) >= cfg.pto.d) & (x1 != 0.0))
+    over = np.full(n, np.nan)
+    if rest.size:  # the largest excursion beyond the origin, on the side opposite to x1_0
+        run = b.x1[:, rest] if rest.size < n else b.x1
+        over[rest] = np.maximum((-np.sign(x1[rest])[None, :] * run).max(axis=0), 0.0)
     out = {
-        "stride_overs": stride.sum(axis=0).astype(float),
+        "stride_overs": stride_over_counts(b.x1, b.x2, b.region, cfg).astype(float),
         "limit_cycle_mm": amp,
         "overshoot_mm": over,
     }
@@ -269,12 +270,14 @@ def _measure(
         return out
     T = cfg.plant.sample_time
     hold = math.ceil(SETTLE_HOLD_S / T - 1e-9)
-    k = settle_steps(b.x1, b.x2, SETTLE_BAND_MM, cfg.plant.a * SETTLE_BAND_MM, hold)
+    sel = np.flatnonzero(need)
+    x1s, x2s = (b.x1, b.x2) if sel.size == n else (b.x1[:, sel], b.x2[:, sel])
+    k = np.full(n, -1)
+    k[sel] = settle_steps(x1s, x2s, SETTLE_BAND_MM, cfg.plant.a * SETTLE_BAND_MM, hold)
     settle = np.where(k >= 0, k * T, np.inf)
     ar = np.broadcast_to(np.asarray(mismatch.a_ratio, dtype=float), (n,))
     wr = np.broadcast_to(np.asarray(mismatch.w_max_ratio, dtype=float), (n,))
     n_star = np.full(n, np.nan)
-    sel = np.flatnonzero(need)
     n_star[sel] = _n_star(x1[sel], x2[sel], ar[sel], wr[sel], cfg.plant)
     with np.errstate(divide="ignore", invalid="ignore"):
         out["settling_s"] = np.where(need, settle, np.nan)
