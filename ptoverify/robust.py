@@ -780,6 +780,18 @@ POLISH_ROUNDS = 4  #: rounds of the batched local polish
 POLISH_STEP = 0.05  #: first polish step, as a fraction of each variable's range (halved per round)
 
 
+def _distinct_others(rng: np.random.Generator, n_pop: int, k: int) -> NDArray[np.int64]:
+    """Per member i, ``k`` distinct other members: ``rng.choice`` of the others, draw for draw.
+
+    ``rng.choice(n_pop - 1, k, replace=False)`` draws exactly what
+    ``rng.choice(np.delete(np.arange(n_pop), i), k, replace=False)`` draws (the
+    choice depends only on the population size), shifted past i.
+    """
+    out = np.array([rng.choice(n_pop - 1, k, replace=False) for _ in range(n_pop)])
+    out += out >= np.arange(n_pop)[:, None]
+    return out
+
+
 def _box_bounds(cfg: Config, prop: str) -> tuple[NDArray, NDArray]:
     """Bounds of (x1 [mm], x2 [mm/s], a_ratio, w_max_ratio) searched for ``prop``."""
     box, p = cfg.robustness, cfg.plant
@@ -951,16 +963,11 @@ def _de_search(cfg: Config, starts: dict[str, list[dict[str, Any]]], s: RobustSe
         for pop, f, (lo, hi) in zip(pops, fit, bounds, strict=True):
             n_pop = len(pop)
             b = pop[int(np.argmax(f))] if DE_STRATEGY == "best1bin" else None
-            r = np.array(
-                [rng.choice(np.delete(np.arange(n_pop), i), 2, replace=False) for i in range(n_pop)]
-            )
+            # the best/1 donors are drawn whatever the strategy (the seeded stream stays
+            # that of the published runs), then rand/1's three
+            r = _distinct_others(rng, n_pop, 2)
             if b is None:
-                r = np.array(
-                    [
-                        rng.choice(np.delete(np.arange(n_pop), i), 3, replace=False)
-                        for i in range(n_pop)
-                    ]
-                )
+                r = _distinct_others(rng, n_pop, 3)
                 mutant = pop[r[:, 2]] + f_weight * (pop[r[:, 0]] - pop[r[:, 1]])
             else:
                 mutant = b + f_weight * (pop[r[:, 0]] - pop[r[:, 1]])
