@@ -203,15 +203,27 @@ def oscillating(x1: np.ndarray, band: float) -> np.ndarray:
     >>> oscillating(np.sin(0.3 * t), 1e-3).tolist(), oscillating(np.exp(-0.1 * t), 1e-3).tolist()
     ([True], [False])
     """
-    big = np.abs(x1) > band
-    sgn = np.where(big, np.sign(x1), 0.0)
-    # carry the last nonzero sign forward so that small samples do not count
-    idx = np.where(big, np.arange(x1.shape[0])[:, None], 0)
-    np.maximum.accumulate(idx, axis=0, out=idx)
-    carried = np.take_along_axis(sgn, idx, axis=0)
-    changes = np.sum((carried[1:] * carried[:-1]) < 0, axis=0)
+    W = x1.shape[0]  # noqa: N806
+    pos = x1 > band
+    big = x1 < -band
+    big |= pos
+    # carry the sign of the last sample beyond the band forward, so that small samples
+    # do not count: code 2 (k + 1) + [x1_k > 0] at such samples, 0 elsewhere, carried
+    # by a running maximum (0: none yet; its parity: the sign)
+    code = big.astype(np.int16 if 2 * W + 2 < 2**15 else np.int64)
+    code *= (2 * np.arange(1, W + 1, dtype=code.dtype))[:, None]
+    code += pos
+    for k in range(1, W):  # row by row: contiguous, unlike accumulate along axis 0
+        np.maximum(code[k], code[k - 1], out=code[k])
+    flips = code[1:] != 0
+    flips &= code[:-1] != 0
+    parity = code[1:] ^ code[:-1]
+    parity &= 1
+    flips &= parity.astype(bool)
+    changes = np.count_nonzero(flips, axis=0)
     half = x1.shape[0] // 2
-    first, second = np.abs(x1[:half]).max(axis=0), np.abs(x1[half:]).max(axis=0)
+    ax = np.abs(x1)
+    first, second = ax[:half].max(axis=0), ax[half:].max(axis=0)
     return (changes >= 4) & (second > band) & (second >= 0.5 * first)
 
 
@@ -233,7 +245,8 @@ def _crossings(
     a, w, d = p.a, p.w_max, cfg.pto.d
     tol = tie_band(w, a, p.position_range)
     n = X1.shape[1]
-    out = np.abs(X1) >= d
+    out = X1 >= d  # |x1| >= d, without a float temporary of the whole grid
+    out |= X1 <= -d
     R = R[: X1.shape[0] - 1]
     zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
     f = np.flatnonzero(out[:-1] & ~zone)
