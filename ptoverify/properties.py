@@ -248,7 +248,10 @@ def _crossings(
     out = X1 >= d  # |x1| >= d, without a float temporary of the whole grid
     out |= X1 <= -d
     R = R[: X1.shape[0] - 1]
-    zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
+    if R.dtype == np.int8 and Region.ZONE_N == Region.ZONE_P + 1:  # one pass: R in {P, N}
+        zone = (R - np.int8(Region.ZONE_P)).view(np.uint8) <= 1
+    else:
+        zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
     f = np.flatnonzero(out[:-1] & ~zone)
     x1, x2 = np.ravel(X1), np.ravel(X2)
     ends = np.concatenate([f, f + n])
