@@ -232,19 +232,18 @@ def _crossings(
     X2: np.ndarray,  # noqa: N803
     R: np.ndarray,  # noqa: N803
     cfg: Config,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Find the transitions that cross l1 - o - l2 (see :func:`crossing_masks`), compressed.
 
-    Returns the flat indices f into the (steps, n) transition grid of the
-    transitions that start outside the zones and the linear zone, whether each
-    crosses, and whether it lands outside the linear zone.  sigma is evaluated
-    only at the two ends of these transitions (it is elementwise, so the values
-    are those of the whole grid).
+    Returns the sample k and trajectory j of each transition k -> k + 1 that
+    starts outside the zones and the linear zone, whether it crosses, and whether
+    it lands outside the linear zone.  sigma is evaluated only at the two ends of
+    these transitions (it is elementwise, so the values are those of the whole grid).
+    Views of larger arrays are read in place.
     """
     p = cfg.plant
     a, w, d = p.a, p.w_max, cfg.pto.d
     tol = tie_band(w, a, p.position_range)
-    n = X1.shape[1]
     out = X1 >= d  # |x1| >= d, without a float temporary of the whole grid
     out |= X1 <= -d
     R = R[: X1.shape[0] - 1]
@@ -252,15 +251,18 @@ def _crossings(
         zone = (R - np.int8(Region.ZONE_P)).view(np.uint8) <= 1
     else:
         zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
-    f = np.flatnonzero(out[:-1] & ~zone)
-    x1, x2 = np.ravel(X1), np.ravel(X2)
-    ends = np.concatenate([f, f + n])
-    sig = switching_function(x1[ends], x2[ends], a, w)
-    s0, s1, v0 = sig[: f.size], sig[f.size :], x2[f]
+    src = out[:-1]
+    src &= ~zone
+    f = np.flatnonzero(src)  # src is a fresh C-ordered array: flat index k n + j
+    k, j = np.divmod(f, X1.shape[1])
+    k1 = k + 1
+    v0 = X2[k, j]
+    s0 = switching_function(X1[k, j], v0, a, w)
+    s1 = switching_function(X1[k1, j], X2[k1, j], a, w)
     n_side = (s0 > 0) | ((s0 == 0) & (v0 > 0))
     p_side = (s0 < 0) | ((s0 == 0) & (v0 < 0))
     cross = (n_side & (s1 < -tol)) | (p_side & (s1 > tol))
-    return f, cross, np.ravel(out)[f + n]
+    return k, j, cross, out[k1, j]
 
 
 def crossing_masks(
@@ -288,11 +290,13 @@ def crossing_masks(
     -------
     stride, into_linear : ndarray of bool, shape (steps, n)
     """
-    f, cross, lands_out = _crossings(X1, X2, R, cfg)
+    k, j, cross, lands_out = _crossings(X1, X2, R, cfg)
     shape = (X1.shape[0] - 1, X1.shape[1])
     stride, into = np.zeros(shape, dtype=bool), np.zeros(shape, dtype=bool)
-    stride.ravel()[f[cross & lands_out]] = True
-    into.ravel()[f[cross & ~lands_out]] = True
+    hit = cross & lands_out
+    stride[k[hit], j[hit]] = True
+    hit = cross & ~lands_out
+    into[k[hit], j[hit]] = True
     return stride, into
 
 
@@ -329,9 +333,8 @@ def stride_over_counts(
     >>> counts.tolist() == crossing_masks(b.x1, b.x2, b.region, cfg)[0].sum(axis=0).tolist()
     True
     """
-    f, cross, lands_out = _crossings(X1, X2, R, cfg)
-    n = X1.shape[1]
-    return np.bincount(f[cross & lands_out] % n, minlength=n)
+    _, j, cross, lands_out = _crossings(X1, X2, R, cfg)
+    return np.bincount(j[cross & lands_out], minlength=X1.shape[1])
 
 
 def law_properties(

@@ -50,12 +50,13 @@ from scipy.stats import qmc
 from ptoverify.config import Config, Plant
 from ptoverify.errors import ClusterError, InputError
 from ptoverify.laws import Law, make_law
+from ptoverify.lockstep import Ask, Job, run_lockstep
 from ptoverify.mintime import min_time
 from ptoverify.plant import zoh_matrices
 from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import oscillating, stride_over_counts
 from ptoverify.reach import zonotope_steps_each
-from ptoverify.simulate import BatchResult, Mismatch, simulate_batch, simulate_laws
+from ptoverify.simulate import BatchResult, Mismatch, simulate_batch
 from ptoverify.sweep import settle_steps
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED, Verdict
 
@@ -356,6 +357,48 @@ def _summarize(props: dict[str, NDArray], x1: NDArray, x2: NDArray) -> dict[str,
     return summary
 
 
+def _maps_job(
+    fn: Law,
+    cfg: Config,
+    x1: NDArray,
+    x2: NDArray,
+    ars: list[float],
+    wrs: list[float],
+    delays: list[int],
+) -> Job:
+    """Every map cell of one law (a :mod:`ptoverify.lockstep` job returning the cells).
+
+    All (delay, w, a) cells times all states in one ask per :data:`BATCH_STATES`
+    states, each state with its cell's a_ratio, w_max_ratio and delay; cells in
+    the order delay, w_max_ratio, a_ratio.
+    """
+    box = cfg.robustness
+    cells = [(int(dl), float(wr), float(ar)) for dl in delays for wr in wrs for ar in ars]
+    n = x1.size
+    parts = [[cells[i] for i in group] for group in _groups(len(cells), n)]
+    asks = []
+    for part in parts:
+        m = Mismatch(
+            a_ratio=np.repeat([ar for _, _, ar in part], n),
+            w_max_ratio=np.repeat([wr for _, wr, _ in part], n),
+            delay_samples=np.repeat([dl for dl, _, _ in part], n),
+            position_quantum=box.position_quantum,
+            velocity_noise=box.velocity_noise,
+            seed=box.seed,
+        )
+        asks.append(Ask(fn, np.tile(x1, len(part)), np.tile(x2, len(part)), m, stage="maps"))
+    batches = yield asks
+    out = []
+    for part, ask, batch in zip(parts, asks, batches, strict=True):
+        props = _measure(batch, cfg, ask.x1, ask.x2, ask.mismatch, True, with_tf=False)
+        for i, (dl, wr, ar) in enumerate(part):
+            cell = {k: v[i * n : (i + 1) * n] for k, v in props.items()}
+            out.append(
+                {"a_ratio": ar, "w_max_ratio": wr, "delay_samples": dl} | _summarize(cell, x1, x2)
+            )
+    return out
+
+
 def _map_task(
     law: LawSpec,
     cfg: Config,
@@ -365,39 +408,21 @@ def _map_task(
     wrs: list[float],
     delays: list[int],
 ) -> list[dict[str, Any]]:
-    """Every cell of one law: all (delay, w, a) cells times all states in one batch.
+    """Every cell of one law (:func:`_maps_job` run alone).
 
     A picklable task (the unit :func:`dask_runner` distributes); cells in the
-    order delay, w_max_ratio, a_ratio.  One batch simulation (per
-    :data:`BATCH_STATES` states), each state with its cell's a_ratio,
-    w_max_ratio and delay, since the per-sample cost of a small batch is mostly
-    fixed overhead.
+    order delay, w_max_ratio, a_ratio.
     """
+    job = _maps_job(_law(law, cfg), cfg, x1, x2, ars, wrs, delays)
+    return run_lockstep([job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES).results[0]
+
+
+def _map_axes(cfg: Config, s: RobustSettings) -> tuple[list[float], list[float], list[int]]:
+    """Return the perturbation grid of the maps: a_ratio, w_max_ratio and delay values."""
     box = cfg.robustness
-    cells = [(int(dl), float(wr), float(ar)) for dl in delays for wr in wrs for ar in ars]
-    n = x1.size
-    fn = _law(law, cfg)
-    steps = horizon_steps(cfg)
-    out = []
-    for group in _groups(len(cells), n):
-        part = [cells[i] for i in group]
-        m = Mismatch(
-            a_ratio=np.repeat([ar for _, _, ar in part], n),
-            w_max_ratio=np.repeat([wr for _, wr, _ in part], n),
-            delay_samples=np.repeat([dl for dl, _, _ in part], n),
-            position_quantum=box.position_quantum,
-            velocity_noise=box.velocity_noise,
-            seed=box.seed,
-        )
-        b1, b2 = np.tile(x1, len(part)), np.tile(x2, len(part))
-        batch = simulate_batch(fn, cfg.plant, b1, b2, steps, mismatch=m)
-        props = _measure(batch, cfg, b1, b2, m, True, with_tf=False)
-        for i, (dl, wr, ar) in enumerate(part):
-            cell = {k: v[i * n : (i + 1) * n] for k, v in props.items()}
-            out.append(
-                {"a_ratio": ar, "w_max_ratio": wr, "delay_samples": dl} | _summarize(cell, x1, x2)
-            )
-    return out
+    ars = _ratio_grid(*box.a_ratio, s.n_a).tolist()
+    wrs = _ratio_grid(*box.w_max_ratio, s.n_w).tolist()
+    return ars, wrs, list(range(box.delay_samples[0], box.delay_samples[1] + 1))
 
 
 BATCH_STATES = 16384  #: largest batch simulated at once (memory: ~4 x 8 bytes x states x horizon)
@@ -440,19 +465,21 @@ def robust_maps(
         in the order delay, w_max_ratio, a_ratio.
     """
     s = settings or RobustSettings()
-    box = cfg.robustness
-    ars = _ratio_grid(*box.a_ratio, s.n_a)
-    wrs = _ratio_grid(*box.w_max_ratio, s.n_w)
-    delays = list(range(box.delay_samples[0], box.delay_samples[1] + 1))
+    ars, wrs, delays = _map_axes(cfg, s)
     x1, x2 = map_states(cfg, s)
-    tasks = [(law, cfg, x1, x2, ars.tolist(), wrs.tolist(), delays) for law in s.laws]
+    tasks = [(law, cfg, x1, x2, ars, wrs, delays) for law in s.laws]
     run = runner or (lambda ts: [_map_task(*t) for t in ts])
-    laws = dict(zip(s.laws, run(tasks), strict=True))
+    return _maps_dict(cfg, s, dict(zip(s.laws, run(tasks), strict=True)))
+
+
+def _maps_dict(cfg: Config, s: RobustSettings, laws: dict) -> dict[str, Any]:
+    """Build the ``maps`` object: the grid axes, the states per cell, each law's cells."""
+    ars, wrs, delays = _map_axes(cfg, s)
     return {
-        "a_ratio": ars.tolist(),
-        "w_max_ratio": wrs.tolist(),
+        "a_ratio": ars,
+        "w_max_ratio": wrs,
         "delay_samples": delays,
-        "states": int(x1.size),
+        "states": int(map_states(cfg, s)[0].size),
         "laws": laws,
     }
 
@@ -637,8 +664,8 @@ def no_limit_cycle_margin(
     Saturation, delay and measurement stay nominal (ratio 1, no delay, exact
     measurement) so the interval isolates the bandwidth error.  The property is
     checked on the map's state grid; the endpoints come from a 40-point
-    geometric scan of each side then a 16-section of the bracket to ``rtol``
-    relative, every ratio of a round in one batch simulation.
+    geometric scan of each side (stopping at its first failure) then a
+    16-section of the bracket to ``rtol`` relative (:func:`_edges`).
 
     Parameters
     ----------
@@ -658,65 +685,82 @@ def no_limit_cycle_margin(
         or ``None`` with a note when the nominal loop already has a limit cycle.
     """
     s = settings or RobustSettings()
+    job = _margin_job(_law(law, cfg), cfg, s, rtol=rtol)
+    return run_lockstep([job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES).results[0]
+
+
+SCAN_CHUNK = 8  #: scan points of each side tested per step of :func:`_edges`
+MARGIN_ASK_RATIOS = 16  #: ratios per simulation ask of a margin (so it rides beside others)
+
+
+def _margin_job(fn: Law, cfg: Config, s: RobustSettings, *, rtol: float = 1e-3) -> Job:
+    """:func:`no_limit_cycle_margin` as a :mod:`ptoverify.lockstep` job (its asks ride along)."""
     x1, x2 = map_states(cfg, s)
+    n = x1.size
 
-    fn, steps = _law(law, cfg), horizon_steps(cfg)
-
-    def clean(ratios: NDArray) -> NDArray[np.bool_]:
-        """No limit cycle from any grid state, for each ratio: few batches for all."""
-        out = np.empty(ratios.size, dtype=bool)
-        for g in _groups(ratios.size, x1.size):
-            r = ratios[g.start : g.stop]
-            m = Mismatch(a_ratio=np.repeat(r, x1.size))
-            b = simulate_batch(
-                fn, cfg.plant, np.tile(x1, r.size), np.tile(x2, r.size), steps, mismatch=m
+    def clean(ratios: NDArray) -> Generator[list[Ask], list[BatchResult], NDArray[np.bool_]]:
+        """No limit cycle from any grid state, for each ratio."""
+        parts = [
+            ratios[i : i + MARGIN_ASK_RATIOS] for i in range(0, ratios.size, MARGIN_ASK_RATIOS)
+        ]
+        asks = [
+            Ask(
+                fn,
+                np.tile(x1, r.size),
+                np.tile(x2, r.size),
+                Mismatch(a_ratio=np.repeat(r, n)),
+                rider=True,
+                stage="margins",
             )
-            lc = _limit_cycle_mm(b.x1).reshape(r.size, x1.size)  # the property, measured alone
-            out[g.start : g.stop] = ~(lc > 0).any(axis=1)
-        return out
+            for r in parts
+        ]
+        batches = yield asks
+        lc = [_limit_cycle_mm(b.x1).reshape(-1, n) for b in batches]  # the property alone
+        return ~(np.concatenate(lc) > 0).any(axis=1)
 
-    if not clean(np.array([1.0]))[0]:
+    if not (yield from clean(np.array([1.0])))[0]:
         return {"no_limit_cycle_a_ratio": None, "no_limit_cycle_note": "limit cycles nominally"}
-    lo, hi = _edges_batched(clean, grid=40, rtol=rtol)
-    return {"no_limit_cycle_a_ratio": [lo, hi], "no_limit_cycle_note": ""}
+    edges = _edges(grid=40, rtol=rtol)
+    ratios = next(edges)
+    while True:
+        flags = yield from clean(ratios)
+        try:
+            ratios = edges.send(flags)
+        except StopIteration as stop:
+            lo, hi = stop.value
+            return {"no_limit_cycle_a_ratio": [lo, hi], "no_limit_cycle_note": ""}
 
 
-SCAN_FIRST = 8  #: points of each side's scan tested in the first call of :func:`_edges_batched`
+def _edges(
+    *, grid: int, rtol: float, split: int = 16, chunk: int = SCAN_CHUNK
+) -> Generator[NDArray, NDArray[np.bool_], tuple[float | None, float | None]]:
+    """Both edges of a property around 1 within :data:`MARGIN_RANGE` (a coroutine).
 
-
-def _edges_batched(
-    ok: Callable[[NDArray], NDArray[np.bool_]],
-    *,
-    grid: int,
-    rtol: float,
-    split: int = 16,
-    first: int = SCAN_FIRST,
-) -> tuple[float | None, float | None]:
-    """Both edges of ``ok`` around 1 within :data:`MARGIN_RANGE`, a batch per round.
-
-    The same edge as :func:`_edge` (the first failing point of a ``grid``-point
-    geometric scan from 1 outward, then the bracket narrowed to ``rtol``), but
-    the scan of both sides takes two calls of ``ok``: the ``first`` points of
-    each side nearest 1, then the rest of each side that has not failed yet (a
-    point beyond a side's first failure cannot change its edge, so it is not
-    tested); and each narrowing round tests ``split - 1`` interior points of
-    both brackets at once (the bracket shrinks ``split``-fold per round instead
-    of 2-fold per call).
+    Yields arrays of ratios, is sent whether the property holds at each, and
+    returns the two edges.  The same edge as :func:`_edge`: the first failing
+    point of a ``grid``-point geometric scan from 1 outward, then the bracket
+    narrowed to ``rtol``.  The scan advances both sides ``chunk`` points at a
+    time and stops a side at its first failure (a point beyond it cannot change
+    the edge, so it is not tested); each narrowing round tests ``split - 1``
+    interior points of every bracket at once (the bracket shrinks ``split``-fold
+    per round instead of 2-fold per test).
     """
     sides = [np.geomspace(1.0, end, grid)[1:] for end in MARGIN_RANGE]
     bad_at: list[int | None] = [None, None]
-    for lo_i, hi_i in ((0, first), (first, None)):
-        todo = [i for i in (0, 1) if bad_at[i] is None and sides[i][lo_i:hi_i].size]
+    at = 0
+    while True:
+        todo = [i for i in (0, 1) if bad_at[i] is None and at < sides[i].size]
         if not todo:
             break
-        chunks = [sides[i][lo_i:hi_i] for i in todo]
-        flags = ok(np.concatenate(chunks))
-        at = 0
+        chunks = [sides[i][at : at + chunk] for i in todo]
+        flags = yield np.concatenate(chunks)
+        pos = 0
         for i, c in zip(todo, chunks, strict=True):
-            bad = np.flatnonzero(~flags[at : at + c.size])
-            at += c.size
+            bad = np.flatnonzero(~flags[pos : pos + c.size])
+            pos += c.size
             if bad.size:
-                bad_at[i] = lo_i + int(bad[0])
+                bad_at[i] = at + int(bad[0])
+        at += chunk
     brackets: list[list[float] | None] = []
     for pts, j in zip(sides, bad_at, strict=True):
         brackets.append(
@@ -726,7 +770,7 @@ def _edges_batched(
     while any(abs(b[1] - b[0]) > rtol * min(abs(b[0]), abs(b[1])) for b in live):
         # geometric interior points of each bracket, from its ok end to its failing end
         inner = [b[0] * (b[1] / b[0]) ** (np.arange(1, split) / split) for b in live]
-        f = ok(np.concatenate(inner))
+        f = yield np.concatenate(inner)
         for k, b in enumerate(live):
             fk = f[k * (split - 1) : (k + 1) * (split - 1)]
             bad = np.flatnonzero(~fk)
@@ -850,7 +894,10 @@ def worst_cases(
         and ``params`` (with the full mismatch: quantum, noise, seed),
         ``evaluations`` (trajectories simulated by this search, all properties).
     """
-    return _worst_cases_lockstep(cfg, [(law, starts)], settings)[0]
+    s = settings or RobustSettings()
+    job = _searches_job([_law(law, cfg)], cfg, [starts], s)
+    run = run_lockstep([job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES)
+    return run.results[0][0]
 
 
 #: A search coroutine: yields (candidates (S, 4), delays (S,), settle mask (S,)), is sent
@@ -858,55 +905,107 @@ def worst_cases(
 _Search = Generator[tuple[NDArray, NDArray, NDArray], dict[str, NDArray], dict[str, Any]]
 
 
-def _worst_cases_lockstep(
+def _searches_job(
+    fns: list[Law],
     cfg: Config,
-    searches: list[tuple[LawSpec, dict[str, list[dict[str, Any]]]]],
-    settings: RobustSettings | None = None,
-) -> list[dict[str, dict[str, Any]]]:
-    """:func:`worst_cases` of several laws, advanced together.
+    starts: list[dict[str, list[dict[str, Any]]]],
+    s: RobustSettings,
+) -> Job:
+    """Run the worst-case searches of several laws as one :mod:`ptoverify.lockstep` job.
 
-    Each law's search is its own coroutine (:func:`_de_search`, its own seeded
-    generator, so its result does not depend on the other searches); at each
-    step every law's candidates run in one simulation
-    (:func:`ptoverify.simulate.simulate_laws`) and one measurement, so the
-    per-sample overhead of a small batch is paid once for all laws.
+    Each law's search is its own coroutine (:func:`_de_search`, with its own
+    seeded generator, so its result does not depend on the others); at each
+    step every law's candidates are one ask and all are measured together.
+    Returns the list of :func:`worst_cases` results, in the order of ``fns``.
     """
-    s = settings or RobustSettings()
     box = cfg.robustness
-    steps = horizon_steps(cfg)
-    laws = [_law(spec, cfg) for spec, _ in searches]
-    gens = [_de_search(cfg, starts, s) for _, starts in searches]
-    results: list[dict[str, dict[str, Any]] | None] = [None] * len(gens)
-    asks: list[Any] = [None] * len(gens)
-
-    def advance(i: int, sent: dict[str, NDArray] | None) -> None:
-        try:
-            asks[i] = next(gens[i]) if sent is None else gens[i].send(sent)
-        except StopIteration as done:
-            results[i], asks[i] = done.value, None
-
-    for i in range(len(gens)):
-        advance(i, None)
-    while live := [i for i in range(len(gens)) if asks[i] is not None]:
-        Z = np.concatenate([asks[i][0] for i in live])  # noqa: N806
-        counts = [len(asks[i][0]) for i in live]
+    searches = [_de_search(cfg, st, s) for st in starts]
+    results: list[Any] = [None] * len(searches)
+    sent: list[dict[str, NDArray] | None] = [None] * len(searches)
+    live = list(range(len(searches)))
+    while True:
+        asked = []
+        for i in live:
+            try:
+                z, delay, settle = (
+                    next(searches[i]) if sent[i] is None else searches[i].send(sent[i])
+                )
+            except StopIteration as stop:
+                results[i] = stop.value
+                continue
+            asked.append((i, z, delay, settle))
+        if not asked:
+            return results
+        live = [i for i, *_ in asked]
+        Z = np.concatenate([z for _, z, _, _ in asked])  # noqa: N806
         m = Mismatch(
             a_ratio=Z[:, 2],
             w_max_ratio=Z[:, 3],
-            delay_samples=np.concatenate([asks[i][1] for i in live]),
+            delay_samples=np.concatenate([d for _, _, d, _ in asked]),
             position_quantum=box.position_quantum,
             velocity_noise=box.velocity_noise,
             seed=box.seed,
         )
-        batch = simulate_laws(
-            [laws[i] for i in live], counts, cfg.plant, Z[:, 0], Z[:, 1], steps, mismatch=m
+        x1, x2 = Z[:, 0].copy(), Z[:, 1].copy()
+        edges = np.cumsum([0, *(len(z) for _, z, _, _ in asked)]).tolist()
+        asks = []
+        for (i, z, delay, _), lo, hi in zip(asked, edges[:-1], edges[1:], strict=True):
+            part = Mismatch(
+                a_ratio=Z[lo:hi, 2],
+                w_max_ratio=Z[lo:hi, 3],
+                delay_samples=delay,
+                position_quantum=box.position_quantum,
+                velocity_noise=box.velocity_noise,
+                seed=box.seed,
+            )
+            asks.append(Ask(fns[i], x1[lo:hi], x2[lo:hi], part, stage="worst_case"))
+        batches = yield asks
+        both = BatchResult(
+            *(
+                np.concatenate([getattr(b, f) for b in batches], axis=1)
+                for f in ("x1", "x2", "u", "region")
+            )
         )
-        settle = np.concatenate([asks[i][2] for i in live])
-        out = _measure(batch, cfg, Z[:, 0], Z[:, 1], m, settle, with_tf=False)
-        edges = np.cumsum([0, *counts])
-        for j, i in enumerate(live):
-            advance(i, {k: v[edges[j] : edges[j + 1]] for k, v in out.items()})
-    return results  # type: ignore[return-value]
+        out = _measure(
+            both, cfg, x1, x2, m, np.concatenate([st for *_, st in asked]), with_tf=False
+        )
+        for (i, *_), lo, hi in zip(asked, edges[:-1], edges[1:], strict=True):
+            sent[i] = {k: v[lo:hi] for k, v in out.items()}
+
+
+def _together(jobs: list[Job]) -> Job:
+    """Run several jobs as one: each step asks what all live jobs ask; returns their results."""
+    results: list[Any] = [None] * len(jobs)
+    sent: list[Any] = [None] * len(jobs)
+    live = list(range(len(jobs)))
+    while True:
+        asked = []
+        for i in live:
+            try:
+                asked.append((i, next(jobs[i]) if sent[i] is None else jobs[i].send(sent[i])))
+            except StopIteration as stop:
+                results[i] = stop.value
+        if not asked:
+            return results
+        live = [i for i, _ in asked]
+        batches = yield [a for _, asks in asked for a in asks]
+        at = 0
+        for i, asks in asked:
+            sent[i] = batches[at : at + len(asks)]
+            at += len(asks)
+
+
+def _study_job(
+    fns: list[Law], cfg: Config, s: RobustSettings, cells: list[list[dict[str, Any]]] | None
+) -> Job:
+    """Every law's maps (unless given), then their worst-case searches: (cells, worst) per law."""
+    if cells is None:
+        x1, x2 = map_states(cfg, s)
+        axes = _map_axes(cfg, s)
+        cells = yield from _together([_maps_job(fn, cfg, x1, x2, *axes) for fn in fns])
+    starts = [{prop: grid_worst(c, prop) for prop in s.properties} for c in cells]
+    worst = yield from _searches_job(fns, cfg, starts, s)
+    return list(zip(cells, worst, strict=True))
 
 
 def _de_search(cfg: Config, starts: dict[str, list[dict[str, Any]]], s: RobustSettings) -> _Search:
@@ -1172,32 +1271,47 @@ def run_robust(
     report = progress or (lambda stage, frac: None)
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    report("maps", 0.0)
-    maps = robust_maps(cfg, s, runner=dask_runner(dask) if dask else None)
-    timings["maps"] = time.perf_counter() - t0
-    t1 = time.perf_counter()
-    report("margins", 0.4)
-    margins = (
-        {
-            law: {
-                **linear_loop_margin(law, cfg),
-                **linear_loop_margin(law, cfg, delay_samples=1),
-                **no_limit_cycle_margin(law, cfg, s),
-            }
-            for law in s.laws
+    report("margins", 0.0)
+    linear = {
+        law: {
+            **linear_loop_margin(law, cfg),
+            **linear_loop_margin(law, cfg, delay_samples=1),
         }
-        if s.margins
-        else {}
-    )
-    timings["margins"] = time.perf_counter() - t1
-    t2 = time.perf_counter()
-    report("worst cases", 0.5)
-    searches = [
-        (law, {prop: grid_worst(maps["laws"][law], prop) for prop in s.properties})
         for law in s.laws
-    ]
-    worst = dict(zip(s.laws, _worst_cases_lockstep(cfg, searches, s), strict=True))
-    timings["worst_case"] = time.perf_counter() - t2
+    }
+    t_linear = time.perf_counter() - t0
+    cells: dict[Any, list[dict[str, Any]]] = {}
+    if dask:
+        report("maps", 0.05)
+        t1 = time.perf_counter()
+        cells = robust_maps(cfg, s, runner=dask_runner(dask))["laws"]
+        timings["maps"] = time.perf_counter() - t1
+    # every law's maps, search and margin scan advance together: one simulation per
+    # round, in which the margin scans ride along (ptoverify.lockstep)
+    fns = [_law(law, cfg) for law in s.laws]
+    given = [cells[law] for law in s.laws] if dask else None
+    jobs = [_study_job(fns, cfg, s, given)]
+    if s.margins:
+        jobs += [_margin_job(fn, cfg, s) for fn in fns]
+    run = run_lockstep(
+        jobs,
+        cfg.plant,
+        horizon_steps(cfg),
+        round_states=BATCH_STATES,
+        on_round=lambda r, done, total: report(
+            "maps, margins, worst cases", 0.1 + 0.9 * done / total
+        ),
+    )
+    study = run.results[0]
+    maps = _maps_dict(cfg, s, {law: study[i][0] for i, law in enumerate(s.laws)})
+    worst = {law: study[i][1] for i, law in enumerate(s.laws)}
+    margins = (
+        {law: linear[law] | run.results[1 + i] for i, law in enumerate(s.laws)} if s.margins else {}
+    )
+    if not dask:
+        timings["maps"] = run.seconds.get("maps", 0.0)
+    timings["margins"] = (t_linear if s.margins else 0.0) + run.seconds.get("margins", 0.0)
+    timings["worst_case"] = run.seconds.get("worst_case", 0.0)
     timings["total"] = time.perf_counter() - t0
     return RobustResult(cfg, s, maps, margins, worst, timings, dask or "in-process")
 

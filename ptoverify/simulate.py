@@ -48,7 +48,7 @@ __all__ = [
     "BatchResult",
     "Mismatch",
     "simulate_batch",
-    "simulate_laws",
+    "simulate_segments",
 ]
 
 
@@ -573,8 +573,9 @@ def simulate_batch(
     (True, True)
     """
     if mismatch is not None and not mismatch.is_identity:
-        x1 = np.atleast_1d(np.asarray(x1, dtype=float))
-        return _simulate_mismatch([(law, slice(None))], plant, x1, x2, steps, mismatch)
+        return replace(
+            _simulate_mismatch([(law, x1, x2, mismatch)], plant, steps), mismatch=mismatch
+        )
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     x2 = np.atleast_1d(np.asarray(x2, dtype=float))
     n = x1.shape[0]
@@ -597,42 +598,33 @@ def simulate_batch(
     return BatchResult(X1, X2, U, R, mismatch)
 
 
-def simulate_laws(
-    laws: list[Law],
-    counts: list[int],
-    plant: Plant,
-    x1: ArrayLike,
-    x2: ArrayLike,
-    steps: int,
-    *,
-    mismatch: Mismatch | None = None,
-) -> BatchResult:
-    """:func:`simulate_batch` of several laws in one run: law i drives the next counts[i] states.
+Segment = tuple[Law, ArrayLike, ArrayLike, Mismatch | None]
+"""One group of :func:`simulate_segments`: (law, x1 [mm], x2 [mm/s], mismatch)."""
 
-    Each state's trajectory is the one :func:`simulate_batch` gives for its own law
-    (bit for bit): the laws are evaluated on their own states at each sample and
-    the true plant is advanced for all states at once, so many small batches of
-    different laws cost one run's per-sample overhead.
+
+def simulate_segments(segments: list[Segment], plant: Plant, steps: int) -> BatchResult:
+    """Run several :func:`simulate_batch` calls as one: each segment its law, states and mismatch.
+
+    Each state's trajectory is bit for bit the one ``simulate_batch(law, plant, x1,
+    x2, steps, mismatch=mismatch)`` gives for its segment (a segment with no or the
+    identity mismatch is the nominal loop), but the samples are advanced for all
+    states at once and consecutive segments of the same law share one evaluation
+    of it per sample, so many small batches cost one run's per-sample overhead.
 
     Parameters
     ----------
-    laws : list of Law
-        Feedback laws (their vectorized paths).
-    counts : list of int
-        States per law, in order; they sum to the number of states.
+    segments : list of (Law, array_like, array_like, Mismatch or None)
+        Per segment: the law, initial states x1 [mm] and x2 [mm/s] of shape (n_i,),
+        and the mismatch (per-state arrays of shape (n_i,) allowed).
     plant : Plant
         Design plant and sample time (the laws').
-    x1, x2 : array_like, shape (n,)
-        Initial states [mm], [mm/s], the states of ``laws[0]`` first.
     steps : int
         Number of samples.
-    mismatch : Mismatch, optional
-        True plant and measurement (per-state arrays of shape (n,) allowed).
 
     Returns
     -------
     BatchResult
-        The trajectories of all states, in the order given.
+        The trajectories of all states, segment after segment (``mismatch`` None).
 
     Examples
     --------
@@ -640,71 +632,87 @@ def simulate_laws(
     >>> from ptoverify.laws import pd_law, to_law
     >>> cfg = paper_config()
     >>> m = Mismatch(a_ratio=0.9, delay_samples=1)
-    >>> both = simulate_laws([pd_law(cfg), to_law(cfg)], [1, 1], cfg.plant, [5.0, 5.0],
-    ...                      [0.0, 0.0], 100, mismatch=m)
+    >>> both = simulate_segments([(pd_law(cfg), [5.0], [0.0], None),
+    ...                           (to_law(cfg), [5.0], [0.0], m)], cfg.plant, 100)
     >>> one = simulate_batch(to_law(cfg), cfg.plant, [5.0], [0.0], 100, mismatch=m)
     >>> bool((both.x1[:, 1] == one.x1[:, 0]).all())
     True
     """
-    x1 = np.atleast_1d(np.asarray(x1, dtype=float))
-    x2 = np.atleast_1d(np.asarray(x2, dtype=float))
-    if len(laws) != len(counts) or sum(counts) != x1.size or min(counts, default=0) < 0:
-        raise ValueError("simulate_laws: one count per law, summing to the number of states")
-    edges = np.cumsum([0, *counts]).tolist()
-    if mismatch is None or mismatch.is_identity:  # the nominal loop, law by law
-        parts = [
-            simulate_batch(law, plant, x1[i:j], x2[i:j], steps)
-            for law, i, j in zip(laws, edges[:-1], edges[1:], strict=True)
-        ]
-        return BatchResult(
-            *(
-                np.concatenate([getattr(b, f) for b in parts], axis=1)
-                for f in ("x1", "x2", "u", "region")
-            ),
-            mismatch,
-        )
-    segments = [
-        (law, slice(i, j)) for law, i, j in zip(laws, edges[:-1], edges[1:], strict=True) if j > i
-    ]
-    return _simulate_mismatch(segments, plant, x1, x2, steps, mismatch)
+    return _simulate_mismatch(segments, plant, steps)
 
 
-def _simulate_mismatch(
-    segments: list[tuple[Law, slice]],
-    plant: Plant,
-    x1: ArrayLike,
-    x2: ArrayLike,
-    steps: int,
-    m: Mismatch,
-) -> BatchResult:
-    """Run the loop of :func:`simulate_batch` with a true plant and a measurement model.
+def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> BatchResult:
+    """Run the loop of :func:`simulate_batch` with true plants and measurement models.
 
-    ``segments`` pairs each law with the slice of states it drives.  Vectorized
-    over states, each with its own a_ratio, w_max_ratio and delay; the per-sample
-    work is a fixed sequence of in-place array operations (the same roundings as
-    ``plant.flow`` and ``np.clip``), so a state's trajectory does not depend on
-    the batch it runs in.
+    Vectorized over the states of all segments, each state with its own true a,
+    drive limit and delay, each segment with its own quantizer and noise; the
+    per-sample work is a fixed sequence of in-place array operations (the same
+    roundings as ``plant.flow`` and ``np.clip``), so a state's trajectory does not
+    depend on the batch it runs in.  An identity segment is the nominal loop of
+    :func:`simulate_batch`: no clipping (its limit is +inf), no measurement model.
     """
-    x1 = np.atleast_1d(np.asarray(x1, dtype=float))
-    x2 = np.atleast_1d(np.asarray(x2, dtype=float))
-    n = x1.shape[0]
-    delay = np.broadcast_to(np.asarray(m.delay_samples), (n,))
-    if np.any(delay < 0) or m.position_quantum < 0 or m.velocity_noise < 0:
-        raise InputError("mismatch: delay, quantum and noise must be >= 0")
+    T = plant.sample_time
+    segs = []
+    start = 0
+    for law, s1, s2, m in segments:
+        s1 = np.atleast_1d(np.asarray(s1, dtype=float))
+        s2 = np.atleast_1d(np.asarray(s2, dtype=float))
+        k = s1.shape[0]
+        nominal = m is None or m.is_identity
+        m = m or Mismatch()
+        delay = np.broadcast_to(np.asarray(m.delay_samples), (k,))
+        if np.any(delay < 0) or m.position_quantum < 0 or m.velocity_noise < 0:
+            raise InputError("mismatch: delay, quantum and noise must be >= 0")
+        noisy = m.velocity_noise > 0
+        segs.append(
+            {
+                "law": law,
+                "x1": s1,
+                "x2": s2,
+                "sl": slice(start, start + k),
+                "a": plant.a * np.broadcast_to(np.asarray(m.a_ratio, dtype=float), (k,)),
+                "w": np.full(k, np.inf)
+                if nominal
+                else plant.w_max * np.broadcast_to(np.asarray(m.w_max_ratio, dtype=float), (k,)),
+                "delay": delay,
+                "q": float(m.position_quantum),
+                "noise": np.random.default_rng(m.seed).normal(0.0, m.velocity_noise, steps)
+                if noisy
+                else None,
+                # without noise the law sees x2 + 0.0 (the nominal loop: x2), which is x2
+                # bit for bit unless x2 is -0.0; x2 - dv is -0.0 only where x2 is, so
+                # checking the initial states suffices
+                "add_zero": not nominal
+                and not noisy
+                and bool(np.any((s2 == 0.0) & np.signbit(s2))),
+            }
+        )
+        start += k
+    n = start
     X1, X2 = np.empty((steps + 1, n)), np.empty((steps + 1, n))
     U, R = np.empty((steps, n)), np.empty((steps, n), dtype=np.int8)
-    X1[0], X2[0] = x1, x2
-    T = plant.sample_time
-    a = plant.a * np.broadcast_to(np.asarray(m.a_ratio, dtype=float), (n,))
-    w_true = plant.w_max * np.broadcast_to(np.asarray(m.w_max_ratio, dtype=float), (n,))
+    cat = (
+        (lambda key: np.concatenate([g[key] for g in segs])) if segs else (lambda key: np.empty(0))
+    )
+    X1[0], X2[0] = cat("x1"), cat("x2")
+    a, w_true = cat("a"), cat("w")
+    delay = cat("delay").astype(np.int64) if segs else np.zeros(0, np.int64)
     w_neg = -w_true
     g = -np.expm1(-a * T)
-    q = float(m.position_quantum)
-    noisy = m.velocity_noise > 0
-    noise = np.random.default_rng(m.seed).normal(0.0, m.velocity_noise, steps) if noisy else None
-    # without noise the law sees x2 + 0.0, which is x2 bit for bit unless x2 is -0.0;
-    # and x2 - dv is -0.0 only where x2 is, so checking the initial states suffices
-    add_zero = not noisy and bool(np.any((x2 == 0.0) & np.signbit(x2)))
+    # one law evaluation per run of consecutive segments of the same law; the law
+    # sees the raw samples where no segment of the run measures them otherwise
+    calls = []
+    for seg in segs:
+        if calls and calls[-1][0] is seg["law"]:
+            calls[-1][1].append(seg)
+        else:
+            calls.append((seg["law"], [seg]))
+    plan = []
+    for law, run in calls:
+        sl = slice(run[0]["sl"].start, run[-1]["sl"].stop)
+        raw1 = all(seg["q"] == 0 for seg in run)
+        raw2 = all(seg["noise"] is None and not seg["add_zero"] for seg in run)
+        plan.append((law.vector, sl, run, raw1, raw2))
     # the delay line: sample k applies U[k - delay] (U[0] before it: the controller
     # was running and held what x_0 commands); per distinct delay, a mask of its states
     values = np.unique(delay).tolist() if n else [0]
@@ -715,29 +723,33 @@ def _simulate_mismatch(
         flat_u = U.reshape(-1)
         pick = np.empty(n, dtype=np.intp)
         gathered = np.empty(n)
-    parts = [(law.vector, sl) for law, sl in segments]
     y1, y2 = np.empty(n), np.empty(n)
     uk, dv = np.empty(n), np.empty(n)
     for k in range(steps):
         x1k, x2k = X1[k], X2[k]
-        if q > 0:  # q * round(x1 / q)
-            np.divide(x1k, q, out=y1)
-            np.rint(y1, out=y1)
-            y1 *= q
-            meas1 = y1
-        else:
-            meas1 = x1k
-        if noisy:
-            np.add(x2k, noise[k], out=y2)
-            meas2 = y2
-        elif add_zero:
-            np.add(x2k, 0.0, out=y2)
-            meas2 = y2
-        else:
-            meas2 = x2k
         uk_row, rk_row = U[k], R[k]
-        for vector, sl in parts:
-            uk_row[sl], rk_row[sl] = vector(meas1[sl], meas2[sl])
+        for vector, sl, run, raw1, raw2 in plan:
+            if not raw1:
+                for seg in run:
+                    ss, q = seg["sl"], seg["q"]
+                    if q > 0:  # q * round(x1 / q)
+                        np.divide(x1k[ss], q, out=y1[ss])
+                        np.rint(y1[ss], out=y1[ss])
+                        y1[ss] *= q
+                    else:
+                        y1[ss] = x1k[ss]
+            if not raw2:
+                for seg in run:
+                    ss = seg["sl"]
+                    if seg["noise"] is not None:
+                        np.add(x2k[ss], seg["noise"][k], out=y2[ss])
+                    elif seg["add_zero"]:
+                        np.add(x2k[ss], 0.0, out=y2[ss])
+                    else:
+                        y2[ss] = x2k[ss]
+            uk_row[sl], rk_row[sl] = vector(
+                x1k[sl] if raw1 else y1[sl], x2k[sl] if raw2 else y2[sl]
+            )
         # uk = np.clip(applied, -w_true, w_true), the applied input picked per delay
         if len(others) > 3:  # U[max(k - delay, 0), state]
             np.subtract(k, delay_i, out=pick)
@@ -760,4 +772,4 @@ def _simulate_mismatch(
         x1n += x1k
         dv /= a
         x1n += dv
-    return BatchResult(X1, X2, U, R, m)
+    return BatchResult(X1, X2, U, R, None)
