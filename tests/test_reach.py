@@ -21,7 +21,7 @@ from ptoverify.config import Plant, paper_config
 from ptoverify.errors import InputError
 from ptoverify.mintime import ZOHReach, discrete_min_steps, discrete_min_steps_batch
 from ptoverify.plant import flow
-from ptoverify.reach import MARGIN, ZonotopeTable
+from ptoverify.reach import MARGIN, ZonotopeTable, zonotope_steps_each
 
 PLANTS = {  # a T = 0.015, 0.377, 4
     "small-aT": Plant(a=30.0, w_max=300.0, sample_time=0.0005, position_range=20.0),
@@ -285,3 +285,25 @@ def test_any_start_gives_the_same_n_star():
         d = zonotope_steps(x1, x2, n0, plant)
         assert np.array_equal(d.steps, ref.steps)
         assert np.array_equal(d.below_bound, n0 - 1 >= ref.steps)
+
+
+def test_each_state_with_its_own_plant_equals_the_search_per_plant():
+    """zonotope_steps_each (a plant per state, closed-form generators) against the tabulated
+    search of each state's plant, and the LP on a few of them."""
+    rng = np.random.default_rng(11)
+    checked = 0
+    for T in (0.0005, 0.002):
+        n = 250
+        a, w = rng.uniform(20.0, 3000.0, n), rng.uniform(100.0, 500.0, n)
+        x1 = rng.uniform(-50.0, 50.0, n) * rng.uniform(0.0, 1.0, n) ** 2
+        x2 = rng.uniform(-1.0, 1.0, n) * w
+        x1[:3], x2[:2] = 0.0, 0.0  # the origin and a state at rest
+        got = zonotope_steps_each(x1, x2, 1 + rng.integers(0, 30, n), a, w, T)
+        plants = [Plant(a=a[i], w_max=w[i], sample_time=T, position_range=50.0) for i in range(n)]
+        want = [int(discrete_min_steps_batch(x1[i], x2[i], plants[i]).steps) for i in range(n)]
+        assert got.tolist() == want
+        for i in rng.choice(np.flatnonzero(got < 60), 3, replace=False):
+            lp = discrete_min_steps(float(x1[i]), float(x2[i]), plants[i])
+            assert lp.status == "optimal" and lp.steps == got[i], (x1[i], x2[i], plants[i])
+            checked += 1
+    assert checked == 6
