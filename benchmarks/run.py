@@ -16,7 +16,9 @@ that the harness works.  At full size ``report_s`` times ``ptoverify report
 and ``sweep_s`` ``ptoverify sweep --quiet --json`` (200 x 200 states, 4 laws, settling
 between samples; ``--small``: ``--grid 4``).
 ``robust_s`` times ``ptoverify robust --json`` at the paper's box and default sizes,
-``robust_gates_s`` the two gates of ``check --robust``; the robust maps' throughput
+``robust_gates_s`` the two gates of ``check --robust``, ``robust_study_s`` the study itself
+in-process (``run_robust`` at the defaults, the report's robustness stage, after a warm-up
+that builds the laws; median of 3, on one core); the robust maps' throughput
 is measured in-process and on a Dask LocalCluster side by side (the latter not with
 ``--small``: cluster start-up would dominate).
 """
@@ -75,6 +77,7 @@ TARGETS = {  # key: (target, ">=" or "<=")
     "tune_pto_s": (120.0, "<="),
     "robust_s": (60.0, "<="),
     "robust_gates_s": (60.0, "<="),
+    "robust_study_s": (2.5, "<="),
     "robust_maps_state_cells_per_s": (None, ""),
     "robust_maps_dask_local_state_cells_per_s": (None, ""),
     "robust_maps_trajectory_steps_per_s": (None, ""),
@@ -399,6 +402,33 @@ def bench_robust_maps(cfg, small: bool) -> dict:
     return out
 
 
+def bench_robust_study(cfg, small: bool, repeat: int) -> dict:
+    """``run_robust`` in-process at the defaults: median wall and CPU time, simulations run.
+
+    One warm-up study first (imports, the corrected zone, memoized per plant), as in
+    the report, which has built the laws by then.
+    """
+    from ptoverify.robust import RobustSettings, run_robust
+
+    s = (
+        RobustSettings(n1=3, n2=3, rest=2, n_a=2, n_w=2, search_iterations=1, search_population=5)
+        if small
+        else RobustSettings()
+    )
+    run_robust(cfg, s)
+    walls, cpus = [], []
+    for _ in range(repeat):
+        t0, c0 = time.perf_counter(), time.process_time()
+        res = run_robust(cfg, s)
+        walls.append(time.perf_counter() - t0)
+        cpus.append(time.process_time() - c0)
+    return {
+        "wall_s": statistics.median(walls),
+        "cpu_s": statistics.median(cpus),
+        "stages_s": {k: round(v, 3) for k, v in res.timings_s.items()},
+    }
+
+
 # ---------------------------------------------------------------- machine
 def machine() -> dict:
     cpu = "unknown"
@@ -478,6 +508,9 @@ def run(small: bool) -> tuple[dict, dict]:
     out["robust_maps_dask_local_state_cells_per_s"] = rb["dask_local_state_cells_per_s"]
     out["robust_maps_trajectory_steps_per_s"] = rb["trajectory_steps_per_s"]
     extra["robust_maps"] = rb
+    st = bench_robust_study(cfg, small, 1 if small else 3)
+    out["robust_study_s"] = st["wall_s"]
+    extra["robust_study"] = st
     robust = ["robust", "--quiet", "--json"]
     if small:
         robust += ["--grid", "3", "--law", "pd", "--generations", "1", "--population", "5"]
@@ -533,6 +566,11 @@ def table(out: dict, extra: dict) -> str:
     )
     rows.append(
         f"robust maps: {rb['state_cells']} state-cells in-process {rb['in_process_s']:.3g} s; {dask}"
+    )
+    st = extra["robust_study"]
+    rows.append(
+        f"robust study in-process: wall {st['wall_s']:.3g} s, CPU {st['cpu_s']:.3g} s; "
+        f"stages {st['stages_s']}"
     )
     for k in ("check_note", "report_note", "sweep_note", "robust_note", "robust_gates_note"):
         if extra[k]:

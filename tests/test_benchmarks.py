@@ -40,6 +40,7 @@ KEYS = {
     "tune_pto_s",
     "robust_s",
     "robust_gates_s",
+    "robust_study_s",
     "robust_maps_state_cells_per_s",
     "robust_maps_dask_local_state_cells_per_s",
     "robust_maps_trajectory_steps_per_s",
