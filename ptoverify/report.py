@@ -170,10 +170,9 @@ def _properties(cfg: Config) -> dict[str, Any]:
 
 
 def _environment(cfg: Config) -> dict[str, Any]:
+    from importlib.metadata import version  # the installed versions, without importing them
+
     import casadi
-    import control
-    import scipy
-    import sympy
 
     here = Path(__file__).resolve().parent
     try:
@@ -208,10 +207,10 @@ def _environment(cfg: Config) -> dict[str, Any]:
         "ptoverify": __version__,
         "casadi": casadi.__version__,
         "ipopt": ipopt_version,
-        "sympy": sympy.__version__,
-        "control": control.__version__,
+        "sympy": version("sympy"),
+        "control": version("control"),
         "numpy": np.__version__,
-        "scipy": scipy.__version__,
+        "scipy": version("scipy"),
         "platform": platform.platform(),
         "git_commit": commit,
         "config": cfg.to_mapping(),
