@@ -56,10 +56,14 @@ class GateContext:
         Configuration under test.
     max_iter : int or None
         Cap on IPOPT iterations (None: the solvers' own caps).
+    given_pto_properties : LawProperties or None
+        The corrected PTO's properties on the default grid when the caller has
+        them already (the report's properties section), else computed here.
     """
 
     cfg: Config
     max_iter: int | None = None
+    given_pto_properties: Any = None
 
     def solver_caps(self) -> dict[str, int]:
         """Return keyword arguments capping IPOPT (empty without a cap)."""
@@ -68,6 +72,8 @@ class GateContext:
     @functools.cached_property
     def pto_properties(self):
         """Closed-loop properties of the corrected PTO law over the default grid."""
+        if self.given_pto_properties is not None:
+            return self.given_pto_properties
         from ptoverify.laws import make_law
         from ptoverify.properties import law_properties
 
@@ -598,6 +604,7 @@ def run_checks(
     *,
     max_iter: int | None = None,
     robust: bool = False,
+    context: GateContext | None = None,
 ) -> list[Verdict]:
     """Run the gates (all, or the named ones) in registration order.
 
@@ -612,6 +619,9 @@ def run_checks(
         that does not converge makes its gate ``unverified``).
     robust : bool
         Also run :data:`ROBUST_GATES` (naming one in ``names`` runs it too).
+    context : GateContext, optional
+        The context to run in (results the caller shares with the gates);
+        default ``GateContext(cfg, max_iter=max_iter)``.
 
     Returns
     -------
@@ -628,7 +638,7 @@ def run_checks(
         unknown = [g for g in names if g not in known]
         if unknown:
             raise InputError(f"unknown gate '{unknown[0]}' (choose from {', '.join(known)})")
-    ctx = GateContext(cfg, max_iter=max_iter)
+    ctx = context if context is not None else GateContext(cfg, max_iter=max_iter)
     out = [fn(ctx) for name, fn in GATES.items() if names is None or name in names]
     wanted = [g for g in ROBUST_GATES if (names is None and robust) or (names and g in names)]
     if wanted:

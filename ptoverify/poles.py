@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
-import control as ct
 import numpy as np
 
 from ptoverify.config import Config
@@ -187,6 +186,8 @@ def loop_poles(name: str, a: float, T: float, k_x1: float, k_x2: float) -> LoopP
     >>> lp.stable_continuous, lp.pole_mismatch < 1e-12
     (True, True)
     """
+    import control as ct  # here, not at import: python-control pulls in scipy.signal and pyplot
+
     A, B = _plant(a)
     K = np.array([[k_x1, k_x2]])
     cl = ct.ss(A - B @ K, B, np.eye(2), np.zeros((2, 1)))

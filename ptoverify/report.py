@@ -1,31 +1,34 @@
-"""The verification report: collect every result once, then draw and render it.
+"""The verification report: compute every result once, draw it, render it.
 
-``collect(cfg)`` is the one step that computes: the derivations, the ground
-truth, the zones, the poles, the closed-loop properties, the Section 6 claims,
-the sweep, the gates, and the responses and trajectories the figures draw
-(:func:`figure_inputs`).  It returns one dict: the JSON-able results
-(``results.json``) plus private keys (``_records``, ``_sweep``, ``_figures``,
-``ground_truth._study``) holding the objects that the figures and the
-derivation section need.  The figures (:mod:`ptoverify.plots`) and the sections
-(:mod:`ptoverify.report_sections`) only draw from it; the neutral blocks are
-printed by :mod:`ptoverify.render`.  Work shared with the gates (the corrected
-zone and its grid check, the corrected PTO's closed-loop properties, the
-claims) is memoized per frozen configuration in the numeric modules, so it runs
-once per report.  The SymPy derivations share nothing with the numerics and
-take about a third of the time, so they run in a separate Python process while
-the numerics run (in this process where no process can be started).
+``collect(cfg)`` is the one step that computes.  It runs the report's
+independent stages (:data:`STAGES`): the SymPy derivations with the derivation
+gate, the closed loop (zones, poles, properties, Section 6 claims, the numeric
+gates), the robustness study, the tuning comparison, the suboptimality sweep,
+the ground truth (with the environment) and the paper's figures.  Each stage
+draws its own figures (:mod:`ptoverify.plots`, which only draws) from its own
+results, so nothing large travels between processes.  The stages share only
+the configuration, so they run in a pool of spawned Python processes
+(``jobs``, default one per available CPU), longest first; with ``jobs=1`` they
+run in this process one after the other, and the results are the same either
+way.  Work shared inside a stage (the corrected zone and its grid check, the
+corrected PTO's closed-loop properties, the claims) is memoized per frozen
+configuration in the numeric modules, and the properties section hands its
+PTO properties to the gates, so each runs once.  The sections
+(:mod:`ptoverify.report_sections`) render the JSON results; the neutral blocks
+are printed by :mod:`ptoverify.render`.
 
-Two stages cost more than the rest together and are optional: the robustness
-study (:func:`ptoverify.robust.run_robust` at :data:`ROBUST_SETTINGS`, the
-command's defaults) and the tuning comparison (:func:`tuning_results`: PD and
-PTO tuned on the step under shared overshoot bounds, at the reduced search
-effort :data:`TUNE_SETTINGS`).  ``skip`` (the
-command's ``--skip robust,tuning``) leaves them out for a quick report; their
-sections then say so.  Each stage's wall time is kept in ``res["_timings"]``
-(not in ``results.json``, which stays reproducible).
+Two stages are optional: the robustness study
+(:func:`ptoverify.robust.run_robust` at :data:`ROBUST_SETTINGS`, the command's
+defaults) and the tuning comparison (:func:`tuning_results`: PD and PTO tuned
+on the step under shared overshoot bounds, at the reduced search effort
+:data:`TUNE_SETTINGS`).  ``skip`` (the command's ``--skip robust,tuning``)
+leaves them out for a quick report; their sections then say so.  Each stage's
+wall time is kept in ``res["_timings"]`` (not in ``results.json``, which stays
+reproducible).
 
-``write_report`` writes the folder atomically: everything goes to a temporary
-sibling folder that is renamed into place only when complete.
+``write_report`` writes the folder atomically: everything, figures included,
+goes to a temporary sibling folder that is renamed into place only when
+complete, and is removed when the run fails.
 
 Two runs give the same ``results.json`` except ``meta.generated``: wall-clock
 timings are not part of the results.
@@ -38,10 +41,8 @@ import json
 import math
 import platform
 import subprocess
-import sys
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -169,10 +170,9 @@ def _properties(cfg: Config) -> dict[str, Any]:
 
 
 def _environment(cfg: Config) -> dict[str, Any]:
+    from importlib.metadata import version  # the installed versions, without importing them
+
     import casadi
-    import control
-    import scipy
-    import sympy
 
     here = Path(__file__).resolve().parent
     try:
@@ -207,10 +207,10 @@ def _environment(cfg: Config) -> dict[str, Any]:
         "ptoverify": __version__,
         "casadi": casadi.__version__,
         "ipopt": ipopt_version,
-        "sympy": sympy.__version__,
-        "control": control.__version__,
+        "sympy": version("sympy"),
+        "control": version("control"),
         "numpy": np.__version__,
-        "scipy": scipy.__version__,
+        "scipy": version("scipy"),
         "platform": platform.platform(),
         "git_commit": commit,
         "config": cfg.to_mapping(),
@@ -309,109 +309,253 @@ def figure_inputs(cfg: Config) -> Any:
     )
 
 
+# ------------------------------------------------------------------ stages
+# Each stage computes one independent part of the report and, given a figure
+# folder, draws that part's figures at once, so no large object travels back
+# between processes.  Stages share nothing but the configuration: memoized work
+# (zones, properties, claims) is shared inside a stage, never relied on across.
+
+
+def _stage_derivations(cfg: Config, figdir: Path | None) -> dict[str, Any]:
+    """SymPy: the equation records and the derivation gate (the only SymPy users)."""
+    import derivations
+    from ptoverify.checks import run_checks
+
+    p = cfg.plant
+    plant = derivations.PlantNumbers(
+        a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
+    )
+    records = derivations.all_records(plant)
+    return {
+        "derivations": [r.to_json() for r in records],
+        "_records": records,
+        "_checks": run_checks(cfg, [SYMBOLIC_GATE]),
+    }
+
+
+def _stage_ground_truth(cfg: Config, figdir: Path | None) -> dict[str, Any]:
+    """CasADi: the minimum-time table, the convergence study, and the environment."""
+    gt = _ground_truth(cfg)
+    files = [] if figdir is None else _plots().save_ground_truth(gt.pop("_study"), figdir)
+    return {"ground_truth": gt, "environment": _environment(cfg), "_files": files}
+
+
+def _stage_core(cfg: Config, figdir: Path | None) -> dict[str, Any]:
+    """Zones, poles, properties, claims and the numeric gates (they share memoized work)."""
+    from ptoverify.checks import GATES, GateContext, run_checks
+    from ptoverify.claims import evaluate_claims, response_metrics
+    from ptoverify.properties import all_properties
+    from ptoverify.zones import zone_summary
+
+    props = all_properties(cfg)
+    ctx = GateContext(cfg, given_pto_properties=props["pto"])
+    return {
+        "zone": zone_summary(cfg),
+        "poles": _poles(cfg),
+        "properties": {k: v.to_json() for k, v in props.items()},
+        "claims": [c.to_json() for c in evaluate_claims(cfg)],
+        "responses": response_metrics(cfg),
+        "_checks": run_checks(cfg, [g for g in GATES if g != SYMBOLIC_GATE], context=ctx),
+    }
+
+
+def _stage_sweep(cfg: Config, figdir: Path | None) -> dict[str, Any]:
+    """Run the suboptimality sweep and draw its maps."""
+    from ptoverify.sweep import run_sweep
+
+    sweep = run_sweep(cfg)
+    return {
+        "sweep": {
+            "laws": {k: v.to_json() for k, v in sweep.laws.items()},
+            "grid": list(sweep.x1.shape),
+            "steps": sweep.steps,
+            "velocity_band": sweep.velocity_band,
+            "skipped": sweep.skipped,
+            "settings": _settings_json(sweep.settings),
+        },
+        "_files": [] if figdir is None else _plots().save_sweep(sweep, figdir),
+    }
+
+
+def _stage_robust(cfg: Config, figdir: Path | None) -> dict[str, Any]:
+    """Run the robustness study at :data:`ROBUST_SETTINGS` and draw its heat maps."""
+    res = _robust(cfg)
+    return {
+        "robust": res,
+        "_files": [] if figdir is None else _plots().save_robust(res["maps"], figdir),
+    }
+
+
+def _stage_tuning(cfg: Config, figdir: Path | None) -> dict[str, Any]:
+    """Run the fair tuning comparison and draw its Pareto fronts."""
+    res = tuning_results(cfg)
+    return {"tuning": res, "_files": [] if figdir is None else _plots().save_tuning(res, figdir)}
+
+
+def _stage_figures(cfg: Config, figdir: Path | None) -> dict[str, Any]:
+    """Draw the paper's figures and the zone geometry (inputs from :func:`figure_inputs`)."""
+    if figdir is None:
+        return {"_files": []}
+    return {"_files": _plots().save_all(figure_inputs(cfg), figdir)}
+
+
+def _plots():
+    from ptoverify import plots
+
+    return plots
+
+
+#: The gate that needs SymPy: it runs in the derivations' stage, the others in ``core``.
+SYMBOLIC_GATE = "derivation-identities-vs-numerics"
+
+#: The report's stages, longest first (the order a pool starts them in).
+_STAGE_FUNCTIONS: dict[str, Callable[[Config, Path | None], dict[str, Any]]] = {
+    "derivations": _stage_derivations,
+    "closed loop, claims and gates": _stage_core,
+    "robustness": _stage_robust,
+    "tuning": _stage_tuning,
+    "suboptimality sweep": _stage_sweep,
+    "ground truth": _stage_ground_truth,
+    "figures": _stage_figures,
+}
+_SKIP_STAGE = {"robust": "robustness", "tuning": "tuning"}
+
+
+def _run_stage(name: str, cfg: Config, figdir: Path | None) -> tuple[dict[str, Any], float]:
+    """Run one stage; return its results and its wall time [s] (a pool's task)."""
+    t0 = time.perf_counter()
+    out = _STAGE_FUNCTIONS[name](cfg, figdir)
+    return out, time.perf_counter() - t0
+
+
+def default_jobs() -> int:
+    """Worker processes ``collect`` uses by default: the CPUs this process may use.
+
+    Returns
+    -------
+    int
+        ``len(os.sched_getaffinity(0))`` where available, else ``os.cpu_count()``
+        (at least 1).
+    """
+    import os
+
+    try:
+        n = len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        n = os.cpu_count() or 1
+    return max(1, n)
+
+
 # ------------------------------------------------------------------ collect
-
-
 def collect(
-    cfg: Config, progress: Progress | None = None, skip: tuple[str, ...] = ()
+    cfg: Config,
+    progress: Progress | None = None,
+    skip: tuple[str, ...] = (),
+    figdir: Path | None = None,
+    jobs: int | None = None,
 ) -> dict[str, Any]:
-    """Compute every result of the report, each once.
+    """Compute every result of the report, each once, and draw its figures.
+
+    The stages (:data:`STAGES`) are independent: with ``jobs`` > 1 they run in
+    a pool of fresh Python processes (spawned: no fork of solver or BLAS
+    state), longest first, each drawing its own figures into ``figdir``; with
+    ``jobs`` = 1 they run here, one after the other.  Both give the same
+    results.
 
     Parameters
     ----------
     cfg : Config
         Configuration.
     progress : callable, optional
-        ``progress(stage)`` before each stage (:data:`STAGES`).
+        ``progress(stage, fraction)`` as each stage ends.
     skip : tuple of str
         Stages of :data:`SKIPPABLE` to leave out (their results are None).
+    figdir : Path, optional
+        Folder the figures are drawn into (none are drawn without it).
+    jobs : int, optional
+        Worker processes (default :func:`default_jobs`, at most one per stage).
 
     Returns
     -------
     dict
-        JSON-able results, plus private keys with the objects the figures and
-        sections need: ``_records`` (derivation records), ``_sweep``
-        (SweepResult), ``_figures`` (:class:`ptoverify.plots.FigureInputs`) and
-        ``ground_truth._study`` (ConvergenceStudy); :func:`write_report` drops
-        them from the JSON.
+        JSON-able results, plus private keys: ``_records`` (the derivation
+        records), ``_files`` (the figure files written), ``_timings`` (each
+        stage's wall time [s]) and ``_jobs`` (the processes used);
+        :func:`write_report` drops them from the JSON.
+
+    Raises
+    ------
+    InputError
+        An unknown ``skip`` stage or ``jobs`` < 1.
     """
+    from ptoverify.checks import GATES, summarize
     from ptoverify.errors import InputError
 
     bad = sorted(set(skip) - set(SKIPPABLE))
     if bad:
         raise InputError(f"--skip: unknown stage '{bad[0]}' (choose from {', '.join(SKIPPABLE)})")
-    timings: dict[str, float] = {}
-    clock = {"stage": None, "t": time.perf_counter()}
+    if jobs is not None and jobs < 1:
+        raise InputError(f"--jobs must be at least 1, got {jobs}")
+    names = [n for n in _STAGE_FUNCTIONS if n not in {_SKIP_STAGE[s] for s in skip}]
+    jobs = min(jobs or default_jobs(), len(names))
+    done: dict[str, tuple[dict[str, Any], float]] = {}
 
-    def say(stage: str) -> None:
-        now = time.perf_counter()
-        if clock["stage"] is not None:
-            timings[clock["stage"]] = now - clock["t"]
-        clock.update(stage=stage, t=now)
-        if progress and stage:
-            progress(stage)
+    def finished(name: str, result: tuple[dict[str, Any], float]) -> None:
+        done[name] = result
+        if progress:
+            progress(name, len(done) / len(names))
 
-    out: dict[str, Any] = {"derivations": None, "skipped": sorted(set(skip))}
-    say("derivations")
-    import derivations
+    if jobs == 1:
+        for name in names:
+            finished(name, _run_stage(name, cfg, figdir))
+    else:
+        _run_in_pool(names, cfg, figdir, jobs, finished)
 
-    p = cfg.plant
-    plant = derivations.PlantNumbers(
-        a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
-    )
-    with _in_background("derivations", "all_records", plant) as records_later:
-        _numerics(cfg, out, say, set(skip))
-        say("waiting for the derivations")
-        records = records_later()
-    say("")
-    timings.pop("", None)
-    out["_timings"] = timings
-    out["derivations"] = [r.to_json() for r in records]
-    out["_records"] = records
-    out["summary"] = _summary(out, out.pop("_gates"))
+    out: dict[str, Any] = {"derivations": None, "robust": None, "tuning": None}
+    files: list[Path] = []
+    checks = []
+    for name in names:
+        part = done[name][0]
+        files += part.pop("_files", [])
+        checks += part.pop("_checks", [])
+        out.update(part)
+    order = list(GATES)
+    checks.sort(key=lambda v: order.index(v.name))
+    out["checks"] = [c.to_json() for c in checks]
+    out["skipped"] = sorted(set(skip))
+    out["summary"] = _summary(out, summarize(checks))
+    out["_files"] = files
+    out["_timings"] = {name: done[name][1] for name in names}
+    out["_jobs"] = jobs
     return out
 
 
-def _numerics(cfg: Config, out: dict[str, Any], say: Callable[[str], None], skip: set[str]) -> None:
-    """Run the numeric stages of :func:`collect` in order, into ``out``."""
-    from ptoverify.checks import run_checks, summarize
-    from ptoverify.claims import evaluate_claims, response_metrics
-    from ptoverify.sweep import run_sweep
-    from ptoverify.zones import zone_summary
+def _run_in_pool(
+    names: list[str],
+    cfg: Config,
+    figdir: Path | None,
+    jobs: int,
+    finished: Callable[[str, tuple[dict[str, Any], float]], None],
+) -> None:
+    """Run the stages in ``jobs`` spawned processes; ``finished(name, result)`` as each ends.
 
-    say("ground truth")
-    out["ground_truth"] = _ground_truth(cfg)
-    say("switching zone")
-    out["zone"] = zone_summary(cfg)
-    say("poles")
-    out["poles"] = _poles(cfg)
-    say("closed-loop properties")
-    out["properties"] = _properties(cfg)
-    say("Section 6 claims")
-    out["claims"] = [c.to_json() for c in evaluate_claims(cfg)]
-    out["responses"] = response_metrics(cfg)
-    say("suboptimality sweep")
-    sweep = run_sweep(cfg)
-    out["sweep"] = {
-        "laws": {k: v.to_json() for k, v in sweep.laws.items()},
-        "grid": list(sweep.x1.shape),
-        "steps": sweep.steps,
-        "velocity_band": sweep.velocity_band,
-        "skipped": sweep.skipped,
-        "settings": _settings_json(sweep.settings),
-    }
-    out["_sweep"] = sweep
-    say("gates")
-    checks = run_checks(cfg)
-    out["checks"] = [c.to_json() for c in checks]
-    out["_gates"] = summarize(checks)
-    out["environment"] = _environment(cfg)
-    say("robustness")
-    out["robust"] = None if "robust" in skip else _robust(cfg)
-    say("tuning")
-    out["tuning"] = None if "tuning" in skip else tuning_results(cfg)
-    say("figure data")
-    out["_figures"] = figure_inputs(cfg)
+    A stage's exception is raised here (its type kept, so an ``InputError``
+    stays one); the remaining stages are cancelled.
+    """
+    import multiprocessing
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+        pending = {pool.submit(_run_stage, n, cfg, figdir): n for n in names}
+        try:
+            while pending:
+                ready, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for fut in ready:
+                    finished(pending.pop(fut), fut.result())
+        finally:
+            for fut in pending:
+                fut.cancel()
 
 
 def _robust(cfg: Config) -> dict[str, Any]:
@@ -451,72 +595,6 @@ def tuning_results(cfg: Config) -> dict[str, Any]:
     res = fair_comparison(cfg, TuneBudget(**TUNE_SETTINGS))
     res.pop("seconds", None)
     return res
-
-
-_CHILD = (
-    "import importlib, pickle, sys\n"
-    "fn = getattr(importlib.import_module(sys.argv[1]), sys.argv[2])\n"
-    "with open(sys.argv[3], 'rb') as f:\n"
-    "    args = pickle.load(f)\n"
-    "with open(sys.argv[3], 'wb') as f:\n"
-    "    pickle.dump(fn(*args), f)\n"
-)
-
-
-@contextmanager
-def _in_background(module: str, name: str, *args: Any) -> Iterator[Callable[[], Any]]:
-    """Run ``module.name(*args)`` in a fresh Python process while the body runs.
-
-    Yields a getter of its result.  The SymPy derivations take about as long
-    as all the numerics together and share nothing with them, so on two cores
-    the report overlaps the two.  The worker is a new interpreter started with
-    ``sys.executable`` (no fork of solver or BLAS state, no re-import of the
-    caller's ``__main__``), with this process's ``sys.path``; it returns its
-    result pickled through a temporary file.  A failure in it raises
-    ``RuntimeError`` with its last lines of stderr.  Where no process can be
-    started, ``module.name()`` runs here when the result is asked for.
-    """
-    import importlib
-    import os
-    import pickle
-    import tempfile
-
-    fd, result = tempfile.mkstemp(suffix=".pickle")
-    with os.fdopen(fd, "wb") as f:  # the arguments go in; the child overwrites with its result
-        pickle.dump(args, f)
-    log = tempfile.TemporaryFile()
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
-    try:
-        try:
-            child = subprocess.Popen(
-                [sys.executable, "-c", _CHILD, module, name, result],
-                stdin=subprocess.DEVNULL,
-                stdout=subprocess.DEVNULL,
-                stderr=log,
-                env=env,
-            )
-        except OSError:  # no process can be started here: compute in this process
-            fn = getattr(importlib.import_module(module), name)
-            yield lambda: fn(*args)
-            return
-
-        def get() -> Any:
-            if child.wait() != 0:
-                log.seek(0)
-                tail = log.read().decode(errors="replace").strip().splitlines()[-3:]
-                raise RuntimeError(f"{module}.{name} failed in its worker: {' | '.join(tail)}")
-            with open(result, "rb") as f:
-                return pickle.load(f)  # noqa: S301 - our own child's output
-
-        try:
-            yield get
-        finally:
-            if child.poll() is None:
-                child.kill()
-                child.wait()
-    finally:
-        log.close()
-        os.unlink(result)
 
 
 def _settings_json(settings: Any) -> dict[str, Any]:
@@ -595,26 +673,13 @@ def build_sections(
 
 
 # ------------------------------------------------------------------ writing
-def _figures(res: dict[str, Any], figdir: Path) -> dict[str, str]:
-    """Draw every figure from the collected results; return key -> relative path."""
-    from ptoverify import plots
-
-    files = plots.save_all(res["_figures"], figdir)
-    files += plots.save_sweep(res["_sweep"], figdir)
-    files += plots.save_ground_truth(res["ground_truth"]["_study"], figdir)
-    if res.get("robust"):
-        files += plots.save_robust(res["robust"]["maps"], figdir)
-    if res.get("tuning"):
-        files += plots.save_tuning(res["tuning"], figdir)
-    return {Path(f).stem: f"figures/{Path(f).name}" for f in files}
-
-
 def write_report(
     cfg: Config,
     out: str | Path | None = None,
     progress: Progress | None = None,
     skip: tuple[str, ...] = (),
     timings: dict[str, float] | None = None,
+    jobs: int | None = None,
 ) -> Path:
     """Compute and write the report folder atomically.
 
@@ -630,7 +695,9 @@ def write_report(
     skip : tuple of str
         Stages of :data:`SKIPPABLE` to leave out (a quick report).
     timings : dict, optional
-        Filled with the wall time of each stage [s] (figures included).
+        Filled with the wall time of each stage [s] (its figures included).
+    jobs : int, optional
+        Worker processes (:func:`collect`; default :func:`default_jobs`).
 
     Returns
     -------
@@ -649,15 +716,12 @@ def write_report(
     out = check_target(
         Path("reports") / cfg.name if default else out, config_hash=cfg.digest(), default=default
     )
-    res = collect(cfg, progress, skip)  # nothing is written before this ends
-    tmp = make_temp(out)
+    tmp = make_temp(out)  # figures are drawn into it; it is renamed into place when complete
     try:
-        if progress:
-            progress("figures")
-        t0 = time.perf_counter()
-        figures = _figures(res, tmp / "figures")
+        res = collect(cfg, progress, skip, figdir=tmp / "figures", jobs=jobs)
+        figures = {Path(f).stem: f"figures/{Path(f).name}" for f in res["_files"]}
         if timings is not None:
-            timings.update(res["_timings"], figures=time.perf_counter() - t0)
+            timings.update(res["_timings"])
         public = _clean({k: v for k, v in res.items() if not k.startswith("_")})
         public["ground_truth"] = _clean(
             {k: v for k, v in res["ground_truth"].items() if not k.startswith("_")}
@@ -681,22 +745,8 @@ def write_report(
     return out
 
 
-#: The stages ``collect`` and ``write_report`` announce, in order.
-STAGES = (
-    "derivations",
-    "ground truth",
-    "switching zone",
-    "poles",
-    "closed-loop properties",
-    "Section 6 claims",
-    "suboptimality sweep",
-    "gates",
-    "robustness",
-    "tuning",
-    "figure data",
-    "waiting for the derivations",
-    "figures",
-)
+#: The stages ``collect`` runs (and announces as each ends), longest first.
+STAGES = tuple(_STAGE_FUNCTIONS)
 
 
 def stderr_progress(quiet: bool) -> Progress | None:

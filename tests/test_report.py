@@ -20,11 +20,15 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.fixture(scope="module")
 def two_reports(tmp_path_factory):
-    """A full report and a quick one (``skip`` robust, tuning): the second checks that
-    everything else is reproducible without paying twice for the expensive stages."""
+    """A full report in a pool of two processes and a quick one (``skip`` robust,
+    tuning) in this process: the second checks that everything else is reproducible,
+    whatever the process layout, without paying twice for the expensive stages."""
     base = tmp_path_factory.mktemp("rep")
     cfg = paper_config()
-    return write_report(cfg, base / "one"), write_report(cfg, base / "two", skip=SKIPPABLE)
+    return (
+        write_report(cfg, base / "one", jobs=2),
+        write_report(cfg, base / "two", skip=SKIPPABLE, jobs=1),
+    )
 
 
 def _without_meta(path: Path) -> dict:
@@ -469,3 +473,10 @@ def test_robust_map_places_each_cell():
     mesh = plot_robust_map(maps, "pd", "limit_cycle_states", 0)["map"]
     z = np.asarray(mesh.get_array()).reshape(len(wrs), len(ars))
     np.testing.assert_array_equal(z, [[0, 1, 2], [10, 11, 12]], err_msg="cell placement")
+
+
+def test_jobs_below_one_is_an_input_error(tmp_path, capsys):
+    assert main(["report", "--out", str(tmp_path / "r"), "--jobs", "0"]) == 2
+    err = capsys.readouterr().err
+    assert "--jobs" in err and len(err.splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
