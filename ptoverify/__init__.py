@@ -23,7 +23,8 @@ mintime     min_time: closed-form minimum time and switch time from any state;
             discrete_min_steps (N*, the discrete-time limit, by LPs), ZOHReach;
             discrete_min_steps_batch (N* for many states by zonotopes, see reach);
             batch_table (mintime --states)
-reach       ZonotopeTable, zonotope_steps: N-step null-controllable sets as 2-D zonotopes
+reach       ZonotopeTable, zonotope_steps: N-step null-controllable sets as 2-D zonotopes;
+            zonotope_steps_each (a plant per state)
 ocp         TwoPhaseOCP, CollocationOCP (CasADi + IPOPT), convergence_study
 groundtruth verified_mintime -> GroundTruth: closed form, both OCPs and N* from one state, each
             OCP answer checked a posteriori (exact-flow arcs, re-simulated collocation) or
@@ -38,12 +39,15 @@ poles       PD and linear-zone (eq. 37) loops: poles, damping, margins (python-c
 Closed loop and metrics
 simulate    Reference (step/ramp/sine, custom), simulate (tracking: feedforward, none, error;
             results carry their reference), Mismatch, simulate_batch (true plant, delay,
-            quantization, noise)
+            quantization, noise), simulate_segments (several laws and mismatches, one run)
+lockstep    run_lockstep: dependent simulation workloads (jobs yielding Asks) gathered into
+            rounds of one simulate_segments each (the robustness study)
 exact       metrics between samples on the exact ZOH flow: overshoot, settling (last exit),
             rise time, linear-zone entry, sine phase; exact and sample-grid values side by side
 metrics     summarize (exact metrics with their grid twins), oscillation_amplitude,
             sign_reversals, ramp_lag, sine_fit/phase_delay, input_switches
-properties  closed-loop properties over a grid: stride-overs, limit cycles, chattering, overshoot
+properties  closed-loop properties over a grid: stride-overs (crossing_masks,
+            stride_over_counts), limit cycles, chattering, overshoot
 sweep       run_sweep: settling time / t_f* and / N* T over a 200 x 200 grid of initial states
 
 Verdicts and studies

@@ -32,6 +32,19 @@ The worst-case search is a seeded differential evolution (scipy's default
 strategy, all searches of a law in lockstep so each generation is one batch
 simulation) started from the grid's worst cells, then a batched local polish,
 so the searched value is never below the grid's worst.
+
+How the study runs.  Its simulations are sequential workloads (a generation
+needs the previous one, a margin bracket the previous bracket), each small; a
+small batch costs what a large one does per sample.  So :func:`run_robust`
+runs them as :mod:`ptoverify.lockstep` jobs: every law's maps, then the
+searches of all laws, one simulation per round, and the no-limit-cycle margin
+scans riding along in those rounds (each law is then evaluated 18 times 385
+samples in all: its maps and 17 search generations).  Every trajectory is bit
+for bit the one it has simulated alone, so the results do not depend on the
+grouping (tested); ``timings_s`` books each round's time to the stages of its
+states.  N* of the true plants comes from
+:func:`ptoverify.reach.zonotope_steps_each` (a plant per state, one vectorized
+search), the stride-overs from :func:`ptoverify.properties.stride_over_counts`.
 """
 
 from __future__ import annotations
