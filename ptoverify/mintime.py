@@ -250,7 +250,12 @@ class ZOHReach:
         if res.status != 0:
             return False, None, f"lp_failed: {res.message}"
         v = _polish(A, b, np.asarray(res.x, dtype=float))
-        if np.max(np.abs(v)) > 1.0 + _U_TOL:
+        # HiGHS accepts A v = b to an absolute 1e-7: a state that small (or a sequence too
+        # short to steer both components) passes its test without reaching the origin.
+        # The polished sequence must solve A v = b to round-off (backward error), else
+        # this n is feasible only within the LP's tolerance.
+        slack = 64 * np.finfo(float).eps * (np.abs(A) @ np.abs(v) + np.abs(b))
+        if np.max(np.abs(v)) > 1.0 + _U_TOL or np.any(np.abs(A @ v - b) > slack):
             return False, None, "boundary"
         return True, np.clip(v, -1.0, 1.0) * self.plant.w_max, "feasible"
 

@@ -126,6 +126,22 @@ def test_batch_matches_single():
     assert batch.steps.tolist() == single
 
 
+def test_tiny_states_not_accepted_within_the_lp_tolerance():
+    """HiGHS accepts A u = b to 1e-7: a state of nanometres 'reaches' the origin in one
+    sample without being steered.  Its N* agrees with the zonotope's (the independent
+    exact path) and its sequence ends at the origin."""
+    plant = PLANTS["paper"]
+    x1 = np.array([2.85e-9, -1e-8, 1e-6, 3e-12, 0.0])
+    x2 = np.array([0.0, 0.0, 1e-7, 0.0, -2e-9])
+    batch = discrete_min_steps_batch(x1, x2, plant)
+    for i in range(x1.size):
+        d = discrete_min_steps(x1[i], x2[i], plant)
+        assert d.status == "optimal", (x1[i], x2[i], d.status)
+        assert d.steps == batch.steps[i] >= 1
+        e1, e2 = simulate(x1[i], x2[i], d.u, plant)
+        assert abs(e1) <= 1e-9 and abs(e2) <= 1e-6
+
+
 @settings(max_examples=60, deadline=None)
 @given(x1=st.floats(-60.0, 60.0), x2=st.floats(-900.0, 900.0))
 def test_property_not_faster_than_continuous(x1, x2):
