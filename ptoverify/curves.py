@@ -90,6 +90,17 @@ def blockwise(fn, *arrays: ArrayLike, block: int = BLOCK):
     ndarray or tuple of ndarray
         As ``fn``, of the broadcast shape.
     """
+    first = arrays[0]
+    if (  # one block of 1-D float arrays of one shape: fn on them as they are
+        type(first) is np.ndarray
+        and first.ndim == 1
+        and first.size <= 2 * block
+        and all(
+            type(a) is np.ndarray and a.dtype == np.float64 and a.shape == first.shape
+            for a in arrays
+        )
+    ):
+        return fn(*arrays)
     arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in arrays))
     shape, n = arrays[0].shape, arrays[0].size
     flat = [a.ravel() for a in arrays]
@@ -167,14 +178,30 @@ def h(r: ArrayLike) -> Array:
     return _h_block(r)
 
 
+#: Up to this many series values per array are summed one by one in Python
+#: (:func:`_horner`, bit for bit); more, by numpy passes over all of them.
+FEW = 8
+
+
 def _h_block(r: Array) -> Array:
     """:func:`h` on an array: r - log1p(r), and the series where |r| < 0.2."""
     with np.errstate(invalid="ignore", divide="ignore"):
         out = r - np.log1p(r)
-    small = np.abs(r) < 0.2  # the series only where it is used
-    if small.any():
-        out[small] = _series(r[small], _H_SERIES, 2)
+    _put_series(out, r, np.abs(r) < 0.2, _H_SERIES, _H_COEF)  # the series only where used
     return out
+
+
+def _put_series(out: Array, x: Array, where: NDArray[np.bool_], coef: Array, hcoef) -> None:
+    """Overwrite ``out`` with the series of x (lowest power 2) where ``where`` holds."""
+    idx = np.flatnonzero(where)
+    if idx.size == 0:
+        return
+    if idx.size <= FEW:  # a few values: no 2 x 20 numpy passes for them
+        flat = out.reshape(-1)  # out is a fresh contiguous array: a view
+        for i, v in zip(idx.tolist(), x.reshape(-1)[idx].tolist(), strict=True):
+            flat[i] = _horner(v, hcoef)
+    else:
+        out[where] = _series(x[where], coef, 2)
 
 
 def _e2(u: Array) -> Array:
@@ -188,9 +215,7 @@ def _e2(u: Array) -> Array:
             return np.asarray(np.expm1(u) - u)
     with np.errstate(over="ignore", invalid="ignore"):
         out = np.expm1(u) - u
-    small = np.abs(u) < 0.5  # the series only where it is used
-    if small.any():
-        out[small] = _series(u[small], _E2_SERIES, 2)
+    _put_series(out, u, np.abs(u) < 0.5, _E2_SERIES, _E2_COEF)  # the series only where used
     return out
 
 
