@@ -14,13 +14,31 @@ candidate's d (:func:`ptoverify.zones.corrected_zone`); a d for which no zone ca
 be built is infeasible.
 
 Method (a non-smooth objective, so no gradients): PD by
-``scipy.optimize.differential_evolution`` over (log10 kp, kd), fixed seed.  The
-PTO's zone costs about a second per d, so d runs over a geometric grid and for
-each d differential evolution tunes (log10 k1, k2); the best d is then refined
-by a golden-section search between its grid neighbours.  The cheap constraints
+``scipy.optimize.differential_evolution`` over (log10 kp, kd), fixed seed.  For
+the PTO, d runs over a geometric grid and for each d differential evolution
+tunes (log10 k1, k2); the best d is then refined by a golden-section search
+between its grid neighbours.  A compass search then polishes the best points
+(up to :data:`COMPASS_STARTS`, at the best d).  The cheap constraints
 (stability, overshoot) are applied to every candidate; the grid properties,
-which cost seconds, are checked on the best candidates in order until one
-passes (never skipped: a candidate that has not passed them is not returned).
+which cost a tenth of a second, are checked on the best candidates in order
+until one passes (never skipped: a candidate that has not passed them is not
+returned).
+
+Speed, and what it does not change:
+
+* Each generation of differential evolution is one batch (scipy's
+  ``vectorized=True``, so ``updating="deferred"``), and on the step a batch is
+  one :func:`ptoverify.simulate.simulate_batch` run with per-state gains
+  (:class:`_StepScreen`).  The searches at several d (the grid, each
+  golden-section pair) run side by side with their batches merged
+  (:func:`_lockstep`); so do the two tunings of a law in :func:`fair_tunings`.
+  A candidate's screened numbers do not depend on its batch, so the outcome is
+  deterministic for a seed.
+* The screen agrees with ``simulate --json`` (scalar simulation,
+  :mod:`ptoverify.exact`) to round-off, not bit for bit.  Every candidate tune
+  reports (best, runner-up, front) is re-measured on the ``simulate --json``
+  path, and the best is the first, in the screen's order, that meets the bound
+  there too; so ``simulate --config tuned.toml`` reproduces its figures exactly.
 """
 
 from __future__ import annotations
@@ -284,6 +302,42 @@ def worst_ratio_nt(
     return float(np.max(st[ok] / nt[ok]))
 
 
+def _worst_ratios(
+    cfg: Config, law: str, batch: Sequence[dict[str, float]], n1: int, n2: int
+) -> list[float]:
+    """:func:`worst_ratio_nt` of many gain sets, the states of several in one simulation.
+
+    Each gain set's grid states are simulated with a law whose gains are one per
+    state (:func:`ptoverify.laws.with_state_gains`); the evaluation is per state, so
+    every value is that of :func:`worst_ratio_nt` for the gain set alone.
+    """
+    p = cfg.plant
+    x1, x2, nt, steps, hold = _envelope(p, n1, n2)
+    ok = np.isfinite(nt)
+    m = x1.size
+    keys = ("kp", "kd") if law == "pd" else ("d", "k1", "k2")
+    band = SweepSettings().band
+    per = max(1, 4096 // m)  # gain sets per simulation (sweep.settling_times' chunk)
+    out = []
+    for i in range(0, len(batch), per):
+        part = batch[i : i + per]
+        gains = {k: np.repeat([g[k] for g in part], m) for k in keys}
+        st = settling_times(
+            with_state_gains(law, cfg, gains),
+            p,
+            np.tile(x1, len(part)),
+            np.tile(x2, len(part)),
+            steps,
+            band,
+            p.a * band,
+            hold * p.sample_time,
+            chunk=m * len(part),
+        ).grid.reshape(len(part), m)
+        for row in st:
+            out.append(float(np.max(row[ok] / nt[ok])) if np.isfinite(row[ok]).all() else math.inf)
+    return out
+
+
 def evaluate(
     cfg: Config,
     law: str,
@@ -319,6 +373,11 @@ def evaluate(
     Candidate
         The candidate (``verified`` False).
     """
+    return _evaluate(cfg, law, gains, signal, objective, max_overshoot, worst_ratio, None)
+
+
+def _evaluate(cfg, law, gains, signal, objective, max_overshoot, worst_ratio, memo) -> Candidate:
+    """:func:`evaluate`; ``memo`` (a dict, optional) keeps the response metrics by gains."""
     tcfg = tuned_config(cfg, law, gains)
     p = cfg.plant
     nan = math.nan
@@ -333,7 +392,13 @@ def evaluate(
 
             z = zone_for_law(tcfg, "corrected")
             omega0 = float(z.omega0) if z.omega0 is not None else None
-        m = response_metrics(tcfg, law, signal)
+        if memo is None:
+            m = response_metrics(tcfg, law, signal)
+        else:
+            k = (signal, _key(gains))
+            if k not in memo:
+                memo[k] = response_metrics(tcfg, law, signal)
+            m = memo[k]
     except InputError as exc:
         return Candidate(gains, math.inf, nan, nan, nan, False, reason=str(exc))
     if max_overshoot is not None and not m["overshoot_mm"] <= max_overshoot:
@@ -493,8 +558,12 @@ def _screened(
     objective: str,
     max_overshoot: float | None,
     worst_ratio: Callable[[Config, str], float] | None,
+    ratio: float | None = None,
 ) -> Candidate:
-    """Return the candidate of a screened response: :func:`evaluate`'s rules on its numbers."""
+    """Return the candidate of a screened response: :func:`evaluate`'s rules on its numbers.
+
+    ``ratio``: its worst settling / N*T when computed already (``worst_ratio_nt``).
+    """
     nan = math.nan
     if raw.reason:
         return Candidate(gains, math.inf, nan, nan, nan, False, reason=raw.reason)
@@ -504,7 +573,9 @@ def _screened(
     else:
         reason = ""
         if objective == "worst_ratio_nt":
-            value = (worst_ratio or worst_ratio_nt)(tuned_config(cfg, law, gains), law)
+            if ratio is None:
+                ratio = (worst_ratio or worst_ratio_nt)(tuned_config(cfg, law, gains), law)
+            value = ratio
         else:
             value = raw.settling_2pct_s if objective == "settling_2pct" else raw.settling_0p01mm_s
         if not math.isfinite(value):
@@ -902,7 +973,8 @@ def tune(
         ``f(cfg, law) -> worst settling / N*T`` for ``worst_ratio_nt``; default
         :func:`worst_ratio_nt` over the :data:`WORST_GRID` grid.
     polish : int
-        Rounds of the compass search after each differential evolution (0: none).
+        Most rounds of the compass search that polishes the best points (0: none);
+        it runs at most ``maxiter`` rounds.
     find_runner_up : bool
         Search the runner-up (grid-checked; ``False`` leaves it None).
 
@@ -970,8 +1042,15 @@ def _tune(
     polish: int,
     find_runner_up: bool,
     screen: Callable[[list[dict[str, float]]], list[_Raw]] | None,
+    remeasured: dict | None = None,
 ) -> TuneResult:
-    """:func:`tune` with its arguments checked; ``screen`` measures step responses."""
+    """:func:`tune` with its arguments checked.
+
+    ``screen`` measures step responses in batches (None: every candidate on the
+    ``simulate --json`` path); ``remeasured`` keeps that path's metrics by gains
+    (tunings of one law on one configuration may share it).
+    """
+    remeasured = {} if remeasured is None else remeasured
     t0 = time.perf_counter()
     seen: dict[tuple, Candidate] = {}
     opts = {"objective": objective, "max_overshoot": max_overshoot, "worst_ratio": worst_ratio}
@@ -981,8 +1060,23 @@ def _tune(
         new = {key(g): g for g in gs if key(g) not in seen}
         if new:
             if screen is not None:  # the whole batch in one simulation
-                raws = screen(list(new.values()))
-                cs = [_screened(cfg, law, g, r, **opts) for g, r in zip(new.values(), raws)]
+                gs_new = list(new.values())
+                raws = screen(gs_new)
+                ratios: list[float | None] = [None] * len(gs_new)
+                if objective == "worst_ratio_nt" and worst_ratio is None:  # batched too
+                    within = [
+                        i
+                        for i, r in enumerate(raws)
+                        if not r.reason
+                        and (max_overshoot is None or r.overshoot_mm <= max_overshoot)
+                    ]
+                    vals = _worst_ratios(cfg, law, [gs_new[i] for i in within], *WORST_GRID)
+                    for i, v in zip(within, vals, strict=True):
+                        ratios[i] = v
+                cs = [
+                    _screened(cfg, law, g, r, **opts, ratio=q)
+                    for g, r, q in zip(gs_new, raws, ratios, strict=True)
+                ]
             else:  # evaluated one by one on the simulate --json path
                 cs = [evaluate(cfg, law, g, signal=signal, **opts) for g in new.values()]
             seen.update(zip(new, cs, strict=True))
@@ -996,7 +1090,9 @@ def _tune(
         if screen is None:  # the search measured it on that path already
             return c
         if k not in measured:
-            measured[k] = evaluate(cfg, law, c.gains, signal=signal, **opts)
+            measured[k] = _evaluate(
+                cfg, law, c.gains, signal, objective, max_overshoot, worst_ratio, remeasured
+            )
         return measured[k]
 
     keys = ("kp", "kd") if law == "pd" else ("k1", "k2")
@@ -1031,7 +1127,8 @@ def _tune(
     if polish and starts:  # a local polish of the search's best points (d fixed)
         space = _Space(batch_fn, keys, law, {"d": starts[0].gains["d"]} if law == "pto" else {})
         xs = np.array([space.point(c.gains) for c in starts])
-        _compass(space.f, xs, np.array([c.objective for c in starts]), space.bounds, polish)
+        rounds = min(polish, maxiter)  # as many rounds as generations, at most
+        _compass(space.f, xs, np.array([c.objective for c in starts]), space.bounds, rounds)
     # the best: in order of the search's objective, the first that passes every
     # constraint measured on the simulate --json path and on the gate grid
     cands = sorted((c for c in seen.values() if c.feasible), key=lambda c: c.objective)
@@ -1099,7 +1196,8 @@ class TuneBudget:
     seed : int
         Seed (fixed, so the comparison is reproducible).
     polish : int
-        Rounds of the compass search that polishes the best points.
+        Most rounds of the compass search that polishes the best points (at most
+        ``maxiter`` of them run).
     """
 
     maxiter: int = 30
@@ -1169,7 +1267,9 @@ def _fair_tunings(cfg: Config, budget: TuneBudget) -> FairTunings:
         for v in values:
             _check(law, "step", "settling_2pct", v, **{k: effort[k] for k in effort if k != "seed"})
 
-        def job(ev, law=law, v=0.0):
+        shared: dict = {}
+
+        def job(ev, law=law, v=0.0, shared=shared):
             by_value[(law, v)] = _tune(
                 cfg,
                 law,
@@ -1179,6 +1279,7 @@ def _fair_tunings(cfg: Config, budget: TuneBudget) -> FairTunings:
                 worst_ratio=None,
                 find_runner_up=False,  # the comparison does not show one
                 screen=ev,
+                remeasured=shared,
                 **effort,
             )
 
