@@ -795,8 +795,9 @@ def _lockstep(batch_fn, jobs: list[Callable[[Callable], None]]) -> None:
     into one call of ``batch_fn`` here and the results handed back.  A job sees
     exactly what ``batch_fn`` alone would give it (the evaluation is per candidate),
     so the outcome is that of running the jobs one after the other, and as
-    deterministic; only the number of batches drops.  An exception in a job is
-    raised here once all have stopped.
+    deterministic; only the number of batches drops.  An exception in a job (or in
+    ``batch_fn``, which every job waiting on that batch then sees) is raised here
+    once all have stopped (the first job's, in job order).
     """
     if len(jobs) < 2:
         for job in jobs:
@@ -804,9 +805,9 @@ def _lockstep(batch_fn, jobs: list[Callable[[Callable], None]]) -> None:
         return
     cv = threading.Condition()
     pending: dict[int, list] = {}
-    results: dict[int, list] = {}
+    results: dict[int, list | BaseException] = {}
     running = set(range(len(jobs)))
-    errors: list[BaseException] = []
+    errors: dict[int, BaseException] = {}
 
     def evaluator(i: int):
         def ev(gs: list) -> list:
@@ -815,7 +816,10 @@ def _lockstep(batch_fn, jobs: list[Callable[[Callable], None]]) -> None:
                 cv.notify_all()
                 while i not in results:
                     cv.wait()
-                return results.pop(i)
+                out = results.pop(i)
+            if isinstance(out, BaseException):  # the batch failed: stop this job too
+                raise out
+            return out
 
         return ev
 
@@ -823,7 +827,7 @@ def _lockstep(batch_fn, jobs: list[Callable[[Callable], None]]) -> None:
         try:
             jobs[i](evaluator(i))
         except BaseException as exc:  # noqa: BLE001 - re-raised by the coordinator
-            errors.append(exc)
+            errors[i] = exc
         finally:
             with cv:
                 running.discard(i)
@@ -839,17 +843,22 @@ def _lockstep(batch_fn, jobs: list[Callable[[Callable], None]]) -> None:
             if not running:
                 break
             order = sorted(pending)
-            merged = batch_fn([g for i in order for g in pending[i]])
-            at = 0
-            for i in order:
-                n = len(pending[i])
-                results[i], at = merged[at : at + n], at + n
+            try:
+                merged = batch_fn([g for i in order for g in pending[i]])
+            except BaseException as exc:  # noqa: BLE001 - handed to every waiting job
+                for i in order:
+                    results[i] = exc
+            else:
+                at = 0
+                for i in order:
+                    n = len(pending[i])
+                    results[i], at = merged[at : at + n], at + n
             pending.clear()
             cv.notify_all()
     for th in threads:
         th.join()
     if errors:
-        raise errors[0]
+        raise errors[min(errors)]
 
 
 def _de(space: _Space, seed: int, maxiter: int, popsize: int) -> None:

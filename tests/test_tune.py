@@ -435,3 +435,26 @@ def test_batched_worst_ratios_are_worst_ratio_nt():
         gs = [{k: float(v) for k, v in g.items()} for g in gs]
         want = [worst_ratio_nt(tuned_config(CFG, law, g), law, n1=4, n2=4) for g in gs]
         assert _worst_ratios(CFG, law, gs, 4, 4) == want
+
+
+def test_lockstep_merges_batches_and_stops_on_errors():
+    from ptoverify import tune as tune_mod
+
+    calls = []
+
+    def batch_fn(xs):
+        calls.append(list(xs))
+        if any(x < 0 for x in xs):
+            raise InputError("negative")
+        return [2 * x for x in xs]
+
+    got = {}
+
+    def job(ev, k):
+        got[k] = [ev([k, k + 10]), ev([k + 20])]
+
+    tune_mod._lockstep(batch_fn, [lambda ev, k=k: job(ev, k) for k in (1, 2, 3)])
+    assert got == {k: [[2 * k, 2 * k + 20], [2 * k + 40]] for k in (1, 2, 3)}
+    assert calls == [[1, 11, 2, 12, 3, 13], [21, 22, 23]], "one batch per round, job order"
+    with pytest.raises(InputError, match="negative"):
+        tune_mod._lockstep(batch_fn, [lambda ev: ev([1]), lambda ev: ev([-1]), lambda ev: None])
