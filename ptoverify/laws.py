@@ -334,7 +334,7 @@ def pto_law(
     name: str = "pto",
     note: str = "",
     *,
-    gains: tuple[NDArray, NDArray] | None = None,
+    gains: tuple[NDArray, ...] | None = None,
 ) -> Law:
     """PTO law, eq. (35), with the saturated linear zone of eq. (34).
 
@@ -360,9 +360,8 @@ def pto_law(
         Law name and one-line description.
     gains : tuple of ndarray, optional
         Per-state (k1 [1/s], k2 [-]) of the linear zone in place of the
-        configuration's, and optionally per-state d [mm] and zone level [mm/s]
-        (NaN: no zone) in place of cfg's d and ``omega0`` (see
-        :func:`with_state_gains`).
+        configuration's, or (k1, k2, d [mm], zone level [mm/s], NaN: no zone)
+        in place of cfg's gains, d and ``omega0`` (see :func:`with_state_gains`).
 
     Returns
     -------

@@ -7,7 +7,8 @@ constraints for every law:
 * the sampled linear loop (PD, or the PTO's linear zone, eq. 34) is stable
   (spectral radius < 1 on the ZOH plant);
 * no limit cycle, and for the PTO no stride-over, from any state of the gates'
-  grid (:func:`ptoverify.properties.law_properties`, 101 x 101 + 200 states).
+  grid (:func:`ptoverify.properties.law_properties`, 101 x 101 + 200 states;
+  :func:`grid_counts` computes just these two counts, the same way).
 
 The PTO's omega0 always comes from the corrected construction for the
 candidate's d (:func:`ptoverify.zones.corrected_zone`); a d for which no zone can
