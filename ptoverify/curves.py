@@ -31,6 +31,8 @@ The bisection solvers are kept as the independent reference.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.special import lambertw
@@ -38,6 +40,7 @@ from scipy.special import lambertw
 __all__ = [
     "h",
     "level_residual",
+    "level_term",
     "switching_function",
     "level_curve_x1",
     "root_22",
@@ -55,6 +58,9 @@ Array = NDArray[np.float64]
 _H_SERIES = np.array([(-1.0) ** n / n for n in range(2, 26)])
 # of E2(u) = e^u - 1 - u = sum_{n>=2} u^n / n!
 _E2_SERIES = np.array([1.0 / np.prod(np.arange(1, n + 1, dtype=float)) for n in range(2, 22)])
+# the same, highest first, as Python floats (the one-value paths of h and _e2)
+_H_COEF = tuple(float(c) for c in _H_SERIES[::-1])
+_E2_COEF = tuple(float(c) for c in _E2_SERIES[::-1])
 
 
 BLOCK = 8192  # states per block: 64 kB per float array, heap-allocated and cache-resident
@@ -84,6 +90,17 @@ def blockwise(fn, *arrays: ArrayLike, block: int = BLOCK):
     ndarray or tuple of ndarray
         As ``fn``, of the broadcast shape.
     """
+    first = arrays[0]
+    if (  # one block of 1-D float arrays of one shape: fn on them as they are
+        type(first) is np.ndarray
+        and first.ndim == 1
+        and first.size <= 2 * block
+        and all(
+            type(a) is np.ndarray and a.dtype == np.float64 and a.shape == first.shape
+            for a in arrays
+        )
+    ):
+        return fn(*arrays)
     arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in arrays))
     shape, n = arrays[0].shape, arrays[0].size
     flat = [a.ravel() for a in arrays]
@@ -105,12 +122,30 @@ def blockwise(fn, *arrays: ArrayLike, block: int = BLOCK):
 
 
 def _series(x: Array, coef: Array, lowest: int) -> Array:
-    """Evaluate sum_j coef[j] x^(lowest + j) by Horner's rule."""
-    acc = np.zeros_like(x)
-    for c in coef[::-1]:  # in place: the same roundings as acc * x + c
+    """Evaluate sum_j coef[j] x^(lowest + j) by Horner's rule (x finite).
+
+    The accumulator starts at the top coefficient, which is what the first step
+    0 * x + coef[-1] gives for finite x, so the roundings are those of Horner's
+    rule from zero.
+    """
+    acc = np.full_like(x, coef[-1])
+    for c in coef[-2::-1]:  # in place: the same roundings as acc * x + c
         acc *= x
         acc += c
     return acc * x**lowest
+
+
+def _horner(x: float, coef: tuple[float, ...]) -> float:
+    """:func:`_series` with ``lowest = 2`` for one Python float, highest coefficient first.
+
+    Python floats round as numpy's float64 (IEEE double, no fused multiply-add),
+    and ``x**2`` is ``x * x`` in numpy, so the result is bit for bit that of
+    :func:`_series` on an array holding x.
+    """
+    acc = coef[0]
+    for c in coef[1:]:
+        acc = acc * x + c
+    return acc * (x * x)
 
 
 def h(r: ArrayLike) -> Array:
@@ -132,26 +167,55 @@ def h(r: ArrayLike) -> Array:
     4.999999999666667e-21
     """
     r = np.asarray(r, dtype=float)
+    if r.ndim == 0:  # one value: Horner on a Python float (bit for bit, see _horner)
+        x = float(r)
+        if abs(x) < 0.2:
+            return np.asarray(_horner(x, _H_COEF))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.asarray(r - np.log1p(r))
+    if r.size > 2 * BLOCK:  # cache-sized blocks (see blockwise); elementwise, so identical
+        return blockwise(_h_block, r)
+    return _h_block(r)
+
+
+#: Up to this many series values per array are summed one by one in Python
+#: (:func:`_horner`, bit for bit); more, by numpy passes over all of them.
+FEW = 8
+
+
+def _h_block(r: Array) -> Array:
+    """:func:`h` on an array: r - log1p(r), and the series where |r| < 0.2."""
     with np.errstate(invalid="ignore", divide="ignore"):
         out = r - np.log1p(r)
-    if out.ndim == 0:
-        return np.asarray(out if abs(r) >= 0.2 else _series(r, _H_SERIES, 2))
-    small = np.abs(r) < 0.2  # the series only where it is used
-    if small.any():
-        out[small] = _series(r[small], _H_SERIES, 2)
+    _put_series(out, r, np.abs(r) < 0.2, _H_SERIES, _H_COEF)  # the series only where used
     return out
+
+
+def _put_series(out: Array, x: Array, where: NDArray[np.bool_], coef: Array, hcoef) -> None:
+    """Overwrite ``out`` with the series of x (lowest power 2) where ``where`` holds."""
+    idx = np.flatnonzero(where)
+    if idx.size == 0:
+        return
+    if idx.size <= FEW:  # a few values: no 2 x 20 numpy passes for them
+        flat = out.reshape(-1)  # out is a fresh contiguous array: a view
+        for i, v in zip(idx.tolist(), x.reshape(-1)[idx].tolist(), strict=True):
+            flat[i] = _horner(v, hcoef)
+    else:
+        out[where] = _series(x[where], coef, 2)
 
 
 def _e2(u: Array) -> Array:
     """Return e^u - 1 - u, exact to round-off near u = 0."""
     u = np.asarray(u, dtype=float)
+    if u.ndim == 0:  # one value: Horner on a Python float (bit for bit, see _horner)
+        x = float(u)
+        if abs(x) < 0.5:
+            return np.asarray(_horner(x, _E2_COEF))
+        with np.errstate(over="ignore", invalid="ignore"):
+            return np.asarray(np.expm1(u) - u)
     with np.errstate(over="ignore", invalid="ignore"):
         out = np.expm1(u) - u
-    if out.ndim == 0:
-        return np.asarray(out if abs(u) >= 0.5 else _series(u, _E2_SERIES, 2))
-    small = np.abs(u) < 0.5  # the series only where it is used
-    if small.any():
-        out[small] = _series(u[small], _E2_SERIES, 2)
+    _put_series(out, u, np.abs(u) < 0.5, _E2_SERIES, _E2_COEF)  # the series only where used
     return out
 
 
@@ -174,7 +238,45 @@ def level_residual(x1: ArrayLike, x2: ArrayLike, a: float, omega: ArrayLike) -> 
         right of it, negative left of it.
     """
     x1, x2, omega = (np.asarray(v, dtype=float) for v in (x1, x2, omega))
-    return a * x1 + np.sign(x2) * omega * h(np.abs(x2) / omega)
+    if x1.ndim == 0 and x2.ndim == 0 and omega.ndim == 0:
+        return a * x1 + level_term(x2, omega)
+    if max(x1.size, x2.size) > 2 * BLOCK:  # cache-sized blocks; elementwise, so identical
+        if omega.ndim == 0:
+            return blockwise(lambda b1, b2: _level_residual(b1, b2, a, omega), x1, x2)
+        return blockwise(lambda b1, b2, bo: _level_residual(b1, b2, a, bo), x1, x2, omega)
+    return _level_residual(x1, x2, a, omega)
+
+
+def _level_residual(x1: Array, x2: Array, a: float, omega: Array) -> Array:
+    """:func:`level_residual` on float arrays (one block)."""
+    return a * x1 + level_term(x2, omega)
+
+
+def level_term(x2: ArrayLike, omega: ArrayLike) -> Array:
+    """Return the velocity term of :func:`level_residual`, sgn(x2) omega h(|x2| / omega).
+
+    ``level_residual(x1, x2, a, omega)`` is ``a * x1 + level_term(x2, omega)``, bit
+    for bit, so a caller that scans many x1 at fixed velocities computes it once.
+
+    Parameters
+    ----------
+    x2 : array_like
+        Velocity [mm/s].
+    omega : array_like
+        Input level of the curve [mm/s], omega > 0.
+
+    Returns
+    -------
+    ndarray
+        sgn(x2) omega h(|x2| / omega) [mm/s].
+
+    Examples
+    --------
+    >>> bool(level_residual(2.0, -50.0, 188.5, 300.0) == 188.5 * 2.0 + level_term(-50.0, 300.0))
+    True
+    """
+    x2, omega = np.asarray(x2, dtype=float), np.asarray(omega, dtype=float)
+    return np.sign(x2) * omega * h(np.abs(x2) / omega)
 
 
 def switching_function(x1: ArrayLike, x2: ArrayLike, a: float, w_max: float) -> Array:
@@ -253,6 +355,8 @@ def root_22(b0: ArrayLike, branch: int = -1) -> Array:
     if branch not in (-1, 0):
         raise ValueError("branch must be -1 or 0")
     b0 = np.asarray(b0, dtype=float)
+    if b0.ndim == 0:
+        return np.asarray(_root_22_one(float(b0), branch))
     ok = np.isfinite(b0) & (b0 >= 0)
     bb = np.where(ok, b0, 1.0)
     sign = 1.0 if branch == -1 else -1.0
@@ -283,6 +387,44 @@ def root_22(b0: ArrayLike, branch: int = -1) -> Array:
                 yl = bb + np.log1p(yl)
             y = np.where(large, yl, y)
     return np.where(ok, np.where(bb == 0.0, 0.0, y), np.nan)
+
+
+def _nanmax(x: float, y: float) -> float:
+    """np.maximum for two floats: NaN if either is NaN."""
+    return x if (x >= y or x != x) else y
+
+
+def _root_22_one(b0: float, branch: int) -> float:
+    """:func:`root_22` for one value, bit for bit.
+
+    The same operations in the same order as the array path, on Python floats;
+    each transcendental function is numpy's (whose results differ from
+    ``math``'s in the last bit for some arguments), so every rounding is the
+    array path's.  Only the branch that the array path selects is computed.
+    """
+    ok = math.isfinite(b0) and b0 >= 0
+    bb = b0 if ok else 1.0
+    sign = 1.0 if branch == -1 else -1.0
+    with np.errstate(all="ignore"):
+        if bb < 1e-3:
+            u = sign * math.sqrt(2.0 * bb) * (1.0 + sign * math.sqrt(2.0 * bb) / 3.0)
+        else:
+            y_w = -1.0 - float(_lambertw_real(-np.exp(-1.0 - bb), branch))
+            u = float(np.log1p(_nanmax(y_w, -1.0 + 1e-300)))
+        if not math.isfinite(u):  # e^{-1-b0} underflowed: y ~ b0 + ln(1+b0)
+            u = float(np.log1p(bb + float(np.log1p(bb)))) if sign > 0 else -bb - 1.0
+        if branch == 0:
+            u = _nanmax(u, -bb - 1.0)
+        for _ in range(4):  # Newton on E2(u) = b0; E2'(u) = e^u - 1
+            if u != 0.0:
+                u = u - (float(_e2(u)) - bb) / float(np.expm1(u))
+        y = float(np.expm1(u))
+        if branch == -1 and bb > 20.0:
+            for _ in range(12):
+                y = bb + float(np.log1p(y))
+    if not ok:
+        return math.nan
+    return 0.0 if bb == 0.0 else y
 
 
 def _m_of_u(u: Array) -> Array:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import IntEnum
 
 import numpy as np
@@ -32,6 +32,7 @@ __all__ = [
     "pto_printed_law",
     "omega_c_scalar",
     "make_law",
+    "with_state_gains",
     "LAW_NAMES",
     "h_scalar",
 ]
@@ -48,6 +49,8 @@ class Region(IntEnum):
     LINEAR = 5  #: linear (PD) input, unsaturated (eq. 34 or PD)
     SATURATED = 6  #: linear input clipped at +-w_max
 
+
+_I8 = {r: np.int8(r) for r in Region}  # region codes as int8 scalars (np.where keeps int8)
 
 ArrayFn = Callable[
     [NDArray[np.float64], NDArray[np.float64]], tuple[NDArray[np.float64], NDArray[np.int8]]
@@ -83,7 +86,9 @@ class Law:
         self, x1: ArrayLike, x2: ArrayLike
     ) -> tuple[NDArray[np.float64], NDArray[np.int8]]:
         """Evaluate the law on arrays; returns (u [mm/s], region codes)."""
-        x1, x2 = np.broadcast_arrays(np.asarray(x1, dtype=float), np.asarray(x2, dtype=float))
+        x1, x2 = np.asarray(x1, dtype=float), np.asarray(x2, dtype=float)
+        if x1.shape != x2.shape:
+            x1, x2 = np.broadcast_arrays(x1, x2)
         return self.vector(x1, x2)
 
 
@@ -149,7 +154,15 @@ def _bang(sigma: NDArray[np.float64], x2: NDArray[np.float64], w: float):
     """Time-optimal input from the switching function: S_P u l1 -> +w, S_N u l2 -> -w."""
     pos = (sigma < 0) | ((sigma == 0) & (x2 < 0))
     u = np.where(pos, w, -w)
-    region = np.where(pos, Region.BANG_P, Region.BANG_N).astype(np.int8)
+    region = np.where(pos, _I8[Region.BANG_P], _I8[Region.BANG_N])
+    return u, region
+
+
+def _origin(x1, x2, u, region):
+    """Set u = 0, region ORIGIN at the origin (in place); return (u, region)."""
+    origin = (x1 == 0) & (x2 == 0)
+    if origin.any():
+        u[origin], region[origin] = 0.0, Region.ORIGIN
     return u, region
 
 
@@ -217,12 +230,12 @@ def saturate_linear(v: NDArray[np.float64], w: float):
     >>> u.tolist(), [Region(k).name for k in r]
     ([1.0, -300.0], ['LINEAR', 'SATURATED'])
     """
-    u = np.clip(v, -w, w)
-    region = np.where(np.abs(v) > w, Region.SATURATED, Region.LINEAR).astype(np.int8)
+    u = np.minimum(np.maximum(v, -w), w)  # np.clip(v, -w, w), without its wrapper
+    region = np.where(np.abs(v) > w, _I8[Region.SATURATED], _I8[Region.LINEAR])
     return u, region
 
 
-def pd_law(cfg: Config) -> Law:
+def pd_law(cfg: Config, *, gains: tuple[NDArray, NDArray] | None = None) -> Law:
     """PD law u = sat(-kp x1 - kd x2), saturated at +-w_max.
 
     In tracking, x1 is the position error x1 - r, so u = kp (r - x1) - kd x2.
@@ -233,6 +246,9 @@ def pd_law(cfg: Config) -> Law:
     ----------
     cfg : Config
         Configuration (w_max, kp [1/s], kd [-]).
+    gains : tuple of ndarray, optional
+        Per-state (kp [1/s], kd [-]) in place of the configuration's, for
+        evaluating many gain sets in one batch (see :func:`with_state_gains`).
 
     Returns
     -------
@@ -246,6 +262,10 @@ def pd_law(cfg: Config) -> Law:
     (-35.6, 5)
     """
     w, kp, kd = cfg.plant.w_max, cfg.pd.kp, cfg.pd.kd
+    if gains is not None:
+        return _state_gains_law(
+            "pd", lambda x1, x2: saturate_linear(-gains[0] * x1 - gains[1] * x2, w), w
+        )
 
     def vector(x1, x2):
         return saturate_linear(-kp * x1 - kd * x2, w)
@@ -308,7 +328,14 @@ def omega_c_scalar(x1: float, x2: float, a: float) -> float:
     return abs(x2) / math.expm1(u)
 
 
-def pto_law(cfg: Config, omega0: float | None, name: str = "pto", note: str = "") -> Law:
+def pto_law(
+    cfg: Config,
+    omega0: float | None,
+    name: str = "pto",
+    note: str = "",
+    *,
+    gains: tuple[NDArray, ...] | None = None,
+) -> Law:
     """PTO law, eq. (35), with the saturated linear zone of eq. (34).
 
     Regions, first match wins:
@@ -331,6 +358,10 @@ def pto_law(cfg: Config, omega0: float | None, name: str = "pto", note: str = ""
         Level of l1*, l2* [mm/s], 0 < omega0 < w_max; None: no switching zone.
     name, note : str
         Law name and one-line description.
+    gains : tuple of ndarray, optional
+        Per-state (k1 [1/s], k2 [-]) of the linear zone in place of the
+        configuration's, or (k1, k2, d [mm], zone level [mm/s], NaN: no zone)
+        in place of cfg's gains, d and ``omega0`` (see :func:`with_state_gains`).
 
     Returns
     -------
@@ -349,38 +380,50 @@ def pto_law(cfg: Config, omega0: float | None, name: str = "pto", note: str = ""
     zone = omega0 is not None and 0.0 < omega0 < w
     om = float(omega0) if zone else w
 
-    def block(x1, x2):
+    def block(x1, x2, g1=k1, g2=k2, dd=d, lv=om if zone else math.nan):
         # each branch on the states it acts on (the linear zone first, as it takes
         # precedence); the same elementwise arithmetic as evaluating every branch
-        # everywhere and selecting, so the result is unchanged
+        # everywhere and selecting, so the result is unchanged.  g1, g2: the linear
+        # gains, dd: d, lv: the zone's level (NaN: no zone); floats or one per state
+        lin = np.abs(x1) < dd
+        if lin.all():  # all in the linear zone: no masks
+            u, region = saturate_linear(-g1 * x1 - g2 * x2, w)
+            return _origin(x1, x2, u, region)
         u = np.empty(x1.shape)
         region = np.empty(x1.shape, dtype=np.int8)
-        lin = np.abs(x1) < d
         if lin.any():
-            u[lin], region[lin] = saturate_linear(-k1 * x1[lin] - k2 * x2[lin], w)
+            if np.ndim(g1):
+                g1, g2 = g1[lin], g2[lin]
+            u[lin], region[lin] = saturate_linear(-g1 * x1[lin] - g2 * x2[lin], w)
         out = ~lin
         if out.any():
             y1, y2 = x1[out], x2[out]
             sig = switching_function(y1, y2, a, w)
             uo, ro = _bang(sig, y2, w)
-            if zone:
-                cand = np.flatnonzero(((y2 < 0) & (sig > 0)) | ((y2 > 0) & (sig < 0)))
+            per = np.ndim(lv) > 0
+            if per or not math.isnan(lv):
+                between = ((y2 < 0) & (sig > 0)) | ((y2 > 0) & (sig < 0))
+                if per:
+                    lv = lv[out]
+                    between &= ~np.isnan(lv)
+                cand = np.flatnonzero(between)
                 if cand.size:
                     c1, c2 = y1[cand], y2[cand]
-                    r0 = level_residual(c1, c2, a, om)
+                    lc = lv[cand] if per else lv
+                    r0 = level_residual(c1, c2, a, lc)
                     zp = (c2 < 0) & (r0 <= 0)
                     inz = zp | ((c2 > 0) & (r0 >= 0))
                     if inz.any():  # closed form only where it is used
-                        wc = np.clip(omega_c(c1[inz], c2[inz], a), om, w)
+                        wc = np.clip(omega_c(c1[inz], c2[inz], a), lc[inz] if per else lc, w)
                         zpi = zp[inz]
                         idx = cand[inz]
                         uo[idx] = np.where(zpi, wc, -wc)
                         ro[idx] = np.where(zpi, Region.ZONE_P, Region.ZONE_N)
             u[out], region[out] = uo, ro
-        origin = (x1 == 0) & (x2 == 0)
-        if origin.any():
-            u[origin], region[origin] = 0.0, Region.ORIGIN
-        return u, region
+        return _origin(x1, x2, u, region)
+
+    if gains is not None:
+        return _state_gains_law(name, lambda x1, x2: blockwise(block, x1, x2, *gains), w)
 
     def vector(x1, x2):
         return blockwise(block, x1, x2)
@@ -408,13 +451,15 @@ def pto_law(cfg: Config, omega0: float | None, name: str = "pto", note: str = ""
     return Law(name, vector, scalar, w, note or f"PTO eq. (35), omega0 = {om:g} mm/s")
 
 
-def pto_corrected_law(cfg: Config) -> Law:
+def pto_corrected_law(cfg: Config, *, gains: tuple[NDArray, NDArray] | None = None) -> Law:
     """PTO law with the corrected omega0 (``zones.corrected_zone``, strict reading).
 
     Parameters
     ----------
     cfg : Config
         Configuration.
+    gains : tuple of ndarray, optional
+        Per-state (k1, k2), as :func:`pto_law`.
 
     Returns
     -------
@@ -422,21 +467,34 @@ def pto_corrected_law(cfg: Config) -> Law:
         ``pto``; without a usable corrected zone, the law has no switching zone
         and its note says so.
     """
-    from ptoverify.zones import zone_for_law
-
-    z = zone_for_law(cfg, "corrected")
+    z = _corrected(cfg)
     if z.usable and not z.degenerate:
         note = (
             f"PTO eq. (35), corrected omega0 = {z.omega0:.6g} mm/s "
             f"({'valid' if z.valid else 'NOT valid'})"
         )
-        return pto_law(cfg, z.omega0, "pto", note)
+        return pto_law(cfg, z.omega0, "pto", note, gains=gains)
     return pto_law(
         cfg,
         None,
         "pto",
         f"PTO eq. (35) without switching zone: no corrected omega0 acts ({z.reason})",
+        gains=gains,
     )
+
+
+def _corrected(cfg: Config):
+    """Return the corrected zone the ``pto`` law of ``cfg`` uses (``zones.zone_for_law``)."""
+    from ptoverify.zones import zone_for_law
+
+    return zone_for_law(cfg, "corrected")
+
+
+def _corrected_level(cfg: Config) -> float:
+    """Level [mm/s] of the zone the ``pto`` law of ``cfg`` acts with; NaN: no zone."""
+    z = _corrected(cfg)
+    lv = z.omega0 if z.usable and not z.degenerate else None
+    return float(lv) if lv is not None and 0.0 < lv < cfg.plant.w_max else math.nan
 
 
 def pto_printed_law(cfg: Config) -> Law:
@@ -475,6 +533,66 @@ def pto_printed_law(cfg: Config) -> Law:
         " mm/s: [omega0, w_max] is empty, so no switching zone; time-optimal outside"
         " the linear zone, saturated eq. (34) inside",
     )
+
+
+def _state_gains_law(name: str, vector: ArrayFn, w: float) -> Law:
+    """Return a law whose gains are one per state: only its vector path exists."""
+
+    def scalar(x1: float, x2: float) -> tuple[float, int]:
+        raise TypeError("a law with per-state gains has no scalar path; call it on arrays")
+
+    return Law(name, vector, scalar, w, f"{name} with per-state linear gains")
+
+
+def with_state_gains(name: str, cfg: Config, gains: dict[str, ArrayLike]) -> Law:
+    """Return the law ``name`` with linear gains that differ from state to state.
+
+    Evaluating many gain sets in one batch: call the law on arrays of the
+    gains' shape, and state i is driven by gains i.  Each entry is computed
+    with the same arithmetic as the vector path of the law built from a
+    configuration holding that entry's gains, so it equals it bit for bit.
+    For the PTO, d [mm] may be given per state too (key ``d``); each state then
+    acts with the corrected zone of its d, as ``make_law("pto", ...)`` builds
+    it; without it, d and the zone are ``cfg``'s.
+
+    Parameters
+    ----------
+    name : str
+        ``pd`` (gains ``kp`` [1/s], ``kd`` [-]) or ``pto`` (``k1`` [1/s], ``k2`` [-]).
+    cfg : Config
+        Configuration (plant; for the PTO its d [mm]).
+    gains : dict
+        The two gains of the law (and the PTO's ``d``), arrays of one shape.
+
+    Returns
+    -------
+    Law
+        Vector path only (its scalar path raises TypeError).
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> law = with_state_gains("pd", paper_config(), {"kp": [100.0, 200.0], "kd": [0.0, 0.0]})
+    >>> law(np.array([0.1, 0.1]), np.zeros(2))[0].tolist()
+    [-10.0, -20.0]
+    """
+    keys = {"pd": ("kp", "kd"), "pto": ("k1", "k2")}
+    if name not in keys:
+        raise InputError(f"per-state gains: law '{name}' has none (choose from pd, pto)")
+    g1, g2 = (np.asarray(gains[k], dtype=float) for k in keys[name])
+    if g1.shape != g2.shape:
+        raise InputError("per-state gains: both gains need one shape")
+    if name == "pd":
+        return pd_law(cfg, gains=(g1, g2))
+    if "d" not in gains:
+        d = np.full(g1.shape, cfg.pto.d)
+    else:
+        d = np.broadcast_to(np.asarray(gains["d"], dtype=float), g1.shape).copy()
+    levels = {
+        v: _corrected_level(replace(cfg, pto=replace(cfg.pto, d=v))) for v in np.unique(d).tolist()
+    }
+    lv = np.array([levels[v] for v in d.ravel().tolist()]).reshape(d.shape)
+    return pto_law(cfg, None, "pto", gains=(g1, g2, d, lv))
 
 
 _FACTORIES: dict[str, Callable[[Config], Law]] = {

@@ -60,7 +60,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ptoverify.config import Config, PTOSettings
-from ptoverify.curves import level_curve_x1, level_residual, root_22, root_k
+from ptoverify.curves import level_curve_x1, level_residual, level_term, root_22, root_k
 from ptoverify.plant import flow
 from ptoverify.verdict import tie_band
 
@@ -185,20 +185,27 @@ def _source_intervals(cfg: Config, omega0: float, x2: NDArray[np.float64], d: fl
     Returns two intervals (lo, hi) per velocity; an empty one has lo > hi.
     """
     a, w = cfg.plant.a, cfg.plant.w_max
-    neg, pos = x2 < 0, x2 > 0
+    neg = x2 < 0
     with np.errstate(all="ignore"):
         l1s = np.where(neg, _l1star_x1(np.where(neg, x2, -1.0), a, min(omega0, w)), 0.0)
-        l2 = level_curve_x1(np.where(pos, x2, 1.0), a, w)
     lo_a = np.where(neg, np.maximum(l1s, d), d)  # right piece: x1 >= d
     hi_a = np.full_like(x2, np.inf)
-    lo_b = np.where(pos & (l2 <= -d), l2, np.inf)  # left piece: l2 <= x1 <= -d
+    return (lo_a, hi_a), _l2_sources(cfg, x2, d)
+
+
+def _l2_sources(cfg: Config, x2: NDArray[np.float64], d: float):
+    """Return the left piece of the sources, l2 <= x1 <= -d (free of omega0)."""
+    pos = x2 > 0
+    with np.errstate(all="ignore"):
+        l2 = level_curve_x1(np.where(pos, x2, 1.0), cfg.plant.a, cfg.plant.w_max)
+    lo_b = np.where(pos & (l2 <= -d), l2, np.inf)
     hi_b = np.full_like(x2, -d)
-    return (lo_a, hi_a), (lo_b, hi_b)
+    return lo_b, hi_b
 
 
 def principle_margin(
     cfg: Config,
-    omega0: float,
+    omega0: float | NDArray[np.float64],
     x2: NDArray[np.float64] | None = None,
     *,
     reading: str = "strict",
@@ -211,8 +218,10 @@ def principle_margin(
     ----------
     cfg : Config
         Configuration (a [rad/s], w_max [mm/s], T [s], d [mm]).
-    omega0 : float
+    omega0 : float or ndarray
         Level of l1* [mm/s]; values >= w_max mean no zone; 0 is the limit omega0 -> 0+.
+        An array is broadcast against ``x2`` (``omegas[:, None]`` with a 1-D ``x2``
+        gives one row per omega0; equal shapes pair them elementwise).
     x2 : ndarray, optional
         Velocities [mm/s], |x2| <= w_max; default ``points`` evenly over [-w_max, w_max].
     reading : {"strict", "lenient"}
@@ -227,6 +236,8 @@ def principle_margin(
     ndarray
         min over the sources at that velocity of sigma(F_{-w_max}(x)) [mm/s];
         +inf where the rule exempts every source.  The principle holds where >= 0.
+        Of the broadcast shape of ``omega0`` and ``x2``; every entry is what a
+        scalar ``omega0`` gives, bit for bit (the evaluation is elementwise).
     """
     if reading not in READINGS:
         raise ValueError(f"reading must be one of {READINGS}")
@@ -235,19 +246,84 @@ def principle_margin(
     if x2 is None:
         x2 = np.linspace(-w, w, points)
     x2 = np.asarray(x2, dtype=float)
-    c1, f2 = flow(0.0, x2, -w, cfg.plant.sample_time, a)  # F1 = x1 + c1, F2 = f2
-    margin = np.full_like(x2, np.inf)
-    for lo, hi in _source_intervals(cfg, omega0, x2, d):
-        cands = (
-            [lo]
-            if reading == "strict"
-            else [np.maximum(lo, d - c1), np.where(lo <= -d - c1, lo, np.inf)]
+    om = np.asarray(omega0, dtype=float)
+    if om.ndim == 0:
+        c1, f2 = flow(0.0, x2, -w, cfg.plant.sample_time, a)  # F1 = x1 + c1, F2 = f2
+        with np.errstate(all="ignore"):
+            term = level_term(f2, w)  # sigma(F) = a F1 + term: the part that is x1-free
+        (lo_a, hi_a), (lo_b, hi_b) = _source_intervals(cfg, float(om), x2, d)
+        return np.minimum(
+            _side_margin(lo_a, hi_a, c1, term, a, d, reading),
+            _side_margin(lo_b, hi_b, c1, term, a, d, reading),
         )
-        for x1 in cands:
-            ok = (x1 <= hi) & np.isfinite(x1)
-            with np.errstate(all="ignore"):
-                r = level_residual(np.where(ok, x1, 0.0) + c1, f2, a, w)
-            margin = np.minimum(margin, np.where(ok, r, np.inf))
+    # an array of omega0: the l2 side, and the l1* side at x2 >= 0 (sources x1 >= d),
+    # do not depend on omega0; evaluate them on x2 once and l1* only where x2 < 0
+    outer = x2.ndim == 1 and om.shape == (om.shape[0], 1)  # one row per omega0
+    if outer:  # the even grid of _worst_margins: the same velocities call after call
+        c1, term, m_b, m_fixed = _omega_free_memo(cfg.plant, d, reading, x2.tobytes())
+    else:
+        c1, term, m_b, m_fixed = _omega_free(cfg.plant, d, reading, x2)
+    shape = np.broadcast_shapes(om.shape, x2.shape)
+    out = np.array(np.broadcast_to(m_fixed, shape))
+    om = np.minimum(om, w)
+    if outer:  # columns x2 < 0
+        cols = np.flatnonzero(x2 < 0)
+        sel = (slice(None), cols)
+        xn, on, c1n, tn, mbn = x2[cols], om, c1[cols], term[cols], m_b[cols]
+    else:
+        x2b = np.broadcast_to(x2, shape)
+        sel = x2b < 0
+        xn, on = x2b[sel], np.broadcast_to(om, shape)[sel]
+        c1n, tn = np.broadcast_to(c1, shape)[sel], np.broadcast_to(term, shape)[sel]
+        mbn = np.broadcast_to(m_b, shape)[sel]
+    with np.errstate(all="ignore"):
+        l1s = np.where(on <= 0.0, -xn / a, level_curve_x1(xn, a, np.where(on <= 0.0, 1.0, on)))
+    lo = np.maximum(l1s, d)  # right piece: x1 >= max(l1*, d)
+    out[sel] = np.minimum(_side_margin(lo, np.inf, c1n, tn, a, d, reading), mbn)
+    return out
+
+
+def _omega_free(plant, d: float, reading: str, x2: NDArray[np.float64]):
+    """Return what the margin at velocities x2 has that does not depend on omega0.
+
+    Returns c1 and term (sigma(F) = a (x1 + c1) + term after one sample of -w_max),
+    the l2 side's margin, and the minimum of it and the l1* side's margin where that
+    side's sources are x1 >= d whatever omega0 (x2 >= 0).
+    """
+    cfg = Config(name="zone", plant=plant)
+    a, w = plant.a, plant.w_max
+    c1, f2 = flow(0.0, x2, -w, plant.sample_time, a)
+    with np.errstate(all="ignore"):
+        term = level_term(f2, w)
+    lo_b, hi_b = _l2_sources(cfg, x2, d)
+    m_b = _side_margin(lo_b, hi_b, c1, term, a, d, reading)
+    m_fixed = np.minimum(_side_margin(np.full_like(x2, d), np.inf, c1, term, a, d, reading), m_b)
+    return c1, term, m_b, m_fixed
+
+
+@functools.lru_cache(maxsize=32)
+def _omega_free_memo(plant, d: float, reading: str, x2_bytes: bytes):
+    """:func:`_omega_free` of a 1-D velocity array, memoized on its bytes (read-only)."""
+    out = _omega_free(plant, d, reading, np.frombuffer(x2_bytes, dtype=float))
+    for arr in out:
+        arr.flags.writeable = False
+    return out
+
+
+def _side_margin(lo, hi, c1, term, a: float, d: float, reading: str):
+    """Worst landing residual from the left end(s) of one family of source intervals."""
+    cands = (
+        [lo]
+        if reading == "strict"
+        else [np.maximum(lo, d - c1), np.where(lo <= -d - c1, lo, np.inf)]
+    )
+    margin = None
+    for x1 in cands:
+        ok = np.isfinite(x1) if np.ndim(hi) == 0 and hi == np.inf else (x1 <= hi) & np.isfinite(x1)
+        with np.errstate(all="ignore"):
+            r = a * (np.where(ok, x1, 0.0) + c1) + term  # level_residual(F1, F2, a, w_max)
+        m = np.where(ok, r, np.inf)
+        margin = m if margin is None else np.minimum(margin, m)
     return margin
 
 
@@ -257,15 +333,25 @@ def _kinks(cfg: Config, omega0: float, d: float) -> list[float]:
     l1* meets x1 = d at x2 = -omega0 y, h(y) = a d / omega0 (as eq. 22 with 2aT
     removed); l2 meets x1 = -d at x2 = w_max y, h(y) = a d / w_max.
     """
+    return _kinks_many(cfg, np.array([float(omega0)]), d)[0]
+
+
+def _kinks_many(cfg: Config, omegas: NDArray[np.float64], d: float) -> list[list[float]]:
+    """:func:`_kinks` for each omega0 of an array (root_22 is elementwise, so identical)."""
     a, w = cfg.plant.a, cfg.plant.w_max
-    out = []
+    out: list[list[float]] = [[] for _ in omegas]
     if d > 0:
-        if 0 < omega0 < w:
-            out.append(-omega0 * float(root_22(a * d / omega0)))
-        elif omega0 <= 0:
-            out.append(-a * d)
-        out.append(w * float(root_22(a * d / w)))
-    return [v for v in out if -w <= v <= w]
+        zone = (omegas > 0) & (omegas < w)
+        ys = root_22(a * d / omegas[zone]) if zone.any() else np.empty(0)
+        y_l2 = w * float(root_22(a * d / w))
+        it = iter(ys)
+        for lst, om, inside in zip(out, omegas.tolist(), zone.tolist(), strict=True):
+            if inside:
+                lst.append(-om * float(next(it)))
+            elif om <= 0:
+                lst.append(-a * d)
+            lst.append(y_l2)
+    return [[v for v in lst if -w <= v <= w] for lst in out]
 
 
 def _worst_margin(cfg: Config, omega0: float, reading: str, d: float | None = None) -> float:
@@ -275,19 +361,65 @@ def _worst_margin(cfg: Config, omega0: float, reading: str, d: float | None = No
     one, where a coarse grid would miss it by slope x spacing), and 201 points
     around each of the 8 lowest local minima of the even grid.
     """
+    return _worst_margins(cfg, np.array([float(omega0)]), reading, d)[0]
+
+
+def _worst_margins(
+    cfg: Config,
+    omegas: NDArray[np.float64],
+    reading: str,
+    d: float | None = None,
+    *,
+    below: float = -math.inf,
+) -> list[float]:
+    """:func:`_worst_margin` for each omega0 of an array, bit for bit, in two evaluations.
+
+    The even grids of all omega0 are one broadcast :func:`principle_margin` call and
+    their refinement points (kinks and minima, different per omega0) one elementwise
+    call; the evaluation is elementwise, so each value is that of its own call.  An
+    omega0 whose even grid already has a margin < ``below`` is not refined: its value
+    is then that grid minimum, still < ``below`` (the refined value can only be
+    lower), which is all a feasibility test against ``below`` needs.
+    """
     w = cfg.plant.w_max
     d = cfg.pto.d if d is None else d
+    omegas = np.asarray(omegas, dtype=float).ravel()
     x2 = np.linspace(-w, w, 4001)
-    m = principle_margin(cfg, omega0, x2, reading=reading, d=d)
+    M = principle_margin(cfg, omegas[:, None], x2, reading=reading, d=d)
     step = x2[1] - x2[0]
-    loc = np.flatnonzero((m[1:-1] <= m[:-2]) & (m[1:-1] <= m[2:])) + 1
-    loc = loc[np.argsort(m[loc])[:8]]
-    extra = [np.array(_kinks(cfg, omega0, d))]
-    extra += [np.linspace(x2[i] - step, x2[i] + step, 201) for i in loc]
-    fine = np.clip(np.concatenate(extra), -w, w)
-    if fine.size:
-        return float(min(m.min(), principle_margin(cfg, omega0, fine, reading=reading, d=d).min()))
-    return float(m.min())
+    dense = M.min(axis=1)
+    refine = ~(dense < below)
+    is_min = (M[:, 1:-1] <= M[:, :-2]) & (M[:, 1:-1] <= M[:, 2:])
+    kinks = _kinks_many(cfg, omegas, d)
+    locs = []
+    for k in range(omegas.size):
+        if not refine[k]:
+            kinks[k] = []
+            locs.append(np.zeros(0, dtype=np.intp))
+            continue
+        loc = np.flatnonzero(is_min[k]) + 1
+        locs.append(loc[np.argsort(M[k][loc])[:8]])
+    centre = x2[np.concatenate(locs)]
+    # one linspace per minimum, all at once (linspace is elementwise in its ends)
+    bands = np.linspace(centre - step, centre + step, 201, axis=1)
+    fines, sizes, j = [], [], 0
+    for k in range(omegas.size):
+        n = locs[k].size
+        fine = np.clip(np.concatenate([np.array(kinks[k]), bands[j : j + n].ravel()]), -w, w)
+        j += n
+        fines.append(fine)
+        sizes.append(fine.size)
+    sizes_a = np.array(sizes)
+    out = [float(v) for v in dense]
+    if sizes_a.sum():
+        pts = np.concatenate(fines)
+        fm = principle_margin(cfg, np.repeat(omegas, sizes_a), pts, reading=reading, d=d)
+        has = np.flatnonzero(sizes_a)
+        starts = np.concatenate([[0], np.cumsum(sizes_a)[:-1]])[has]
+        mins = np.minimum.reduceat(fm, starts)
+        for k, fmin in zip(has.tolist(), mins, strict=True):
+            out[k] = float(min(dense[k], fmin))
+    return out
 
 
 def principle_violations(
@@ -470,12 +602,12 @@ def _feasible_intervals(cfg: Config, reading: str, scan: int) -> list[tuple[floa
     grid = np.unique(
         np.concatenate([np.geomspace(1e-4 * w, w, scan // 2), np.linspace(w / scan, w, scan // 2)])
     )
-    ok = np.array([_worst_margin(cfg, float(om), reading) >= -tol for om in grid])
+    ok = np.array(_worst_margins(cfg, grid, reading, below=-tol)) >= -tol
 
     def edge(good: float, bad: float) -> float:
         for _ in range(60):
             mid = 0.5 * (good + bad)
-            if _worst_margin(cfg, mid, reading) >= -tol:
+            if _worst_margins(cfg, np.array([mid]), reading, below=-tol)[0] >= -tol:
                 good = mid
             else:
                 bad = mid
@@ -498,7 +630,6 @@ def _feasible_intervals(cfg: Config, reading: str, scan: int) -> list[tuple[floa
     return intervals
 
 
-@functools.lru_cache(maxsize=16)
 def smallest_d(cfg: Config, reading: str = "strict") -> float:
     """Smallest d [mm] for which some omega0 > 0 meets the principle (limit omega0 -> 0+).
 
@@ -514,11 +645,21 @@ def smallest_d(cfg: Config, reading: str = "strict") -> float:
     float
         The infimum d [mm] (bisection to 1e-9 of the position range); NaN if even
         d = position_range fails.
+
+    Notes
+    -----
+    It depends on the plant alone, and is memoized on it (``clear_caches`` empties
+    the memo).
     """
+    return _smallest_d(Config(name="zone", plant=cfg.plant), reading)
+
+
+@functools.lru_cache(maxsize=16)
+def _smallest_d(cfg: Config, reading: str) -> float:
     tol, R = _tol(cfg), cfg.plant.position_range
 
     def feasible(d: float) -> bool:
-        return _worst_margin(cfg, 0.0, reading, d=d) >= -tol
+        return _worst_margins(cfg, np.zeros(1), reading, d, below=-tol)[0] >= -tol
 
     if feasible(0.0):
         return 0.0
@@ -685,7 +826,7 @@ def _zone_for_law(cfg: Config, variant: str) -> PTOZone:
 
 def clear_caches() -> None:
     """Empty the memos of this module (zones, feasible intervals, d_min per configuration)."""
-    for fn in (_corrected_zone, _feasible_intervals, smallest_d, _zone_for_law):
+    for fn in (_corrected_zone, _feasible_intervals, _smallest_d, _zone_for_law, _omega_free_memo):
         fn.cache_clear()
 
 

@@ -269,3 +269,192 @@ def test_fair_comparison_bounds_constraints_and_floor():
     for c in fc["claims"]:
         assert c["sentence"] and len(c["readings"]) == 3, c["id"]
     json.dumps(fc, allow_nan=True)
+
+
+# ---------------------------------------------------------------- speed without change
+def test_spectral_radii_are_the_sampled_loop_radius():
+    from ptoverify.poles import sampled_spectral_radius
+    from ptoverify.tune import spectral_radii
+
+    rng = np.random.default_rng(8)
+    k1, k2 = 10 ** rng.uniform(0, 3.6, 300), rng.uniform(-1, 10, 300)
+    for a, T in ((CFG.plant.a, CFG.plant.T), (60.0, 0.004)):
+        got = spectral_radii(a, T, k1, k2)
+        want = [sampled_spectral_radius(a, T, float(p), float(q)) for p, q in zip(k1, k2)]
+        assert got.tolist() == want
+    # and an independent reference: the eigenvalues of the scipy ZOH loop
+    assert spectral_radii(CFG.plant.a, CFG.plant.T, [900.0], [0.1])[0] == pytest.approx(
+        _spectral_radius(CFG.plant.a, CFG.plant.T, 900.0, 0.1), rel=1e-12
+    )
+
+
+def test_grid_counts_are_the_gate_properties(monkeypatch):
+    from ptoverify import tune as tune_mod
+    from ptoverify.config import Config, PDGains, Plant, PTOSettings
+    from ptoverify.laws import pto_law
+
+    for cfg, law in ((CFG, "pto"), (CFG, "pd"), (CFG, "to")):
+        lp = law_properties(make_law(law, cfg), cfg)
+        cycles, strides = tune_mod.grid_counts(cfg, law)
+        assert cycles == lp.limit_cycles
+        assert strides == (lp.stride_overs if law == "pto" else 0)
+    assert tune_mod.grid_counts(CFG, "to")[0] > 0, "the sampled TO law chatters"
+    # a PTO without its zone on a plant where that strides over (the gate's own failing case)
+    stride_cfg = Config(
+        "stride",
+        Plant(a=100.0, w_max=100.0, sample_time=0.003, position_range=20.0),
+        PDGains(kp=50.0, kd=0.5),
+        PTOSettings(d=0.3, k1=50.0, k2=1.0),
+    )
+    monkeypatch.setattr(tune_mod, "make_law", lambda name, c: pto_law(c, None))
+    lp = law_properties(pto_law(stride_cfg, None), stride_cfg)
+    assert lp.stride_overs > 0
+    assert tune_mod.grid_counts(stride_cfg, "pto") == (lp.limit_cycles, lp.stride_overs)
+
+
+def test_limit_cycle_band_is_the_gate_default():
+    import inspect
+
+    from ptoverify.tune import LIMIT_CYCLE_BAND
+
+    assert inspect.signature(law_properties).parameters["band"].default == LIMIT_CYCLE_BAND
+
+
+@pytest.mark.parametrize("law, d", [("pd", None), ("pto", 0.3), ("pto", 1.0), ("pto", 2.3)])
+def test_screen_agrees_with_the_simulate_json_path(law, d):
+    from ptoverify import tune as tune_mod
+
+    rng = np.random.default_rng(9)
+    if law == "pd":
+        batch = [{"kp": 10 ** rng.uniform(1, 3.45), "kd": rng.uniform(0, 4)} for _ in range(60)]
+    else:
+        batch = [
+            {"d": d, "k1": 10 ** rng.uniform(1, 3.45), "k2": rng.uniform(0, 10)} for _ in range(60)
+        ]
+    batch = [{k: float(v) for k, v in g.items()} for g in batch]
+    raws = tune_mod._StepScreen(CFG, law, True)(batch)
+    feasible = 0
+    for g, raw in zip(batch, raws):
+        for bound in (0.05, 1.0):
+            ref = tune_mod.evaluate(CFG, law, g, max_overshoot=bound)
+            cand = tune_mod._screened(
+                CFG, law, g, raw, objective="settling_2pct", max_overshoot=bound, worst_ratio=None
+            )
+            assert cand.feasible == ref.feasible, (g, cand.reason, ref.reason)
+            feasible += ref.feasible
+        if math.isfinite(ref.overshoot_mm):
+            assert raw.overshoot_mm == pytest.approx(ref.overshoot_mm, abs=1e-12)
+        for a, b in (
+            (raw.settling_2pct_s, ref.settling_2pct_s),
+            (raw.settling_0p01mm_s, ref.settling_0p01mm_s),
+        ):
+            assert (math.isnan(a) and math.isnan(b)) or a == pytest.approx(b, abs=1e-12)
+    assert feasible > 0
+
+
+def test_side_by_side_searches_are_the_searches_one_by_one(monkeypatch):
+    from ptoverify import tune as tune_mod
+
+    kw = {
+        "max_overshoot": 0.05,
+        "maxiter": 4,
+        "popsize": 4,
+        "d_grid": 3,
+        "d_refine": 1,
+        "polish": 4,
+    }
+    together = tune(CFG, "pto", "step", **kw)
+
+    def one_by_one(batch_fn, jobs):
+        for job in jobs:
+            job(batch_fn)
+
+    monkeypatch.setattr(tune_mod, "_lockstep", one_by_one)
+    alone = tune(CFG, "pto", "step", **kw)
+    assert together.best == alone.best and together.front == alone.front
+    assert together.evaluations == alone.evaluations
+
+
+@pytest.mark.slow
+def test_fair_tunings_are_the_tunings_one_by_one():
+    ft = fair_tunings(CFG, SMALL)
+    for (law, name), r in ft.results.items():
+        alone = tune(
+            CFG,
+            law,
+            "step",
+            max_overshoot=ft.bounds[name],
+            seed=SMALL.seed,
+            maxiter=SMALL.maxiter,
+            popsize=SMALL.popsize,
+            d_grid=SMALL.d_grid,
+            d_refine=SMALL.d_refine,
+            polish=SMALL.polish,
+            find_runner_up=False,
+        )
+        assert r.best == alone.best and r.front == alone.front, (law, name)
+
+
+def test_reported_numbers_are_those_of_simulate_json():
+    from ptoverify.tune import evaluate
+
+    r = tune(CFG, "pd", "step", max_overshoot=0.02, maxiter=3, popsize=5)
+    for c in [r.best, r.runner_up, *r.front]:
+        if c is None:
+            continue
+        ref = evaluate(CFG, "pd", c.gains, max_overshoot=0.02)
+        assert (c.settling_2pct_s, c.overshoot_mm, c.settling_0p01mm_s) == (
+            ref.settling_2pct_s,
+            ref.overshoot_mm,
+            ref.settling_0p01mm_s,
+        )
+
+
+def test_tune_is_deterministic():
+    a = tune(CFG, "pto", "step", max_overshoot=0.0, maxiter=3, popsize=4, d_grid=2, d_refine=1)
+    b = tune(CFG, "pto", "step", max_overshoot=0.0, maxiter=3, popsize=4, d_grid=2, d_refine=1)
+    assert a.best == b.best and a.front == b.front and a.evaluations == b.evaluations
+
+
+def test_batched_worst_ratios_are_worst_ratio_nt():
+    from ptoverify.tune import _worst_ratios, tuned_config
+
+    rng = np.random.default_rng(12)
+    for law in ("pd", "pto"):
+        if law == "pd":
+            gs = [{"kp": 10 ** rng.uniform(1.5, 3.3), "kd": rng.uniform(0.2, 3)} for _ in range(6)]
+        else:
+            gs = [
+                {
+                    "d": rng.choice([0.5, 1.0]),
+                    "k1": 10 ** rng.uniform(1.5, 3.3),
+                    "k2": rng.uniform(0.2, 5),
+                }
+                for _ in range(6)
+            ]
+        gs = [{k: float(v) for k, v in g.items()} for g in gs]
+        want = [worst_ratio_nt(tuned_config(CFG, law, g), law, n1=4, n2=4) for g in gs]
+        assert _worst_ratios(CFG, law, gs, 4, 4) == want
+
+
+def test_lockstep_merges_batches_and_stops_on_errors():
+    from ptoverify import tune as tune_mod
+
+    calls = []
+
+    def batch_fn(xs):
+        calls.append(list(xs))
+        if any(x < 0 for x in xs):
+            raise InputError("negative")
+        return [2 * x for x in xs]
+
+    got = {}
+
+    def job(ev, k):
+        got[k] = [ev([k, k + 10]), ev([k + 20])]
+
+    tune_mod._lockstep(batch_fn, [lambda ev, k=k: job(ev, k) for k in (1, 2, 3)])
+    assert got == {k: [[2 * k, 2 * k + 20], [2 * k + 40]] for k in (1, 2, 3)}
+    assert calls == [[1, 11, 2, 12, 3, 13], [21, 22, 23]], "one batch per round, job order"
+    with pytest.raises(InputError, match="negative"):
+        tune_mod._lockstep(batch_fn, [lambda ev: ev([1]), lambda ev: ev([-1]), lambda ev: None])
