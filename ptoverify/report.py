@@ -75,7 +75,7 @@ ROBUST_SETTINGS: dict[str, Any] = {}
 
 #: Search effort of the report's tunings (:class:`ptoverify.tune.TuneBudget`, fixed seed),
 #: reduced from ``ptoverify tune``'s defaults (30 generations, population factor 10, 9 d
-#: points, 4 refinements) so the four tunings take about a minute.
+#: points, 4 refinements): the four tunings take a few seconds (benchmarks/README.md).
 TUNE_SETTINGS = {"maxiter": 15, "popsize": 8, "d_grid": 5, "d_refine": 2, "seed": 0}
 
 #: States of the ground-truth table [mm], [mm/s]: a step, moves with speed, on/near a
