@@ -83,16 +83,17 @@ class PlantNumbers:
 
 @lru_cache(maxsize=None)
 def _flow_general() -> tuple[sp.Expr, sp.Expr]:
-    """Solve eq. (1) with constant input u and x(0) = (x10, x20) by dsolve."""
+    """Solve eq. (1) with constant input u and x(0) = (x10, x20) by dsolve.
+
+    Eq. (1) is a cascade: dsolve the velocity equation, then the position
+    equation with that velocity.  The position is returned expanded, the velocity
+    as one fraction (``cancel``).
+    """
     a, t, u, x10, x20 = (S[n] for n in ("a", "t", "u", "x10", "x20"))
     X1, X2 = sp.Function("X1"), sp.Function("X2")
-    sol = sp.dsolve(
-        [sp.Eq(X1(t).diff(t), X2(t)), sp.Eq(X2(t).diff(t), -a * X2(t) + a * u)],
-        [X1(t), X2(t)],
-        ics={X1(0): x10, X2(0): x20},
-    )
-    by = {s.lhs.func: s.rhs for s in sol}
-    return sp.simplify(by[X1]), sp.simplify(by[X2])
+    v = sp.dsolve(sp.Eq(X2(t).diff(t), -a * X2(t) + a * u), X2(t), ics={X2(0): x20}).rhs
+    p = sp.dsolve(sp.Eq(X1(t).diff(t), v), X1(t), ics={X1(0): x10}).rhs
+    return sp.expand(p), sp.cancel(v)
 
 
 def flow(

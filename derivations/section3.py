@@ -60,17 +60,28 @@ def trajectory_residual(level: sp.Expr) -> sp.Expr:
     """Trajectory of input ``level`` through (x10, x20) with t eliminated, eqs. (8), (10).
 
     Solves x2(t) = x2 for t in the flow of eq. (7) and substitutes into x1(t);
-    returns a (x1 - x1(t(x2))), which vanishes on the trajectory.
+    returns a (x1 - x1(t(x2))), which vanishes on the trajectory.  The derivation
+    uses only that the level's magnitude is a positive constant: for
+    ``level = +-L`` with L a positive symbol other than omega_m (omega_c in
+    eqs. 28, 33) it is the residual of ``+-omega_m`` with omega_m renamed L.
 
     Parameters
     ----------
     level : sympy.Expr
-        The constant input (omega_m or -omega_m).
+        The constant input (omega_m or -omega_m; omega_c or -omega_c).
 
     Returns
     -------
     sympy.Expr
     """
+    sign, mag = (-1, -level) if level.could_extract_minus_sign() else (1, level)
+    if isinstance(mag, sp.Symbol) and mag.is_positive and mag != wm:
+        return _trajectory_residual(sign * wm).xreplace({wm: mag})
+    return _trajectory_residual(level)
+
+
+@lru_cache(maxsize=None)
+def _trajectory_residual(level: sp.Expr) -> sp.Expr:
     X1, X2 = flow(level)
     (t_of_x2,) = sp.solve(sp.Eq(X2, x2), t)
     r = sp.expand(sp.simplify(a * (x1 - X1.subs(t, t_of_x2))))

@@ -84,6 +84,7 @@ def one_step(sign: int = +1) -> tuple[sp.Expr, sp.Expr]:
     return flow_T(sign * wm, x1, x2)
 
 
+@lru_cache(maxsize=None)
 def one_step_inverse(sign: int = +1) -> tuple[sp.Expr, sp.Expr]:
     """Inverse of the one-step map, (x1, x2) from (tx1, tx2) (eq. 17 for sign = +1).
 
@@ -101,6 +102,7 @@ def one_step_inverse(sign: int = +1) -> tuple[sp.Expr, sp.Expr]:
     return sp.simplify(sol[x1]), sp.simplify(sol[x2])
 
 
+@lru_cache(maxsize=None)
 def preimage_l1() -> sp.Expr:
     """Corrected l~1: states that reach l1 after one sample of u = -omega_m.
 
@@ -129,16 +131,21 @@ def corrected_b0() -> dict[str, sp.Expr]:
         ``residual`` (corrected (20) divided by omega_m, in y), ``shift``
         (Y - y), ``b0c``, ``form22`` (ln(1 + Y) - (Y - b0c) in y).
     """
+    return dict(_corrected_b0())
+
+
+@lru_cache(maxsize=None)
+def _corrected_b0() -> tuple[tuple[str, sp.Expr], ...]:
     r = preimage_l1().subs({x1: d, x2: -y * wm}) / wm
     shift = 2 * (sp.exp(a * T) - 1)
     b0c = a * d / wm + 2 * (sp.exp(a * T) - 1 - a * T)
     Y = y + shift
-    return {
-        "residual": sp.expand(r),
-        "shift": shift,
-        "b0c": b0c,
-        "form22": sp.log(1 + Y) - (Y - b0c),
-    }
+    return (
+        ("residual", sp.expand(r)),
+        ("shift", shift),
+        ("b0c", b0c),
+        ("form22", sp.log(1 + Y) - (Y - b0c)),
+    )
 
 
 def root_22_W(bb: sp.Expr = b0, branch: int = -1) -> sp.Expr:
@@ -210,6 +217,13 @@ def intersection(
         ``b0``, ``y``, ``x20`` [mm/s], ``k``, ``z``, ``omega0`` [mm/s] (NaN when no
         non-trivial root exists).
     """
+    return dict(_intersection(a_, w_max, T_, d_, corrected))
+
+
+@lru_cache(maxsize=32, typed=True)
+def _intersection(
+    a_: float, w_max: float, T_: float, d_: float, corrected: bool
+) -> tuple[tuple[str, float], ...]:
     num = {a: a_, wm: w_max, T: T_, d: d_}
     with mpmath.workdps(30):
         if corrected:
@@ -228,14 +242,14 @@ def intersection(
         else:
             zz = sp.nan
         om0 = -x20 / zz if zz != 0 else sp.nan
-    return {
-        "b0": float(bb),
-        "y": float(yy),
-        "x20": float(x20),
-        "k": float(kk),
-        "z": float(zz),
-        "omega0": float(om0),
-    }
+    return (
+        ("b0", float(bb)),
+        ("y", float(yy)),
+        ("x20", float(x20)),
+        ("k", float(kk)),
+        ("z", float(zz)),
+        ("omega0", float(om0)),
+    )
 
 
 def _rec_13_17() -> list[EquationRecord]:
@@ -756,8 +770,11 @@ def _rec_lambert() -> list[EquationRecord]:
             printed_str="(not in the paper)",
         )
     )
-    (p26,) = parsed("26")
-    for id_, var in (("26W", z), ("31W", w)):
+    (p26,), (p31,) = parsed("26"), parsed("31")
+    # (31) is (26) with w for z: with the root substituted both are the same expression
+    # in k, judged at the same points, so each judgement is computed once
+    done: dict[tuple[sp.Expr, int], list] = {}
+    for id_, var, p_ in (("26W", z, p26), ("31W", w, p31)):
         js = []
         for br, lo, hi in ((-1, 0.01, 0.99), (0, 1.01, 20.0)):
 
@@ -765,8 +782,13 @@ def _rec_lambert() -> list[EquationRecord]:
                 return {k: rng.uniform(lo, hi, n)}
 
             r = root_k_W(k, br)
-            js.append(judge(p26.subs(z, r), sp.Integer(0), sk, symbolic=False))
-            js.append(_branch_signs(r, br, sk))
+            resid = p_.subs(var, r)
+            if (resid, br) not in done:
+                done[resid, br] = [
+                    judge(resid, sp.Integer(0), sk, symbolic=False),
+                    _branch_signs(r, br, sk),
+                ]
+            js += done[resid, br]
         out.append(
             record_from(
                 id_,

@@ -73,13 +73,19 @@ def zoh_spectral_radius(a_: float, T_: float, k1_: float, k2_: float) -> float:
     float
         max |eigenvalue|; < 1 means the sampled, unsaturated loop is stable.
     """
+    M = _zoh_closed_loop().subs({a: a_, T: T_, k1: k1_, k2: k2_})
+    return float(max(abs(complex(ev)) for ev in np.linalg.eigvals(np.array(M, dtype=float))))
+
+
+@lru_cache(maxsize=None)
+def _zoh_closed_loop() -> sp.Matrix:
+    """Ad - Bd K in the symbols a, T, k1, k2 (the SymPy matrix exponential and its integral)."""
     s = sp.Symbol("s", positive=True)
     A = sp.Matrix([[0, 1], [0, -a]])
     B = sp.Matrix([0, a])
     Ad = (A * T).exp()
     Bd = (A * s).exp().integrate((s, 0, T)) * B
-    M = (Ad - Bd * sp.Matrix([[k1, k2]])).subs({a: a_, T: T_, k1: k1_, k2: k2_})
-    return float(max(abs(complex(ev)) for ev in np.linalg.eigvals(np.array(M, dtype=float))))
+    return sp.ImmutableMatrix(Ad - Bd * sp.Matrix([[k1, k2]]))
 
 
 def _rec_36() -> EquationRecord:
