@@ -85,14 +85,15 @@ class PlantNumbers:
 def _flow_general() -> tuple[sp.Expr, sp.Expr]:
     """Solve eq. (1) with constant input u and x(0) = (x10, x20) by dsolve.
 
-    Eq. (1) is a cascade: dsolve the velocity equation, then the position
-    equation with that velocity.  The position is returned expanded, the velocity
-    as one fraction (``cancel``).
+    Eq. (1) is a cascade: dsolve the velocity equation x2' = -a x2 + a u, then
+    the position x1' = x2 is its integral, x1(t) = x10 + int_0^t x2.  The position
+    is returned expanded, the velocity as one fraction (``cancel``).
     """
     a, t, u, x10, x20 = (S[n] for n in ("a", "t", "u", "x10", "x20"))
-    X1, X2 = sp.Function("X1"), sp.Function("X2")
+    X2 = sp.Function("X2")
     v = sp.dsolve(sp.Eq(X2(t).diff(t), -a * X2(t) + a * u), X2(t), ics={X2(0): x20}).rhs
-    p = sp.dsolve(sp.Eq(X1(t).diff(t), v), X1(t), ics={X1(0): x10}).rhs
+    s = sp.Dummy("s")
+    p = x10 + sp.integrate(v.subs(t, s), (s, 0, t))
     return sp.expand(p), sp.cancel(v)
 
 

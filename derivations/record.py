@@ -39,6 +39,7 @@ __all__ = [
     "SEED",
     "definition",
     "as_tuple",
+    "log_normal",
 ]
 
 VERDICTS = ("verified", "erratum", "definition", "unchecked")
@@ -218,8 +219,30 @@ def _expand_logs(diff: sp.Expr) -> sp.Expr:
     return sp.expand(sp.expand_log(sp.expand(diff), force=True))
 
 
-def _split_logs(diff: sp.Expr) -> sp.Expr:
-    return sp.expand(sp.expand_log(diff.replace(sp.log, _log_abs_split), force=True))
+def log_normal(expr: sp.Expr) -> sp.Expr:
+    """Expand expr with every log argument split into sign-normalized factors.
+
+    Each log(z) becomes the sum of e*log(f) over the irreducible factors f^e of z,
+    with f's sign removed, then everything is expanded (``expand_log(force=True)``
+    for what is left).  Valid where every log argument is > 0 (there log z =
+    log|z|, a homomorphism of the nonzero reals).  An identity holds on that set
+    when the result of its difference is 0 after ``cancel``.
+
+    Parameters
+    ----------
+    expr : sympy.Expr
+
+    Returns
+    -------
+    sympy.Expr
+
+    Examples
+    --------
+    >>> w, v = sp.symbols("omega_m x2", positive=True)
+    >>> log_normal(sp.log(1 - v / w) - sp.log(w - v) + sp.log(w))
+    0
+    """
+    return sp.expand(sp.expand_log(expr.replace(sp.log, _log_abs_split), force=True))
 
 
 def _symbolic_zero(diff: sp.Expr, full: bool = True) -> bool | None:
@@ -245,7 +268,7 @@ def _symbolic_zero(diff: sp.Expr, full: bool = True) -> bool | None:
         return True
     try:
         # cheap steps first; log expansion is valid where log arguments are > 0 (admissible)
-        for rewrite in (_expand_logs, _split_logs):
+        for rewrite in (_expand_logs, log_normal):
             e = rewrite(diff)
             if e == 0 or sp.cancel(e) == 0:
                 return True
