@@ -417,7 +417,7 @@ def _rec_mintime() -> EquationRecord:
         }
 
     j_alt = judge((t1_alt, t2_alt), (t1_q, e["t2"]), samp_q)
-    pos = judge(sp.Min(t1, t2, -q) > 0, sp.true, samp, symbolic=False)
+    pos = judge(sp.Min(t1, t2, -q, evaluate=False) > 0, sp.true, samp, symbolic=False)
     steps = [
         "arc 2: +omega_m from (p, q) reaches 0: t2 = " + sp.sstr(t2),
         "and p on l1 (eq. 9)",

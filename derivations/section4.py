@@ -98,8 +98,10 @@ def one_step_inverse(sign: int = +1) -> tuple[sp.Expr, sp.Expr]:
     x1, x2 : sympy.Expr
     """
     m1, m2 = one_step(sign)
-    sol = sp.solve([sp.Eq(m1, tx1), sp.Eq(m2, tx2)], [x1, x2], dict=True)[0]
-    return sp.simplify(sol[x1]), sp.simplify(sol[x2])
+    # the map is affine in (x1, x2): a linear solve; x1 over its denominator a
+    (sol,) = sp.linsolve([m1 - tx1, m2 - tx2], [x1, x2])
+    num, den = sp.fraction(sp.together(sol[0]))
+    return sp.collect(num, a) / den, sp.expand(sol[1])
 
 
 @lru_cache(maxsize=None)
@@ -116,7 +118,7 @@ def preimage_l1() -> sp.Expr:
     """
     m1, m2 = one_step(-1)
     r = a * m1 + m2 + wm * sp.log(1 - m2 / wm)
-    return sp.expand(sp.simplify(r))
+    return sp.expand(r.replace(sp.log, lambda z: sp.log(sp.factor(z))))
 
 
 def corrected_b0() -> dict[str, sp.Expr]:
@@ -471,7 +473,8 @@ def _rec_18_19() -> list[EquationRecord]:
         )
     )
     # 19c: verify the preimage by mapping back, and its side
-    x1_on = sp.solve(pre, x1)[0]
+    c1 = pre.coeff(x1)  # pre is affine in x1
+    x1_on = sp.cancel(-(pre - c1 * x1) / c1)
     n1, n2 = one_step(-1)
     m_img = (n1.subs(x1, x1_on), n2.subs(x1, x1_on))
     on_l1 = a * m_img[0] + m_img[1] + wm * sp.log(1 - m_img[1] / wm)
