@@ -7,6 +7,11 @@ first symbolically, then numerically at random admissible points, and returns
 ``verified`` or ``erratum`` (with a counterexample), or ``unchecked`` when the
 comparison could not be carried out.
 
+Points.  A comparison proved symbolically is cross-checked at ``N_CROSS = 50``
+random points (the proof decides; the points confirm that its log expansions
+hold on the admissible set); one without a proof is decided by the numbers at
+``N_POINTS = 200`` points.
+
 Numeric tolerance.  The numeric comparison evaluates both expressions with
 mpmath at ``DPS = 50`` significant digits at points whose coordinates are exact
 binary floats.  Round-off is then below ~1e-48 relative to the largest term;
@@ -36,6 +41,7 @@ __all__ = [
     "DPS",
     "RTOL",
     "N_POINTS",
+    "N_CROSS",
     "SEED",
     "definition",
     "as_tuple",
@@ -46,6 +52,7 @@ VERDICTS = ("verified", "erratum", "definition", "unchecked")
 DPS = 50
 RTOL = 1e-30
 N_POINTS = 200
+N_CROSS = 50
 SEED = 20241121
 
 Sampler = Callable[[np.random.Generator, int], dict[sp.Symbol, np.ndarray]]
@@ -245,37 +252,43 @@ def log_normal(expr: sp.Expr) -> sp.Expr:
     return sp.expand(sp.expand_log(expr.replace(sp.log, _log_abs_split), force=True))
 
 
-def _symbolic_zero(diff: sp.Expr, full: bool = True) -> bool | None:
-    """Try to prove diff == 0: cheap rewrites first, then simplify.
+def _rewrite_zero(diff: sp.Expr) -> bool | None:
+    """Try to prove diff == 0 by cheap rewrites; False when they show it nonzero.
 
-    The steps, cheapest first, stop at the first that reduces diff to 0:
-    ``expand`` after ``expand_log(force=True)``, then ``cancel``; every log
-    argument factored and split into sign-normalized factors
-    (:func:`_log_abs_split`), expanded, then ``cancel``; ``simplify``; and
-    ``simplify`` after ``expand_log(force=True)``.  The log rewrites are valid on
-    the admissible set, where every log argument is > 0.  When a rewrite leaves a
-    form that SymPy's assumptions show nonzero (``is_zero is False``, e.g.
-    ``2*T*a*omega_m`` with positive symbols), no proof of equality exists and the
-    later steps are skipped.  With ``full=False`` (the numbers already disagree)
-    only the rewrites are tried: ``simplify`` could only fail there, or contradict
-    the numbers through the same log expansion the rewrites use.
+    The rewrites, in order: ``expand`` after ``expand_log(force=True)``, then
+    ``cancel``; :func:`log_normal` (every log argument factored into
+    sign-normalized factors), then ``cancel``.  Both are valid on the admissible
+    set, where every log argument is > 0.  When a rewrite leaves a form that
+    SymPy's assumptions show nonzero (``is_zero is False``, e.g. ``2*T*a*omega_m``
+    with positive symbols), diff is nonzero there: no proof of equality exists.
+
+    Returns
+    -------
+    bool or None
+        True: proved zero; False: proved nonzero; None: neither.
+    """
+    if diff == 0:
+        return True
+    try:
+        for rewrite in (_expand_logs, log_normal):
+            e = rewrite(diff)
+            if e == 0 or sp.cancel(e) == 0:
+                return True
+            if e.is_zero is False:
+                return False
+    except Exception:  # noqa: BLE001 - any failure of the CAS means "cannot prove"
+        return None
+    return None
+
+
+def _simplify_zero(diff: sp.Expr) -> bool | None:
+    """Try to prove diff == 0 by ``simplify``, then ``simplify`` after ``expand_log``.
 
     Returns True when proved and None otherwise: a failure to simplify to 0 (or a
     ``False`` from ``equals``, which tests at points that may lie outside the
     admissible set or on another Lambert-W branch) is never taken as a disproof.
     """
-    if diff == 0:
-        return True
     try:
-        # cheap steps first; log expansion is valid where log arguments are > 0 (admissible)
-        for rewrite in (_expand_logs, log_normal):
-            e = rewrite(diff)
-            if e == 0 or sp.cancel(e) == 0:
-                return True
-            if e.is_zero is False:  # diff equals a provably nonzero form: no proof exists
-                return None
-        if not full:
-            return None
         s = sp.simplify(diff)
         if s == 0:
             return True
@@ -331,11 +344,13 @@ def judge(
     """Compare a printed and a derived form; compute the verdict.
 
     Both arguments are SymPy expressions (or equal-length tuples of them) in the
-    free symbols that ``sampler`` draws.  Both are evaluated at ``n`` admissible
-    random points (fixed ``seed``) in ``DPS``-digit arithmetic, and ``printed -
-    derived == 0`` is tried symbolically (:func:`_symbolic_zero`; when the numbers
-    already disagree, only its cheap rewrites).  The numeric step decides: a
-    symbolic "cannot prove" is never a pass on its own.
+    free symbols that ``sampler`` draws.  Step 1 tries to prove ``printed - derived
+    == 0`` by cheap rewrites (:func:`_rewrite_zero`).  Step 2 evaluates both at
+    admissible random points (fixed ``seed``) in ``DPS``-digit arithmetic:
+    ``N_CROSS`` points cross-check a proof, ``n`` points decide otherwise.  Step 3,
+    only when step 1 neither proved nor disproved and the numbers do not disagree,
+    tries ``simplify`` (:func:`_simplify_zero`) to upgrade the comparison to a
+    proof.  A symbolic "cannot prove" is never a pass on its own.
 
     Parameters
     ----------
@@ -345,7 +360,8 @@ def judge(
         ``sampler(rng, n) -> {symbol: array of n floats}``, admissible points (it may
         return fewer than n when it filters out inadmissible draws).
     n : int
-        Number of points (at least 200 are required for a verdict).
+        Number of points when there is no proof (at least ``N_POINTS`` = 200 must
+        evaluate for a verdict; with a proof, ``N_CROSS`` = 50).
     seed : int
         Seed of the point generator.
     symbolic : bool
@@ -355,8 +371,9 @@ def judge(
     -------
     Judgement
         ``verified`` if every admissible point agrees within ``RTOL``; ``erratum``
-        with the worst point if any disagrees; ``unchecked`` if fewer than 200
-        points could be evaluated or a symbolic proof of equality contradicts the numbers.
+        with the worst point if any disagrees; ``unchecked`` if fewer than 200 (50
+        with a proof) points could be evaluated or a symbolic proof of equality
+        contradicts the numbers.
 
     Examples
     --------
@@ -370,7 +387,13 @@ def judge(
     p_t, d_t = as_tuple(printed), as_tuple(derived)
     if len(p_t) != len(d_t):
         raise ValueError("printed and derived have different lengths")
-    pts = sampler(np.random.default_rng(seed), n)
+    # step 1: the cheap rewrites (a proof, a proof of a difference, or neither)
+    diffs = [sp.sympify(p - d) for p, d in zip(p_t, d_t)] if symbolic else []
+    cheap = [_rewrite_zero(e) for e in diffs]
+    proved = symbolic and all(c is True for c in cheap)
+    need = N_CROSS if proved else N_POINTS
+    # step 2: the numbers (a proof needs only a cross-check)
+    pts = sampler(np.random.default_rng(seed), min(n, N_CROSS) if proved else n)
     syms = list(pts)
     free = set().union(*(e.free_symbols for e in p_t + d_t))
     missing = free - set(syms)
@@ -399,25 +422,21 @@ def judge(
                     "printed": [float(v) for v in vp],
                     "derived": [float(v) for v in vd],
                 }
-    # the numbers disagree: only the cheap rewrites can contradict them (simplify cannot
-    # prove a nonzero difference zero), so the costly fallback is tried only otherwise
+    # step 3: simplify, only to upgrade agreeing numbers to a proof (where the numbers
+    # disagree it could only fail, or contradict them through the log expansion of step 1)
+    sym: bool | None = True if proved else None
     disagree = n_ok >= N_POINTS and worst_err > RTOL
-    sym: bool | None = True
-    if symbolic:
-        for p, d in zip(p_t, d_t):
-            if _symbolic_zero(sp.sympify(p - d), full=not disagree) is not True:
-                sym = None
-                break
-    else:
-        sym = None
-    if n_ok < N_POINTS:
+    if symbolic and not proved and not disagree and all(c is not False for c in cheap):
+        if all(c is True or _simplify_zero(e) is True for c, e in zip(cheap, diffs)):
+            sym = True
+    if n_ok < need:
         return Judgement(
             "unchecked",
             sym,
             n_ok,
             worst_err,
             None,
-            f"only {n_ok} admissible points evaluated (need {N_POINTS})",
+            f"only {n_ok} admissible points evaluated (need {need})",
         )
     ok = worst_err <= RTOL
     if ok:
