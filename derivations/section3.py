@@ -402,7 +402,7 @@ def _rec_mintime() -> EquationRecord:
     # parametrized by the switch velocity qs, with x1 eliminated through the q relation
     e = extremal()
     qs = e["q_symbol"]
-    x1_of_q = sp.solve(e["q_relation"].subs(q, qs), x1, check=False)[0]
+    (x1_of_q,) = sp.solve(e["q_relation"], x1, check=False, simplify=False)
     t1_q = e["t1"].subs(x1, x1_of_q)
     t1_alt = ((sp.log(1 - qs / wm) + (a * x1 + x2) / wm) / a).subs(x1, x1_of_q)
     t2_alt = sp.log(1 - qs / wm) / a

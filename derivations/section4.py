@@ -98,9 +98,13 @@ def one_step_inverse(sign: int = +1) -> tuple[sp.Expr, sp.Expr]:
     x1, x2 : sympy.Expr
     """
     m1, m2 = one_step(sign)
-    # the map is affine in (x1, x2): a linear solve; x1 over its denominator a
-    (sol,) = sp.linsolve([m1 - tx1, m2 - tx2], [x1, x2])
-    num, den = sp.fraction(sp.together(sol[0]))
+    # the map is affine, m = J x + c: x = J^-1 (tx - c); x1 over its denominator a
+    J = sp.Matrix([[m1.diff(x1), m1.diff(x2)], [m2.diff(x1), m2.diff(x2)]])
+    if J.has(x1, x2):
+        raise ArithmeticError("the one-step map is not affine in the state")
+    c = sp.Matrix([m1, m2]).subs({x1: 0, x2: 0})
+    sol = J.LUsolve(sp.Matrix([tx1, tx2]) - c)
+    num, den = sp.fraction(sp.together(sp.expand(sol[0])))
     return sp.collect(num, a) / den, sp.expand(sol[1])
 
 
