@@ -15,7 +15,16 @@ from functools import lru_cache
 import numpy as np
 import sympy as sp
 
-from derivations.common import S, combine, flow, parsed, record_from, rhs, switch_curve_x1
+from derivations.common import (
+    S,
+    combine,
+    flow,
+    linear_ode_solution,
+    parsed,
+    record_from,
+    rhs,
+    switch_curve_x1,
+)
 from derivations.record import EquationRecord, definition, judge, log_normal
 
 __all__ = ["records", "hamiltonian", "trajectory_residual", "extremal", "min_time_closed_form"]
@@ -153,10 +162,12 @@ def extremal() -> dict[str, sp.Expr]:
     if H.diff(x1) != 0:
         raise ArithmeticError("dH/dx1 is not zero")
     lam1 = -1 / q
-    L2 = sp.Function("L2")
-    lam2 = sp.dsolve(
-        sp.Eq(L2(s).diff(s), -H.diff(x2).subs({l1: lam1, l2: L2(s)})), L2(s), ics={L2(t1s): 0}
-    ).rhs
+    # lambda2' = -dH/dx2 = -lambda1 + a lambda2: linear with constant coefficients
+    rhs2 = sp.expand(-H.diff(x2).subs(l1, lam1))
+    alpha, beta = rhs2.coeff(l2), rhs2.subs(l2, 0)
+    if alpha.has(l2, s) or beta.has(l2, s):
+        raise ArithmeticError("the costate equation is not linear with constant coefficients")
+    lam2 = linear_ode_solution(alpha, beta, sp.Integer(0), t1s, s)
     lam2_tf = sp.cancel(sp.expand(lam2.subs(s, t1s + t2s).subs(t2s, t2)))
     H_tf = sp.cancel(H.subs({l1: lam1, l2: lam2_tf, x2: 0, u: wm}))
     return {
@@ -247,7 +258,7 @@ def _rec_3_to_6() -> list[EquationRecord]:
     j6 = judge(rhs(p6, u_star), d6, samp6)
     # brute force: H(u*) is the minimum of H over a grid of admissible u
     rng = np.random.default_rng(6)
-    f_H = sp.lambdify((a, x2, u, l1, l2), H, "numpy")
+    f_H = sp.lambdify((a, x2, u, l1, l2), H, "math")  # arithmetic only: works on arrays
     lam2v = rng.uniform(-5, 5, 200)
     grid = np.linspace(-1.0, 1.0, 201)
     ok = all(
