@@ -222,10 +222,6 @@ def _log_abs_split(z: sp.Expr) -> sp.Expr:
     return sp.Add(*terms)
 
 
-def _expand_logs(diff: sp.Expr) -> sp.Expr:
-    return sp.expand(sp.expand_log(sp.expand(diff), force=True))
-
-
 def log_normal(expr: sp.Expr) -> sp.Expr:
     """Expand expr with every log argument split into sign-normalized factors.
 
@@ -255,12 +251,12 @@ def log_normal(expr: sp.Expr) -> sp.Expr:
 def _rewrite_zero(diff: sp.Expr) -> bool | None:
     """Try to prove diff == 0 by cheap rewrites; False when they show it nonzero.
 
-    The rewrites, in order: ``expand`` after ``expand_log(force=True)``, then
-    ``cancel``; :func:`log_normal` (every log argument factored into
-    sign-normalized factors), then ``cancel``.  Both are valid on the admissible
-    set, where every log argument is > 0.  When a rewrite leaves a form that
-    SymPy's assumptions show nonzero (``is_zero is False``, e.g. ``2*T*a*omega_m``
-    with positive symbols), diff is nonzero there: no proof of equality exists.
+    The rewrite is :func:`log_normal` (every log argument factored into
+    sign-normalized factors, everything expanded), then ``cancel``; it is valid
+    on the admissible set, where every log argument is > 0.  When it leaves a
+    form that SymPy's assumptions show nonzero (``is_zero is False``, e.g.
+    ``2*T*a*omega_m`` with positive symbols), diff is nonzero there: no proof of
+    equality exists.
 
     Returns
     -------
@@ -270,15 +266,12 @@ def _rewrite_zero(diff: sp.Expr) -> bool | None:
     if diff == 0:
         return True
     try:
-        for rewrite in (_expand_logs, log_normal):
-            e = rewrite(diff)
-            if e == 0 or sp.cancel(e) == 0:
-                return True
-            if e.is_zero is False:
-                return False
+        e = log_normal(diff)
+        if e == 0 or sp.cancel(e) == 0:
+            return True
+        return False if e.is_zero is False else None
     except Exception:  # noqa: BLE001 - any failure of the CAS means "cannot prove"
         return None
-    return None
 
 
 def _simplify_zero(diff: sp.Expr) -> bool | None:
