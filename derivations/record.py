@@ -407,7 +407,9 @@ def judge(
             if any(v is None for v in vp + vd):
                 continue
             n_ok += 1
-            err = max(float(abs(p - d) / (1 + abs(p) + abs(d))) for p, d in zip(vp, vd))
+            err = max(
+                0.0 if p == d else float(abs(p - d) / (1 + abs(p) + abs(d))) for p, d in zip(vp, vd)
+            )
             if err > worst_err:
                 worst_err = err
                 worst = {

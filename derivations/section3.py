@@ -97,21 +97,24 @@ def _fraction(z: sp.Expr) -> sp.Expr:
     return num / den
 
 
-def _solve_time(eq: sp.Eq, var: sp.Symbol) -> sp.Expr:
-    """Solve a flow equation for a time (one solution), log argument as one fraction.
+def _solve_time(expr: sp.Expr, var: sp.Symbol) -> sp.Expr:
+    """Solve expr = 0 for the time var, expr affine in e^{-a var} (a flow velocity).
 
-    ``solve`` without its generic simplification and substitution check (the
-    results are judged downstream); the log arguments are then written as one
-    fraction by :func:`_fraction`.
+    With E = e^{-a var}, expr = c1 E + c0, so E = -c0/c1 and var = ln(-c1/c0)/a;
+    the log argument is written as one fraction by :func:`_fraction`.
     """
-    (sol,) = sp.solve(eq, var, check=False, simplify=False)
-    return sol.replace(sp.log, lambda z: sp.log(_fraction(z)))
+    E = sp.Dummy("E", positive=True)
+    lin = sp.expand(expr).subs(sp.exp(-a * var), E)
+    c1, c0 = lin.coeff(E), lin.subs(E, 0)
+    if lin.has(var) or c1.has(E) or c1 == 0 or sp.expand(lin - (c1 * E + c0)) != 0:
+        raise ArithmeticError(f"{expr} is not affine in exp(-a*{var})")
+    return sp.log(_fraction(-c1 / c0)) / a
 
 
 @lru_cache(maxsize=None)
 def _trajectory_residual(level: sp.Expr) -> sp.Expr:
     X1, X2 = flow(level)
-    t_of_x2 = _solve_time(sp.Eq(X2, x2), t)
+    t_of_x2 = _solve_time(X2 - x2, t)
     r = sp.expand(sp.cancel(a * (x1 - X1.subs(t, t_of_x2))))
     return r.replace(sp.log, lambda z: sp.log(sp.together(z)))
 
@@ -134,13 +137,13 @@ def extremal() -> dict[str, sp.Expr]:
     q, p, t1s, t2s, s = sp.symbols("q p t_1 t_2 s", real=True)
     # arc 2: +omega_m from (p, q) to the origin in time t2
     A1, A2 = flow(wm, p, q, t2s)
-    t2 = _solve_time(sp.Eq(A2, 0), t2s)
+    t2 = _solve_time(A2, t2s)
     if A1.diff(p) != 1:
         raise ArithmeticError("the position flow is not x10 + terms free of x10")
     p_q = sp.cancel(p - A1.subs(t2s, t2))  # A1 = p + (terms free of p) = 0
     # arc 1: -omega_m from (x1, x2) to (p, q) in time t1
     B1, B2 = flow(-wm, x1, x2, t1s)
-    t1 = _solve_time(sp.Eq(B2, q), t1s)
+    t1 = _solve_time(B2 - q, t1s)
     join = sp.expand(sp.cancel(a * (B1.subs(t1s, t1) - p_q)))  # = 0 at the switch
     # join = omega_m ln((wm^2 - q^2) / (wm (wm + x2))) + a x1 + x2: exponentiate
     rel = sp.expand(wm * (wm + x2) * sp.exp(-(a * x1 + x2) / wm) - (wm - q) * (wm + q))
