@@ -88,7 +88,14 @@ def _linear_ode_general() -> tuple[sp.Expr, tuple[sp.Symbol, ...]]:
     alpha = sp.Symbol("alpha", real=True, nonzero=True)
     beta, y0, s0, s = sp.symbols("beta y0 s0 s", real=True)
     Y = sp.Function("Y")
-    sol = sp.dsolve(sp.Eq(Y(s).diff(s), alpha * Y(s) + beta), Y(s), ics={Y(s0): y0}).rhs
+    # constant coefficients and forcing: the method of undetermined coefficients
+    sol = sp.dsolve(
+        sp.Eq(Y(s).diff(s), alpha * Y(s) + beta),
+        Y(s),
+        ics={Y(s0): y0},
+        hint="nth_linear_constant_coeff_undetermined_coefficients",
+        simplify=False,
+    ).rhs
     return sol, (alpha, beta, y0, s0, s)
 
 

@@ -54,6 +54,7 @@ def _state_sampler(side: int):
     return draw
 
 
+@lru_cache(maxsize=None)
 def hamiltonian() -> sp.Expr:
     """Hamiltonian of (1)-(2): H = 1 + lambda^T f(x, u), eq. (3).
 
