@@ -70,7 +70,7 @@ def all_records(numbers: PlantNumbers) -> list[EquationRecord]:
 
     Ids "1" to "39" are all present; extras ("mintime", "15inv", "19c", "22c",
     "22W", "26W", "31W", "36Z", "39L") follow the equation they extend.  The
-    first call derives everything (about ten seconds); the symbolic part is
+    first call derives everything (about 2.5 s of one core); the symbolic part is
     cached, so a call for another plant only redoes the numeric examples.
 
     Parameters

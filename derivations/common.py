@@ -23,6 +23,7 @@ __all__ = [
     "S",
     "flow",
     "flow_T",
+    "linear_ode_solution",
     "switch_curve_x1",
     "uniform",
     "record_from",
@@ -82,17 +83,67 @@ class PlantNumbers:
 
 
 @lru_cache(maxsize=None)
-def _flow_general() -> tuple[sp.Expr, sp.Expr]:
-    """Solve eq. (1) with constant input u and x(0) = (x10, x20) by dsolve."""
-    a, t, u, x10, x20 = (S[n] for n in ("a", "t", "u", "x10", "x20"))
-    X1, X2 = sp.Function("X1"), sp.Function("X2")
+def _linear_ode_general() -> tuple[sp.Expr, tuple[sp.Symbol, ...]]:
+    """Solve y' = alpha y + beta, y(s0) = y0 (constants, alpha != 0) by dsolve, once."""
+    alpha = sp.Symbol("alpha", real=True, nonzero=True)
+    beta, y0, s0, s = sp.symbols("beta y0 s0 s", real=True)
+    Y = sp.Function("Y")
+    # constant coefficients and forcing: the method of undetermined coefficients
     sol = sp.dsolve(
-        [sp.Eq(X1(t).diff(t), X2(t)), sp.Eq(X2(t).diff(t), -a * X2(t) + a * u)],
-        [X1(t), X2(t)],
-        ics={X1(0): x10, X2(0): x20},
-    )
-    by = {s.lhs.func: s.rhs for s in sol}
-    return sp.simplify(by[X1]), sp.simplify(by[X2])
+        sp.Eq(Y(s).diff(s), alpha * Y(s) + beta),
+        Y(s),
+        ics={Y(s0): y0},
+        hint="nth_linear_constant_coeff_undetermined_coefficients",
+        simplify=False,
+    ).rhs
+    return sol, (alpha, beta, y0, s0, s)
+
+
+def linear_ode_solution(
+    alpha: sp.Expr, beta: sp.Expr, y0: sp.Expr, s0: sp.Expr, s: sp.Expr
+) -> sp.Expr:
+    """Solution of the scalar linear ODE y' = alpha y + beta with y(s0) = y0, by dsolve.
+
+    The ODE is solved once with symbolic constants; the velocity of eq. (1) and
+    the costate lambda2 of the minimum principle are both of this form.
+
+    Parameters
+    ----------
+    alpha, beta : sympy.Expr
+        Constant coefficients (alpha nonzero).
+    y0, s0 : sympy.Expr
+        Initial value and initial time.
+    s : sympy.Expr
+        The independent variable.
+
+    Returns
+    -------
+    sympy.Expr
+
+    Examples
+    --------
+    >>> t = sp.Symbol("t", real=True)
+    >>> linear_ode_solution(sp.Integer(-1), sp.Integer(0), sp.Integer(1), sp.Integer(0), t)
+    exp(-t)
+    """
+    sol, syms = _linear_ode_general()
+    return sol.xreplace(dict(zip(syms, (alpha, beta, y0, s0, s))))
+
+
+@lru_cache(maxsize=None)
+def _flow_general() -> tuple[sp.Expr, sp.Expr]:
+    """Solve eq. (1) with constant input u and x(0) = (x10, x20).
+
+    Eq. (1) is a cascade: the velocity equation x2' = -a x2 + a u is solved by
+    dsolve (:func:`linear_ode_solution`), then the position x1' = x2 is its
+    integral, x1(t) = x10 + int_0^t x2.  The position is returned expanded, the
+    velocity as one fraction (``cancel``).
+    """
+    a, t, u, x10, x20 = (S[n] for n in ("a", "t", "u", "x10", "x20"))
+    s = sp.Dummy("s")
+    v = linear_ode_solution(-a, a * u, x20, sp.Integer(0), s)
+    p = x10 + sp.integrate(v, (s, 0, t))
+    return sp.expand(p), sp.cancel(v.subs(s, t))
 
 
 def flow(

@@ -12,6 +12,8 @@ symbols (``in_SP`` is "(x1, x2) in S_P").  Symbols the paper implies positive
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import sympy as sp
 from sympy.parsing.sympy_parser import parse_expr
 
@@ -115,6 +117,7 @@ PRINTED: dict[str, str | tuple[str, ...]] = {
 }
 
 
+@lru_cache(maxsize=None)
 def parse(text: str) -> sp.Basic:
     """Parse SymPy source with the declared symbols.
 

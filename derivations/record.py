@@ -7,6 +7,11 @@ first symbolically, then numerically at random admissible points, and returns
 ``verified`` or ``erratum`` (with a counterexample), or ``unchecked`` when the
 comparison could not be carried out.
 
+Points.  A comparison proved symbolically is cross-checked at ``N_CROSS = 50``
+random points (the proof decides; the points confirm that its log expansions
+hold on the admissible set); one without a proof is decided by the numbers at
+``N_POINTS = 200`` points.
+
 Numeric tolerance.  The numeric comparison evaluates both expressions with
 mpmath at ``DPS = 50`` significant digits at points whose coordinates are exact
 binary floats.  Round-off is then below ~1e-48 relative to the largest term;
@@ -20,6 +25,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 import mpmath
@@ -35,15 +41,18 @@ __all__ = [
     "DPS",
     "RTOL",
     "N_POINTS",
+    "N_CROSS",
     "SEED",
     "definition",
     "as_tuple",
+    "log_normal",
 ]
 
 VERDICTS = ("verified", "erratum", "definition", "unchecked")
 DPS = 50
 RTOL = 1e-30
 N_POINTS = 200
+N_CROSS = 50
 SEED = 20241121
 
 Sampler = Callable[[np.random.Generator, int], dict[sp.Symbol, np.ndarray]]
@@ -192,20 +201,87 @@ class Judgement:
     reason: str
 
 
-def _symbolic_zero(diff: sp.Expr) -> bool | None:
-    """Try to prove diff == 0: simplify, then log-expanded simplify.
+def _log_abs_split(z: sp.Expr) -> sp.Expr:
+    """log|z| as a sum over the irreducible factors of z, each with its sign removed.
+
+    ``z`` is put over one denominator and factored; a factor f^e contributes
+    e log|f|, written ``e*log(f)`` with f's sign normalized (``-f`` when f could
+    extract a minus sign), so log(omega_m - x2) and log(x2 - omega_m) meet as one
+    term.  On the admissible set every log argument of the judged forms is > 0,
+    where log z = log|z| and log|.| is a homomorphism of the nonzero reals.
+    """
+    z = sp.factor(sp.together(z))
+    terms = []
+    for f in sp.Mul.make_args(z):
+        base, e = f.as_base_exp()
+        if base.is_number:
+            base = abs(base)
+        elif base.could_extract_minus_sign():
+            base = -base
+        terms.append(e * sp.log(base))
+    return sp.Add(*terms)
+
+
+def log_normal(expr: sp.Expr) -> sp.Expr:
+    """Expand expr with every log argument split into sign-normalized factors.
+
+    Each log(z) becomes the sum of e*log(f) over the irreducible factors f^e of z,
+    with f's sign removed, then everything is expanded (``expand_log(force=True)``
+    for what is left).  Valid where every log argument is > 0 (there log z =
+    log|z|, a homomorphism of the nonzero reals).  An identity holds on that set
+    when the result of its difference is 0 after ``cancel``.
+
+    Parameters
+    ----------
+    expr : sympy.Expr
+
+    Returns
+    -------
+    sympy.Expr
+
+    Examples
+    --------
+    >>> w, v = sp.symbols("omega_m x2", positive=True)
+    >>> log_normal(sp.log(1 - v / w) - sp.log(w - v) + sp.log(w))
+    0
+    """
+    return sp.expand(sp.expand_log(expr.replace(sp.log, _log_abs_split), force=True))
+
+
+def _rewrite_zero(diff: sp.Expr) -> bool | None:
+    """Try to prove diff == 0 by cheap rewrites; False when they show it nonzero.
+
+    The rewrite is :func:`log_normal` (every log argument factored into
+    sign-normalized factors, everything expanded), then ``cancel``; it is valid
+    on the admissible set, where every log argument is > 0.  When it leaves a
+    form that SymPy's assumptions show nonzero (``is_zero is False``, e.g.
+    ``2*T*a*omega_m`` with positive symbols), diff is nonzero there: no proof of
+    equality exists.
+
+    Returns
+    -------
+    bool or None
+        True: proved zero; False: proved nonzero; None: neither.
+    """
+    if diff == 0:
+        return True
+    try:
+        e = log_normal(diff)
+        if e == 0 or sp.cancel(e) == 0:
+            return True
+        return False if e.is_zero is False else None
+    except Exception:  # noqa: BLE001 - any failure of the CAS means "cannot prove"
+        return None
+
+
+def _simplify_zero(diff: sp.Expr) -> bool | None:
+    """Try to prove diff == 0 by ``simplify``, then ``simplify`` after ``expand_log``.
 
     Returns True when proved and None otherwise: a failure to simplify to 0 (or a
     ``False`` from ``equals``, which tests at points that may lie outside the
     admissible set or on another Lambert-W branch) is never taken as a disproof.
     """
-    if diff == 0:
-        return True
     try:
-        # cheap steps first; log expansion is valid where log arguments are > 0 (admissible)
-        e = sp.expand(sp.expand_log(sp.expand(diff), force=True))
-        if e == 0 or sp.cancel(e) == 0:
-            return True
         s = sp.simplify(diff)
         if s == 0:
             return True
@@ -214,6 +290,25 @@ def _symbolic_zero(diff: sp.Expr) -> bool | None:
         return True if s2 == 0 else None
     except Exception:  # noqa: BLE001 - any failure of the CAS means "cannot prove"
         return None
+
+
+@lru_cache(maxsize=4096)
+def _lambertw_at(x: Any, k: int, prec: int) -> Any:
+    with mpmath.workprec(prec):
+        return mpmath.lambertw(x, k)
+
+
+def _lambertw(x: Any, k: int = 0) -> Any:
+    """Lambert W of mpmath at the working precision, each distinct value computed once.
+
+    Records 22W, 26W and 31W evaluate the same root at the same points in several
+    comparisons (substitution, branch signs); the value is the one mpmath computes.
+    """
+    return _lambertw_at(x, k, mpmath.mp.prec)
+
+
+# lambdify's mpmath namespace with the memoized Lambert W (the printed code is unchanged)
+_MODULES = [{"LambertW": _lambertw}, "mpmath"]
 
 
 def _to_real(v: Any) -> float | None:
@@ -243,9 +338,12 @@ def judge(
 
     Both arguments are SymPy expressions (or equal-length tuples of them) in the
     free symbols that ``sampler`` draws.  Step 1 tries to prove ``printed - derived
-    == 0`` symbolically; step 2 evaluates both at ``n`` admissible random points
-    (fixed ``seed``) in ``DPS``-digit arithmetic.  The numeric step decides: a
-    symbolic "cannot prove" is never a pass on its own.
+    == 0`` by cheap rewrites (:func:`_rewrite_zero`).  Step 2 evaluates both at
+    admissible random points (fixed ``seed``) in ``DPS``-digit arithmetic:
+    ``N_CROSS`` points cross-check a proof, ``n`` points decide otherwise.  Step 3,
+    only when step 1 neither proved nor disproved and the numbers do not disagree,
+    tries ``simplify`` (:func:`_simplify_zero`) to upgrade the comparison to a
+    proof.  A symbolic "cannot prove" is never a pass on its own.
 
     Parameters
     ----------
@@ -255,7 +353,8 @@ def judge(
         ``sampler(rng, n) -> {symbol: array of n floats}``, admissible points (it may
         return fewer than n when it filters out inadmissible draws).
     n : int
-        Number of points (at least 200 are required for a verdict).
+        Number of points when there is no proof (at least ``N_POINTS`` = 200 must
+        evaluate for a verdict; with a proof, ``N_CROSS`` = 50).
     seed : int
         Seed of the point generator.
     symbolic : bool
@@ -265,8 +364,9 @@ def judge(
     -------
     Judgement
         ``verified`` if every admissible point agrees within ``RTOL``; ``erratum``
-        with the worst point if any disagrees; ``unchecked`` if fewer than 200
-        points could be evaluated or a symbolic proof of equality contradicts the numbers.
+        with the worst point if any disagrees; ``unchecked`` if fewer than 200 (50
+        with a proof) points could be evaluated or a symbolic proof of equality
+        contradicts the numbers.
 
     Examples
     --------
@@ -280,21 +380,20 @@ def judge(
     p_t, d_t = as_tuple(printed), as_tuple(derived)
     if len(p_t) != len(d_t):
         raise ValueError("printed and derived have different lengths")
-    sym: bool | None = True
-    if symbolic:
-        for p, d in zip(p_t, d_t):
-            if _symbolic_zero(sp.sympify(p - d)) is not True:
-                sym = None
-    else:
-        sym = None
-    pts = sampler(np.random.default_rng(seed), n)
+    # step 1: the cheap rewrites (a proof, a proof of a difference, or neither)
+    diffs = [sp.sympify(p - d) for p, d in zip(p_t, d_t)] if symbolic else []
+    cheap = [_rewrite_zero(e) for e in diffs]
+    proved = symbolic and all(c is True for c in cheap)
+    need = N_CROSS if proved else N_POINTS
+    # step 2: the numbers (a proof needs only a cross-check)
+    pts = sampler(np.random.default_rng(seed), min(n, N_CROSS) if proved else n)
     syms = list(pts)
     free = set().union(*(e.free_symbols for e in p_t + d_t))
     missing = free - set(syms)
     if missing:
         raise ValueError(f"sampler does not draw {sorted(map(str, missing))}")
-    f_p = sp.lambdify(syms, list(p_t), modules="mpmath")
-    f_d = sp.lambdify(syms, list(d_t), modules="mpmath")
+    f_p = sp.lambdify(syms, list(p_t), modules=_MODULES, docstring_limit=0)
+    f_d = sp.lambdify(syms, list(d_t), modules=_MODULES, docstring_limit=0)
     worst, worst_err, n_ok = None, -1.0, 0
     n_drawn = min((len(v) for v in pts.values()), default=0)  # a sampler may filter points
     with mpmath.workdps(DPS):
@@ -308,7 +407,9 @@ def judge(
             if any(v is None for v in vp + vd):
                 continue
             n_ok += 1
-            err = max(float(abs(p - d) / (1 + abs(p) + abs(d))) for p, d in zip(vp, vd))
+            err = max(
+                0.0 if p == d else float(abs(p - d) / (1 + abs(p) + abs(d))) for p, d in zip(vp, vd)
+            )
             if err > worst_err:
                 worst_err = err
                 worst = {
@@ -316,14 +417,21 @@ def judge(
                     "printed": [float(v) for v in vp],
                     "derived": [float(v) for v in vd],
                 }
-    if n_ok < N_POINTS:
+    # step 3: simplify, only to upgrade agreeing numbers to a proof (where the numbers
+    # disagree it could only fail, or contradict them through the log expansion of step 1)
+    sym: bool | None = True if proved else None
+    disagree = n_ok >= N_POINTS and worst_err > RTOL
+    if symbolic and not proved and not disagree and all(c is not False for c in cheap):
+        if all(c is True or _simplify_zero(e) is True for c, e in zip(cheap, diffs)):
+            sym = True
+    if n_ok < need:
         return Judgement(
             "unchecked",
             sym,
             n_ok,
             worst_err,
             None,
-            f"only {n_ok} admissible points evaluated (need {N_POINTS})",
+            f"only {n_ok} admissible points evaluated (need {need})",
         )
     ok = worst_err <= RTOL
     if ok:

@@ -15,8 +15,17 @@ from functools import lru_cache
 import numpy as np
 import sympy as sp
 
-from derivations.common import S, combine, flow, parsed, record_from, rhs, switch_curve_x1
-from derivations.record import EquationRecord, definition, judge
+from derivations.common import (
+    S,
+    combine,
+    flow,
+    linear_ode_solution,
+    parsed,
+    record_from,
+    rhs,
+    switch_curve_x1,
+)
+from derivations.record import EquationRecord, definition, judge, log_normal
 
 __all__ = ["records", "hamiltonian", "trajectory_residual", "extremal", "min_time_closed_form"]
 
@@ -45,6 +54,7 @@ def _state_sampler(side: int):
     return draw
 
 
+@lru_cache(maxsize=None)
 def hamiltonian() -> sp.Expr:
     """Hamiltonian of (1)-(2): H = 1 + lambda^T f(x, u), eq. (3).
 
@@ -60,20 +70,53 @@ def trajectory_residual(level: sp.Expr) -> sp.Expr:
     """Trajectory of input ``level`` through (x10, x20) with t eliminated, eqs. (8), (10).
 
     Solves x2(t) = x2 for t in the flow of eq. (7) and substitutes into x1(t);
-    returns a (x1 - x1(t(x2))), which vanishes on the trajectory.
+    returns a (x1 - x1(t(x2))), which vanishes on the trajectory.  The derivation
+    uses only that the level's magnitude is a positive constant: for
+    ``level = +-L`` with L a positive symbol other than omega_m (omega_c in
+    eqs. 28, 33) it is the residual of ``+-omega_m`` with omega_m renamed L.
 
     Parameters
     ----------
     level : sympy.Expr
-        The constant input (omega_m or -omega_m).
+        The constant input (omega_m or -omega_m; omega_c or -omega_c).
 
     Returns
     -------
     sympy.Expr
     """
+    sign, mag = (-1, -level) if level.could_extract_minus_sign() else (1, level)
+    if isinstance(mag, sp.Symbol) and mag.is_positive and mag != wm:
+        return _trajectory_residual(sign * wm).xreplace({wm: mag})
+    return _trajectory_residual(level)
+
+
+def _fraction(z: sp.Expr) -> sp.Expr:
+    """Write z as one fraction, negating numerator and denominator when both lead with a minus."""
+    num, den = sp.fraction(sp.together(sp.expand(z)))
+    if num.could_extract_minus_sign() and den.could_extract_minus_sign():
+        num, den = -num, -den
+    return num / den
+
+
+def _solve_time(expr: sp.Expr, var: sp.Symbol) -> sp.Expr:
+    """Solve expr = 0 for the time var, expr affine in e^{-a var} (a flow velocity).
+
+    With E = e^{-a var}, expr = c1 E + c0, so E = -c0/c1 and var = ln(-c1/c0)/a;
+    the log argument is written as one fraction by :func:`_fraction`.
+    """
+    E = sp.Dummy("E", positive=True)
+    lin = sp.expand(expr).subs(sp.exp(-a * var), E)
+    c1, c0 = lin.coeff(E), lin.subs(E, 0)
+    if lin.has(var) or c1.has(E) or c1 == 0 or sp.expand(lin - (c1 * E + c0)) != 0:
+        raise ArithmeticError(f"{expr} is not affine in exp(-a*{var})")
+    return sp.log(_fraction(-c1 / c0)) / a
+
+
+@lru_cache(maxsize=None)
+def _trajectory_residual(level: sp.Expr) -> sp.Expr:
     X1, X2 = flow(level)
-    (t_of_x2,) = sp.solve(sp.Eq(X2, x2), t)
-    r = sp.expand(sp.simplify(a * (x1 - X1.subs(t, t_of_x2))))
+    t_of_x2 = _solve_time(X2 - x2, t)
+    r = sp.expand(sp.cancel(a * (x1 - X1.subs(t, t_of_x2))))
     return r.replace(sp.log, lambda z: sp.log(sp.together(z)))
 
 
@@ -95,37 +138,42 @@ def extremal() -> dict[str, sp.Expr]:
     q, p, t1s, t2s, s = sp.symbols("q p t_1 t_2 s", real=True)
     # arc 2: +omega_m from (p, q) to the origin in time t2
     A1, A2 = flow(wm, p, q, t2s)
-    (t2,) = sp.solve(sp.Eq(A2, 0), t2s)
-    (p_q,) = sp.solve(sp.Eq(A1.subs(t2s, t2), 0), p)
+    t2 = _solve_time(A2, t2s)
+    if A1.diff(p) != 1:
+        raise ArithmeticError("the position flow is not x10 + terms free of x10")
+    p_q = sp.cancel(p - A1.subs(t2s, t2))  # A1 = p + (terms free of p) = 0
     # arc 1: -omega_m from (x1, x2) to (p, q) in time t1
     B1, B2 = flow(-wm, x1, x2, t1s)
-    (t1,) = sp.solve(sp.Eq(B2, q), t1s)
-    join = sp.expand(sp.simplify(a * (B1.subs(t1s, t1) - p_q)))  # = 0 at the switch
-    # join/omega_m = ln((wm^2 - q^2) / (wm (wm + x2))) + (a x1 + x2)/wm: exponentiate
+    t1 = _solve_time(B2 - q, t1s)
+    join = sp.expand(sp.cancel(a * (B1.subs(t1s, t1) - p_q)))  # = 0 at the switch
+    # join = omega_m ln((wm^2 - q^2) / (wm (wm + x2))) + a x1 + x2: exponentiate
     rel = sp.expand(wm * (wm + x2) * sp.exp(-(a * x1 + x2) / wm) - (wm - q) * (wm + q))
-    # exp(join/omega_m) omega_m (omega_m + x2) e^{-(a x1 + x2)/omega_m} = (omega_m - q)(omega_m + q)
-    check = sp.simplify(
-        sp.exp(join / wm) * wm * (wm + x2) * sp.exp(-(a * x1 + x2) / wm) - (wm - q) * (wm + q)
-    )
-    if check != 0:
+    claimed = a * x1 + x2 + wm * sp.log((wm - q) * (wm + q) / (wm * (wm + x2)))
+    check = log_normal(join - claimed)
+    if check != 0 and sp.cancel(check) != 0:
         raise ArithmeticError("switch relation did not reduce to the exponential form")
-    roots = sp.solve(rel, q)
+    # rel is quadratic in q; solve's roots, exponentials combined
+    roots = [
+        sp.powsimp(r, deep=True, combine="exp").replace(
+            sp.exp, lambda z: sp.exp(sp.factor_terms(z))
+        )
+        for r in sp.solve(rel, q, check=False, simplify=False)
+    ]
     (q_neg,) = [r for r in roots if sp.sign(r.subs({x1: 1, x2: 0, a: 1, wm: 1})) < 0]
-    # costate: lambda1' = -dH/dx1, lambda2' = -dH/dx2, lambda2(t1) = 0, H(t1) = 0
+    # costate: lambda1' = -dH/dx1 = 0, so lambda1 = -1/q from H(t1) = 0 (u switches at t1,
+    # lambda2(t1) = 0); lambda2' = -dH/dx2 with lambda2(t1) = 0
     H = hamiltonian()
-    L1, L2 = sp.Function("L1"), sp.Function("L2")
-    costate = sp.dsolve(
-        [
-            sp.Eq(L1(s).diff(s), -H.diff(x1).subs({l1: L1(s), l2: L2(s)})),
-            sp.Eq(L2(s).diff(s), -H.diff(x2).subs({l1: L1(s), l2: L2(s)})),
-        ],
-        [L1(s), L2(s)],
-        ics={L2(t1s): 0, L1(t1s): -1 / q},
-    )
-    lam = {e.lhs.func: e.rhs for e in costate}
-    lam2 = lam[L2]
-    lam2_tf = sp.simplify(lam2.subs(s, t1s + t2s).subs(t2s, t2))
-    H_tf = sp.simplify(H.subs({l1: lam[L1], l2: lam2_tf, x2: 0, u: wm}))
+    if H.diff(x1) != 0:
+        raise ArithmeticError("dH/dx1 is not zero")
+    lam1 = -1 / q
+    # lambda2' = -dH/dx2 = -lambda1 + a lambda2: linear with constant coefficients
+    rhs2 = sp.expand(-H.diff(x2).subs(l1, lam1))
+    alpha, beta = rhs2.coeff(l2), rhs2.subs(l2, 0)
+    if alpha.has(l2, s) or beta.has(l2, s):
+        raise ArithmeticError("the costate equation is not linear with constant coefficients")
+    lam2 = linear_ode_solution(alpha, beta, sp.Integer(0), t1s, s)
+    lam2_tf = sp.cancel(sp.expand(lam2.subs(s, t1s + t2s).subs(t2s, t2)))
+    H_tf = sp.cancel(H.subs({l1: lam1, l2: lam2_tf, x2: 0, u: wm}))
     return {
         "q": q_neg,
         "q_relation": rel,
@@ -134,7 +182,7 @@ def extremal() -> dict[str, sp.Expr]:
         "p": p_q,
         "join": join,
         "lambda1": -1 / q,
-        "lambda2_0": sp.simplify(lam2.subs(s, 0)),
+        "lambda2_0": sp.together(lam2.subs(s, 0)),
         "H_tf": H_tf,
         "lambda2_tf": lam2_tf,
         "q_symbol": q,
@@ -214,7 +262,7 @@ def _rec_3_to_6() -> list[EquationRecord]:
     j6 = judge(rhs(p6, u_star), d6, samp6)
     # brute force: H(u*) is the minimum of H over a grid of admissible u
     rng = np.random.default_rng(6)
-    f_H = sp.lambdify((a, x2, u, l1, l2), H, "numpy")
+    f_H = sp.lambdify((a, x2, u, l1, l2), H, "math")  # arithmetic only: works on arrays
     lam2v = rng.uniform(-5, 5, 200)
     grid = np.linspace(-1.0, 1.0, 201)
     ok = all(
@@ -254,7 +302,10 @@ def _rec_7_to_11() -> list[EquationRecord]:
         record_from(
             "7",
             (X1, X2),
-            ["dsolve of x1' = x2, x2' = -a x2 + a u with u = omega_m, x(0) = (x10, x20)"],
+            [
+                "dsolve of x2' = -a x2 + a u with u = omega_m, x2(0) = x20; x1 = x10 + the "
+                "integral of x2 (x1' = x2)"
+            ],
             j,
             "Flow under u = +omega_m from dsolve compared with the printed flow.",
         )
@@ -366,7 +417,7 @@ def _rec_mintime() -> EquationRecord:
     # parametrized by the switch velocity qs, with x1 eliminated through the q relation
     e = extremal()
     qs = e["q_symbol"]
-    x1_of_q = sp.solve(e["q_relation"].subs(q, qs), x1)[0]
+    (x1_of_q,) = sp.solve(e["q_relation"], x1, check=False, simplify=False)
     t1_q = e["t1"].subs(x1, x1_of_q)
     t1_alt = ((sp.log(1 - qs / wm) + (a * x1 + x2) / wm) / a).subs(x1, x1_of_q)
     t2_alt = sp.log(1 - qs / wm) / a
@@ -381,7 +432,7 @@ def _rec_mintime() -> EquationRecord:
         }
 
     j_alt = judge((t1_alt, t2_alt), (t1_q, e["t2"]), samp_q)
-    pos = judge(sp.Min(t1, t2, -q) > 0, sp.true, samp, symbolic=False)
+    pos = judge(sp.Min(t1, t2, -q, evaluate=False) > 0, sp.true, samp, symbolic=False)
     steps = [
         "arc 2: +omega_m from (p, q) reaches 0: t2 = " + sp.sstr(t2),
         "and p on l1 (eq. 9)",

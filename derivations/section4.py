@@ -84,6 +84,7 @@ def one_step(sign: int = +1) -> tuple[sp.Expr, sp.Expr]:
     return flow_T(sign * wm, x1, x2)
 
 
+@lru_cache(maxsize=None)
 def one_step_inverse(sign: int = +1) -> tuple[sp.Expr, sp.Expr]:
     """Inverse of the one-step map, (x1, x2) from (tx1, tx2) (eq. 17 for sign = +1).
 
@@ -97,10 +98,17 @@ def one_step_inverse(sign: int = +1) -> tuple[sp.Expr, sp.Expr]:
     x1, x2 : sympy.Expr
     """
     m1, m2 = one_step(sign)
-    sol = sp.solve([sp.Eq(m1, tx1), sp.Eq(m2, tx2)], [x1, x2], dict=True)[0]
-    return sp.simplify(sol[x1]), sp.simplify(sol[x2])
+    # the map is affine, m = J x + c: x = J^-1 (tx - c); x1 over its denominator a
+    J = sp.Matrix([[m1.diff(x1), m1.diff(x2)], [m2.diff(x1), m2.diff(x2)]])
+    if J.has(x1, x2):
+        raise ArithmeticError("the one-step map is not affine in the state")
+    c = sp.Matrix([m1, m2]).subs({x1: 0, x2: 0})
+    sol = J.LUsolve(sp.Matrix([tx1, tx2]) - c)
+    num, den = sp.fraction(sp.together(sp.expand(sol[0])))
+    return sp.collect(num, a) / den, sp.expand(sol[1])
 
 
+@lru_cache(maxsize=None)
 def preimage_l1() -> sp.Expr:
     """Corrected l~1: states that reach l1 after one sample of u = -omega_m.
 
@@ -114,7 +122,7 @@ def preimage_l1() -> sp.Expr:
     """
     m1, m2 = one_step(-1)
     r = a * m1 + m2 + wm * sp.log(1 - m2 / wm)
-    return sp.expand(sp.simplify(r))
+    return sp.expand(r.replace(sp.log, lambda z: sp.log(sp.factor(z))))
 
 
 def corrected_b0() -> dict[str, sp.Expr]:
@@ -129,16 +137,21 @@ def corrected_b0() -> dict[str, sp.Expr]:
         ``residual`` (corrected (20) divided by omega_m, in y), ``shift``
         (Y - y), ``b0c``, ``form22`` (ln(1 + Y) - (Y - b0c) in y).
     """
+    return dict(_corrected_b0())
+
+
+@lru_cache(maxsize=None)
+def _corrected_b0() -> tuple[tuple[str, sp.Expr], ...]:
     r = preimage_l1().subs({x1: d, x2: -y * wm}) / wm
     shift = 2 * (sp.exp(a * T) - 1)
     b0c = a * d / wm + 2 * (sp.exp(a * T) - 1 - a * T)
     Y = y + shift
-    return {
-        "residual": sp.expand(r),
-        "shift": shift,
-        "b0c": b0c,
-        "form22": sp.log(1 + Y) - (Y - b0c),
-    }
+    return (
+        ("residual", sp.expand(r)),
+        ("shift", shift),
+        ("b0c", b0c),
+        ("form22", sp.log(1 + Y) - (Y - b0c)),
+    )
 
 
 def root_22_W(bb: sp.Expr = b0, branch: int = -1) -> sp.Expr:
@@ -210,6 +223,13 @@ def intersection(
         ``b0``, ``y``, ``x20`` [mm/s], ``k``, ``z``, ``omega0`` [mm/s] (NaN when no
         non-trivial root exists).
     """
+    return dict(_intersection(a_, w_max, T_, d_, corrected))
+
+
+@lru_cache(maxsize=32, typed=True)
+def _intersection(
+    a_: float, w_max: float, T_: float, d_: float, corrected: bool
+) -> tuple[tuple[str, float], ...]:
     num = {a: a_, wm: w_max, T: T_, d: d_}
     with mpmath.workdps(30):
         if corrected:
@@ -228,14 +248,14 @@ def intersection(
         else:
             zz = sp.nan
         om0 = -x20 / zz if zz != 0 else sp.nan
-    return {
-        "b0": float(bb),
-        "y": float(yy),
-        "x20": float(x20),
-        "k": float(kk),
-        "z": float(zz),
-        "omega0": float(om0),
-    }
+    return (
+        ("b0", float(bb)),
+        ("y", float(yy)),
+        ("x20", float(x20)),
+        ("k", float(kk)),
+        ("z", float(zz)),
+        ("omega0", float(om0)),
+    )
 
 
 def _rec_13_17() -> list[EquationRecord]:
@@ -457,7 +477,8 @@ def _rec_18_19() -> list[EquationRecord]:
         )
     )
     # 19c: verify the preimage by mapping back, and its side
-    x1_on = sp.solve(pre, x1)[0]
+    c1 = pre.coeff(x1)  # pre is affine in x1
+    x1_on = sp.cancel(-(pre - c1 * x1) / c1)
     n1, n2 = one_step(-1)
     m_img = (n1.subs(x1, x1_on), n2.subs(x1, x1_on))
     on_l1 = a * m_img[0] + m_img[1] + wm * sp.log(1 - m_img[1] / wm)
@@ -756,8 +777,11 @@ def _rec_lambert() -> list[EquationRecord]:
             printed_str="(not in the paper)",
         )
     )
-    (p26,) = parsed("26")
-    for id_, var in (("26W", z), ("31W", w)):
+    (p26,), (p31,) = parsed("26"), parsed("31")
+    # (31) is (26) with w for z: with the root substituted both are the same expression
+    # in k, judged at the same points, so each judgement is computed once
+    done: dict[tuple[sp.Expr, int], list] = {}
+    for id_, var, p_ in (("26W", z, p26), ("31W", w, p31)):
         js = []
         for br, lo, hi in ((-1, 0.01, 0.99), (0, 1.01, 20.0)):
 
@@ -765,8 +789,13 @@ def _rec_lambert() -> list[EquationRecord]:
                 return {k: rng.uniform(lo, hi, n)}
 
             r = root_k_W(k, br)
-            js.append(judge(p26.subs(z, r), sp.Integer(0), sk, symbolic=False))
-            js.append(_branch_signs(r, br, sk))
+            resid = p_.subs(var, r)
+            if (resid, br) not in done:
+                done[resid, br] = [
+                    judge(resid, sp.Integer(0), sk, symbolic=False),
+                    _branch_signs(r, br, sk),
+                ]
+            js += done[resid, br]
         out.append(
             record_from(
                 id_,

@@ -14,6 +14,7 @@ from functools import lru_cache
 
 import numpy as np
 import sympy as sp
+from sympy.printing.numpy import NumPyPrinter
 
 from derivations.common import PlantNumbers, S, combine, parsed, record_from, rhs
 from derivations.record import EquationRecord, definition, judge
@@ -57,7 +58,8 @@ def lyapunov_derivative() -> sp.Expr:
 def zoh_spectral_radius(a_: float, T_: float, k1_: float, k2_: float) -> float:
     """Spectral radius of the ZOH-sampled linear zone, Ad - Bd K.
 
-    Ad = e^{A T}, Bd = int_0^T e^{A s} ds B, from the SymPy matrix exponential.
+    Ad = e^{A T}, Bd = int_0^T e^{A s} ds B, from the SymPy matrix exponential
+    (Van Loan's block form).
 
     Parameters
     ----------
@@ -73,13 +75,24 @@ def zoh_spectral_radius(a_: float, T_: float, k1_: float, k2_: float) -> float:
     float
         max |eigenvalue|; < 1 means the sampled, unsaturated loop is stable.
     """
-    s = sp.Symbol("s", positive=True)
+    M = _zoh_closed_loop().subs({a: a_, T: T_, k1: k1_, k2: k2_})
+    return float(max(abs(complex(ev)) for ev in np.linalg.eigvals(np.array(M, dtype=float))))
+
+
+@lru_cache(maxsize=None)
+def _zoh_closed_loop() -> sp.Matrix:
+    """Ad - Bd K in the symbols a, T, k1, k2.
+
+    Ad = e^{A T} and Bd = int_0^T e^{A s} ds B are read off one matrix exponential,
+    exp([[A, B], [0, 0]] T) = [[Ad, Bd], [0, 1]] (Van Loan).
+    """
     A = sp.Matrix([[0, 1], [0, -a]])
     B = sp.Matrix([0, a])
-    Ad = (A * T).exp()
-    Bd = (A * s).exp().integrate((s, 0, T)) * B
-    M = (Ad - Bd * sp.Matrix([[k1, k2]])).subs({a: a_, T: T_, k1: k1_, k2: k2_})
-    return float(max(abs(complex(ev)) for ev in np.linalg.eigvals(np.array(M, dtype=float))))
+    Z = sp.zeros(3, 3)
+    Z[:2, :2], Z[:2, 2] = A, B
+    E = (Z * T).exp()
+    Ad, Bd = E[:2, :2], E[:2, 2]
+    return sp.ImmutableMatrix(Ad - Bd * sp.Matrix([[k1, k2]]))
 
 
 def _rec_36() -> EquationRecord:
@@ -130,7 +143,8 @@ def _rec_36_claim(num: PlantNumbers) -> EquationRecord:
     img = {x1: n1.subs(x1, x1_star), x2: n2.subs(x1, x1_star)}
     resid = (a * x1 + x2 + wm * sp.log(1 - x2 / wm)).subs(img, simultaneous=True)
     av, wv, Tv, dv = num.a, num.w_max, num.T, num.d
-    f_x1 = sp.lambdify((x2, a, w0), x1_star, "numpy")
+    # numpy's functions by name (numpy.log), without lambdify's "from numpy import *"
+    f_x1 = sp.lambdify((x2, a, w0), x1_star, modules=[{"numpy": np}], printer=NumPyPrinter)
 
     def sampler(om0):
         def draw(rng, n):

@@ -76,7 +76,62 @@ def test_verified_path(records):
     assert records["39"].verdict == "verified"
     x = sp.Symbol("x", positive=True)
     j = judge(sp.log(x**2), 2 * sp.log(x), lambda rng, n: {x: rng.uniform(0.1, 5, n)})
-    assert j.verdict == "verified" and j.symbolic is True and j.n_points >= 200
+    # a proof is cross-checked at N_CROSS points
+    assert j.verdict == "verified" and j.symbolic is True and j.n_points == record.N_CROSS
+    assert f"proved symbolically and agrees at {record.N_CROSS} random points" in j.reason
+
+
+def test_numbers_decide_without_a_proof():
+    x = sp.Symbol("x", positive=True)
+
+    def s(rng, n):
+        return {x: rng.uniform(0.1, 5, n)}
+
+    j = judge(sp.log(x**2), 2 * sp.log(x), s, symbolic=False)
+    assert j.verdict == "verified" and j.symbolic is None and j.n_points == record.N_POINTS
+
+
+def test_simplify_upgrades_agreeing_numbers_to_a_proof():
+    # beyond the log rewrites: only simplify proves it, after 200 agreeing points
+    x = sp.Symbol("x", real=True)
+
+    def s(rng, n):
+        return {x: rng.uniform(-3, 3, n)}
+
+    j = judge(sp.sin(x) ** 2 + sp.cos(x) ** 2, sp.Integer(1), s)
+    assert j.verdict == "verified" and j.symbolic is True and j.n_points == record.N_POINTS
+
+
+def test_provably_different_forms_are_an_erratum():
+    # the rewrite leaves 2*T*a*omega_m (positive symbols): numbers decide, no proof claimed
+    x = sp.Symbol("x", real=True)
+
+    def s(rng, n):
+        return {x: rng.uniform(-3, 3, n), **{v: rng.uniform(1, 2, n) for v in (a, T, wm)}}
+
+    j = judge(x + 2 * T * a * wm, x, s)
+    assert j.verdict == "erratum" and j.symbolic is None and j.n_points == record.N_POINTS
+
+
+@pytest.mark.parametrize(
+    "lhs, rhs",
+    [
+        ("log(1 - x2/omega_m)", "log(omega_m - x2) - log(omega_m)"),
+        ("log((x2 - omega_m)/(x20 - omega_m))", "log((omega_m - x2)/(omega_m - x20))"),
+        ("log(exp(a*T)*(omega_m - x2)/omega_m)", "a*T + log(1 - x2/omega_m)"),
+    ],
+)
+def test_log_normal_identities_hold_numerically(lhs, rhs):
+    # log_normal proves these; the identities hold at points where every log argument is > 0
+    diff = parse(lhs) - parse(rhs)
+    assert sp.cancel(record.log_normal(diff)) == 0
+    f = sp.lambdify([a, T, wm, x2, x20], diff, "mpmath")
+    rng = np.random.default_rng(5)
+    with mpmath.workdps(30):
+        for _ in range(20):
+            w = rng.uniform(1, 100)
+            args = [rng.uniform(1, 5), rng.uniform(0, 1), w, *rng.uniform(-0.9, 0.9, 2) * w]
+            assert abs(f(*map(mpmath.mpf, args))) < 1e-25
 
 
 def test_definition_path(records):
