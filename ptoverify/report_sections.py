@@ -655,6 +655,8 @@ def derivations(res: dict[str, Any], records: list) -> list[Block]:
     step derived (their JSON form is ``res["derivations"]``); they carry the
     SymPy expressions that render as MathML.
     """
+    from derivations.record import N_CROSS, N_POINTS
+
     rows_html, rows_md = [], []
     for r in records:
         ml = r.to_mathml()
@@ -693,8 +695,9 @@ def derivations(res: dict[str, Any], records: list) -> list[Block]:
         Block(
             "p",
             text="Each equation is re-derived with SymPy from eq. (1) and compared "
-            "with its transcription, symbolically, then at 200 random "
-            "admissible points. Where a record quotes plant numbers (the "
+            "with its transcription: proved symbolically where SymPy can (then "
+            f"cross-checked at {N_CROSS} random admissible points), otherwise "
+            f"compared at {N_POINTS} random admissible points. Where a record quotes plant numbers (the "
             "printed zone chain, the linear-zone spectral radius) they are "
             "evaluated at this report's configuration.",
         ),
