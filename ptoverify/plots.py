@@ -1083,6 +1083,8 @@ def save_robust(maps: Mapping, outdir: str | Path) -> list[Path]:
     """
     outdir = _folder(outdir)
     laws, delays = list(maps["laws"]), list(maps["delay_samples"])
+    size = (3.8 * len(delays) + 1.2, 2.9 * len(laws))
+    ratios = (1.0,) * len(delays) + (0.07,)  # the panels, then the colour bar
     files = []
     for key, label, stem in ROBUST_MAPS:
         vals = [_robust_cell_value(c, key) for law in laws for c in maps["laws"][law]]
@@ -1090,8 +1092,7 @@ def save_robust(maps: Mapping, outdir: str | Path) -> list[Path]:
         vmax = max(max(finite, default=1.0), 1.0)
 
         def draw(fig, key=key, label=label, vmax=vmax):
-            outer = fig.add_gridspec(1, 2, width_ratios=(1.0, 0.035))  # panels | colour bar
-            grid = outer[0].subgridspec(len(laws), len(delays), wspace=0.2, hspace=0.25)
+            grid = fig.add_gridspec(len(laws), len(delays) + 1, width_ratios=ratios)
             for r, law in enumerate(laws):
                 for c, dl in enumerate(delays):
                     ax = fig.add_subplot(grid[r, c])
@@ -1100,12 +1101,10 @@ def save_robust(maps: Mapping, outdir: str | Path) -> list[Path]:
                         ax.set_xlabel("")
                     if c > 0:
                         ax.set_ylabel("")
-            cax = fig.add_subplot(outer[1].subgridspec(3, 1, height_ratios=(1, 8, 1))[1])
-            fig.colorbar(mesh, cax=cax, label=label)
+            fig.colorbar(mesh, cax=fig.add_subplot(grid[:, -1]), label=label)
 
-        size = (3.8 * len(delays) + 1.2, 2.9 * len(laws))
-        save_drawing(outdir / f"{stem}.png", draw, size, (0.75, 0.75, 0.55, 0.3), (0.08, 0.0))
-        files.append(outdir / f"{stem}.png")
+        path = outdir / f"{stem}.png"
+        files.append(save_drawing(path, draw, size, (0.75, 0.75, 0.55, 0.33), (0.25, 0.23)))
     return files
 
 
