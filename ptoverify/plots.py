@@ -41,6 +41,7 @@ import numpy as np  # noqa: E402
 from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.transforms import Bbox  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 from PIL import Image  # noqa: E402
 
@@ -938,10 +939,31 @@ def _fits(fig: Figure) -> bool:
                 return False
     if len(fig.axes) > 1:
         boxes = [
-            ax.get_tightbbox(renderer, bbox_extra_artists=[]) for ax in fig.axes if ax.get_visible()
+            Bbox.union([ax.bbox] + [t.get_window_extent(renderer) for t in _drawn_texts(ax)])
+            for ax in fig.axes
+            if ax.get_visible()
         ]
         return not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1 :])
     return True
+
+
+def _drawn_texts(ax) -> list:
+    """Return the title, axis labels, offset texts and tick labels an axes showed when drawn.
+
+    Read from the draw (the ticks it placed in view), not laid out again as
+    ``Axes.get_tightbbox`` would: a fifth of a multi-panel figure's time.
+    """
+    texts = [ax.title]
+    for axis in (ax.xaxis, ax.yaxis):
+        if not axis.get_visible():
+            continue
+        texts += [axis.label, axis.offsetText]
+        lo, hi = sorted(axis.get_view_interval())
+        tol = 1e-9 * max(abs(lo), abs(hi))
+        for tick in axis.get_major_ticks() + axis.get_minor_ticks():
+            if lo - tol <= tick.get_loc() <= hi + tol:
+                texts += [tick.label1, tick.label2]
+    return [t for t in texts if t.get_visible() and t.get_text()]
 
 
 def _png(fig: Figure, path: str | Path) -> None:
