@@ -263,6 +263,28 @@ def test_saved_figure_is_never_clipped(tmp_path, monkeypatch, scale, relaid):
         assert lo <= gap <= hi, f"{side}: {gap:.3f} in"
 
 
+@pytest.mark.parametrize(("scale", "relaid"), [(1.0, False), (1e3, True)])
+def test_panels_never_overlap(tmp_path, monkeypatch, scale, relaid):
+    """Side-by-side panels keep the guessed spacing unless one's tick labels reach into
+    the other; the figure written has no two panels' decorations overlapping."""
+    laid, figs = [], []
+    tight = Figure.tight_layout
+    monkeypatch.setattr(Figure, "tight_layout", lambda fig: laid.append(fig) or tight(fig))
+
+    def draw(fig):
+        figs.append(fig)
+        for ax, k in zip(fig.subplots(1, 2), (1.0, scale), strict=True):
+            ax.plot([0.0, 1.0], [0.0, -300 * k])  # only the right panel's labels vary
+            ax.set_title("panel")
+            ax.set_ylabel("y [mm]")
+
+    plots.save_drawing(tmp_path / "f.png", draw, (8.0, 3.0), spacing=(0.26, 0.2))
+    assert bool(laid) == relaid
+    r = figs[-1].canvas.get_renderer()
+    left, right = (ax.get_tightbbox(r, bbox_extra_artists=[]) for ax in figs[-1].axes)
+    assert left.x1 < right.x0, "the right panel's tick labels clear the left panel"
+
+
 def test_title_never_covers_the_offset_text(tmp_path):
     """A y offset text under a wide title sends the figure to Matplotlib's title placement."""
     figs = []
