@@ -26,6 +26,8 @@ import functools
 import gc
 import math
 import os
+import struct
+import zlib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -43,7 +45,6 @@ from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.transforms import Bbox  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
-from PIL import Image  # noqa: E402
 
 from ptoverify.config import Config, Plant  # noqa: E402
 from ptoverify.curves import h, level_curve_x1  # noqa: E402
@@ -70,6 +71,8 @@ __all__ = [
     "plot_convergence",
     "plot_switch_profiles",
     "save_figure",
+    "save_drawing",
+    "png_bytes",
     "save_all",
     "save_sweep",
     "save_ground_truth",
@@ -87,7 +90,7 @@ MARGINS = (0.84, 0.26, 0.6, 0.36)
 #: rcParams of the saved PNGs: unhinted glyphs (as in Matplotlib's own image tests), laid
 #: out and rendered about 2.5x faster than with the TrueType hinter, same shapes.
 RENDER_RC = {"text.hinting": "no_hinting"}
-#: zlib level of the PNGs: 1 writes about 15 % more bytes in two thirds of the time.
+#: zlib level of the PNGs (:func:`png_bytes`): the fastest, as small as Pillow's level 6.
 PNG_COMPRESSION = 1
 STYLE = {
     "to": dict(color="tab:red", lw=1.0, label="TO"),
@@ -967,12 +970,58 @@ def _drawn_texts(ax) -> list:
 
 
 def _png(fig: Figure, path: str | Path) -> None:
-    """Write the drawn canvas as a PNG (RGB when opaque; zlib :data:`PNG_COMPRESSION`)."""
+    """Write the drawn canvas as a PNG (RGB when opaque), see :func:`png_bytes`."""
     rgba = np.asarray(fig.canvas.buffer_rgba())
-    img = Image.frombuffer("RGBA", rgba.shape[1::-1], rgba, "raw", "RGBA", 0, 1)
-    if rgba[..., 3].min() == 255:
-        img = img.convert("RGB")
-    img.save(path, format="png", compress_level=PNG_COMPRESSION, dpi=(fig.dpi, fig.dpi))
+    img = rgba[..., :3] if rgba[..., 3].min() == 255 else rgba
+    Path(path).write_bytes(png_bytes(img, fig.dpi))
+
+
+def png_bytes(img: NDArray[np.uint8], dpi: float = DPI) -> bytes:
+    """Encode an image as PNG: every row filtered "Up", zlib level :data:`PNG_COMPRESSION`.
+
+    A plot's rows mostly repeat the row above, so the Up filter leaves runs of
+    zeros that deflate's fastest level packs as tightly as an encoder choosing
+    a filter per row (Pillow's), in about a third of the time.
+
+    Parameters
+    ----------
+    img : ndarray of uint8, shape (h, w, 3) or (h, w, 4)
+        RGB or (straight) RGBA pixels, top row first.
+    dpi : float
+        Resolution written in the pHYs chunk [1/inch].
+
+    Returns
+    -------
+    bytes
+        The PNG file.
+
+    Examples
+    --------
+    >>> png_bytes(np.zeros((1, 2, 3), np.uint8))[1:4]
+    b'PNG'
+    """
+    h, w, c = img.shape
+    if img.dtype != np.uint8 or c not in (3, 4):
+        raise ValueError(f"need uint8 RGB or RGBA pixels, got {img.dtype} with {c} channels")
+    rows = np.empty((h, 1 + w * c), np.uint8)
+    rows[:, 0] = 2  # filter type Up: each byte minus the one above (mod 256)
+    flat = img.reshape(h, w * c)
+    rows[0, 1:] = flat[0]
+    np.subtract(flat[1:], flat[:-1], out=rows[1:, 1:])
+
+    def chunk(tag: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data))
+
+    ppm = round(dpi / 0.0254)  # pixels per metre
+    return b"".join(
+        (
+            b"\x89PNG\r\n\x1a\n",
+            chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2 if c == 3 else 6, 0, 0, 0)),
+            chunk(b"pHYs", struct.pack(">IIB", ppm, ppm, 1)),
+            chunk(b"IDAT", zlib.compress(rows, PNG_COMPRESSION)),
+            chunk(b"IEND", b""),
+        )
+    )
 
 
 def _folder(outdir: str | Path) -> Path:

@@ -2,6 +2,7 @@
 
 import ast
 import gc
+import io
 import os
 import subprocess
 import sys
@@ -317,3 +318,27 @@ def test_save_all_writes_figures_2_to_14(tmp_path):
     for f in files:
         assert f.exists() and f.stat().st_size > 10_000, f"{f.name} is too small"
         assert f.stat().st_size < 400_000, f"{f.name} is too large for a report"
+
+
+@pytest.mark.parametrize("shape", [(1, 1, 3), (2, 5, 4), (37, 61, 3), (40, 23, 4)])
+def test_png_bytes_round_trip(shape):
+    """Pillow (an independent decoder) reads back every byte and the resolution."""
+    img = np.random.default_rng(sum(shape)).integers(0, 256, shape, dtype=np.uint8)
+    back = Image.open(io.BytesIO(plots.png_bytes(img, 110.0)))
+    assert back.mode == ("RGB" if shape[2] == 3 else "RGBA")
+    assert_array_equal(np.asarray(back), img)
+    assert back.info["dpi"] == pytest.approx((110.0, 110.0), abs=0.01)
+
+
+def test_saved_png_holds_the_drawn_pixels(tmp_path):
+    figs = []
+
+    def draw(fig):
+        figs.append(fig)
+        ax = fig.add_subplot()
+        ax.imshow(np.random.default_rng(0).random((30, 40)), cmap="viridis")
+        ax.set_title("noise")
+
+    path = plots.save_drawing(tmp_path / "f.png", draw, plots.SIZE)
+    drawn = np.asarray(figs[-1].canvas.buffer_rgba())[..., :3]
+    assert_array_equal(np.asarray(Image.open(path)), drawn)
