@@ -479,7 +479,14 @@ def plot_state_trajectories(sims: Mapping[str, SimResult], ax=None) -> dict:
 
 
 def plot_sweep(
-    res: SweepResult, law: str, which: str = "tf", ax=None, *, vmax: float | None = None
+    res: SweepResult,
+    law: str,
+    which: str = "tf",
+    ax=None,
+    *,
+    vmin: float | None = None,
+    vmax: float | None = None,
+    colorbar: bool = True,
 ) -> dict:
     """Heat map of a law's settling time over t_f* (``tf``) or N* T (``nt``).
 
@@ -493,15 +500,20 @@ def plot_sweep(
         Denominator: continuous t_f* or discrete N* T.
     ax : matplotlib Axes, optional
         Where to draw.
+    vmin : float, optional
+        Bottom of the colour scale [-] (default: the least ratio, at most 1).
     vmax : float, optional
         Top of the colour scale [-] (default: the 99th percentile, at least 2).
+    colorbar : bool
+        Draw the panel's colour bar (False when the caller draws one for several
+        panels on the same scale).
 
     Returns
     -------
     dict
         ``mesh`` (ratio), ``unsettled`` (grey cells where the law never settles),
         ``contours`` (iso-ratio lines at 1.5, 2 and 4 where in range),
-        ``worst`` (marker at the worst state), ``colorbar``.
+        ``worst`` (marker at the worst state), ``colorbar`` (when drawn).
     """
     ax = _ax(ax)
     ls = res.laws[law]
@@ -515,7 +527,7 @@ def plot_sweep(
     drawn["mesh"] = cells(
         np.ma.masked_invalid(ratio),
         cmap="viridis",
-        vmin=min(1.0, finite.min()) if finite.size else 0.9,
+        vmin=vmin if vmin is not None else _floor_of(finite),
         vmax=vmax,
     )
     bad = ~np.isfinite(ls.settle_time)
@@ -537,7 +549,8 @@ def plot_sweep(
     worst = ls.worst_ratio_tf if which == "tf" else ls.worst_ratio_nt
     if math.isfinite(wr[0]):
         (drawn["worst"],) = ax.plot(*wr, "r*", ms=10, label=f"worst ratio {worst:.2f}")
-    drawn["colorbar"] = ax.figure.colorbar(drawn["mesh"], ax=ax, label=f"settling time / {den} [-]")
+    if colorbar:
+        drawn["colorbar"] = ax.figure.colorbar(drawn["mesh"], ax=ax, label=_sweep_label(which))
     ax.set_xlabel("initial position x1 [mm]")
     ax.set_ylabel("initial velocity x2 [mm/s]")
     ax.set_title(
@@ -548,6 +561,15 @@ def plot_sweep(
     if "worst" in drawn:
         ax.legend(fontsize=7, loc="upper right")
     return drawn
+
+
+def _floor_of(ratios: NDArray[np.float64]) -> float:
+    """Bottom of a ratio map's colour scale: its least finite value, at most 1 (0.9 if none)."""
+    return min(1.0, float(ratios.min())) if ratios.size else 0.9
+
+
+def _sweep_label(which: str) -> str:
+    return f"settling time / {'t_f*' if which == 'tf' else 'N* T'} [-]"
 
 
 def _cells(ax, x1: NDArray[np.float64], x2: NDArray[np.float64]) -> Callable:
@@ -1034,7 +1056,8 @@ def _folder(outdir: str | Path) -> Path:
 def save_sweep(res: SweepResult, outdir: str | Path) -> list[Path]:
     """Write the sweep's heat maps (one PNG per denominator, a panel per law).
 
-    The panels of one PNG share their colour scale, so the laws compare by eye.
+    The panels of one PNG share their colour scale (one colour bar), so the laws
+    compare by eye.
 
     Parameters
     ----------
@@ -1057,17 +1080,18 @@ def save_sweep(res: SweepResult, outdir: str | Path) -> list[Path]:
         ratios = [r.ratio_tf if which == "tf" else r.ratio_nt for r in res.laws.values()]
         finite = np.concatenate([r[np.isfinite(r)] for r in ratios])
         vmax = max(2.0, float(np.percentile(finite, 99))) if finite.size else 2.0
+        scale = {"vmin": _floor_of(finite), "vmax": vmax}
 
-        def draw(fig, which=which, vmax=vmax):
-            axes = fig.subplots(rows, cols, squeeze=False)
-            for ax, law in zip(axes.flat, laws, strict=False):
-                plot_sweep(res, law, which, ax, vmax=vmax)
-            for ax in list(axes.flat)[len(laws) :]:
-                ax.set_visible(False)
+        def draw(fig, which=which, scale=scale):
+            grid = fig.add_gridspec(rows, cols + 1, width_ratios=(1.0,) * cols + (0.05,))
+            for k, law in enumerate(laws):
+                ax = fig.add_subplot(grid[k // cols, k % cols])
+                mesh = plot_sweep(res, law, which, ax, **scale, colorbar=False)["mesh"]
+            fig.colorbar(mesh, cax=fig.add_subplot(grid[:, -1]), label=_sweep_label(which))
 
         path = outdir / f"sweep_ratio_{which}.png"
-        size = (5.6 * cols, 4.2 * rows)
-        files.append(save_drawing(path, draw, size, (0.84, 0.26, 0.6, 0.34), (0.2, 0.23)))
+        size = (5.3 * cols + 1.0, 4.2 * rows)
+        files.append(save_drawing(path, draw, size, (0.84, 0.7, 0.6, 0.34), (0.3, 0.23)))
     return files
 
 

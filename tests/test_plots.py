@@ -218,6 +218,8 @@ def test_sweep_heat_map(tmp_path):
         [x1[0] - h1, x1[-1] + h1, x2[0] - h2, x2[-1] + h2],
         err_msg="each cell centred on its state, spanning half-way to its neighbours",
     )
+    shared = plots.plot_sweep(res, "pd", "nt", vmin=0.5, vmax=7.0, colorbar=False)
+    assert shared["mesh"].get_clim() == (0.5, 7.0) and "colorbar" not in shared
     files = plots.save_sweep(res, tmp_path)
     assert [f.name for f in files] == ["sweep_ratio_tf.png", "sweep_ratio_nt.png"]
     assert gc.isenabled(), "the garbage collector is back on after the batch"
