@@ -10,6 +10,12 @@ come from the pure functions of :mod:`ptoverify.curves`.  The report's collect
 step (:func:`ptoverify.report.collect`) computes the inputs once.  Nothing is
 shown; the backend is Agg unless the caller chose another one first.
 
+Speed (the report's thirty figures): the ``save_*`` functions draw each figure
+once on its own Agg canvas outside pyplot, at first-guess margins kept only
+when nothing is clipped or overlapping (:func:`save_drawing`; tight layout and
+a second draw otherwise), with unhinted text (:data:`RENDER_RC`), the garbage
+collector paused for the batch, and write the PNG with :func:`png_bytes`.
+
 Figures: Fig. 2 trajectories under +-w_max with l1, l2 (eqs. 8-11); Fig. 3
 time-optimal trajectories with saturation (eq. 12); Fig. 4 switching and
 linear zones (l1, l2, l1*, l2*, |x1| < d, eqs. 13-14); Fig. 5 l1, l1* and the
