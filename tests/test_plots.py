@@ -1,6 +1,8 @@
 """Figures are drawn headless, draw exactly the results they are given, compute nothing."""
 
 import ast
+import gc
+import io
 import os
 import subprocess
 import sys
@@ -10,7 +12,9 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+from matplotlib.figure import Figure
 from numpy.testing import assert_allclose, assert_array_equal
+from PIL import Image
 
 from ptoverify import plots
 from ptoverify.config import paper_config
@@ -207,8 +211,102 @@ def test_sweep_heat_map(tmp_path):
         assert_allclose(
             np.ravel(d["worst"].get_data()), res.laws["pd"].worst_state_nt, err_msg="worst"
         )
+    x1, x2 = res.x1[0], res.x2[:, 0]
+    h1, h2 = (x1[1] - x1[0]) / 2, (x2[1] - x2[0]) / 2
+    assert_allclose(
+        d["mesh"].get_extent(),
+        [x1[0] - h1, x1[-1] + h1, x2[0] - h2, x2[-1] + h2],
+        err_msg="each cell centred on its state, spanning half-way to its neighbours",
+    )
+    shared = plots.plot_sweep(res, "pd", "nt", vmin=0.5, vmax=7.0, colorbar=False)
+    assert shared["mesh"].get_clim() == (0.5, 7.0) and "colorbar" not in shared
     files = plots.save_sweep(res, tmp_path)
     assert [f.name for f in files] == ["sweep_ratio_tf.png", "sweep_ratio_nt.png"]
+    assert gc.isenabled(), "the garbage collector is back on after the batch"
+
+    uneven = replace(res, x1=np.sign(res.x1) * res.x1**2 / np.abs(res.x1).max())
+    d = plots.plot_sweep(uneven, "pd", "nt")
+    edges = d["mesh"].get_coordinates()[0, :, 0]
+    mid = uneven.x1[0]
+    assert_allclose(edges[1:-1], (mid[1:] + mid[:-1]) / 2, err_msg="uneven grid: mid-way edges")
+    drawn = np.ma.masked_invalid(d["mesh"].get_array()).reshape(ratio.shape)
+    assert_array_equal(drawn.filled(np.nan), np.where(np.isfinite(ratio), ratio, np.nan))
+
+
+def _ink_gaps(path: Path) -> list[float]:
+    """Distance from the outermost non-background pixel to each edge [inch] (l, r, b, t)."""
+    px = np.asarray(Image.open(path).convert("RGB")).astype(int)
+    ink = np.any(px != px[0, 0], axis=2)
+    rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
+    h, w = ink.shape
+    gaps = (cols[0], w - 1 - cols[-1], h - 1 - rows[-1], rows[0])
+    return [g / plots.DPI for g in gaps]
+
+
+@pytest.mark.parametrize(("scale", "relaid"), [(100.0, False), (1e5, True)])
+def test_saved_figure_is_never_clipped(tmp_path, monkeypatch, scale, relaid):
+    """Tick labels as wide as the paper's keep the first-guess margins (one draw); much
+    wider ones (another configuration) are laid out anew.  Either way nothing drawn is
+    nearer the edge than FIT_GAP[0] nor farther than FIT_GAP[1]."""
+    laid = []
+    tight = Figure.tight_layout
+    monkeypatch.setattr(Figure, "tight_layout", lambda fig: laid.append(fig) or tight(fig))
+    t = np.linspace(0.0, 1.0, 50)
+
+    def draw(ax):
+        ax.plot(t, -3 * scale * t)
+        ax.set_title("a title")
+        ax.set_xlabel("time t [s]")
+        ax.set_ylabel("position x1 [mm]")
+
+    path = plots.save_figure(tmp_path / "f.png", draw)
+    assert bool(laid) == relaid
+    lo, hi = plots.FIT_GAP
+    for side, gap in zip(("left", "right", "bottom", "top"), _ink_gaps(path), strict=True):
+        assert lo <= gap <= hi, f"{side}: {gap:.3f} in"
+
+
+@pytest.mark.parametrize(("scale", "relaid"), [(1.0, False), (1e3, True)])
+def test_panels_never_overlap(tmp_path, monkeypatch, scale, relaid):
+    """Side-by-side panels keep the guessed spacing unless one's tick labels reach into
+    the other; the figure written has no two panels' decorations overlapping."""
+    laid, figs = [], []
+    tight = Figure.tight_layout
+    monkeypatch.setattr(Figure, "tight_layout", lambda fig: laid.append(fig) or tight(fig))
+
+    def draw(fig):
+        figs.append(fig)
+        for ax, k in zip(fig.subplots(1, 2), (1.0, scale), strict=True):
+            ax.plot([0.0, 1.0], [0.0, -300 * k])  # only the right panel's labels vary
+            ax.set_title("panel")
+            ax.set_ylabel("y [mm]")
+
+    plots.save_drawing(tmp_path / "f.png", draw, (8.0, 3.0), spacing=(0.26, 0.2))
+    assert bool(laid) == relaid
+    r = figs[-1].canvas.get_renderer()
+    left, right = (ax.get_tightbbox(r, bbox_extra_artists=[]) for ax in figs[-1].axes)
+    assert left.x1 < right.x0, "the right panel's tick labels clear the left panel"
+
+
+def test_title_never_covers_the_offset_text(tmp_path):
+    """A y offset text under a wide title sends the figure to Matplotlib's title placement."""
+    figs = []
+    title = "a title wide enough to reach over the offset text at the top left of the axes"
+
+    def draw(fig):
+        figs.append(fig)
+        ax = fig.add_subplot()
+        ax.plot([0.0, 1.0], [1000.0, 1000.001])
+        ax.set_title(title, fontsize=10)
+
+    plots.save_drawing(tmp_path / "f.png", draw, plots.SIZE)
+    boxes = []
+    for fig in figs:
+        ax, r = fig.axes[0], fig.canvas.get_renderer()
+        assert ax.yaxis.offsetText.get_text(), "the data need an offset"
+        boxes.append((ax.yaxis.offsetText.get_window_extent(r), ax.title.get_window_extent(r)))
+    assert len(figs) == 2 and boxes[0][0].overlaps(boxes[0][1]), "first guess overlapped"
+    assert not boxes[1][0].overlaps(boxes[1][1]), "final figure: title above the offset"
 
 
 @pytest.mark.slow
@@ -222,3 +320,27 @@ def test_save_all_writes_figures_2_to_14(tmp_path):
     for f in files:
         assert f.exists() and f.stat().st_size > 10_000, f"{f.name} is too small"
         assert f.stat().st_size < 400_000, f"{f.name} is too large for a report"
+
+
+@pytest.mark.parametrize("shape", [(1, 1, 3), (2, 5, 4), (37, 61, 3), (40, 23, 4)])
+def test_png_bytes_round_trip(shape):
+    """Pillow (an independent decoder) reads back every byte and the resolution."""
+    img = np.random.default_rng(sum(shape)).integers(0, 256, shape, dtype=np.uint8)
+    back = Image.open(io.BytesIO(plots.png_bytes(img, 110.0)))
+    assert back.mode == ("RGB" if shape[2] == 3 else "RGBA")
+    assert_array_equal(np.asarray(back), img)
+    assert back.info["dpi"] == pytest.approx((110.0, 110.0), abs=0.01)
+
+
+def test_saved_png_holds_the_drawn_pixels(tmp_path):
+    figs = []
+
+    def draw(fig):
+        figs.append(fig)
+        ax = fig.add_subplot()
+        ax.imshow(np.random.default_rng(0).random((30, 40)), cmap="viridis")
+        ax.set_title("noise")
+
+    path = plots.save_drawing(tmp_path / "f.png", draw, plots.SIZE)
+    drawn = np.asarray(figs[-1].canvas.buffer_rgba())[..., :3]
+    assert_array_equal(np.asarray(Image.open(path)), drawn)
