@@ -41,6 +41,7 @@ import json
 import math
 import platform
 import subprocess
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -530,6 +531,32 @@ def collect(
     return out
 
 
+#: A pool worker: runs the stages it is sent (pickled on stdin) and answers on its
+#: own copy of stdout; anything a stage prints (C libraries included) goes to stderr.
+_WORKER = r"""
+import os, pickle, sys, traceback
+answer = os.fdopen(os.dup(1), "wb")
+os.dup2(2, 1)
+from ptoverify.report import _run_stage
+while True:
+    try:
+        task = pickle.load(sys.stdin.buffer)
+    except EOFError:
+        break
+    try:
+        result = ("ok", _run_stage(*task))
+    except BaseException as exc:
+        trace = traceback.format_exc()
+        try:
+            pickle.dumps(exc)
+        except Exception:
+            exc = RuntimeError(f"{type(exc).__name__}: {exc}")
+        result = ("error", exc, trace)
+    pickle.dump(result, answer)
+    answer.flush()
+"""
+
+
 def _run_in_pool(
     names: list[str],
     cfg: Config,
@@ -537,25 +564,85 @@ def _run_in_pool(
     jobs: int,
     finished: Callable[[str, tuple[dict[str, Any], float]], None],
 ) -> None:
-    """Run the stages in ``jobs`` spawned processes; ``finished(name, result)`` as each ends.
+    """Run the stages in ``jobs`` worker processes; ``finished(name, result)`` as each ends.
 
-    A stage's exception is raised here (its type kept, so an ``InputError``
-    stays one); the remaining stages are cancelled.
+    Each worker is a fresh interpreter (``sys.executable -c``, this process's
+    ``sys.path``): no fork of solver or BLAS state, and no re-import of the
+    caller's ``__main__``, so a script calling :func:`write_report` needs no
+    ``if __name__ == "__main__"`` guard.  Workers take the stages in the order
+    given (longest first).  A stage's exception is raised here with its type
+    (an ``InputError`` stays one) and the worker's traceback as a note; the
+    workers are then killed.  Where no process can be started, the stages run
+    in this process.
     """
-    import multiprocessing
-    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    import os
+    import pickle
+    import queue
+    import threading
 
-    ctx = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
-        pending = {pool.submit(_run_stage, n, cfg, figdir): n for n in names}
-        try:
-            while pending:
-                ready, _ = wait(pending, return_when=FIRST_COMPLETED)
-                for fut in ready:
-                    finished(pending.pop(fut), fut.result())
-        finally:
-            for fut in pending:
-                fut.cancel()
+    todo: queue.SimpleQueue = queue.SimpleQueue()
+    for name in names:
+        todo.put(name)
+    answers: queue.SimpleQueue = queue.SimpleQueue()
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+    procs: list[subprocess.Popen] = []
+    try:
+        for _ in range(jobs):
+            procs.append(
+                subprocess.Popen(
+                    [sys.executable, "-c", _WORKER],
+                    stdin=subprocess.PIPE,
+                    stdout=subprocess.PIPE,
+                    env=env,
+                )
+            )
+    except OSError:  # no process can be started here: run the stages in this one
+        for proc in procs:
+            proc.kill()
+        for name in names:
+            finished(name, _run_stage(name, cfg, figdir))
+        return
+
+    def serve(proc: subprocess.Popen) -> None:
+        while True:
+            try:
+                name = todo.get_nowait()
+            except queue.Empty:
+                return
+            try:
+                pickle.dump((name, cfg, figdir), proc.stdin)
+                proc.stdin.flush()
+                answers.put((name, pickle.load(proc.stdout)))  # noqa: S301 - our own worker
+            except (EOFError, OSError, pickle.UnpicklingError):
+                code = proc.wait()
+                why = RuntimeError(f"report stage '{name}': its worker process died (exit {code})")
+                answers.put((name, ("error", why, "")))
+                return
+
+    threads = [threading.Thread(target=serve, args=(p,), daemon=True) for p in procs]
+    for t in threads:
+        t.start()
+    complete = False
+    try:
+        for _ in names:
+            name, answer = answers.get()
+            if answer[0] == "error":
+                exc, trace = answer[1], answer[2]
+                if trace:
+                    exc.add_note(f"in report stage '{name}' (worker process):\n{trace}")
+                raise exc
+            finished(name, answer[1])
+        complete = True
+    finally:
+        for proc in procs:
+            if not complete:  # an error or an interrupt: no stage is waited for
+                proc.kill()
+            try:
+                proc.stdin.close()  # a worker ends at the end of its input
+            except OSError:
+                pass
+        for proc in procs:
+            proc.wait()
 
 
 def _robust(cfg: Config) -> dict[str, Any]:

@@ -480,3 +480,35 @@ def test_jobs_below_one_is_an_input_error(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "--jobs" in err and len(err.splitlines()) == 1
     assert list(tmp_path.iterdir()) == []
+
+
+def test_pool_worker_error_keeps_its_type_and_trace():
+    """A stage that raises in a worker process raises here, same type, with its trace."""
+    from ptoverify.report import _run_in_pool
+
+    with pytest.raises(KeyError) as info:
+        _run_in_pool(["no such stage"], paper_config(), None, 1, lambda *a: None)
+    assert "no such stage" in str(info.value)
+    assert any("worker process" in n for n in getattr(info.value, "__notes__", []))
+
+
+def test_pool_from_an_unguarded_script(tmp_path):
+    """The pool starts fresh interpreters: a script without an ``if __name__`` guard is
+    not re-run in the workers (multiprocessing's spawn would re-import it)."""
+    import sys
+
+    script = tmp_path / "plain.py"
+    script.write_text(
+        "from ptoverify.config import paper_config\n"
+        "from ptoverify.report import _run_in_pool\n"
+        "print('script ran')\n"
+        "try:\n"
+        "    _run_in_pool(['no such stage'], paper_config(), None, 1, lambda *a: None)\n"
+        "except KeyError:\n"
+        "    print('stage error arrived')\n"
+    )
+    res = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, timeout=120, cwd=tmp_path
+    )
+    assert res.returncode == 0, res.stderr[-2000:]
+    assert res.stdout.split() == ["script", "ran", "stage", "error", "arrived"], res.stdout
