@@ -35,6 +35,8 @@ KEYS = {
     "discrete_batch_vs_lp_ratio",
     "check_s",
     "report_s",
+    "report_jobs1_s",
+    "report_pool_speedup",
     "sweep_s",
     "tune_pd_s",
     "tune_pto_s",
@@ -71,6 +73,8 @@ def test_values_finite_positive(small_run, key):
         # only the whole-process figures may be missing, and then with a reason
         assert key in (
             "report_s",
+            "report_jobs1_s",
+            "report_pool_speedup",
             "check_s",
             "robust_s",
             "robust_gates_s",
