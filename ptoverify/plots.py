@@ -46,9 +46,10 @@ if "MPLBACKEND" not in os.environ:
 
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.text import Text  # noqa: E402
 from matplotlib.transforms import Bbox  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
@@ -78,6 +79,7 @@ __all__ = [
     "plot_switch_profiles",
     "save_figure",
     "save_drawing",
+    "FigureSheet",
     "png_bytes",
     "save_all",
     "save_sweep",
@@ -928,11 +930,157 @@ def save_drawing(
     return Path(path)
 
 
+class _Canvas(FigureCanvasAgg):
+    """An Agg canvas drawing with the one renderer kept per pixel size.
+
+    Matplotlib caches text metrics per renderer, so figures of one size share
+    the layout of every label they have in common.  ``draw`` clears the
+    renderer first; the saved figures are written before the next one draws.
+    """
+
+    _renderers: dict[tuple[int, int, float], RendererAgg] = {}
+
+    def get_renderer(self) -> RendererAgg:
+        w, h = self.get_width_height(physical=True)
+        key = (w, h, self.figure.dpi)
+        renderer = self._renderers.get(key)
+        if renderer is None:
+            renderer = self._renderers[key] = RendererAgg(*key)
+        self.renderer = renderer
+        return renderer
+
+
 def _figure(size: tuple[float, float]) -> Figure:
     """Make a figure on its own Agg canvas, outside pyplot (nothing to register or close)."""
     fig = Figure(figsize=size, dpi=DPI)
-    FigureCanvasAgg(fig)
+    _Canvas(fig)
     return fig
+
+
+class FigureSheet:
+    """A figure kept for a family of PNGs of one layout, its axes cleared between them.
+
+    The axes and their ticks (the costliest part of a fresh figure: a tick is
+    two lines, two texts and a grid line, each styled anew) are built once by
+    ``build(fig) -> list of Axes``; each :meth:`save` removes what the last
+    drawing added (lines, collections, images, texts, legend), resets the data
+    and view limits, the colour cycle and the title and label styles, then
+    ``draw(axes)`` draws and the PNG is written as by :func:`save_drawing`
+    (first-guess margins, a fresh figure with tight layout when they do not
+    fit).  The picture is the one a fresh figure gives, pixel for pixel
+    (``tests/test_plots.py``), when the family's drawings style the ticks and
+    the grid alike (kept between drawings; the grid is switched off).  Colour bars go through :meth:`colorbar`, which
+    updates the one already drawn.
+
+    Parameters
+    ----------
+    size : tuple of float
+        Figure size [inch].
+    build : callable
+        ``build(fig)`` adds the axes to the (empty) figure and returns them.
+    margins : tuple of float
+        First guess of the (left, right, bottom, top) margins [inch].
+    spacing : tuple of float, optional
+        First guess of (wspace, hspace) between subplots [-].
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> sheet = FigureSheet(SIZE, lambda fig: [fig.add_subplot()])
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     paths = [sheet.save(f"{d}/{k}.png", lambda axes: axes[0].plot([0, k])) for k in (1, 2)]
+    ...     [p.stat().st_size > 0 for p in paths]
+    [True, True]
+    """
+
+    def __init__(
+        self,
+        size: tuple[float, float],
+        build: Callable[[Figure], list],
+        margins: tuple[float, float, float, float] = MARGINS,
+        spacing: tuple[float, float] | None = None,
+    ):
+        self.size, self.build, self.margins, self.spacing = size, build, margins, spacing
+        self.fig: Figure | None = None
+        self.axes: list = []
+        self._styles: list = []
+        self._bars: dict = {}
+
+    def colorbar(self, mappable, cax, label: str):
+        """Draw ``mappable``'s colour bar in ``cax`` (update it when the sheet drew one there)."""
+        bar = self._bars.get(cax)
+        if bar is None or cax.figure is not self.fig:
+            bar = cax.figure.colorbar(mappable, cax=cax, label=label)
+            if cax.figure is self.fig:
+                self._bars[cax] = bar
+            return bar
+        bar.update_normal(mappable)
+        bar.set_label(label)
+        return bar
+
+    def save(self, path: str | Path, draw: Callable[[list], object]) -> Path:
+        """Draw on the sheet's axes and write the PNG; return its path."""
+        with matplotlib.rc_context({**RENDER_RC, "axes.titley": 1.0}):
+            if self.fig is None:
+                self.fig = _figure(self.size)
+                self.axes = list(self.build(self.fig))
+                self._styles = [_text_styles(ax) for ax in self.axes]
+                w, h = self.size
+                left, right, bottom, top = self.margins
+                wspace, hspace = self.spacing or (None, None)
+                self.fig.subplots_adjust(
+                    left / w, bottom / h, 1 - right / w, 1 - top / h, wspace=wspace, hspace=hspace
+                )
+            else:
+                for ax, styles in zip(self.axes, self._styles):
+                    if ax not in self._bars:
+                        _clear(ax, styles)
+            draw(self.axes)
+            self.fig.canvas.draw()
+            done = _fits(self.fig)
+        if done:
+            _png(self.fig, path)
+            return Path(path)
+        fig = _figure(self.size)
+        with matplotlib.rc_context(RENDER_RC):
+            draw(list(self.build(fig)))
+            _write(fig, path)
+        return Path(path)
+
+
+def _text_styles(ax) -> list:
+    """Return copies of the style of an axes' title and axis labels (see :func:`_clear`)."""
+    styles = []
+    for text in (ax.title, ax.xaxis.label, ax.yaxis.label):
+        copy = Text()
+        copy.update_from(text)
+        styles.append((text, copy))
+    return styles
+
+
+def _clear(ax, styles: list) -> None:
+    """Remove what was drawn on ``ax`` and reset it to the state it was built in.
+
+    Kept: the axes, their ticks, the tick parameters and the grid's style (a drawing
+    that shows a grid sets it again; the family's drawings style it alike).
+    """
+    for art in [*ax.collections, *ax.images, *ax.lines, *ax.patches]:
+        art.remove()
+    for art in [*ax.texts, *ax.artists]:  # after the collections: contour labels go with them
+        art.remove()
+    if ax.legend_ is not None:
+        ax.legend_.remove()
+    ax.containers.clear()
+    for text, style in styles:
+        text.update_from(style)
+        text.set_text("")
+    ax.grid(False)
+    ax.set_prop_cycle(None)
+    ax.dataLim.set_points(Bbox.null().get_points())
+    ax.ignore_existing_data_limits = True
+    ax.set_autoscale_on(True)
+    ax.relim()
+    ax.autoscale_view()
 
 
 def _write(fig: Figure, path: str | Path) -> None:
@@ -1082,22 +1230,26 @@ def save_sweep(res: SweepResult, outdir: str | Path) -> list[Path]:
     laws = list(res.laws)
     cols = 2 if len(laws) > 1 else 1
     rows = math.ceil(len(laws) / cols)
+    size = (5.3 * cols + 1.0, 4.2 * rows)
+
+    def build(fig):
+        grid = fig.add_gridspec(rows, cols + 1, width_ratios=(1.0,) * cols + (0.05,))
+        panels = [fig.add_subplot(grid[k // cols, k % cols]) for k in range(len(laws))]
+        return [*panels, fig.add_subplot(grid[:, -1])]
+
+    sheet = FigureSheet(size, build, (0.84, 0.7, 0.6, 0.34), (0.3, 0.23))
     for which in ("tf", "nt"):
         ratios = [r.ratio_tf if which == "tf" else r.ratio_nt for r in res.laws.values()]
         finite = np.concatenate([r[np.isfinite(r)] for r in ratios])
         vmax = max(2.0, float(np.percentile(finite, 99))) if finite.size else 2.0
         scale = {"vmin": _floor_of(finite), "vmax": vmax}
 
-        def draw(fig, which=which, scale=scale):
-            grid = fig.add_gridspec(rows, cols + 1, width_ratios=(1.0,) * cols + (0.05,))
-            for k, law in enumerate(laws):
-                ax = fig.add_subplot(grid[k // cols, k % cols])
+        def draw(axes, which=which, scale=scale):
+            for ax, law in zip(axes, laws):
                 mesh = plot_sweep(res, law, which, ax, **scale, colorbar=False)["mesh"]
-            fig.colorbar(mesh, cax=fig.add_subplot(grid[:, -1]), label=_sweep_label(which))
+            sheet.colorbar(mesh, axes[-1], _sweep_label(which))
 
-        path = outdir / f"sweep_ratio_{which}.png"
-        size = (5.3 * cols + 1.0, 4.2 * rows)
-        files.append(save_drawing(path, draw, size, (0.84, 0.7, 0.6, 0.34), (0.3, 0.23)))
+        files.append(sheet.save(outdir / f"sweep_ratio_{which}.png", draw))
     return files
 
 
@@ -1186,26 +1338,30 @@ def save_robust(maps: Mapping, outdir: str | Path) -> list[Path]:
     laws, delays = list(maps["laws"]), list(maps["delay_samples"])
     size = (3.8 * len(delays) + 1.2, 2.9 * len(laws))
     ratios = (1.0,) * len(delays) + (0.07,)  # the panels, then the colour bar
+
+    def build(fig):
+        grid = fig.add_gridspec(len(laws), len(delays) + 1, width_ratios=ratios)
+        panels = [fig.add_subplot(grid[r, c]) for r in range(len(laws)) for c in range(len(delays))]
+        return [*panels, fig.add_subplot(grid[:, -1])]
+
+    sheet = FigureSheet(size, build, (0.75, 0.75, 0.55, 0.33), (0.25, 0.23))
     files = []
     for key, label, stem in ROBUST_MAPS:
         vals = [_robust_cell_value(c, key) for law in laws for c in maps["laws"][law]]
         finite = [v for v in vals if math.isfinite(v)]
         vmax = max(max(finite, default=1.0), 1.0)
 
-        def draw(fig, key=key, label=label, vmax=vmax):
-            grid = fig.add_gridspec(len(laws), len(delays) + 1, width_ratios=ratios)
-            for r, law in enumerate(laws):
-                for c, dl in enumerate(delays):
-                    ax = fig.add_subplot(grid[r, c])
-                    mesh = plot_robust_map(maps, law, key, dl, ax, vmax=vmax)["map"]
-                    if r < len(laws) - 1:
-                        ax.set_xlabel("")
-                    if c > 0:
-                        ax.set_ylabel("")
-            fig.colorbar(mesh, cax=fig.add_subplot(grid[:, -1]), label=label)
+        def draw(axes, key=key, label=label, vmax=vmax):
+            for k, ax in enumerate(axes[:-1]):
+                r, c = divmod(k, len(delays))
+                mesh = plot_robust_map(maps, laws[r], key, delays[c], ax, vmax=vmax)["map"]
+                if r < len(laws) - 1:
+                    ax.set_xlabel("")
+                if c > 0:
+                    ax.set_ylabel("")
+            sheet.colorbar(mesh, axes[-1], label)
 
-        path = outdir / f"{stem}.png"
-        files.append(save_drawing(path, draw, size, (0.75, 0.75, 0.55, 0.33), (0.25, 0.23)))
+        files.append(sheet.save(outdir / f"{stem}.png", draw))
     return files
 
 
@@ -1312,9 +1468,14 @@ def save_all(inputs: FigureInputs, outdir: str | Path) -> list[Path]:
     outdir = _folder(outdir)
     cfg, fi = inputs.cfg, inputs
     files: list[Path] = []
+    sheet = FigureSheet(SIZE, lambda fig: [fig.add_subplot()])  # Figs. 2-14: one layout
 
     def one(name: str, draw: Callable, size: tuple[float, float] = SIZE) -> None:
-        files.append(save_figure(outdir / f"{name}.png", draw, size))
+        path = outdir / f"{name}.png"
+        if size == SIZE:
+            files.append(sheet.save(path, lambda axes: draw(axes[0])))
+        else:
+            files.append(save_figure(path, draw, size))
 
     one("fig02_trajectories", lambda ax: plot_fig2(cfg.plant, *fi.open_loop.values(), ax))
     one("fig03_saturation", lambda ax: plot_fig3(fi.to_batch, cfg.plant, ax))
