@@ -46,9 +46,11 @@ if "MPLBACKEND" not in os.environ:
 
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.backends import backend_agg  # noqa: E402
 from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.font_manager import findfont, get_font  # noqa: E402
 from matplotlib.text import Text  # noqa: E402
 from matplotlib.transforms import Bbox  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
@@ -930,6 +932,65 @@ def save_drawing(
     return Path(path)
 
 
+class _Renderer(RendererAgg):
+    """Agg renderer remembering each font's line metrics (Matplotlib's hook for them).
+
+    ``Text`` lays out every label with its font's ascender, descender and line
+    gap, read from the font's tables at each layout; here once per font, size
+    and dpi, by the same rule (OS/2 typo metrics, else hhea).
+    """
+
+    _metrics: dict = {}
+    _glyphs: dict = {}
+    #: Matplotlib >= 3.11 draws text glyph by glyph from a shaped layout, which is
+    #: remembered here per string, font and size; older versions draw as they do.
+    _shaped = hasattr(RendererAgg, "_draw_text_glyphs_and_boxes") and hasattr(
+        backend_agg, "get_hinting_flag"
+    )
+
+    def draw_text(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):
+        if ismath or not self._shaped:
+            return super().draw_text(gc, x, y, s, prop, angle, ismath=ismath, mtext=mtext)
+        features = mtext.get_fontfeatures() if mtext is not None else None
+        language = mtext.get_language() if mtext is not None else None
+        flags = backend_agg.get_hinting_flag()
+        key = (s, hash(prop), self.dpi, flags, repr(features), repr(language))
+        glyphs = self._glyphs.get(key)
+        if glyphs is None:
+            font = self._prepare_font(prop)
+            size = prop.get_size_in_points()
+            items = font._layout(s, flags=flags, features=features, language=language)
+            glyphs = [(i.ft_object, size, i.glyph_index, 0, 1, i.x, i.y) for i in items]
+            if len(self._glyphs) > 20_000:  # a bound for long-lived processes
+                self._glyphs.clear()
+            self._glyphs[key] = glyphs
+        self._draw_text_glyphs_and_boxes(gc, x, y, angle, glyphs, [])
+        return None
+
+    def _get_font_height_metrics(self, prop) -> tuple:
+        key = (hash(prop), prop.get_size_in_points(), self.dpi)
+        found = self._metrics.get(key)
+        if found is None:
+            font = get_font(findfont(prop))
+            found = (None, None, None)
+            for name, gap, asc, desc in (
+                ("OS/2", "sTypoLineGap", "sTypoAscender", "sTypoDescender"),
+                ("hhea", "lineGap", "ascent", "descent"),
+            ):
+                table = font.get_sfnt_table(name)
+                if table is not None:
+                    scale = (
+                        prop.get_size_in_points()
+                        * self.dpi
+                        / 72
+                        / font.get_sfnt_table("head")["unitsPerEm"]
+                    )
+                    found = (table[asc] * scale, -table[desc] * scale, table[gap] * scale)
+                    break
+            self._metrics[key] = found
+        return found
+
+
 class _Canvas(FigureCanvasAgg):
     """An Agg canvas drawing with the one renderer kept per pixel size.
 
@@ -938,14 +999,14 @@ class _Canvas(FigureCanvasAgg):
     renderer first; the saved figures are written before the next one draws.
     """
 
-    _renderers: dict[tuple[int, int, float], RendererAgg] = {}
+    _renderers: dict[tuple[int, int, float], _Renderer] = {}
 
-    def get_renderer(self) -> RendererAgg:
+    def get_renderer(self) -> _Renderer:
         w, h = self.get_width_height(physical=True)
         key = (w, h, self.figure.dpi)
         renderer = self._renderers.get(key)
         if renderer is None:
-            renderer = self._renderers[key] = RendererAgg(*key)
+            renderer = self._renderers[key] = _Renderer(*key)
         self.renderer = renderer
         return renderer
 

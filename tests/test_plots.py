@@ -405,3 +405,27 @@ def test_sheet_colour_bar_and_contour_labels_as_fresh(tmp_path):
         new = plots.FigureSheet((9.0, 3.5), build, (0.6, 0.8, 0.5, 0.3), (0.3, 0.2))
         b = new.save(tmp_path / f"new{k}.png", lambda axes, d=draw, s=new: d(axes, s))
         assert_array_equal(_pixels(a), _pixels(b), err_msg=f"drawing {k}")
+
+
+def test_kept_renderer_draws_as_matplotlib(tmp_path, sims):
+    """The saved figures' renderer (kept per size, text layouts and font metrics
+    remembered) gives Matplotlib's own Agg pixels, drawing after drawing."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    def draw(ax, k):
+        plots.plot_response(sims, ("position", "error")[k % 2], ax, cfg=CFG)
+        ax.text(0.5, 0.5, f"rotated {k}", rotation=30, fontsize=6 + 3 * k)
+        ax.set_ylabel(f"label {k} [mm]", fontsize=9 + k)
+
+    for k in range(3):
+        with plt.rc_context(plots.RENDER_RC):
+            ours = plots.FigureSheet(plots.SIZE, lambda fig: [fig.add_subplot()])
+            path = ours.save(tmp_path / f"ours{k}.png", lambda axes, k=k: draw(axes[0], k))
+            fig = Figure(figsize=plots.SIZE, dpi=plots.DPI)
+            FigureCanvasAgg(fig)
+            ax = fig.add_subplot()
+            ax.set_position(ours.axes[0].get_position())
+            draw(ax, k)
+            fig.canvas.draw()
+        theirs = np.asarray(fig.canvas.buffer_rgba())[..., :3]
+        assert_array_equal(_pixels(path), theirs, err_msg=f"drawing {k}")
