@@ -544,6 +544,8 @@ def plot_sweep(
     drawn["unsettled"] = cells(
         np.ma.masked_where(~bad, bad.astype(float)), cmap=ListedColormap(["0.6"])
     )
+    for layer, shown in ((drawn["mesh"], finite.size > 0), (drawn["unsettled"], bad.any())):
+        layer.set_visible(bool(shown))  # an all-masked layer paints nothing: not drawn
     levels = [v for v in (1.5, 2.0, 4.0) if finite.size and finite.min() < v < finite.max()]
     if levels:  # iso-ratio lines: where the law is within 50 %, 2x, 4x of the floor
         drawn["contours"] = ax.contour(
@@ -1135,7 +1137,8 @@ def _clear(ax, styles: list) -> None:
     for text, style in styles:
         text.update_from(style)
         text.set_text("")
-    ax.grid(False)
+    if any(t.gridline.get_visible() for t in (ax.xaxis.majorTicks[0], ax.yaxis.majorTicks[0])):
+        ax.grid(False)
     ax.set_prop_cycle(None)
     ax.dataLim.set_points(Bbox.null().get_points())
     ax.ignore_existing_data_limits = True
