@@ -51,6 +51,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg  # noqa
 from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.font_manager import findfont, get_font  # noqa: E402
+from matplotlib.ft2font import FT2Font  # noqa: E402
 from matplotlib.text import Text  # noqa: E402
 from matplotlib.transforms import Bbox  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
@@ -946,8 +947,15 @@ class _Renderer(RendererAgg):
     _glyphs: dict = {}
     #: Matplotlib >= 3.11 draws text glyph by glyph from a shaped layout, which is
     #: remembered here per string, font and size; older versions draw as they do.
-    _shaped = hasattr(RendererAgg, "_draw_text_glyphs_and_boxes") and hasattr(
-        backend_agg, "get_hinting_flag"
+    _shaped = all(
+        hasattr(owner, name)
+        for owner, name in (
+            (backend_agg, "get_hinting_flag"),
+            (backend_agg, "RenderMode"),
+            (FT2Font, "_layout"),
+            (FT2Font, "_set_transform"),
+            (FT2Font, "_render_glyph"),
+        )
     )
 
     def draw_text(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):
@@ -966,8 +974,43 @@ class _Renderer(RendererAgg):
             if len(self._glyphs) > 20_000:  # a bound for long-lived processes
                 self._glyphs.clear()
             self._glyphs[key] = glyphs
-        self._draw_text_glyphs_and_boxes(gc, x, y, angle, glyphs, [])
+        self._blit(gc, x, y, angle, glyphs)
         return None
+
+    _bitmaps: dict = {}
+
+    def _blit(self, gc, x: float, y: float, angle: float, glyphs: list) -> None:
+        """Draw shaped glyphs as Matplotlib's Agg renderer does, each bitmap rendered once.
+
+        A glyph's bitmap depends on its font, size, rotation and the sub-pixel
+        part (1/64 px) of its position; the whole-pixel part only moves it.
+        Positions, transform and rendering flags are Matplotlib's (3.11).
+        """
+        cos, sin = math.cos(math.radians(angle)), math.sin(math.radians(angle))
+        matrix = (0x10000 * np.array([[cos, -sin], [sin, cos]])).round().astype(int)
+        flags = backend_agg.get_hinting_flag()
+        smooth = gc.get_antialiased()
+        mode = backend_agg.RenderMode.NORMAL if smooth else backend_agg.RenderMode.MONO
+        height = self.height
+        for font, size, index, _, _, dx, dy in glyphs:
+            tx = round(0x40 * (x + dx * cos - dy * sin))
+            ty = round(0x40 * (height - y + dx * sin + dy * cos))
+            key = (font, size, self.dpi, index, angle, flags, smooth, tx & 63, ty & 63)
+            hit = self._bitmaps.get(key)
+            if hit is None:
+                font.set_size(size, self.dpi)
+                font._set_transform(matrix, [tx, ty])
+                bitmap = font._render_glyph(index, flags, mode)
+                buffer = np.array(bitmap.buffer, copy=True)
+                if not smooth:
+                    buffer *= 0xFF
+                if len(self._bitmaps) > 50_000:
+                    self._bitmaps.clear()
+                hit = self._bitmaps[key] = (buffer, bitmap.left - (tx >> 6), bitmap.top - (ty >> 6))
+            buffer, left, top = hit
+            self._renderer.draw_text_image(
+                buffer, left + (tx >> 6), int(height) - (top + (ty >> 6)) + buffer.shape[0], 0, gc
+            )
 
     def _get_font_height_metrics(self, prop) -> tuple:
         key = (hash(prop), prop.get_size_in_points(), self.dpi)
