@@ -11,10 +11,15 @@ step (:func:`ptoverify.report.collect`) computes the inputs once.  Nothing is
 shown; the backend is Agg unless the caller chose another one first.
 
 Speed (the report's thirty figures): the ``save_*`` functions draw each figure
-once on its own Agg canvas outside pyplot, at first-guess margins kept only
-when nothing is clipped or overlapping (:func:`save_drawing`; tight layout and
-a second draw otherwise), with unhinted text (:data:`RENDER_RC`), the garbage
+once on an Agg canvas outside pyplot, at first-guess margins kept only when
+nothing is clipped or overlapping (:func:`save_drawing`; tight layout and a
+second draw otherwise), with unhinted text (:data:`RENDER_RC`), the garbage
 collector paused for the batch, and write the PNG with :func:`png_bytes`.
+Figures of one layout (Figs. 2-14; the two sweep maps; the two robustness
+maps) are drawn on one kept figure, a :class:`FigureSheet`, whose axes and
+ticks are built once and cleared between PNGs (the same pixels as a new
+figure).  Every canvas of a size shares one renderer that remembers font
+metrics, shaped strings and glyph bitmaps (the same pixels as Matplotlib's).
 
 Figures: Fig. 2 trajectories under +-w_max with l1, l2 (eqs. 8-11); Fig. 3
 time-optimal trajectories with saturation (eq. 12); Fig. 4 switching and
