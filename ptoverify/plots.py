@@ -11,10 +11,15 @@ step (:func:`ptoverify.report.collect`) computes the inputs once.  Nothing is
 shown; the backend is Agg unless the caller chose another one first.
 
 Speed (the report's thirty figures): the ``save_*`` functions draw each figure
-once on its own Agg canvas outside pyplot, at first-guess margins kept only
-when nothing is clipped or overlapping (:func:`save_drawing`; tight layout and
-a second draw otherwise), with unhinted text (:data:`RENDER_RC`), the garbage
+once on an Agg canvas outside pyplot, at first-guess margins kept only when
+nothing is clipped or overlapping (:func:`save_drawing`; tight layout and a
+second draw otherwise), with unhinted text (:data:`RENDER_RC`), the garbage
 collector paused for the batch, and write the PNG with :func:`png_bytes`.
+Figures of one layout (Figs. 2-14; the two sweep maps; the two robustness
+maps) are drawn on one kept figure, a :class:`FigureSheet`, whose axes and
+ticks are built once and cleared between PNGs (the same pixels as a new
+figure).  Every canvas of a size shares one renderer that remembers font
+metrics, shaped strings and glyph bitmaps (the same pixels as Matplotlib's).
 
 Figures: Fig. 2 trajectories under +-w_max with l1, l2 (eqs. 8-11); Fig. 3
 time-optimal trajectories with saturation (eq. 12); Fig. 4 switching and
@@ -46,9 +51,13 @@ if "MPLBACKEND" not in os.environ:
 
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
+from matplotlib.backends import backend_agg  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.font_manager import findfont, get_font  # noqa: E402
+from matplotlib.ft2font import FT2Font  # noqa: E402
+from matplotlib.text import Text  # noqa: E402
 from matplotlib.transforms import Bbox  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
@@ -78,6 +87,7 @@ __all__ = [
     "plot_switch_profiles",
     "save_figure",
     "save_drawing",
+    "FigureSheet",
     "png_bytes",
     "save_all",
     "save_sweep",
@@ -540,6 +550,8 @@ def plot_sweep(
     drawn["unsettled"] = cells(
         np.ma.masked_where(~bad, bad.astype(float)), cmap=ListedColormap(["0.6"])
     )
+    for layer, shown in ((drawn["mesh"], finite.size > 0), (drawn["unsettled"], bad.any())):
+        layer.set_visible(bool(shown))  # an all-masked layer paints nothing: not drawn
     levels = [v for v in (1.5, 2.0, 4.0) if finite.size and finite.min() < v < finite.max()]
     if levels:  # iso-ratio lines: where the law is within 50 %, 2x, 4x of the floor
         drawn["contours"] = ax.contour(
@@ -928,11 +940,259 @@ def save_drawing(
     return Path(path)
 
 
+class _Renderer(RendererAgg):
+    """Agg renderer remembering each font's line metrics (Matplotlib's hook for them).
+
+    ``Text`` lays out every label with its font's ascender, descender and line
+    gap, read from the font's tables at each layout; here once per font, size
+    and dpi, by the same rule (OS/2 typo metrics, else hhea).
+    """
+
+    _metrics: dict = {}
+    _glyphs: dict = {}
+    #: Matplotlib >= 3.11 draws text glyph by glyph from a shaped layout, which is
+    #: remembered here per string, font and size; older versions draw as they do.
+    _shaped = all(
+        hasattr(owner, name)
+        for owner, name in (
+            (backend_agg, "get_hinting_flag"),
+            (backend_agg, "RenderMode"),
+            (FT2Font, "_layout"),
+            (FT2Font, "_set_transform"),
+            (FT2Font, "_render_glyph"),
+        )
+    )
+
+    def draw_text(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):
+        if ismath or not self._shaped:
+            return super().draw_text(gc, x, y, s, prop, angle, ismath=ismath, mtext=mtext)
+        features = mtext.get_fontfeatures() if mtext is not None else None
+        language = mtext.get_language() if mtext is not None else None
+        flags = backend_agg.get_hinting_flag()
+        key = (s, hash(prop), self.dpi, flags, repr(features), repr(language))
+        glyphs = self._glyphs.get(key)
+        if glyphs is None:
+            font = self._prepare_font(prop)
+            size = prop.get_size_in_points()
+            items = font._layout(s, flags=flags, features=features, language=language)
+            glyphs = [(i.ft_object, size, i.glyph_index, 0, 1, i.x, i.y) for i in items]
+            if len(self._glyphs) > 20_000:  # a bound for long-lived processes
+                self._glyphs.clear()
+            self._glyphs[key] = glyphs
+        self._blit(gc, x, y, angle, glyphs)
+        return None
+
+    _bitmaps: dict = {}
+
+    def _blit(self, gc, x: float, y: float, angle: float, glyphs: list) -> None:
+        """Draw shaped glyphs as Matplotlib's Agg renderer does, each bitmap rendered once.
+
+        A glyph's bitmap depends on its font, size, rotation and the sub-pixel
+        part (1/64 px) of its position; the whole-pixel part only moves it.
+        Positions, transform and rendering flags are Matplotlib's (3.11).
+        """
+        cos, sin = math.cos(math.radians(angle)), math.sin(math.radians(angle))
+        matrix = (0x10000 * np.array([[cos, -sin], [sin, cos]])).round().astype(int)
+        flags = backend_agg.get_hinting_flag()
+        smooth = gc.get_antialiased()
+        mode = backend_agg.RenderMode.NORMAL if smooth else backend_agg.RenderMode.MONO
+        height = self.height
+        for font, size, index, _, _, dx, dy in glyphs:
+            tx = round(0x40 * (x + dx * cos - dy * sin))
+            ty = round(0x40 * (height - y + dx * sin + dy * cos))
+            key = (font, size, self.dpi, index, angle, flags, smooth, tx & 63, ty & 63)
+            hit = self._bitmaps.get(key)
+            if hit is None:
+                font.set_size(size, self.dpi)
+                font._set_transform(matrix, [tx, ty])
+                bitmap = font._render_glyph(index, flags, mode)
+                buffer = np.array(bitmap.buffer, copy=True)
+                if not smooth:
+                    buffer *= 0xFF
+                if len(self._bitmaps) > 50_000:
+                    self._bitmaps.clear()
+                hit = self._bitmaps[key] = (buffer, bitmap.left - (tx >> 6), bitmap.top - (ty >> 6))
+            buffer, left, top = hit
+            self._renderer.draw_text_image(
+                buffer, left + (tx >> 6), int(height) - (top + (ty >> 6)) + buffer.shape[0], 0, gc
+            )
+
+    def _get_font_height_metrics(self, prop) -> tuple:
+        key = (hash(prop), prop.get_size_in_points(), self.dpi)
+        found = self._metrics.get(key)
+        if found is None:
+            font = get_font(findfont(prop))
+            found = (None, None, None)
+            for name, gap, asc, desc in (
+                ("OS/2", "sTypoLineGap", "sTypoAscender", "sTypoDescender"),
+                ("hhea", "lineGap", "ascent", "descent"),
+            ):
+                table = font.get_sfnt_table(name)
+                if table is not None:
+                    scale = (
+                        prop.get_size_in_points()
+                        * self.dpi
+                        / 72
+                        / font.get_sfnt_table("head")["unitsPerEm"]
+                    )
+                    found = (table[asc] * scale, -table[desc] * scale, table[gap] * scale)
+                    break
+            self._metrics[key] = found
+        return found
+
+
+class _Canvas(FigureCanvasAgg):
+    """An Agg canvas drawing with the one renderer kept per pixel size.
+
+    Matplotlib caches text metrics per renderer, so figures of one size share
+    the layout of every label they have in common.  ``draw`` clears the
+    renderer first; the saved figures are written before the next one draws.
+    """
+
+    _renderers: dict[tuple[int, int, float], _Renderer] = {}
+
+    def get_renderer(self) -> _Renderer:
+        w, h = self.get_width_height(physical=True)
+        key = (w, h, self.figure.dpi)
+        renderer = self._renderers.get(key)
+        if renderer is None:
+            renderer = self._renderers[key] = _Renderer(*key)
+        self.renderer = renderer
+        return renderer
+
+
 def _figure(size: tuple[float, float]) -> Figure:
     """Make a figure on its own Agg canvas, outside pyplot (nothing to register or close)."""
     fig = Figure(figsize=size, dpi=DPI)
-    FigureCanvasAgg(fig)
+    _Canvas(fig)
     return fig
+
+
+class FigureSheet:
+    """A figure kept for a family of PNGs of one layout, its axes cleared between them.
+
+    The axes and their ticks (the costliest part of a fresh figure: a tick is
+    two lines, two texts and a grid line, each styled anew) are built once by
+    ``build(fig) -> list of Axes``; each :meth:`save` removes what the last
+    drawing added (lines, collections, images, texts, legend), resets the data
+    and view limits, the colour cycle and the title and label styles, then
+    ``draw(axes)`` draws and the PNG is written as by :func:`save_drawing`
+    (first-guess margins, a fresh figure with tight layout when they do not
+    fit).  The picture is the one a fresh figure gives, pixel for pixel
+    (``tests/test_plots.py``), when the family's drawings style the ticks and
+    the grid alike (kept between drawings; the grid is switched off).  Colour bars go through :meth:`colorbar`, which
+    updates the one already drawn.
+
+    Parameters
+    ----------
+    size : tuple of float
+        Figure size [inch].
+    build : callable
+        ``build(fig)`` adds the axes to the (empty) figure and returns them.
+    margins : tuple of float
+        First guess of the (left, right, bottom, top) margins [inch].
+    spacing : tuple of float, optional
+        First guess of (wspace, hspace) between subplots [-].
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> sheet = FigureSheet(SIZE, lambda fig: [fig.add_subplot()])
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     paths = [sheet.save(f"{d}/{k}.png", lambda axes: axes[0].plot([0, k])) for k in (1, 2)]
+    ...     [p.stat().st_size > 0 for p in paths]
+    [True, True]
+    """
+
+    def __init__(
+        self,
+        size: tuple[float, float],
+        build: Callable[[Figure], list],
+        margins: tuple[float, float, float, float] = MARGINS,
+        spacing: tuple[float, float] | None = None,
+    ):
+        self.size, self.build, self.margins, self.spacing = size, build, margins, spacing
+        self.fig: Figure | None = None
+        self.axes: list = []
+        self._styles: list = []
+        self._bars: dict = {}
+
+    def colorbar(self, mappable, cax, label: str):
+        """Draw ``mappable``'s colour bar in ``cax`` (update it when the sheet drew one there)."""
+        bar = self._bars.get(cax)
+        if bar is None or cax.figure is not self.fig:
+            bar = cax.figure.colorbar(mappable, cax=cax, label=label)
+            if cax.figure is self.fig:
+                self._bars[cax] = bar
+            return bar
+        bar.update_normal(mappable)
+        bar.set_label(label)
+        return bar
+
+    def save(self, path: str | Path, draw: Callable[[list], object]) -> Path:
+        """Draw on the sheet's axes and write the PNG; return its path."""
+        with matplotlib.rc_context({**RENDER_RC, "axes.titley": 1.0}):
+            if self.fig is None:
+                self.fig = _figure(self.size)
+                self.axes = list(self.build(self.fig))
+                self._styles = [_text_styles(ax) for ax in self.axes]
+                w, h = self.size
+                left, right, bottom, top = self.margins
+                wspace, hspace = self.spacing or (None, None)
+                self.fig.subplots_adjust(
+                    left / w, bottom / h, 1 - right / w, 1 - top / h, wspace=wspace, hspace=hspace
+                )
+            else:
+                for ax, styles in zip(self.axes, self._styles):
+                    if ax not in self._bars:
+                        _clear(ax, styles)
+            draw(self.axes)
+            self.fig.canvas.draw()
+            done = _fits(self.fig)
+        if done:
+            _png(self.fig, path)
+            return Path(path)
+        fig = _figure(self.size)
+        with matplotlib.rc_context(RENDER_RC):
+            draw(list(self.build(fig)))
+            _write(fig, path)
+        return Path(path)
+
+
+def _text_styles(ax) -> list:
+    """Return copies of the style of an axes' title and axis labels (see :func:`_clear`)."""
+    styles = []
+    for text in (ax.title, ax.xaxis.label, ax.yaxis.label):
+        copy = Text()
+        copy.update_from(text)
+        styles.append((text, copy))
+    return styles
+
+
+def _clear(ax, styles: list) -> None:
+    """Remove what was drawn on ``ax`` and reset it to the state it was built in.
+
+    Kept: the axes, their ticks, the tick parameters and the grid's style (a drawing
+    that shows a grid sets it again; the family's drawings style it alike).
+    """
+    for art in [*ax.collections, *ax.images, *ax.lines, *ax.patches]:
+        art.remove()
+    for art in [*ax.texts, *ax.artists]:  # after the collections: contour labels go with them
+        art.remove()
+    if ax.legend_ is not None:
+        ax.legend_.remove()
+    ax.containers.clear()
+    for text, style in styles:
+        text.update_from(style)
+        text.set_text("")
+    if any(t.gridline.get_visible() for t in (ax.xaxis.majorTicks[0], ax.yaxis.majorTicks[0])):
+        ax.grid(False)
+    ax.set_prop_cycle(None)
+    ax.dataLim.set_points(Bbox.null().get_points())
+    ax.ignore_existing_data_limits = True
+    ax.set_autoscale_on(True)
+    ax.relim()
+    ax.autoscale_view()
 
 
 def _write(fig: Figure, path: str | Path) -> None:
@@ -1082,22 +1342,26 @@ def save_sweep(res: SweepResult, outdir: str | Path) -> list[Path]:
     laws = list(res.laws)
     cols = 2 if len(laws) > 1 else 1
     rows = math.ceil(len(laws) / cols)
+    size = (5.3 * cols + 1.0, 4.2 * rows)
+
+    def build(fig):
+        grid = fig.add_gridspec(rows, cols + 1, width_ratios=(1.0,) * cols + (0.05,))
+        panels = [fig.add_subplot(grid[k // cols, k % cols]) for k in range(len(laws))]
+        return [*panels, fig.add_subplot(grid[:, -1])]
+
+    sheet = FigureSheet(size, build, (0.84, 0.7, 0.6, 0.34), (0.3, 0.23))
     for which in ("tf", "nt"):
         ratios = [r.ratio_tf if which == "tf" else r.ratio_nt for r in res.laws.values()]
         finite = np.concatenate([r[np.isfinite(r)] for r in ratios])
         vmax = max(2.0, float(np.percentile(finite, 99))) if finite.size else 2.0
         scale = {"vmin": _floor_of(finite), "vmax": vmax}
 
-        def draw(fig, which=which, scale=scale):
-            grid = fig.add_gridspec(rows, cols + 1, width_ratios=(1.0,) * cols + (0.05,))
-            for k, law in enumerate(laws):
-                ax = fig.add_subplot(grid[k // cols, k % cols])
+        def draw(axes, which=which, scale=scale):
+            for ax, law in zip(axes, laws):
                 mesh = plot_sweep(res, law, which, ax, **scale, colorbar=False)["mesh"]
-            fig.colorbar(mesh, cax=fig.add_subplot(grid[:, -1]), label=_sweep_label(which))
+            sheet.colorbar(mesh, axes[-1], _sweep_label(which))
 
-        path = outdir / f"sweep_ratio_{which}.png"
-        size = (5.3 * cols + 1.0, 4.2 * rows)
-        files.append(save_drawing(path, draw, size, (0.84, 0.7, 0.6, 0.34), (0.3, 0.23)))
+        files.append(sheet.save(outdir / f"sweep_ratio_{which}.png", draw))
     return files
 
 
@@ -1186,26 +1450,30 @@ def save_robust(maps: Mapping, outdir: str | Path) -> list[Path]:
     laws, delays = list(maps["laws"]), list(maps["delay_samples"])
     size = (3.8 * len(delays) + 1.2, 2.9 * len(laws))
     ratios = (1.0,) * len(delays) + (0.07,)  # the panels, then the colour bar
+
+    def build(fig):
+        grid = fig.add_gridspec(len(laws), len(delays) + 1, width_ratios=ratios)
+        panels = [fig.add_subplot(grid[r, c]) for r in range(len(laws)) for c in range(len(delays))]
+        return [*panels, fig.add_subplot(grid[:, -1])]
+
+    sheet = FigureSheet(size, build, (0.75, 0.75, 0.55, 0.33), (0.25, 0.23))
     files = []
     for key, label, stem in ROBUST_MAPS:
         vals = [_robust_cell_value(c, key) for law in laws for c in maps["laws"][law]]
         finite = [v for v in vals if math.isfinite(v)]
         vmax = max(max(finite, default=1.0), 1.0)
 
-        def draw(fig, key=key, label=label, vmax=vmax):
-            grid = fig.add_gridspec(len(laws), len(delays) + 1, width_ratios=ratios)
-            for r, law in enumerate(laws):
-                for c, dl in enumerate(delays):
-                    ax = fig.add_subplot(grid[r, c])
-                    mesh = plot_robust_map(maps, law, key, dl, ax, vmax=vmax)["map"]
-                    if r < len(laws) - 1:
-                        ax.set_xlabel("")
-                    if c > 0:
-                        ax.set_ylabel("")
-            fig.colorbar(mesh, cax=fig.add_subplot(grid[:, -1]), label=label)
+        def draw(axes, key=key, label=label, vmax=vmax):
+            for k, ax in enumerate(axes[:-1]):
+                r, c = divmod(k, len(delays))
+                mesh = plot_robust_map(maps, laws[r], key, delays[c], ax, vmax=vmax)["map"]
+                if r < len(laws) - 1:
+                    ax.set_xlabel("")
+                if c > 0:
+                    ax.set_ylabel("")
+            sheet.colorbar(mesh, axes[-1], label)
 
-        path = outdir / f"{stem}.png"
-        files.append(save_drawing(path, draw, size, (0.75, 0.75, 0.55, 0.33), (0.25, 0.23)))
+        files.append(sheet.save(outdir / f"{stem}.png", draw))
     return files
 
 
@@ -1312,9 +1580,14 @@ def save_all(inputs: FigureInputs, outdir: str | Path) -> list[Path]:
     outdir = _folder(outdir)
     cfg, fi = inputs.cfg, inputs
     files: list[Path] = []
+    sheet = FigureSheet(SIZE, lambda fig: [fig.add_subplot()])  # Figs. 2-14: one layout
 
     def one(name: str, draw: Callable, size: tuple[float, float] = SIZE) -> None:
-        files.append(save_figure(outdir / f"{name}.png", draw, size))
+        path = outdir / f"{name}.png"
+        if size == SIZE:
+            files.append(sheet.save(path, lambda axes: draw(axes[0])))
+        else:
+            files.append(save_figure(path, draw, size))
 
     one("fig02_trajectories", lambda ax: plot_fig2(cfg.plant, *fi.open_loop.values(), ax))
     one("fig03_saturation", lambda ax: plot_fig3(fi.to_batch, cfg.plant, ax))

@@ -344,3 +344,88 @@ def test_saved_png_holds_the_drawn_pixels(tmp_path):
     path = plots.save_drawing(tmp_path / "f.png", draw, plots.SIZE)
     drawn = np.asarray(figs[-1].canvas.buffer_rgba())[..., :3]
     assert_array_equal(np.asarray(Image.open(path)), drawn)
+
+
+def _pixels(path):
+    return np.asarray(Image.open(path))
+
+
+def test_sheet_draws_each_figure_as_a_fresh_one(tmp_path, sims):
+    """Figures drawn one after another on one kept FigureSheet are, pixel for pixel, the
+    figures drawn on new ones: nothing (limits, colour cycle, title style, legend,
+    fills, texts, grid) leaks from one drawing into the next."""
+
+    def fixed_view(ax):  # explicit limits, fills, texts, markers, a larger title
+        ax.fill_betweenx([-1.0, 1.0], [0.0, 0.5], [1.0, 2.0], alpha=0.2, label="fill")
+        ax.scatter([0.2, 0.4], [0.1, -0.3], color="tab:red", label="marks")
+        ax.text(0.5, 0.5, "a note")
+        ax.set_xlim(-3.0, 4.0)
+        ax.set_title("explicit limits", fontsize=12)
+        ax.legend(loc="lower left")
+
+    draws = [
+        lambda ax: plots.plot_response(sims, "position", ax, cfg=CFG),
+        fixed_view,
+        lambda ax: plots.plot_response(sims, "error", ax, cfg=CFG),
+        lambda ax: ax.plot([0.0, 1.0], [5.0, 7.0]),  # default colour, untitled, autoscaled
+        lambda ax: plots.plot_state_trajectories(sims, ax),
+    ]
+    sheet = plots.FigureSheet(plots.SIZE, lambda fig: [fig.add_subplot()])
+    for k, draw in enumerate(draws):
+        kept = sheet.save(tmp_path / f"kept{k}.png", lambda axes, draw=draw: draw(axes[0]))
+        new = plots.save_figure(tmp_path / f"new{k}.png", draw)
+        assert_array_equal(_pixels(kept), _pixels(new), err_msg=f"drawing {k}")
+
+
+def test_sheet_colour_bar_and_contour_labels_as_fresh(tmp_path):
+    """A kept multi-panel sheet with a shared colour bar (updated, not redrawn) and
+    labelled contours gives the pixels of a new sheet for each drawing."""
+    x1, x2 = np.meshgrid(np.linspace(-1.0, 1.0, 30), np.linspace(-2.0, 2.0, 20))
+
+    def build(fig):
+        grid = fig.add_gridspec(1, 3, width_ratios=(1.0, 1.0, 0.05))
+        return [fig.add_subplot(grid[0, k]) for k in range(3)]
+
+    def drawing(scale, label):
+        def draw(axes, sheet):
+            for ax, p in zip(axes[:2], (1.0, 2.0), strict=True):
+                z = scale * (x1**2 + p * x2**2)
+                img = ax.imshow(z, origin="lower", extent=(-1, 1, -2, 2), aspect="auto")
+                img.set_clim(0.0, scale * 9.0)
+                ax.clabel(ax.contour(x1, x2, z, levels=[scale, 2 * scale]), fmt="%g")
+                ax.set_title(f"scale {scale:g}")
+            sheet.colorbar(img, axes[2], label)
+
+        return draw
+
+    kept = plots.FigureSheet((9.0, 3.5), build, (0.6, 0.8, 0.5, 0.3), (0.3, 0.2))
+    for k, (scale, label) in enumerate(((1.0, "ratio [-]"), (40.0, "count [-]"))):
+        draw = drawing(scale, label)
+        a = kept.save(tmp_path / f"kept{k}.png", lambda axes, d=draw: d(axes, kept))
+        new = plots.FigureSheet((9.0, 3.5), build, (0.6, 0.8, 0.5, 0.3), (0.3, 0.2))
+        b = new.save(tmp_path / f"new{k}.png", lambda axes, d=draw, s=new: d(axes, s))
+        assert_array_equal(_pixels(a), _pixels(b), err_msg=f"drawing {k}")
+
+
+def test_kept_renderer_draws_as_matplotlib(tmp_path, sims):
+    """The saved figures' renderer (kept per size, text layouts and font metrics
+    remembered) gives Matplotlib's own Agg pixels, drawing after drawing."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    def draw(ax, k):
+        plots.plot_response(sims, ("position", "error")[k % 2], ax, cfg=CFG)
+        ax.text(0.5, 0.5, f"rotated {k}", rotation=30, fontsize=6 + 3 * k)
+        ax.set_ylabel(f"label {k} [mm]", fontsize=9 + k)
+
+    for k in range(3):
+        with plt.rc_context(plots.RENDER_RC):
+            ours = plots.FigureSheet(plots.SIZE, lambda fig: [fig.add_subplot()])
+            path = ours.save(tmp_path / f"ours{k}.png", lambda axes, k=k: draw(axes[0], k))
+            fig = Figure(figsize=plots.SIZE, dpi=plots.DPI)
+            FigureCanvasAgg(fig)
+            ax = fig.add_subplot()
+            ax.set_position(ours.axes[0].get_position())
+            draw(ax, k)
+            fig.canvas.draw()
+        theirs = np.asarray(fig.canvas.buffer_rgba())[..., :3]
+        assert_array_equal(_pixels(path), theirs, err_msg=f"drawing {k}")
