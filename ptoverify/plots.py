@@ -950,9 +950,11 @@ class _Renderer(RendererAgg):
 
     _metrics: dict = {}
     _glyphs: dict = {}
-    #: Matplotlib >= 3.11 draws text glyph by glyph from a shaped layout, which is
-    #: remembered here per string, font and size; older versions draw as they do.
-    _shaped = all(
+    #: Matplotlib 3.11 draws text glyph by glyph from a shaped layout, which is
+    #: remembered here per string, font and size.  This follows its private text
+    #: path, so it is used only on the 3.11 series it was checked against (pixel
+    #: for pixel, tests/test_plots.py); other versions draw as Matplotlib does.
+    _shaped = matplotlib.__version__.startswith("3.11.") and all(
         hasattr(owner, name)
         for owner, name in (
             (backend_agg, "get_hinting_flag"),
