@@ -377,8 +377,10 @@ def law_properties(
     x1, x2, is_rest = initial_grid(cfg, n1, n2, rest)
     res = simulate_batch(law, p, x1, x2, steps)
     X1, X2, R = res.x1, res.x2, res.region
-    stride, into_lin = crossing_masks(X1, X2, R, cfg)
-    zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
+    # the transitions of crossing_masks, counted without the (steps, n) masks
+    _, j, cross, lands_out = _crossings(X1, X2, R, cfg)
+    j_stride = j[cross & lands_out]
+    zone_samples = int(np.count_nonzero(R == Region.ZONE_P) + np.count_nonzero(R == Region.ZONE_N))
     inside = np.abs(X1) < d
     first_in = np.where(inside.any(axis=0), inside.argmax(axis=0), -1)
     never = first_in < 0
@@ -389,16 +391,17 @@ def law_properties(
     entry = np.where(entered, np.abs(X2[np.maximum(first_in, 0), np.arange(x1.size)]), 0.0)
     chat = (R[1:-1] != R[:-2]) & (R[1:-1] != R[2:]) & (R[:-2] == R[2:])
     osc = oscillating(X1[-window:], band)
-    over = np.where(is_rest, (-np.sign(x1)[None, :] * X1).max(axis=0), 0.0)
+    over = np.zeros(x1.size)  # only the states at rest can overshoot
+    over[is_rest] = (-np.sign(x1[is_rest])[None, :] * X1[:, is_rest]).max(axis=0)
     max_u = float(np.abs(res.u).max())
     return LawProperties(
         law=law.name,
         note=law.note,
         states=int(x1.size),
         steps=int(steps),
-        stride_overs=int(stride.sum()),
-        states_with_stride_over=int(stride.any(axis=0).sum()),
-        crossings_into_linear=int(into_lin.sum()),
+        stride_overs=int(j_stride.size),
+        states_with_stride_over=int(np.unique(j_stride).size),
+        crossings_into_linear=int(np.count_nonzero(cross & ~lands_out)),
         limit_cycles=int(osc.sum()),
         not_settled=int((np.abs(X1[-1]) > band).sum()),
         time_to_linear_max_s=float(t_lin.max()),
@@ -410,7 +413,7 @@ def law_properties(
         u_within_limit=bool(max_u <= w),
         overshoots=int((over > band).sum()),
         max_overshoot_mm=float(max(over.max(), 0.0)),
-        zone_samples=int(zone.sum()),
+        zone_samples=zone_samples,
         entered_linear_from_bang=int(from_bang.sum()),
         max_entry_speed=float(entry.max()),
         band=band,
