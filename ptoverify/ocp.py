@@ -45,7 +45,6 @@ from numpy.typing import NDArray
 from ptoverify.config import Plant
 from ptoverify.curves import switching_function
 from ptoverify.errors import InputError
-from ptoverify.plant import flow
 
 __all__ = [
     "OCPResult",
@@ -365,9 +364,16 @@ def resimulate(t: NDArray, u: NDArray, x1: float, x2: float, a: float) -> tuple[
     x1, x2 : float
         The state at t[-1].
     """
-    for dt, uk in zip(np.diff(t), u, strict=True):
-        x1, x2 = flow(x1, x2, uk, dt, a)
-    return float(x1), float(x2)
+    dts = np.diff(t)
+    # eq. (7) interval by interval, as :func:`ptoverify.plant.flow` computes it (the
+    # same operations in the same order, on Python floats: the same roundings),
+    # with 1 - e^{-a dt} for all intervals at once
+    gs = (-np.expm1(-a * dts)).tolist()
+    x1, x2 = float(x1), float(x2)
+    for dt, uk, g in zip(dts.tolist(), np.asarray(u, dtype=float).tolist(), gs, strict=True):
+        dv = x2 - uk
+        x1, x2 = x1 + uk * dt + dv * g / a, x2 - dv * g
+    return x1, x2
 
 
 class CollocationOCP:
