@@ -323,10 +323,11 @@ def _collocation_solver(
     end = ca.mtimes(zs, D)
     interval = ca.Function("interval", [zs, vs, ts], [ca.vertcat(*res), end])
     imap = interval.map(n)
-    blocks = ca.horzsplit(Z[:, : n * (degree + 1)], degree + 1)
-    Zk = ca.horzcat(*blocks)
+    # the n blocks of degree + 1 columns side by side, and the first column of each
+    # next block (the last: the end point): two slices, O(1) graph nodes
+    Zk = Z[:, : n * (degree + 1)]
     coll, ends = imap(Zk, ca.reshape(v, nu, n), ca.repmat(tau_f, 1, n))
-    starts = ca.horzcat(*[b[:, 0] for b in blocks[1:]], Z[:, -1])
+    starts = Z[:, degree + 1 :: degree + 1]
     g = ca.vertcat(Z[:, 0] - p, ca.vec(coll), ca.vec(ends - starts), Z[:, -1])
     x = ca.vertcat(tau_f, v, ca.vec(Z))
     nlp = {"x": x, "p": p, "f": tau_f, "g": g}
