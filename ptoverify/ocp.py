@@ -582,6 +582,9 @@ class ConvergenceStudy:
         IPOPT converged.
     profiles : dict
         (state index, N) -> (t [s], u [mm/s]) of the solves, for plotting.
+    results : dict
+        (state index, N) -> the :class:`OCPResult` of each (cold) solve, e.g. for
+        ``verified_mintime(..., collocation=...)`` at the same N.
     """
 
     intervals: NDArray[np.int64]
@@ -595,6 +598,7 @@ class ConvergenceStudy:
     order: float
     success: NDArray[np.bool_]
     profiles: dict = field(default_factory=dict, repr=False)
+    results: dict = field(default_factory=dict, repr=False)
 
 
 def _slope(logn: NDArray, loge: NDArray) -> float:
@@ -638,7 +642,7 @@ def convergence_study(
     tf = np.full((len(states), len(ns)), np.nan)
     rs = np.full_like(tf, np.nan)
     ok = np.zeros(tf.shape, dtype=bool)
-    profiles = {}
+    profiles, results = {}, {}
     for j, n in enumerate(ns):
         ocp = CollocationOCP(
             plant, intervals=int(n), degree=degree, warm_start=False, control=control
@@ -647,6 +651,7 @@ def convergence_study(
             r = ocp.solve(x1, x2)
             tf[i, j], rs[i, j], ok[i, j] = r.t_f, r.resim_error, r.success
             profiles[(i, int(n))] = (r.t, r.u)
+            results[(i, int(n))] = r
     rel = np.abs(tf - exact[:, None]) / exact[:, None]
     with np.errstate(divide="ignore"):
         loge = np.log(np.where(rel > 0, rel, np.nan))
@@ -658,7 +663,8 @@ def convergence_study(
     cent_n = np.where(good, logn[None, :], np.nan)
     cent_n = cent_n - np.nanmean(cent_n, axis=1, keepdims=True)
     m = np.isfinite(cent_e) & np.isfinite(cent_n)
-    order = float(-(cent_e[m] @ cent_n[m]) / (cent_n[m] @ cent_n[m])) if m.sum() > 1 else math.nan
+    spread = float(cent_n[m] @ cent_n[m])  # 0 with a single N: no slope
+    order = float(-(cent_e[m] @ cent_n[m]) / spread) if spread > 0 else math.nan
     return ConvergenceStudy(
         intervals=ns,
         states=states,
@@ -671,4 +677,5 @@ def convergence_study(
         order=order,
         success=ok,
         profiles=profiles,
+        results=results,
     )
