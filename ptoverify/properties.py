@@ -227,6 +227,13 @@ def oscillating(x1: np.ndarray, band: float) -> np.ndarray:
     return (changes >= 4) & (second > band) & (second >= 0.5 * first)
 
 
+def _at(A: np.ndarray, flat: np.ndarray) -> np.ndarray:
+    """``A.ravel()[flat]`` (row-major flat indices) without copying a strided view."""
+    if A.flags.c_contiguous:
+        return A.ravel()[flat]
+    return A[np.divmod(flat, A.shape[1])]
+
+
 def _crossings(
     X1: np.ndarray,  # noqa: N803
     X2: np.ndarray,  # noqa: N803
@@ -253,16 +260,22 @@ def _crossings(
         zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
     src = out[:-1]
     src &= ~zone
+    n = X1.shape[1]
     f = np.flatnonzero(src)  # src is a fresh C-ordered array: flat index k n + j
-    k, j = np.divmod(f, X1.shape[1])
-    k1 = k + 1
-    v0 = X2[k, j]
-    s0 = switching_function(X1[k, j], v0, a, w)
-    s1 = switching_function(X1[k1, j], X2[k1, j], a, w)
+    k, j = np.divmod(f, n)
+    # sigma once at every sample that starts or ends such a transition (most do both)
+    ends = np.zeros(X1.shape, dtype=bool)
+    ends[:-1] = src
+    ends[1:] |= src
+    e = np.flatnonzero(ends)
+    sig = np.empty(X1.size)  # written only at e (the pages elsewhere stay untouched)
+    sig[e] = switching_function(_at(X1, e), _at(X2, e), a, w)
+    v0 = _at(X2, f)
+    s0, s1 = sig[f], sig[f + n]
     n_side = (s0 > 0) | ((s0 == 0) & (v0 > 0))
     p_side = (s0 < 0) | ((s0 == 0) & (v0 < 0))
     cross = (n_side & (s1 < -tol)) | (p_side & (s1 > tol))
-    return k, j, cross, out[k1, j]
+    return k, j, cross, out.ravel()[f + n]
 
 
 def crossing_masks(
