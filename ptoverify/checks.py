@@ -362,7 +362,11 @@ def _discrete(ctx: GateContext) -> Verdict:
                 ">=",
             )
         t_f = float(min_time(x1[i], x2[i], cfg.plant).t_f)
-        ok_prev, _, why = reach.feasible(float(x1[i]), float(x2[i]), dm.steps - 1)
+        if dm.below is not None and dm.below[0] == dm.steps - 1:  # solved by the search
+            why = dm.below[1]
+            ok_prev = why == "feasible"
+        else:
+            ok_prev, _, why = reach.feasible(float(x1[i]), float(x2[i]), dm.steps - 1)
         if ok_prev:
             return Verdict(
                 "discrete-limit-consistency",

@@ -30,7 +30,7 @@ import numpy as np
 from ptoverify.config import Config, Plant
 from ptoverify.errors import InputError
 from ptoverify.mintime import DiscreteMinTime, MinTime, discrete_min_steps, min_time
-from ptoverify.ocp import CollocationOCP, OCPResult, TwoPhaseOCP
+from ptoverify.ocp import CollocationOCP, OCPResult, TwoPhaseOCP, resimulate
 from ptoverify.plant import flow
 
 __all__ = [
@@ -242,6 +242,7 @@ def verified_mintime(
     *,
     intervals: int = 100,
     max_iter: int | None = None,
+    collocation: OCPResult | None = None,
 ) -> GroundTruth:
     """Minimum time from (x1, x2) by the closed form, both OCPs and N*, each checked.
 
@@ -262,6 +263,13 @@ def verified_mintime(
         Collocation intervals N, in [1, ``MAX_INTERVALS``].
     max_iter : int, optional
         Cap on IPOPT iterations (default: the solvers' own caps).
+    collocation : OCPResult, optional
+        The answer of a default :class:`~ptoverify.ocp.CollocationOCP` with
+        ``intervals`` from this state, already solved (e.g.
+        :attr:`ptoverify.ocp.ConvergenceStudy.results`): it is checked like a fresh
+        one instead of solving the same NLP again.  Its input must re-simulate to
+        its recorded end state from (x1, x2) (else ``ValueError``: an answer from
+        another state or N); not with ``max_iter``.
 
     Returns
     -------
@@ -297,7 +305,14 @@ def verified_mintime(
         )
     caps = {} if max_iter is None else {"max_iter": max_iter}
     tp = TwoPhaseOCP(plant, **caps).solve(x1, x2)
-    co = CollocationOCP(plant, intervals=intervals, **caps).solve(x1, x2)
+    if collocation is None or (x1 == 0.0 and x2 == 0.0):
+        co = CollocationOCP(plant, intervals=intervals, **caps).solve(x1, x2)
+    else:
+        co = collocation
+        if max_iter is not None or co.u is None or co.u.size != 3 * intervals:
+            raise ValueError("collocation: not a default N-interval answer (or max_iter given)")
+        if resimulate(co.t, co.u, x1, x2, plant.a) != co.resim_end:
+            raise ValueError(f"collocation: not an answer from ({x1:g}, {x2:g})")
     return GroundTruth(
         x0=(x1, x2),
         intervals=int(intervals),

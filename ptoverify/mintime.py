@@ -157,6 +157,10 @@ class DiscreteMinTime:
         The closed-form continuous minimum time t_f* [s] the search started from.
     lp_solves : int
         Number of linear programs solved.
+    below : tuple of (int, str) or None
+        (N, status) of the LP the search solved at N = N* - 1 (``"infeasible"``,
+        ``"boundary"`` or ``"lp_failed: ..."``), None when it solved none there; a
+        check of N* - 1 can read it instead of solving the same LP again.
     """
 
     steps: int
@@ -166,6 +170,7 @@ class DiscreteMinTime:
     end: tuple[float, float]
     t_f_continuous: float
     lp_solves: int
+    below: tuple[int, str] | None = None
 
     @property
     def success(self) -> bool:
@@ -341,6 +346,7 @@ def discrete_min_steps(
     if n0 > n_max:
         return fail(f"not_found: N* > n_max = {n_max}")
     lo, hi, u_hi, step = n0 - 1, n0, None, 1
+    lo_status = None  # LP status at lo, None while lo is only assumed infeasible
     while True:  # exponential search for a feasible N
         ok, u, st = reach.feasible(x1, x2, hi)
         solves += 1
@@ -349,7 +355,7 @@ def discrete_min_steps(
         if ok:
             u_hi = u
             break
-        lo, hi, step = hi, hi + step, 2 * step
+        lo, hi, step, lo_status = hi, hi + step, 2 * step, st
         if hi > n_max:
             return fail(f"not_found: N* > n_max = {n_max}")
     while hi - lo > 1:  # bisection: lo infeasible, hi feasible
@@ -361,11 +367,12 @@ def discrete_min_steps(
         if ok:
             hi, u_hi = mid, u
         else:
-            lo = mid
+            lo, lo_status = mid, st
     status = "optimal"
     if confirm and hi == n0 and hi > 1:  # N* - 1 was assumed, not solved: check it
         ok, _, st = reach.feasible(x1, x2, hi - 1)
         solves += 1
+        lo_status = "feasible" if ok else st
         if ok:
             status = "below_continuous_bound"
         elif st.startswith("lp_failed"):
@@ -373,7 +380,8 @@ def discrete_min_steps(
     end = _simulate_zoh(x1, x2, u_hi, plant)
     if abs(end[0]) > _END_TOL_X1 or abs(end[1]) > _END_TOL_X2:
         status = f"unverified: end state ({end[0]:.3g} mm, {end[1]:.3g} mm/s)"
-    return DiscreteMinTime(hi, hi * plant.sample_time, u_hi, status, end, tf, solves)
+    below = None if lo_status is None else (hi - 1, lo_status)
+    return DiscreteMinTime(hi, hi * plant.sample_time, u_hi, status, end, tf, solves, below)
 
 
 def discrete_min_steps_batch(

@@ -45,7 +45,6 @@ from numpy.typing import NDArray
 from ptoverify.config import Plant
 from ptoverify.curves import switching_function
 from ptoverify.errors import InputError
-from ptoverify.plant import flow
 
 __all__ = [
     "OCPResult",
@@ -324,10 +323,11 @@ def _collocation_solver(
     end = ca.mtimes(zs, D)
     interval = ca.Function("interval", [zs, vs, ts], [ca.vertcat(*res), end])
     imap = interval.map(n)
-    blocks = ca.horzsplit(Z[:, : n * (degree + 1)], degree + 1)
-    Zk = ca.horzcat(*blocks)
+    # the n blocks of degree + 1 columns side by side, and the first column of each
+    # next block (the last: the end point): two slices, O(1) graph nodes
+    Zk = Z[:, : n * (degree + 1)]
     coll, ends = imap(Zk, ca.reshape(v, nu, n), ca.repmat(tau_f, 1, n))
-    starts = ca.horzcat(*[b[:, 0] for b in blocks[1:]], Z[:, -1])
+    starts = Z[:, degree + 1 :: degree + 1]
     g = ca.vertcat(Z[:, 0] - p, ca.vec(coll), ca.vec(ends - starts), Z[:, -1])
     x = ca.vertcat(tau_f, v, ca.vec(Z))
     nlp = {"x": x, "p": p, "f": tau_f, "g": g}
@@ -337,7 +337,11 @@ def _collocation_solver(
         "ipopt.tol": tol,
         "ipopt.mu_strategy": "adaptive",
         "ipopt.bound_relax_factor": 0.0,
-        "expand": True,
+        # not expanded to SX: the graph is one mapped SX interval function, and
+        # expanding it costs more at construction (0.4 s for the seven N of the
+        # report's convergence study) than it saves in evaluations; the iterates
+        # were the same to the last bit on the report's states (checked when changed)
+        "expand": False,
     }
     return ca.nlpsol(f"radau{n}", "ipopt", nlp, opts)
 
@@ -361,9 +365,16 @@ def resimulate(t: NDArray, u: NDArray, x1: float, x2: float, a: float) -> tuple[
     x1, x2 : float
         The state at t[-1].
     """
-    for dt, uk in zip(np.diff(t), u, strict=True):
-        x1, x2 = flow(x1, x2, uk, dt, a)
-    return float(x1), float(x2)
+    dts = np.diff(t)
+    # eq. (7) interval by interval, as :func:`ptoverify.plant.flow` computes it (the
+    # same operations in the same order, on Python floats: the same roundings),
+    # with 1 - e^{-a dt} for all intervals at once
+    gs = (-np.expm1(-a * dts)).tolist()
+    x1, x2 = float(x1), float(x2)
+    for dt, uk, g in zip(dts.tolist(), np.asarray(u, dtype=float).tolist(), gs, strict=True):
+        dv = x2 - uk
+        x1, x2 = x1 + uk * dt + dv * g / a, x2 - dv * g
+    return x1, x2
 
 
 class CollocationOCP:
@@ -571,6 +582,9 @@ class ConvergenceStudy:
         IPOPT converged.
     profiles : dict
         (state index, N) -> (t [s], u [mm/s]) of the solves, for plotting.
+    results : dict
+        (state index, N) -> the :class:`OCPResult` of each (cold) solve, e.g. for
+        ``verified_mintime(..., collocation=...)`` at the same N.
     """
 
     intervals: NDArray[np.int64]
@@ -584,6 +598,7 @@ class ConvergenceStudy:
     order: float
     success: NDArray[np.bool_]
     profiles: dict = field(default_factory=dict, repr=False)
+    results: dict = field(default_factory=dict, repr=False)
 
 
 def _slope(logn: NDArray, loge: NDArray) -> float:
@@ -627,7 +642,7 @@ def convergence_study(
     tf = np.full((len(states), len(ns)), np.nan)
     rs = np.full_like(tf, np.nan)
     ok = np.zeros(tf.shape, dtype=bool)
-    profiles = {}
+    profiles, results = {}, {}
     for j, n in enumerate(ns):
         ocp = CollocationOCP(
             plant, intervals=int(n), degree=degree, warm_start=False, control=control
@@ -636,6 +651,7 @@ def convergence_study(
             r = ocp.solve(x1, x2)
             tf[i, j], rs[i, j], ok[i, j] = r.t_f, r.resim_error, r.success
             profiles[(i, int(n))] = (r.t, r.u)
+            results[(i, int(n))] = r
     rel = np.abs(tf - exact[:, None]) / exact[:, None]
     with np.errstate(divide="ignore"):
         loge = np.log(np.where(rel > 0, rel, np.nan))
@@ -647,7 +663,8 @@ def convergence_study(
     cent_n = np.where(good, logn[None, :], np.nan)
     cent_n = cent_n - np.nanmean(cent_n, axis=1, keepdims=True)
     m = np.isfinite(cent_e) & np.isfinite(cent_n)
-    order = float(-(cent_e[m] @ cent_n[m]) / (cent_n[m] @ cent_n[m])) if m.sum() > 1 else math.nan
+    spread = float(cent_n[m] @ cent_n[m])  # 0 with a single N: no slope
+    order = float(-(cent_e[m] @ cent_n[m]) / spread) if spread > 0 else math.nan
     return ConvergenceStudy(
         intervals=ns,
         states=states,
@@ -660,4 +677,5 @@ def convergence_study(
         order=order,
         success=ok,
         profiles=profiles,
+        results=results,
     )

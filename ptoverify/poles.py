@@ -23,6 +23,7 @@ these conditions do not make the sampled loop stable.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import asdict, dataclass
 
@@ -185,6 +186,15 @@ def loop_poles(name: str, a: float, T: float, k_x1: float, k_x2: float) -> LoopP
     >>> lp = loop_poles("linear", 188.5, 0.002, 323.0, 3.6)
     >>> lp.stable_continuous, lp.pole_mismatch < 1e-12
     (True, True)
+    """
+    return _loop_poles(str(name), float(a), float(T), float(k_x1), float(k_x2))
+
+
+@functools.lru_cache(maxsize=64)
+def _loop_poles(name: str, a: float, T: float, k_x1: float, k_x2: float) -> LoopPoles:  # noqa: N803
+    """Analyse one loop (:func:`loop_poles`), memoized on the scalar arguments.
+
+    The report's poles section and the two sampled-stability gates read the same loops.
     """
     import control as ct  # here, not at import: python-control pulls in scipy.signal and pyplot
 

@@ -227,6 +227,13 @@ def oscillating(x1: np.ndarray, band: float) -> np.ndarray:
     return (changes >= 4) & (second > band) & (second >= 0.5 * first)
 
 
+def _at(A: np.ndarray, flat: np.ndarray) -> np.ndarray:
+    """``A.ravel()[flat]`` (row-major flat indices) without copying a strided view."""
+    if A.flags.c_contiguous:
+        return A.ravel()[flat]
+    return A[np.divmod(flat, A.shape[1])]
+
+
 def _crossings(
     X1: np.ndarray,  # noqa: N803
     X2: np.ndarray,  # noqa: N803
@@ -253,16 +260,22 @@ def _crossings(
         zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
     src = out[:-1]
     src &= ~zone
+    n = X1.shape[1]
     f = np.flatnonzero(src)  # src is a fresh C-ordered array: flat index k n + j
-    k, j = np.divmod(f, X1.shape[1])
-    k1 = k + 1
-    v0 = X2[k, j]
-    s0 = switching_function(X1[k, j], v0, a, w)
-    s1 = switching_function(X1[k1, j], X2[k1, j], a, w)
+    k, j = np.divmod(f, n)
+    # sigma once at every sample that starts or ends such a transition (most do both)
+    ends = np.zeros(X1.shape, dtype=bool)
+    ends[:-1] = src
+    ends[1:] |= src
+    e = np.flatnonzero(ends)
+    sig = np.empty(X1.size)  # written only at e (the pages elsewhere stay untouched)
+    sig[e] = switching_function(_at(X1, e), _at(X2, e), a, w)
+    v0 = _at(X2, f)
+    s0, s1 = sig[f], sig[f + n]
     n_side = (s0 > 0) | ((s0 == 0) & (v0 > 0))
     p_side = (s0 < 0) | ((s0 == 0) & (v0 < 0))
     cross = (n_side & (s1 < -tol)) | (p_side & (s1 > tol))
-    return k, j, cross, out[k1, j]
+    return k, j, cross, out.ravel()[f + n]
 
 
 def crossing_masks(
@@ -377,8 +390,10 @@ def law_properties(
     x1, x2, is_rest = initial_grid(cfg, n1, n2, rest)
     res = simulate_batch(law, p, x1, x2, steps)
     X1, X2, R = res.x1, res.x2, res.region
-    stride, into_lin = crossing_masks(X1, X2, R, cfg)
-    zone = (R == Region.ZONE_P) | (R == Region.ZONE_N)
+    # the transitions of crossing_masks, counted without the (steps, n) masks
+    _, j, cross, lands_out = _crossings(X1, X2, R, cfg)
+    j_stride = j[cross & lands_out]
+    zone_samples = int(np.count_nonzero(R == Region.ZONE_P) + np.count_nonzero(R == Region.ZONE_N))
     inside = np.abs(X1) < d
     first_in = np.where(inside.any(axis=0), inside.argmax(axis=0), -1)
     never = first_in < 0
@@ -389,16 +404,17 @@ def law_properties(
     entry = np.where(entered, np.abs(X2[np.maximum(first_in, 0), np.arange(x1.size)]), 0.0)
     chat = (R[1:-1] != R[:-2]) & (R[1:-1] != R[2:]) & (R[:-2] == R[2:])
     osc = oscillating(X1[-window:], band)
-    over = np.where(is_rest, (-np.sign(x1)[None, :] * X1).max(axis=0), 0.0)
+    over = np.zeros(x1.size)  # only the states at rest can overshoot
+    over[is_rest] = (-np.sign(x1[is_rest])[None, :] * X1[:, is_rest]).max(axis=0)
     max_u = float(np.abs(res.u).max())
     return LawProperties(
         law=law.name,
         note=law.note,
         states=int(x1.size),
         steps=int(steps),
-        stride_overs=int(stride.sum()),
-        states_with_stride_over=int(stride.any(axis=0).sum()),
-        crossings_into_linear=int(into_lin.sum()),
+        stride_overs=int(j_stride.size),
+        states_with_stride_over=int(np.unique(j_stride).size),
+        crossings_into_linear=int(np.count_nonzero(cross & ~lands_out)),
         limit_cycles=int(osc.sum()),
         not_settled=int((np.abs(X1[-1]) > band).sum()),
         time_to_linear_max_s=float(t_lin.max()),
@@ -410,7 +426,7 @@ def law_properties(
         u_within_limit=bool(max_u <= w),
         overshoots=int((over > band).sum()),
         max_overshoot_mm=float(max(over.max(), 0.0)),
-        zone_samples=int(zone.sum()),
+        zone_samples=zone_samples,
         entered_linear_from_bang=int(from_bang.sum()),
         max_entry_speed=float(entry.max()),
         band=band,

@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -714,12 +714,33 @@ def corrected_zone(
     >>> z.valid and 0 < z.omega0 < 300.0
     True
     """
-    return _corrected_zone(cfg, reading, scan, verify)
+    return _corrected_zone(_zone_key(cfg), reading, scan, verify)
+
+
+def _zone_key(cfg: Config) -> Config:
+    """Return what a zone depends on (the plant and d): the memo key of the constructions."""
+    return Config(name="zone", plant=cfg.plant, pto=PTOSettings(d=cfg.pto.d))
 
 
 @functools.lru_cache(maxsize=16)
 def _corrected_zone(cfg: Config, reading: str, scan: int, verify: bool) -> PTOZone:
-    """:func:`corrected_zone`, memoized on its normalised arguments (Config is frozen)."""
+    """:func:`corrected_zone`, memoized on its normalised arguments (Config is frozen).
+
+    The verified zone is the unverified one (shared, e.g. with the laws) plus the
+    grid check.
+    """
+    if verify:
+        base = _corrected_zone(cfg, reading, scan, False)
+        if not base.feasible_intervals:  # no omega0: nothing to verify
+            return base
+        viol, pts = principle_violations(cfg, base.omega0, reading=reading)
+        return replace(
+            base,
+            valid=base.valid and viol == 0,
+            reason=f"{base.reason}; grid check: {viol} violations in {pts} source states",
+            grid_violations=viol,
+            grid_points=pts,
+        )
     a, w, d = cfg.plant.a, cfg.plant.w_max, cfg.pto.d
     intervals = _feasible_intervals(cfg, reading, scan)
     dmin = smallest_d(cfg, reading)
@@ -751,7 +772,6 @@ def _corrected_zone(cfg: Config, reading: str, scan: int, verify: bool) -> PTOZo
     omega0 = (w if no_zone_needed else top) * (1.0 - 1e-6)
     margin = _worst_margin(cfg, omega0, reading)
     degenerate = _degenerate(cfg, omega0)
-    viol, pts = principle_violations(cfg, omega0, reading=reading) if verify else (0, 0)
     y = float(root_22(a * d / omega0))  # l1* meets x1 = d: h(y) = a d / omega0
     x20 = -y * omega0 if y * omega0 <= w else _NAN
     k = 1.0 + a * d / x20 if math.isfinite(x20) else _NAN
@@ -767,9 +787,7 @@ def _corrected_zone(cfg: Config, reading: str, scan: int, verify: bool) -> PTOZo
             f"x2 = -w_max, inside the linear zone d = {d:g} mm: the zone never acts "
             "(degenerate)"
         )
-    if verify:
-        parts.append(f"grid check: {viol} violations in {pts} source states")
-    valid = (not degenerate) and omega0 < w and margin >= -_tol(cfg) and viol == 0
+    valid = (not degenerate) and omega0 < w and margin >= -_tol(cfg)
     details = {
         "usable": 0 < omega0 < w,
         "no_zone_needed": no_zone_needed,
@@ -790,8 +808,6 @@ def _corrected_zone(cfg: Config, reading: str, scan: int, verify: bool) -> PTOZo
         feasible_intervals=tuple(intervals),
         reading=reading,
         margin=margin,
-        grid_violations=viol if verify else None,
-        grid_points=pts if verify else None,
         d_min=dmin,
         details=details,
     )
@@ -815,8 +831,7 @@ def zone_for_law(cfg: Config, variant: str) -> PTOZone:
     PTOZone
         The zone (not grid-verified).
     """
-    key = Config(name="zone", plant=cfg.plant, pto=PTOSettings(d=cfg.pto.d))
-    return _zone_for_law(key, variant)
+    return _zone_for_law(_zone_key(cfg), variant)
 
 
 @functools.lru_cache(maxsize=256)

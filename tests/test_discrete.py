@@ -156,3 +156,16 @@ def test_property_not_faster_than_continuous(x1, x2):
 def test_non_finite_state_rejected():
     with pytest.raises(InputError):
         discrete_min_steps(float("nan"), 0.0, PLANTS["paper"])
+
+
+@pytest.mark.parametrize("name", sorted(PLANTS))
+def test_below_record_is_the_lp_at_n_star_minus_one(name):
+    """The N* - 1 status the search keeps equals a fresh LP at N* - 1, and is not feasible."""
+    plant = PLANTS[name]
+    reach = ZOHReach(plant)
+    for a, b in random_states(plant, 12, seed=5):
+        d = discrete_min_steps(float(a), float(b), plant)
+        assert d.success and d.steps > 1 and d.below is not None
+        assert d.below[0] == d.steps - 1
+        ok, _, status = reach.feasible(float(a), float(b), d.steps - 1)
+        assert not ok and d.below[1] == status

@@ -17,7 +17,7 @@ from ptoverify.groundtruth import (
     state_scale,
     verified_mintime,
 )
-from ptoverify.ocp import CollocationOCP
+from ptoverify.ocp import CollocationOCP, convergence_study
 from ptoverify.verdict import UNVERIFIED
 
 
@@ -117,3 +117,19 @@ def test_to_json_has_the_mintime_keys():
 def test_bad_input_is_input_error(x1, x2, kw):
     with pytest.raises(InputError):
         verified_mintime(x1, x2, paper_config(), **kw)
+
+
+def test_verified_mintime_reuses_a_convergence_study_answer():
+    """An answer of the convergence study at the same N gives the same record as a fresh
+    solve; an answer from another state is refused."""
+    cfg = paper_config()
+    states = np.array([[5.0, 0.0], [-12.0, 150.0]])
+    study = convergence_study(cfg.plant, states, (20,))
+    for i, (x1, x2) in enumerate(states):
+        fresh = verified_mintime(x1, x2, cfg, intervals=20).to_json()
+        reused = verified_mintime(x1, x2, cfg, intervals=20, collocation=study.results[(i, 20)])
+        assert reused.to_json() == fresh
+    with pytest.raises(ValueError, match="not an answer from"):
+        verified_mintime(5.0, 0.0, cfg, intervals=20, collocation=study.results[(1, 20)])
+    with pytest.raises(ValueError, match="not a default"):
+        verified_mintime(5.0, 0.0, cfg, intervals=40, collocation=study.results[(0, 20)])

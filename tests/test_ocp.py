@@ -22,7 +22,8 @@ from ptoverify.config import Config, PDGains, PTOSettings, paper_config
 from ptoverify.curves import level_curve_x1
 from ptoverify.groundtruth import verified_mintime
 from ptoverify.mintime import min_time
-from ptoverify.ocp import CollocationOCP, TwoPhaseOCP, convergence_study
+from ptoverify.ocp import CollocationOCP, TwoPhaseOCP, convergence_study, resimulate
+from ptoverify.plant import flow
 
 
 @pytest.mark.parametrize("name", PLANTS)
@@ -246,3 +247,17 @@ def test_convergence_figures(tmp_path):
     ax = plot_switch_profiles(study, 0)
     ax.figure.savefig(tmp_path / "switch.png")
     assert (tmp_path / "switch.png").stat().st_size > 0
+
+
+def test_resimulate_is_the_exact_flow_interval_by_interval():
+    """resimulate equals plant.flow applied interval by interval, to the last bit."""
+    rng = np.random.default_rng(3)
+    a = 188.5
+    t = np.concatenate([[0.0], np.cumsum(rng.uniform(1e-5, 2e-3, 300))])
+    u = rng.uniform(-300.0, 300.0, 300)
+    x1, x2 = 12.5, -80.0
+    for dt, uk in zip(np.diff(t), u, strict=True):
+        x1, x2 = flow(x1, x2, uk, dt, a)
+    assert resimulate(t, u, 12.5, -80.0, a) == (float(x1), float(x2))
+    with pytest.raises(ValueError):
+        resimulate(t, u[:-1], 12.5, -80.0, a)
