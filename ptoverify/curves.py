@@ -126,10 +126,11 @@ def _series(x: Array, coef: Array, lowest: int) -> Array:
 
     The accumulator starts at the top coefficient, which is what the first step
     0 * x + coef[-1] gives for finite x, so the roundings are those of Horner's
-    rule from zero.
+    rule from zero; its product with x is formed directly (``coef[-1] * x``).
     """
-    acc = np.full_like(x, coef[-1])
-    for c in coef[-2::-1]:  # in place: the same roundings as acc * x + c
+    acc = x * float(coef[-1])  # the first step, coef[-1] * x (exact same product)
+    acc += float(coef[-2])
+    for c in coef[-3::-1].tolist():  # in place: the same roundings as acc * x + c
         acc *= x
         acc += c
     return acc * x**lowest

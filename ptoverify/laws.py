@@ -152,7 +152,10 @@ def sigma_scalar(x1: float, x2: float, a: float, omega: float) -> float:
 
 def _bang(sigma: NDArray[np.float64], x2: NDArray[np.float64], w: float):
     """Time-optimal input from the switching function: S_P u l1 -> +w, S_N u l2 -> -w."""
-    pos = (sigma < 0) | ((sigma == 0) & (x2 < 0))
+    pos = sigma < 0
+    on = sigma == 0
+    if on.any():  # on the curve: the sign of x2 decides
+        pos |= on & (x2 < 0)
     u = np.where(pos, w, -w)
     region = np.where(pos, _I8[Region.BANG_P], _I8[Region.BANG_N])
     return u, region
@@ -193,8 +196,7 @@ def to_law(cfg: Config) -> Law:
 
     def vector(x1, x2):
         u, region = _bang(switching_function(x1, x2, a, w), x2, w)
-        origin = (x1 == 0) & (x2 == 0)
-        return np.where(origin, 0.0, u), np.where(origin, Region.ORIGIN, region).astype(np.int8)
+        return _origin(x1, x2, u, region)
 
     def scalar(x1: float, x2: float) -> tuple[float, int]:
         if x1 == 0.0 and x2 == 0.0:

@@ -712,7 +712,17 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
         sl = slice(run[0]["sl"].start, run[-1]["sl"].stop)
         raw1 = all(seg["q"] == 0 for seg in run)
         raw2 = all(seg["noise"] is None and not seg["add_zero"] for seg in run)
-        plan.append((law.vector, sl, run, raw1, raw2))
+        plan.append((law.vector, sl, [seg for seg in run if not raw2], raw1, raw2))
+    # the quantizer q round(x1 / q), once per sample over all states: elementwise the
+    # same division, rounding and product as segment by segment; states with q = 0
+    # see x1 (copied, as the law's input for them is then y1 too)
+    quanta = [seg["q"] for seg in segs]
+    quantize = any(q > 0 for q in quanta)
+    q_one = quanta[0] if quantize and all(q == quanta[0] for q in quanta) else None
+    if quantize and q_one is None:
+        q_vec = np.concatenate([np.full(seg["x1"].shape[0], seg["q"]) for seg in segs])
+        q_pos = q_vec > 0
+        q_zero = ~q_pos
     # the delay line: sample k applies U[k - delay] (U[0] before it: the controller
     # was running and held what x_0 commands); per distinct delay, a mask of its states
     values = np.unique(delay).tolist() if n else [0]
@@ -728,16 +738,16 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
     for k in range(steps):
         x1k, x2k = X1[k], X2[k]
         uk_row, rk_row = U[k], R[k]
+        if q_one is not None:  # q * round(x1 / q)
+            np.divide(x1k, q_one, out=y1)
+            np.rint(y1, out=y1)
+            y1 *= q_one
+        elif quantize:
+            np.divide(x1k, q_vec, out=y1, where=q_pos)
+            np.rint(y1, out=y1, where=q_pos)
+            np.multiply(y1, q_vec, out=y1, where=q_pos)
+            np.copyto(y1, x1k, where=q_zero)
         for vector, sl, run, raw1, raw2 in plan:
-            if not raw1:
-                for seg in run:
-                    ss, q = seg["sl"], seg["q"]
-                    if q > 0:  # q * round(x1 / q)
-                        np.divide(x1k[ss], q, out=y1[ss])
-                        np.rint(y1[ss], out=y1[ss])
-                        y1[ss] *= q
-                    else:
-                        y1[ss] = x1k[ss]
             if not raw2:
                 for seg in run:
                     ss = seg["sl"]

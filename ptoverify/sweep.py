@@ -316,7 +316,7 @@ def settling_times(
     band: float,
     velocity_band: float,
     hold: float,
-    chunk: int = 4096,
+    chunk: int = 8192,
 ) -> BatchSettling:
     """Settling times of ``law`` from each state, between samples and on the grid.
 
