@@ -194,13 +194,16 @@ def _h_block(r: Array) -> Array:
 
 def _put_series(out: Array, x: Array, where: NDArray[np.bool_], coef: Array, hcoef) -> None:
     """Overwrite ``out`` with the series of x (lowest power 2) where ``where`` holds."""
-    idx = np.flatnonzero(where)
-    if idx.size == 0:
+    count = np.count_nonzero(where)
+    if count == 0:
         return
-    if idx.size <= FEW:  # a few values: no 2 x 20 numpy passes for them
+    if count <= FEW:  # a few values: no 2 x 20 numpy passes for them
+        idx = np.flatnonzero(where)
         flat = out.reshape(-1)  # out is a fresh contiguous array: a view
         for i, v in zip(idx.tolist(), x.reshape(-1)[idx].tolist(), strict=True):
             flat[i] = _horner(v, hcoef)
+    elif count == where.size:  # everywhere: no gather and scatter
+        out[...] = _series(x, coef, 2)
     else:
         out[where] = _series(x[where], coef, 2)
 
