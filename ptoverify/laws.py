@@ -163,9 +163,11 @@ def _bang(sigma: NDArray[np.float64], x2: NDArray[np.float64], w: float):
 
 def _origin(x1, x2, u, region):
     """Set u = 0, region ORIGIN at the origin (in place); return (u, region)."""
-    origin = (x1 == 0) & (x2 == 0)
-    if origin.any():
-        u[origin], region[origin] = 0.0, Region.ORIGIN
+    origin = x1 == 0
+    if origin.any():  # x2 only where x1 is 0 (rare away from the origin)
+        origin &= x2 == 0
+        if origin.any():
+            u[origin], region[origin] = 0.0, Region.ORIGIN
     return u, region
 
 
@@ -388,17 +390,23 @@ def pto_law(
         # everywhere and selecting, so the result is unchanged.  g1, g2: the linear
         # gains, dd: d, lv: the zone's level (NaN: no zone); floats or one per state
         lin = np.abs(x1) < dd
-        if lin.all():  # all in the linear zone: no masks
+        n_lin = np.count_nonzero(lin)
+        if n_lin == lin.size:  # all in the linear zone: no masks
             u, region = saturate_linear(-g1 * x1 - g2 * x2, w)
             return _origin(x1, x2, u, region)
-        u = np.empty(x1.shape)
-        region = np.empty(x1.shape, dtype=np.int8)
-        if lin.any():
-            if np.ndim(g1):
-                g1, g2 = g1[lin], g2[lin]
-            u[lin], region[lin] = saturate_linear(-g1 * x1[lin] - g2 * x2[lin], w)
+        if 2 * n_lin >= lin.size:  # mostly linear: the linear input everywhere, the
+            # other states overwritten below (no gather and scatter of the linear ones)
+            with np.errstate(invalid="ignore", over="ignore"):  # only where overwritten
+                u, region = saturate_linear(-g1 * x1 - g2 * x2, w)
+        else:
+            u = np.empty(x1.shape)
+            region = np.empty(x1.shape, dtype=np.int8)
+            if n_lin:
+                if np.ndim(g1):
+                    g1, g2 = g1[lin], g2[lin]
+                u[lin], region[lin] = saturate_linear(-g1 * x1[lin] - g2 * x2[lin], w)
         out = ~lin
-        if out.any():
+        if n_lin < lin.size:
             y1, y2 = x1[out], x2[out]
             sig = switching_function(y1, y2, a, w)
             uo, ro = _bang(sig, y2, w)
