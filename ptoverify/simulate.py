@@ -736,23 +736,27 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
         raw1 = all(seg["q"] == 0 for seg in run)
         raw2 = all(seg["noise"] is None and not seg["add_zero"] for seg in run)
         plan.append((law.vector, sl, [seg for seg in run if not raw2], raw1, raw2))
-    # the quantizer q round(x1 / q), once per sample over all states: elementwise the
-    # same division, rounding and product as segment by segment; states with q = 0
-    # see x1 (copied, as the law's input for them is then y1 too)
-    quanta = [seg["q"] for seg in segs]
-    quantize = any(q > 0 for q in quanta)
-    q_one = quanta[0] if quantize and all(q == quanta[0] for q in quanta) else None
-    if quantize and q_one is None:
-        q_vec = np.concatenate([np.full(seg["x1"].shape[0], seg["q"]) for seg in segs])
-        q_pos = q_vec > 0
-        q_zero = ~q_pos
+    # the quantizer q round(x1 / q), once per sample over consecutive segments of one
+    # q: elementwise the same division, rounding and product as segment by segment;
+    # states with q = 0 see x1 (copied, as the law's input for them may be y1 too)
+    q_runs: list[list] = []
+    for seg in segs:
+        if q_runs and q_runs[-1][2] == seg["q"]:
+            q_runs[-1][1] = seg["sl"].stop
+        else:
+            q_runs.append([seg["sl"].start, seg["sl"].stop, seg["q"]])
+    quantize = any(q > 0 for _, _, q in q_runs)
+    q_runs = [(slice(lo, hi), q) for lo, hi, q in q_runs]
     # the delay line: sample k applies U[k - delay] (U[0] before it: the controller
     # was running and held what x_0 commands); per distinct delay, a mask of its states
     values = np.unique(delay).tolist() if n else [0]
-    base, others = int(values[0]), [(int(d), delay == d) for d in values[1:]]
-    if len(others) > 3:  # many delays: a gather
+    base, mixed = int(values[0]), len(values) > 1
+    if mixed:  # a gather U[max(k - delay, 0), state] (no masked operations: on an
+        # irregular mask they cost several times a gather)
         cols = np.arange(n, dtype=np.intp)
         delay_i = delay.astype(np.intp)
+        offset = cols - delay_i * n  # k n + offset once k >= every delay
+        d_max = int(values[-1])
         flat_u = U.reshape(-1)
         pick = np.empty(n, dtype=np.intp)
         gathered = np.empty(n)
@@ -761,15 +765,15 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
     for k in range(steps):
         x1k, x2k = X1[k], X2[k]
         uk_row, rk_row = U[k], R[k]
-        if q_one is not None:  # q * round(x1 / q)
-            np.divide(x1k, q_one, out=y1)
-            np.rint(y1, out=y1)
-            y1 *= q_one
-        elif quantize:
-            np.divide(x1k, q_vec, out=y1, where=q_pos)
-            np.rint(y1, out=y1, where=q_pos)
-            np.multiply(y1, q_vec, out=y1, where=q_pos)
-            np.copyto(y1, x1k, where=q_zero)
+        if quantize:
+            for ss, q in q_runs:
+                if q > 0:  # q * round(x1 / q)
+                    yq = y1[ss]
+                    np.divide(x1k[ss], q, out=yq)
+                    np.rint(yq, out=yq)
+                    yq *= q
+                else:
+                    y1[ss] = x1k[ss]
         for vector, sl, run, raw1, raw2 in plan:
             if not raw2:
                 for seg in run:
@@ -784,17 +788,18 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
                 x1k[sl] if raw1 else y1[sl], x2k[sl] if raw2 else y2[sl]
             )
         # uk = np.clip(applied, -w_true, w_true), the applied input picked per delay
-        if len(others) > 3:  # U[max(k - delay, 0), state]
-            np.subtract(k, delay_i, out=pick)
-            np.maximum(pick, 0, out=pick)
-            pick *= n
-            pick += cols
+        if mixed:  # U[max(k - delay, 0), state]
+            if k >= d_max:
+                np.add(offset, k * n, out=pick)
+            else:
+                np.subtract(k, delay_i, out=pick)
+                np.maximum(pick, 0, out=pick)
+                pick *= n
+                pick += cols
             np.take(flat_u, pick, out=gathered)
             np.maximum(gathered, w_neg, out=uk)
         else:
             np.maximum(U[max(k - base, 0)], w_neg, out=uk)
-            for d, mask in others:
-                np.maximum(U[max(k - d, 0)], w_neg, out=uk, where=mask)
         np.minimum(uk, w_true, out=uk)
         # plant.flow of the true plant: x2 - (x2 - u) g,  x1 + u T + (x2 - u) g / a
         np.subtract(x2k, uk, out=dv)
