@@ -130,10 +130,21 @@ def _series(x: Array, coef: Array, lowest: int) -> Array:
     """
     acc = x * float(coef[-1])  # the first step, coef[-1] * x (exact same product)
     acc += float(coef[-2])
-    for c in coef[-3::-1].tolist():  # in place: the same roundings as acc * x + c
+    for c in _constants(coef):  # in place: the same roundings as acc * x + c
         acc *= x
         acc += c
     return acc * x**lowest
+
+
+_CONSTANTS: dict[int, tuple] = {}
+
+
+def _constants(coef: Array) -> tuple:
+    """coef[-3::-1] as 0-d arrays (no conversion of a Python float per operation)."""
+    key = id(coef)
+    if key not in _CONSTANTS or _CONSTANTS[key][0] is not coef:
+        _CONSTANTS[key] = (coef, tuple(np.array(c) for c in coef[-3::-1].tolist()))
+    return _CONSTANTS[key][1]
 
 
 def _horner(x: float, coef: tuple[float, ...]) -> float:

@@ -433,7 +433,10 @@ def pto_law(
             uo, ro = _bang(sig, y2, w)
             per = np.ndim(lv) > 0
             if per or not math.isnan(lv):
-                between = ((y2 < 0) & (sig > 0)) | ((y2 > 0) & (sig < 0))
+                # ((y2 < 0) & (sig > 0)) | ((y2 > 0) & (sig < 0)), in fewer passes
+                between = np.sign(y2)
+                between *= np.sign(sig)
+                between = between < 0
                 if per:
                     lv = lv[out]
                     between &= ~np.isnan(lv)
