@@ -126,13 +126,25 @@ def _series(x: Array, coef: Array, lowest: int) -> Array:
 
     The accumulator starts at the top coefficient, which is what the first step
     0 * x + coef[-1] gives for finite x, so the roundings are those of Horner's
-    rule from zero.
+    rule from zero; its product with x is formed directly (``coef[-1] * x``).
     """
-    acc = np.full_like(x, coef[-1])
-    for c in coef[-2::-1]:  # in place: the same roundings as acc * x + c
+    acc = x * float(coef[-1])  # the first step, coef[-1] * x (exact same product)
+    acc += float(coef[-2])
+    for c in _constants(coef):  # in place: the same roundings as acc * x + c
         acc *= x
         acc += c
     return acc * x**lowest
+
+
+_CONSTANTS: dict[int, tuple] = {}
+
+
+def _constants(coef: Array) -> tuple:
+    """coef[-3::-1] as 0-d arrays (no conversion of a Python float per operation)."""
+    key = id(coef)
+    if key not in _CONSTANTS or _CONSTANTS[key][0] is not coef:
+        _CONSTANTS[key] = (coef, tuple(np.array(c) for c in coef[-3::-1].tolist()))
+    return _CONSTANTS[key][1]
 
 
 def _horner(x: float, coef: tuple[float, ...]) -> float:
@@ -193,13 +205,16 @@ def _h_block(r: Array) -> Array:
 
 def _put_series(out: Array, x: Array, where: NDArray[np.bool_], coef: Array, hcoef) -> None:
     """Overwrite ``out`` with the series of x (lowest power 2) where ``where`` holds."""
-    idx = np.flatnonzero(where)
-    if idx.size == 0:
+    count = np.count_nonzero(where)
+    if count == 0:
         return
-    if idx.size <= FEW:  # a few values: no 2 x 20 numpy passes for them
+    if count <= FEW:  # a few values: no 2 x 20 numpy passes for them
+        idx = np.flatnonzero(where)
         flat = out.reshape(-1)  # out is a fresh contiguous array: a view
         for i, v in zip(idx.tolist(), x.reshape(-1)[idx].tolist(), strict=True):
             flat[i] = _horner(v, hcoef)
+    elif count == where.size:  # everywhere: no gather and scatter
+        out[...] = _series(x, coef, 2)
     else:
         out[where] = _series(x[where], coef, 2)
 

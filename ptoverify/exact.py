@@ -1403,29 +1403,48 @@ def _scan_back(x1, x2, u, a: float, T: float, b1: float, b2: float):  # noqa: N8
     L1 = np.where(np.abs(x1[steps]) > b1, steps, -1)
     L2 = np.where(np.abs(x2[steps]) > b2, steps, -1)
     kk, cc = [], []
-    rows = max(1, 32768 // max(n, 1))
-    for hi in range(steps, 0, -rows):
-        if (L1 >= 0).all() and (L2 >= 0).all():
+    # columns still scanned: a column whose L1 and L2 are both known is done (its
+    # candidates in earlier rows all lie before L1 and are dropped), so once fewer
+    # than half the scanned columns are pending, only those are read on
+    act = np.arange(n)
+    hi = steps
+    while hi > 0:
+        pend = (L1[act] < 0) | (L2[act] < 0)
+        left = int(np.count_nonzero(pend))
+        if left == 0:
             break
+        if 2 * left < act.size:
+            act = act[pend]
+        full = act.size == n
+        rows = max(1, 32768 // act.size)
         lo = max(0, hi - rows)
-        y1, y2 = x1[lo:hi], x2[lo:hi]  # samples lo..hi-1: the intervals' starts
+        if full:  # samples lo..hi-1: the intervals' starts
+            y1, y2, z2, l1, l2 = x1[lo:hi], x2[lo:hi], x2[lo + 1 : hi + 1], L1, L2
+        else:
+            y1, y2, z2 = x1[lo:hi, act], x2[lo:hi, act], x2[lo + 1 : hi + 1, act]
+            l1, l2 = L1[act], L2[act]
         idx = np.arange(lo + 1, hi + 1, dtype=np.int32)[:, None]  # row + 1
         ax1, ax2 = np.abs(y1), np.abs(y2)
-        for L, ay, b in ((L1, ax1, b1), (L2, ax2, b2)):
+        for L, ay, b in ((l1, ax1, b1), (l2, ax2, b2)):
             r = ((ay > b) * idx).max(axis=0)  # last row outside + 1, 0 if none
             if r.any():
                 np.copyto(L, r - 1, where=(L < 0) & (r > 0))
+        if not full:
+            L1[act], L2[act] = l1, l2
         ax2 *= T
         ax2 += ax1
         c = ax2 > b1
         with np.errstate(invalid="ignore"):
-            c &= (y2 * x2[lo + 1 : hi + 1]) < 0.0
+            c &= (y2 * z2) < 0.0
         if c.any():
             k, j = np.nonzero(c)
             k += lo
+            if not full:
+                j = act[j]
             keep = k >= L1[j]  # L1 found in an earlier row later on is < lo <= k
             kk.append(k[keep])
             cc.append(j[keep])
+        hi = lo
     kk = np.concatenate(kk) if kk else np.zeros(0, dtype=np.int64)
     cc = np.concatenate(cc) if cc else np.zeros(0, dtype=np.int64)
     _, y_ex = _x1_extremum(x1[kk, cc], x2[kk, cc], u[kk, cc], a, T)

@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Config
-from ptoverify.curves import blockwise, level_residual, omega_c, switching_function
+from ptoverify.curves import blockwise, level_term, omega_c
 from ptoverify.errors import InputError
 
 __all__ = [
@@ -152,17 +152,44 @@ def sigma_scalar(x1: float, x2: float, a: float, omega: float) -> float:
 
 def _bang(sigma: NDArray[np.float64], x2: NDArray[np.float64], w: float):
     """Time-optimal input from the switching function: S_P u l1 -> +w, S_N u l2 -> -w."""
-    pos = (sigma < 0) | ((sigma == 0) & (x2 < 0))
-    u = np.where(pos, w, -w)
-    region = np.where(pos, _I8[Region.BANG_P], _I8[Region.BANG_N])
-    return u, region
+    pos = sigma < 0
+    on = sigma == 0
+    if on.any():  # on the curve: the sign of x2 decides
+        pos |= on & (x2 < 0)
+    return _pick_sign(pos, w), _pick_region(pos, Region.BANG_P, Region.BANG_N)
+
+
+def _pick_sign(pos, w: float):
+    """``np.where(pos, w, -w)`` without branches: 2 w pos - w, exact for 0 < w < inf.
+
+    (np.where on an irregular mask costs several times the arithmetic.)
+    """
+    u = np.empty(np.shape(pos))
+    if 0.0 < w < math.inf:  # 2 w is exact, 2 w - w = w and 0 - w = -w exactly
+        np.multiply(pos, 2.0 * w, out=u)
+        np.subtract(u, w, out=u)
+    else:
+        u[...] = np.where(pos, w, -w)
+    return u
+
+
+def _pick_region(pos, yes: Region, no: Region):
+    """``np.where(pos, yes, no)`` as int8 codes, without branches (yes = no - 1 or no + 1)."""
+    region = np.empty(np.shape(pos), dtype=np.int8)
+    if yes == no - 1:
+        np.subtract(_I8[no], pos, out=region)
+    else:
+        np.add(_I8[no], pos, out=region)
+    return region
 
 
 def _origin(x1, x2, u, region):
     """Set u = 0, region ORIGIN at the origin (in place); return (u, region)."""
-    origin = (x1 == 0) & (x2 == 0)
-    if origin.any():
-        u[origin], region[origin] = 0.0, Region.ORIGIN
+    origin = x1 == 0
+    if origin.any():  # x2 only where x1 is 0 (rare away from the origin)
+        origin &= x2 == 0
+        if origin.any():
+            u[origin], region[origin] = 0.0, Region.ORIGIN
     return u, region
 
 
@@ -192,9 +219,9 @@ def to_law(cfg: Config) -> Law:
     a, w = cfg.plant.a, cfg.plant.w_max
 
     def vector(x1, x2):
-        u, region = _bang(switching_function(x1, x2, a, w), x2, w)
-        origin = (x1 == 0) & (x2 == 0)
-        return np.where(origin, 0.0, u), np.where(origin, Region.ORIGIN, region).astype(np.int8)
+        # switching_function(x1, x2, a, w), which is a x1 + level_term(x2, w) bit for bit
+        u, region = _bang(a * x1 + level_term(x2, w), x2, w)
+        return _origin(x1, x2, u, region)
 
     def scalar(x1: float, x2: float) -> tuple[float, int]:
         if x1 == 0.0 and x2 == 0.0:
@@ -231,8 +258,7 @@ def saturate_linear(v: NDArray[np.float64], w: float):
     ([1.0, -300.0], ['LINEAR', 'SATURATED'])
     """
     u = np.minimum(np.maximum(v, -w), w)  # np.clip(v, -w, w), without its wrapper
-    region = np.where(np.abs(v) > w, _I8[Region.SATURATED], _I8[Region.LINEAR])
-    return u, region
+    return u, _pick_region(np.abs(v) > w, Region.SATURATED, Region.LINEAR)
 
 
 def pd_law(cfg: Config, *, gains: tuple[NDArray, NDArray] | None = None) -> Law:
@@ -386,23 +412,32 @@ def pto_law(
         # everywhere and selecting, so the result is unchanged.  g1, g2: the linear
         # gains, dd: d, lv: the zone's level (NaN: no zone); floats or one per state
         lin = np.abs(x1) < dd
-        if lin.all():  # all in the linear zone: no masks
+        n_lin = np.count_nonzero(lin)
+        if n_lin == lin.size:  # all in the linear zone: no masks
             u, region = saturate_linear(-g1 * x1 - g2 * x2, w)
             return _origin(x1, x2, u, region)
-        u = np.empty(x1.shape)
-        region = np.empty(x1.shape, dtype=np.int8)
-        if lin.any():
-            if np.ndim(g1):
-                g1, g2 = g1[lin], g2[lin]
-            u[lin], region[lin] = saturate_linear(-g1 * x1[lin] - g2 * x2[lin], w)
+        if 2 * n_lin >= lin.size:  # mostly linear: the linear input everywhere, the
+            # other states overwritten below (no gather and scatter of the linear ones)
+            with np.errstate(invalid="ignore", over="ignore"):  # only where overwritten
+                u, region = saturate_linear(-g1 * x1 - g2 * x2, w)
+        else:
+            u = np.empty(x1.shape)
+            region = np.empty(x1.shape, dtype=np.int8)
+            if n_lin:
+                if np.ndim(g1):
+                    g1, g2 = g1[lin], g2[lin]
+                u[lin], region[lin] = saturate_linear(-g1 * x1[lin] - g2 * x2[lin], w)
         out = ~lin
-        if out.any():
+        if n_lin < lin.size:
             y1, y2 = x1[out], x2[out]
-            sig = switching_function(y1, y2, a, w)
+            sig = a * y1 + level_term(y2, w)  # switching_function, bit for bit
             uo, ro = _bang(sig, y2, w)
             per = np.ndim(lv) > 0
             if per or not math.isnan(lv):
-                between = ((y2 < 0) & (sig > 0)) | ((y2 > 0) & (sig < 0))
+                # ((y2 < 0) & (sig > 0)) | ((y2 > 0) & (sig < 0)), in fewer passes
+                between = np.sign(y2)
+                between *= np.sign(sig)
+                between = between < 0
                 if per:
                     lv = lv[out]
                     between &= ~np.isnan(lv)
@@ -410,7 +445,7 @@ def pto_law(
                 if cand.size:
                     c1, c2 = y1[cand], y2[cand]
                     lc = lv[cand] if per else lv
-                    r0 = level_residual(c1, c2, a, lc)
+                    r0 = a * c1 + level_term(c2, lc)  # level_residual, bit for bit
                     zp = (c2 < 0) & (r0 <= 0)
                     inz = zp | ((c2 > 0) & (r0 >= 0))
                     if inz.any():  # closed form only where it is used

@@ -537,6 +537,7 @@ def simulate_batch(
     steps: int,
     *,
     mismatch: Mismatch | None = None,
+    out: BatchResult | None = None,
 ) -> BatchResult:
     """Simulate the sampled loop to the origin from many initial states at once.
 
@@ -553,6 +554,11 @@ def simulate_batch(
     mismatch : Mismatch, optional
         True plant and measurement relative to ``plant`` (see :class:`Mismatch`);
         None or the identity is the nominal loop, bit for bit.
+    out : BatchResult, optional
+        A result whose arrays are no longer needed (e.g. the previous chunk's in a
+        loop over chunks of states): the nominal loop writes into them when their
+        shapes and types fit, which spares the page faults of fresh arrays; the
+        values are the same.  Ignored otherwise.
 
     Returns
     -------
@@ -579,8 +585,11 @@ def simulate_batch(
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     x2 = np.atleast_1d(np.asarray(x2, dtype=float))
     n = x1.shape[0]
-    X1, X2 = np.empty((steps + 1, n)), np.empty((steps + 1, n))
-    U, R = np.empty((steps, n)), np.empty((steps, n), dtype=np.int8)
+    if out is not None and _fits(out, steps, n):
+        X1, X2, U, R = out.x1, out.x2, out.u, out.region
+    else:
+        X1, X2 = np.empty((steps + 1, n)), np.empty((steps + 1, n))
+        U, R = np.empty((steps, n)), np.empty((steps, n), dtype=np.int8)
     X1[0], X2[0] = x1, x2
     T, a = plant.sample_time, plant.a
     g = -np.expm1(-a * np.float64(T))  # 1 - e^{-aT}, as plant.flow computes it
@@ -596,6 +605,20 @@ def simulate_batch(
         dv /= a
         X1[k + 1] += dv
     return BatchResult(X1, X2, U, R, mismatch)
+
+
+def _fits(b: BatchResult, steps: int, n: int) -> bool:
+    """Whether ``b``'s arrays can hold a nominal run of ``steps`` samples of ``n`` states."""
+    arrays = ((b.x1, steps + 1, np.float64), (b.x2, steps + 1, np.float64))
+    arrays += ((b.u, steps, np.float64), (b.region, steps, np.int8))
+    return all(
+        type(v) is np.ndarray
+        and v.shape == (rows, n)
+        and v.dtype == dt
+        and v.flags.c_contiguous
+        and v.flags.writeable
+        for v, rows, dt in arrays
+    )
 
 
 Segment = tuple[Law, ArrayLike, ArrayLike, Mismatch | None]
@@ -712,14 +735,28 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
         sl = slice(run[0]["sl"].start, run[-1]["sl"].stop)
         raw1 = all(seg["q"] == 0 for seg in run)
         raw2 = all(seg["noise"] is None and not seg["add_zero"] for seg in run)
-        plan.append((law.vector, sl, run, raw1, raw2))
+        plan.append((law.vector, sl, [seg for seg in run if not raw2], raw1, raw2))
+    # the quantizer q round(x1 / q), once per sample over consecutive segments of one
+    # q: elementwise the same division, rounding and product as segment by segment;
+    # states with q = 0 see x1 (copied, as the law's input for them may be y1 too)
+    q_runs: list[list] = []
+    for seg in segs:
+        if q_runs and q_runs[-1][2] == seg["q"]:
+            q_runs[-1][1] = seg["sl"].stop
+        else:
+            q_runs.append([seg["sl"].start, seg["sl"].stop, seg["q"]])
+    quantize = any(q > 0 for _, _, q in q_runs)
+    q_runs = [(slice(lo, hi), q) for lo, hi, q in q_runs]
     # the delay line: sample k applies U[k - delay] (U[0] before it: the controller
     # was running and held what x_0 commands); per distinct delay, a mask of its states
     values = np.unique(delay).tolist() if n else [0]
-    base, others = int(values[0]), [(int(d), delay == d) for d in values[1:]]
-    if len(others) > 3:  # many delays: a gather
+    base, mixed = int(values[0]), len(values) > 1
+    if mixed:  # a gather U[max(k - delay, 0), state] (no masked operations: on an
+        # irregular mask they cost several times a gather)
         cols = np.arange(n, dtype=np.intp)
         delay_i = delay.astype(np.intp)
+        offset = cols - delay_i * n  # k n + offset once k >= every delay
+        d_max = int(values[-1])
         flat_u = U.reshape(-1)
         pick = np.empty(n, dtype=np.intp)
         gathered = np.empty(n)
@@ -728,16 +765,16 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
     for k in range(steps):
         x1k, x2k = X1[k], X2[k]
         uk_row, rk_row = U[k], R[k]
+        if quantize:
+            for ss, q in q_runs:
+                if q > 0:  # q * round(x1 / q)
+                    yq = y1[ss]
+                    np.divide(x1k[ss], q, out=yq)
+                    np.rint(yq, out=yq)
+                    yq *= q
+                else:
+                    y1[ss] = x1k[ss]
         for vector, sl, run, raw1, raw2 in plan:
-            if not raw1:
-                for seg in run:
-                    ss, q = seg["sl"], seg["q"]
-                    if q > 0:  # q * round(x1 / q)
-                        np.divide(x1k[ss], q, out=y1[ss])
-                        np.rint(y1[ss], out=y1[ss])
-                        y1[ss] *= q
-                    else:
-                        y1[ss] = x1k[ss]
             if not raw2:
                 for seg in run:
                     ss = seg["sl"]
@@ -751,17 +788,18 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
                 x1k[sl] if raw1 else y1[sl], x2k[sl] if raw2 else y2[sl]
             )
         # uk = np.clip(applied, -w_true, w_true), the applied input picked per delay
-        if len(others) > 3:  # U[max(k - delay, 0), state]
-            np.subtract(k, delay_i, out=pick)
-            np.maximum(pick, 0, out=pick)
-            pick *= n
-            pick += cols
+        if mixed:  # U[max(k - delay, 0), state]
+            if k >= d_max:
+                np.add(offset, k * n, out=pick)
+            else:
+                np.subtract(k, delay_i, out=pick)
+                np.maximum(pick, 0, out=pick)
+                pick *= n
+                pick += cols
             np.take(flat_u, pick, out=gathered)
             np.maximum(gathered, w_neg, out=uk)
         else:
             np.maximum(U[max(k - base, 0)], w_neg, out=uk)
-            for d, mask in others:
-                np.maximum(U[max(k - d, 0)], w_neg, out=uk, where=mask)
         np.minimum(uk, w_true, out=uk)
         # plant.flow of the true plant: x2 - (x2 - u) g,  x1 + u T + (x2 - u) g / a
         np.subtract(x2k, uk, out=dv)
