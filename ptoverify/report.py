@@ -329,10 +329,13 @@ def _stage_derivations(cfg: Config, figdir: Path | None) -> dict[str, Any]:
     plant = derivations.PlantNumbers(
         a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
     )
+    from ptoverify.report_sections import render_records
+
     records = derivations.all_records(plant)
     return {
         "derivations": [r.to_json() for r in records],
         "_records": records,
+        "_rendered": render_records(records),  # MathML and units: SymPy work, done here
         "_checks": run_checks(cfg, [SYMBOLIC_GATE]),
     }
 
@@ -425,10 +428,10 @@ _STAGE_FUNCTIONS: dict[str, Callable[[Config, Path | None], dict[str, Any]]] = {
     "robustness": _stage_robust,
     "suboptimality sweep": _stage_sweep,
     "derivations": _stage_derivations,
-    "figures and poles": _stage_figures,
     "tuning": _stage_tuning,
     "closed loop, claims and gates": _stage_core,
     "ground truth": _stage_ground_truth,
+    "figures and poles": _stage_figures,
 }
 _SKIP_STAGE = {"robust": "robustness", "tuning": "tuning"}
 
@@ -633,7 +636,6 @@ def _run_in_pool(
     threads = [threading.Thread(target=serve, args=(p,), daemon=True) for p in procs]
     for t in threads:
         t.start()
-    complete = False
     try:
         for _ in names:
             name, answer = answers.get()
@@ -643,13 +645,13 @@ def _run_in_pool(
                     exc.add_note(f"in report stage '{name}' (worker process):\n{trace}")
                 raise exc
             finished(name, answer[1])
-        complete = True
     finally:
+        # every answer is in (or the run failed): a worker holds nothing more, and its
+        # interpreter's shutdown with the numeric libraries loaded costs ~0.3 s
         for proc in procs:
-            if not complete:  # an error or an interrupt: no stage is waited for
-                proc.kill()
+            proc.kill()
             try:
-                proc.stdin.close()  # a worker ends at the end of its input
+                proc.stdin.close()
             except OSError:
                 pass
         for proc in procs:
@@ -731,7 +733,10 @@ def _summary(out: dict[str, Any], gates: dict[str, Any]) -> dict[str, Any]:
 
 # ------------------------------------------------------------------ sections
 def build_sections(
-    res: dict[str, Any], figures: dict[str, str], records: list | None = None
+    res: dict[str, Any],
+    figures: dict[str, str],
+    records: list | None = None,
+    rendered: dict | None = None,
 ) -> list[Section]:
     """Turn the results into ordered sections ``(anchor, title, blocks)``.
 
@@ -744,6 +749,9 @@ def build_sections(
     records : list of derivations.EquationRecord, optional
         The derivation records :func:`collect` made (``res["_records"]``); when
         None they are taken from ``res``.
+    rendered : dict, optional
+        :func:`ptoverify.report_sections.render_records` of them
+        (``res["_rendered"]``), when already computed.
 
     Returns
     -------
@@ -755,8 +763,8 @@ def build_sections(
     parts = [
         ("findings", "Headline findings", rs.headline(res, figures)),
         ("summary", "Summary: gates, errata, claims", rs.summary(res)),
-        ("errata", "Errata in the paper", rs.errata(res, recs)),
-        ("derivations", "Derivations: printed vs derived", rs.derivations(res, recs)),
+        ("errata", "Errata in the paper", rs.errata(res, recs, rendered)),
+        ("derivations", "Derivations: printed vs derived", rs.derivations(res, recs, rendered)),
         ("ground-truth", "Ground truth: minimum time", rs.ground_truth(res, figures)),
         ("zone", "Switching-zone geometry", rs.zone(res, figures)),
         ("poles", "Poles and stability", rs.poles(res)),
@@ -830,7 +838,7 @@ def write_report(
             "generated": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         }
         title = f"ptoverify verification report: {cfg.name}"
-        sections = build_sections(public, figures, res["_records"])
+        sections = build_sections(public, figures, res["_records"], res.get("_rendered"))
         (tmp / "results.json").write_text(
             json.dumps(public, indent=1, sort_keys=True, allow_nan=False) + "\n"
         )

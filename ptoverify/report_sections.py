@@ -573,7 +573,34 @@ def _counterexample_rows(ce: dict[str, Any], unit: str) -> tuple[list[str], list
     return ["quantity", *[t for t, _ in cols]], rows
 
 
-def errata(res: dict[str, Any], records: list) -> list[Block]:
+def render_records(records: list) -> dict[str, dict[str, Any]]:
+    """Render what the derivation sections show of each record (SymPy work, done once).
+
+    Parameters
+    ----------
+    records : list of derivations.EquationRecord
+        The derivation records.
+
+    Returns
+    -------
+    dict
+        Record id -> ``{"mathml": ..., "unit": ...}``: the MathML of each form
+        (:meth:`derivations.EquationRecord.to_mathml`) and, for an erratum, the
+        unit of its expressions ("" otherwise).  The report's derivations stage
+        computes it beside the records, in the same worker process.
+    """
+    return {
+        r.id: {
+            "mathml": r.to_mathml(),
+            "unit": (_expr_unit(r.derived) or _expr_unit(r.printed))
+            if r.verdict == "erratum"
+            else "",
+        }
+        for r in records
+    }
+
+
+def errata(res: dict[str, Any], records: list, rendered: dict | None = None) -> list[Block]:
     """Each erratum: printed and derived forms (MathML), counterexample, downstream links.
 
     Parameters
@@ -582,12 +609,15 @@ def errata(res: dict[str, Any], records: list) -> list[Block]:
         Output of :func:`ptoverify.report.collect` (JSON part).
     records : list of derivations.EquationRecord
         The records the collect step derived (MathML of each form).
+    rendered : dict, optional
+        :func:`render_records` of them, when already computed.
 
     Returns
     -------
     list of Block
     """
     recs = {r.id: r for r in records}
+    rendered = rendered if rendered is not None else render_records(records)
     ids = set(recs)
     err = [r for r in res["derivations"] if r["verdict"] == "erratum"]
     if not err:
@@ -601,9 +631,9 @@ def errata(res: dict[str, Any], records: list) -> list[Block]:
         )
     ]
     for r in err:
-        rec = recs.get(r["id"])
-        ml = rec.to_mathml() if rec is not None else {}
-        unit = _expr_unit(r["derived"]) or _expr_unit(r["printed"])
+        done = rendered.get(r["id"], {})
+        ml = done.get("mathml", {})
+        unit = done.get("unit") or _expr_unit(r["derived"]) or _expr_unit(r["printed"])
         head, rows = _counterexample_rows(r.get("counterexample") or {}, unit)
         tb = table(head, rows)
         forms = []
@@ -648,18 +678,20 @@ def errata(res: dict[str, Any], records: list) -> list[Block]:
 
 
 # ------------------------------------------------------------------ derivations
-def derivations(res: dict[str, Any], records: list) -> list[Block]:
+def derivations(res: dict[str, Any], records: list, rendered: dict | None = None) -> list[Block]:
     """Show printed next to derived (MathML), verdicts; each row anchored as ``eq-<id>``.
 
     ``records`` are the :class:`derivations.EquationRecord` objects the collect
     step derived (their JSON form is ``res["derivations"]``); they carry the
-    SymPy expressions that render as MathML.
+    SymPy expressions that render as MathML.  ``rendered`` is
+    :func:`render_records` of them when already computed.
     """
     from derivations.record import N_CROSS, N_POINTS
 
+    rendered = rendered or {}
     rows_html, rows_md = [], []
     for r in records:
-        ml = r.to_mathml()
+        ml = rendered[r.id]["mathml"] if r.id in rendered else r.to_mathml()
 
         def cell(key: str, text: str, ml=ml) -> str:
             m = ml.get(key, "")
