@@ -56,6 +56,7 @@ from 0 and the state is flagged ``below_bound``.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -288,18 +289,31 @@ def _search(x1: NDArray, x2: NDArray, n0: NDArray, plant: Plant, n_max: int):
         tests += idx.size
         return tab.contains(z1[idx], z2[idx], n)
 
+    steps, below = _bracket(x1, x2, n0, n_max, inside)
+    return steps, below, tests
+
+
+def _bracket(
+    x1: NDArray, x2: NDArray, n0: NDArray, n_max: int, inside: Callable
+) -> tuple[NDArray[np.int64], NDArray[np.bool_]]:
+    """Search N* (n0 - 1, then up exponentially, then bisection): (steps, below_bound).
+
+    ``inside(idx, n)`` says whether the states ``idx`` reach the origin in ``n``
+    samples (the sets are nested in n).  N* T >= t_f* makes n0 - 1 infeasible;
+    a state inside there is flagged ``below_bound`` and searched from 0.
+    """
     origin = (x1 == 0.0) & (x2 == 0.0)
-    lo = n0 - 1  # infeasible by N* T >= t_f*, tested below
+    lo = n0 - 1
     hi = n0.copy()
     found = np.zeros(x1.size, dtype=bool)
     below = np.zeros(x1.size, dtype=bool)
     idx = np.flatnonzero(~origin & (lo >= 1))
     if idx.size:
-        bad = inside(idx, lo[idx])
-        below[idx[bad]] = True
-        lo[idx[bad]] = 0
-        hi[idx[bad]] = n0[idx[bad]] - 1  # known inside
-        found[idx[bad]] = True
+        bad = idx[inside(idx, lo[idx])]
+        below[bad] = True
+        lo[bad] = 0
+        hi[bad] = n0[bad] - 1  # known inside
+        found[bad] = True
     step = np.ones(x1.size, dtype=np.int64)
     act = np.flatnonzero(~origin & ~found & (n0 <= n_max))
     while act.size:  # exponential search for an N inside
@@ -319,7 +333,7 @@ def _search(x1: NDArray, x2: NDArray, n0: NDArray, plant: Plant, n_max: int):
         act = act[hi[act] - lo[act] > 1]
     steps = np.where(found, hi, -1)
     steps[origin] = 0
-    return steps, below, tests
+    return steps, below
 
 
 def _contains_each(z1: NDArray, z2: NDArray, n: NDArray, c: NDArray) -> NDArray[np.bool_]:
@@ -436,34 +450,4 @@ def zonotope_steps_each(
     def inside(idx: NDArray, n: NDArray) -> NDArray[np.bool_]:
         return _contains_each(z1[idx], z2[idx], n, c[idx])
 
-    # the search of :func:`_search`, per state
-    origin = (x1 == 0.0) & (x2 == 0.0)
-    lo = n0 - 1
-    hi = n0.copy()
-    found = np.zeros(x1.size, dtype=bool)
-    idx = np.flatnonzero(~origin & (lo >= 1))
-    if idx.size:
-        bad = idx[inside(idx, lo[idx])]
-        lo[bad] = 0
-        hi[bad] = n0[bad] - 1
-        found[bad] = True
-    step = np.ones(x1.size, dtype=np.int64)
-    act = np.flatnonzero(~origin & ~found & (n0 <= n_max))
-    while act.size:  # exponential search for an N inside
-        ok = inside(act, hi[act])
-        found[act[ok]] = True
-        out = act[~ok]
-        lo[out] = hi[out]
-        step[out] *= 2
-        hi[out] = np.minimum(lo[out] + step[out], n_max)
-        act = out[lo[out] < n_max]
-    act = np.flatnonzero(found & (hi - lo > 1))
-    while act.size:  # bisection: lo outside, hi inside
-        mid = (lo[act] + hi[act]) // 2
-        ok = inside(act, mid)
-        hi[act[ok]] = mid[ok]
-        lo[act[~ok]] = mid[~ok]
-        act = act[hi[act] - lo[act] > 1]
-    steps = np.where(found, hi, -1)
-    steps[origin] = 0
-    return steps
+    return _bracket(x1, x2, n0, n_max, inside)[0]
