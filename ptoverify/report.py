@@ -71,7 +71,7 @@ SKIPPABLE = ("robust", "tuning")
 
 #: Sizes of the report's robustness study: overrides of
 #: :class:`ptoverify.robust.RobustSettings`.  Empty: the report runs the same study as
-#: ``ptoverify robust`` on its defaults (all four laws; about 20-25 s on 2 cores).
+#: ``ptoverify robust`` on its defaults (all four laws; a few seconds, `robust_study_s`).
 ROBUST_SETTINGS: dict[str, Any] = {}
 
 #: Search effort of the report's tunings (:class:`ptoverify.tune.TuneBudget`, fixed seed),
