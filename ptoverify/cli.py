@@ -209,7 +209,7 @@ def _cmd_mintime(args: argparse.Namespace) -> int:
 
 # ---------------------------------------------------------------- simulate
 def _add_simulate(sub) -> None:
-    from ptoverify.laws import LAW_NAMES
+    from ptoverify.config import LAW_NAMES
 
     p = sub.add_parser(
         "simulate",

@@ -45,7 +45,12 @@ __all__ = [
     "config_from_mapping",
     "Robustness",
     "robustness_from_mapping",
+    "LAW_NAMES",
 ]
+
+#: The laws the suite implements (:func:`ptoverify.laws.make_law`), here so that naming
+#: them (the command line's choices) loads no numerics.
+LAW_NAMES: tuple[str, ...] = ("to", "pd", "pto", "pto-printed")
 
 
 @dataclass(frozen=True)

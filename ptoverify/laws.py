@@ -18,7 +18,7 @@ from enum import IntEnum
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ptoverify.config import Config
+from ptoverify.config import LAW_NAMES, Config
 from ptoverify.curves import blockwise, level_term, omega_c
 from ptoverify.errors import InputError
 
@@ -636,7 +636,6 @@ _FACTORIES: dict[str, Callable[[Config], Law]] = {
     "pto": pto_corrected_law,
     "pto-printed": pto_printed_law,
 }
-LAW_NAMES: tuple[str, ...] = ("to", "pd", "pto", "pto-printed")
 
 
 def make_law(name: str, cfg: Config) -> Law:

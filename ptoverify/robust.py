@@ -58,7 +58,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.stats import qmc
 
 from ptoverify.config import Config, Plant
 from ptoverify.errors import ClusterError, InputError
@@ -838,6 +837,23 @@ POLISH_ROUNDS = 4  #: rounds of the batched local polish
 POLISH_STEP = 0.05  #: first polish step, as a fraction of each variable's range (halved per round)
 
 
+def latin_hypercube(rng: np.random.Generator, n: int, d: int) -> NDArray[np.float64]:
+    """``n`` points in [0, 1)^d, one in each of the ``n`` strata of every coordinate.
+
+    Scrambled Latin hypercube sampling, drawn exactly as SciPy's
+    ``scipy.stats.qmc.LatinHypercube(d, rng=rng).random(n)`` draws it (a child
+    generator spawned from ``rng``, uniform offsets, one shuffle per coordinate;
+    ``tests/test_robust.py`` compares the two), without importing
+    ``scipy.stats``, whose import costs more than a second of the report.
+    """
+    child = rng.spawn(1)[0]
+    offsets = child.uniform(size=(n, d))
+    perms = np.tile(np.arange(1, n + 1), (d, 1))
+    for i in range(d):
+        child.shuffle(perms[i, :])
+    return (perms.T - offsets) / n
+
+
 def _distinct_others(rng: np.random.Generator, n_pop: int, k: int) -> NDArray[np.int64]:
     """Per member i, ``k`` distinct other members: ``rng.choice`` of the others, draw for draw.
 
@@ -1057,7 +1073,7 @@ def _de_search(cfg: Config, starts: dict[str, list[dict[str, Any]]], s: RobustSe
     # initial populations: the grid's worst cells of the problem's delay, then uniform
     pops, grid_value = [], {}
     for (prop, dl), (lo, hi) in zip(problems, bounds, strict=True):
-        lhs = qmc.LatinHypercube(d=4, seed=rng).random(s.search_population)
+        lhs = latin_hypercube(rng, s.search_population, 4)
         pop = lo + (hi - lo) * lhs
         mine = [g for g in starts[prop] if int(g["params"]["delay_samples"]) == dl]
         for i, g in enumerate(mine[: s.search_population]):

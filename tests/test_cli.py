@@ -317,3 +317,19 @@ def test_cli_imports_no_solver_and_no_simulator():
     assert not names & forbidden, names & forbidden
     private = [n for n in names if n.rsplit(".", 1)[-1][:1] == "_" and "__" not in n]
     assert not private, private
+
+
+def test_building_the_parser_loads_no_numerics():
+    """The command line is parsed before any worker starts: it must not pay for SciPy or the laws."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\nfrom ptoverify.cli import build_parser\n"
+        "build_parser().parse_args(['report', '--jobs', '2'])\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in ('scipy', 'ptoverify')"
+        " and m in ('scipy', 'ptoverify.laws', 'ptoverify.curves')))"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "[]"

@@ -155,3 +155,11 @@ def test_cli_simulate(name, capsys):
     assert main(["simulate", "--law", name, "--signal", "step", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["law"] == name and abs(out["final_error_mm"]) < 1e-3
+
+
+def test_every_named_law_is_built_and_no_other():
+    """The names the command line offers (config.LAW_NAMES) are exactly the laws make_law builds."""
+    from ptoverify import laws
+
+    assert tuple(laws._FACTORIES) == LAW_NAMES
+    assert [make_law(n, PAPER).name for n in LAW_NAMES] == list(LAW_NAMES)

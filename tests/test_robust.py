@@ -15,6 +15,7 @@ from ptoverify.robust import (
     RobustSettings,
     grid_worst,
     horizon_steps,
+    latin_hypercube,
     linear_loop_margin,
     map_states,
     no_limit_cycle_margin,
@@ -252,3 +253,20 @@ def test_maps_do_not_depend_on_batching(monkeypatch):
     together = robust_maps(CFG, s)
     monkeypatch.setattr(robust_mod, "BATCH_STATES", 1)
     assert robust_maps(CFG, s) == together
+
+
+@pytest.mark.parametrize("seed", [0, 7, 12345])
+@pytest.mark.parametrize(("n", "d"), [(1, 4), (13, 4), (40, 3)])
+def test_latin_hypercube_draws_as_scipy_does(seed, n, d):
+    """The search's own LHS equals SciPy's scrambled LatinHypercube draw for draw,
+    leaves the parent generator where SciPy leaves it, and is a Latin hypercube."""
+    from scipy.stats import qmc
+
+    mine_rng, ref_rng = np.random.default_rng(seed), np.random.default_rng(seed)
+    mine = latin_hypercube(mine_rng, n, d)
+    ref = qmc.LatinHypercube(d=d, rng=ref_rng).random(n)
+    np.testing.assert_array_equal(mine, ref)
+    assert mine_rng.random() == ref_rng.random()
+    assert ((mine >= 0) & (mine < 1)).all()
+    for col in mine.T:  # exactly one point per stratum [j/n, (j+1)/n)
+        assert sorted(np.floor(col * n).astype(int)) == list(range(n))
