@@ -845,6 +845,26 @@ def latin_hypercube(rng: np.random.Generator, n: int, d: int) -> NDArray[np.floa
     generator spawned from ``rng``, uniform offsets, one shuffle per coordinate;
     ``tests/test_robust.py`` compares the two), without importing
     ``scipy.stats``, whose import costs more than a second of the report.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Parent generator (advanced by one spawn, as SciPy advances it).
+    n : int
+        Number of points [-].
+    d : int
+        Dimension [-].
+
+    Returns
+    -------
+    ndarray of float, shape (n, d)
+        The points.
+
+    Examples
+    --------
+    >>> pts = latin_hypercube(np.random.default_rng(0), 4, 2)
+    >>> sorted(np.floor(pts[:, 0] * 4).astype(int).tolist())
+    [0, 1, 2, 3]
     """
     child = rng.spawn(1)[0]
     offsets = child.uniform(size=(n, d))
