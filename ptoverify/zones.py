@@ -464,9 +464,16 @@ def principle_violations(
     b2 = np.broadcast_to(x2[:, None], b1.shape)
     x1 = np.concatenate([g1.ravel(), b1.ravel()])
     x2s = np.concatenate([g2.ravel(), b2.ravel()])
-    sig = level_residual(x1, x2s, a, w)
+    # level_residual(x1, x2, a, omega) is a x1 + level_term(x2, omega) bit for bit: the
+    # velocity term once per grid velocity, repeated along the rows of both grids
+
+    def residual(omega: float):
+        term = level_term(x2, omega)
+        return a * x1 + np.concatenate([np.repeat(term, n1), np.repeat(term, n_band)])
+
+    sig = residual(w)
     in_zone = (
-        (x2s < 0) & (sig >= 0) & (level_residual(x1, x2s, a, min(omega0, w)) < 0)
+        (x2s < 0) & (sig >= 0) & (residual(min(omega0, w)) < 0)
         if 0 < omega0 < w
         else np.zeros_like(sig, dtype=bool)
     )
