@@ -64,7 +64,13 @@ from ptoverify.exact import STEP_FRACTION, TIGHT_BAND, settling_times_batch
 from ptoverify.laws import Law, Region, make_law, with_state_gains
 from ptoverify.mintime import discrete_min_steps_batch, min_time
 from ptoverify.plant import zoh_matrices
-from ptoverify.properties import crossing_masks, default_steps, initial_grid, oscillating
+from ptoverify.properties import (
+    crossing_masks,
+    default_steps,
+    grid_simulation,
+    initial_grid,
+    oscillating,
+)
 from ptoverify.simulate import reference, simulate_batch
 from ptoverify.sweep import SweepSettings, grid_states, settling_times
 
@@ -621,7 +627,12 @@ def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
     """
     x1, x2, _ = initial_grid(cfg)
     steps = default_steps(cfg)
-    res = simulate_batch(make_law(law, cfg), cfg.plant, x1, x2, steps)
+    with grid_simulation(make_law(law, cfg), cfg, x1, x2, steps) as res:
+        return _grid_counts(cfg, law, res, steps)
+
+
+def _grid_counts(cfg: Config, law: str, res, steps: int) -> tuple[int, int]:
+    """Count the limit cycles and stride-overs of :func:`grid_counts` on its grid run."""
     cycles = int(oscillating(res.x1[-max(20, steps // 4) :], LIMIT_CYCLE_BAND).sum())
     strides = 0
     if law == "pto":

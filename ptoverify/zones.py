@@ -464,9 +464,16 @@ def principle_violations(
     b2 = np.broadcast_to(x2[:, None], b1.shape)
     x1 = np.concatenate([g1.ravel(), b1.ravel()])
     x2s = np.concatenate([g2.ravel(), b2.ravel()])
-    sig = level_residual(x1, x2s, a, w)
+    # level_residual(x1, x2, a, omega) is a x1 + level_term(x2, omega) bit for bit: the
+    # velocity term once per grid velocity, repeated along the rows of both grids
+
+    def residual(omega: float):
+        term = level_term(x2, omega)
+        return a * x1 + np.concatenate([np.repeat(term, n1), np.repeat(term, n_band)])
+
+    sig = residual(w)
     in_zone = (
-        (x2s < 0) & (sig >= 0) & (level_residual(x1, x2s, a, min(omega0, w)) < 0)
+        (x2s < 0) & (sig >= 0) & (residual(min(omega0, w)) < 0)
         if 0 < omega0 < w
         else np.zeros_like(sig, dtype=bool)
     )
@@ -595,6 +602,32 @@ def _degenerate(cfg: Config, omega0: float) -> bool:
     return float(level_curve_x1(-w, a, omega0)) < d
 
 
+#: Every this-many-th velocity of the even grid of :func:`_worst_margins` is the coarse
+#: grid on which :func:`_feasible_many` first looks for a violation.
+_COARSE = 32
+#: Halvings of a bisection in :func:`_feasible_intervals` judged in one batch.
+_LOOKAHEAD = 3
+
+
+def _feasible_many(
+    cfg: Config, omegas: NDArray[np.float64], reading: str, tol: float
+) -> NDArray[np.bool_]:
+    """Return ``_worst_margins(cfg, omegas, reading) >= -tol`` per omega0, with less work.
+
+    A margin < -tol on every ``_COARSE``-th velocity of the even grid (evaluated
+    elementwise, so the same values as in the full grid) already makes the worst
+    margin < -tol; only the other omega0 are evaluated in full.  The answers are
+    those of the full evaluation.
+    """
+    w = cfg.plant.w_max
+    coarse = np.linspace(-w, w, 4001)[::_COARSE]
+    m = principle_margin(cfg, omegas[:, None], coarse, reading=reading, d=cfg.pto.d)
+    ok = ~(m.min(axis=1) < -tol)
+    if ok.any():
+        ok[ok] = np.array(_worst_margins(cfg, omegas[ok], reading, below=-tol)) >= -tol
+    return ok
+
+
 @functools.lru_cache(maxsize=16)
 def _feasible_intervals(cfg: Config, reading: str, scan: int) -> list[tuple[float, float]]:
     """Scan omega0 over (0, w_max], then bisect every edge of the feasible set."""
@@ -602,18 +635,28 @@ def _feasible_intervals(cfg: Config, reading: str, scan: int) -> list[tuple[floa
     grid = np.unique(
         np.concatenate([np.geomspace(1e-4 * w, w, scan // 2), np.linspace(w / scan, w, scan // 2)])
     )
-    ok = np.array(_worst_margins(cfg, grid, reading, below=-tol)) >= -tol
+    ok = _feasible_many(cfg, grid, reading, tol)
 
     def edge(good: float, bad: float) -> float:
-        for _ in range(60):
-            mid = 0.5 * (good + bad)
-            if _worst_margins(cfg, np.array([mid]), reading, below=-tol)[0] >= -tol:
-                good = mid
-            else:
-                bad = mid
-            if abs(good - bad) <= 1e-10 * w:
-                break
-        return good
+        # bisection, up to 60 halvings until |good - bad| <= 1e-10 w_max; the midpoints
+        # of the next _LOOKAHEAD halvings (every outcome) are judged in one batch, and
+        # the walk through them takes the very steps one midpoint at a time would
+        done = 0
+        while True:
+            tree = [(good, bad)]  # breadth first: node k's children are 2k + 1 (ok), 2k + 2
+            for k in range(2**_LOOKAHEAD - 1):
+                g, b = tree[k]
+                mid = 0.5 * (g + b)
+                tree += [(mid, b), (g, mid)]
+            mids = np.array([0.5 * (g + b) for g, b in tree[: 2**_LOOKAHEAD - 1]])
+            feasible = _feasible_many(cfg, mids, reading, tol)
+            k = 0
+            for _ in range(_LOOKAHEAD):
+                good, bad = tree[2 * k + 1] if feasible[k] else tree[2 * k + 2]
+                k = 2 * k + 1 if feasible[k] else 2 * k + 2
+                done += 1
+                if abs(good - bad) <= 1e-10 * w or done == 60:
+                    return good
 
     intervals, i = [], 0
     while i < len(grid):

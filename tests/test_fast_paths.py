@@ -290,3 +290,47 @@ def test_omega_c_small_arrays_are_the_large_array():
         ),
         big,
     )
+
+
+def feasible_intervals_reference(cfg, reading, scan=200):
+    """Scan and one-midpoint-at-a-time bisection of the feasible omega0 (the plain algorithm)."""
+    w, tol = cfg.plant.w_max, zones._tol(cfg)
+    grid = np.unique(
+        np.concatenate([np.geomspace(1e-4 * w, w, scan // 2), np.linspace(w / scan, w, scan // 2)])
+    )
+
+    def ok(om):
+        return worst_margin_reference(cfg, float(om), reading, cfg.pto.d) >= -tol
+
+    good_at = [ok(om) for om in grid]
+
+    def edge(good, bad):
+        for _ in range(60):
+            mid = 0.5 * (good + bad)
+            good, bad = (mid, bad) if ok(mid) else (good, mid)
+            if abs(good - bad) <= 1e-10 * w:
+                break
+        return good
+
+    out, i = [], 0
+    while i < len(grid):
+        if not good_at[i]:
+            i += 1
+            continue
+        j = i
+        while j + 1 < len(grid) and good_at[j + 1]:
+            j += 1
+        lo = 0.0 if i == 0 else edge(float(grid[i]), float(grid[i - 1]))
+        hi = w if j == len(grid) - 1 else edge(float(grid[j]), float(grid[j + 1]))
+        out.append((lo, hi))
+        i = j + 1
+    return out
+
+
+@pytest.mark.parametrize("reading", ["strict", "lenient"])
+def test_feasible_intervals_are_the_plain_scan_and_bisection(reading):
+    # the coarse pre-screen and the batched bisection give the plain algorithm's floats
+    for cfg in (CFG, dataclasses.replace(CFG, pto=PTOSettings(d=3.7, k1=10.0, k2=0.1))):
+        zones.clear_caches()
+        got = list(zones.corrected_zone(cfg, reading=reading, verify=False).feasible_intervals)
+        assert got == feasible_intervals_reference(cfg, reading), (cfg.pto.d, reading)
