@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import LAW_NAMES, Config
-from ptoverify.curves import blockwise, level_term, omega_c
+from ptoverify.curves import blockwise, level_side, omega_c
 from ptoverify.errors import InputError
 
 __all__ = [
@@ -219,8 +219,8 @@ def to_law(cfg: Config) -> Law:
     a, w = cfg.plant.a, cfg.plant.w_max
 
     def vector(x1, x2):
-        # switching_function(x1, x2, a, w), which is a x1 + level_term(x2, w) bit for bit
-        u, region = _bang(a * x1 + level_term(x2, w), x2, w)
+        # the sign of switching_function(x1, x2, a, w) = a x1 + level_term(x2, w)
+        u, region = _bang(level_side(a * x1, x2, w), x2, w)
         return _origin(x1, x2, u, region)
 
     def scalar(x1: float, x2: float) -> tuple[float, int]:
@@ -430,7 +430,7 @@ def pto_law(
         out = ~lin
         if n_lin < lin.size:
             y1, y2 = x1[out], x2[out]
-            sig = a * y1 + level_term(y2, w)  # switching_function, bit for bit
+            sig = level_side(a * y1, y2, w)  # the sign of switching_function
             uo, ro = _bang(sig, y2, w)
             per = np.ndim(lv) > 0
             if per or not math.isnan(lv):
@@ -445,7 +445,7 @@ def pto_law(
                 if cand.size:
                     c1, c2 = y1[cand], y2[cand]
                     lc = lv[cand] if per else lv
-                    r0 = a * c1 + level_term(c2, lc)  # level_residual, bit for bit
+                    r0 = level_side(a * c1, c2, lc)  # the sign of level_residual
                     zp = (c2 < 0) & (r0 <= 0)
                     inz = zp | ((c2 > 0) & (r0 >= 0))
                     if inz.any():  # closed form only where it is used
