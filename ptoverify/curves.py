@@ -307,9 +307,10 @@ def level_side(ax1: Array, x2: Array, omega: float | Array, band: float = 0.0) -
     """Return values that compare with 0 and +-band as ``ax1 + level_term(x2, omega)`` does.
 
     Where |ax1| exceeds a bound on the term (x2^2 / (2 omega), 1e-6 relative
-    above it) plus 2 band, the sum has the sign of ax1, is never 0 and is
-    beyond +-band, so ax1 is returned there; elsewhere (and where anything is
-    NaN) the sum itself, bit for bit.  The term, a logarithm and a 24-term
+    above it) plus 2 band, or where ax1 has the term's sign (x2's) and
+    |ax1| > band, the sum has the sign of ax1, is never 0 and is beyond
+    +-band, so ax1 is returned there; elsewhere (and where anything is NaN)
+    the sum itself, bit for bit.  The term, a logarithm and a 24-term
     series near the curve's vertex, is then computed only near the curve.  Use
     it only where the value is read through ``< 0``, ``== 0``, ``> 0``,
     ``np.sign``, ``< -band`` and ``> band``.
@@ -341,7 +342,14 @@ def level_side(ax1: Array, x2: Array, omega: float | Array, band: float = 0.0) -
     bound /= omega
     bound *= _TERM_BOUND
     bound += _TERM_FLOOR + 2.0 * band
-    far = np.abs(ax1) > bound  # False where anything is NaN: computed in full
+    mag = np.abs(ax1)
+    far = mag > bound  # False where anything is NaN: computed in full
+    # a x1 of x2's sign (the term's): no cancellation, |sum| >= |a x1| > band
+    same = ax1 * x2
+    same = same > 0
+    if band > 0.0:
+        same &= mag > band
+    far |= same
     n_far = np.count_nonzero(far)
     if n_far == far.size:
         return ax1.copy()

@@ -157,7 +157,8 @@ def test_level_side_compares_as_the_residual(band, per_state):
     assert (np.isnan(got) == np.isnan(full)).all()
     # a x1 itself or the sum, and the sum bit for bit in the close calls
     assert ((got == ax1) | (got == full) | np.isnan(full)).all()
-    close = np.abs(full) <= 1e-9 * np.abs(term) + band
+    close = (ax1 * x2 <= 0) & (np.abs(full) <= 1e-9 * np.abs(term) + band)
     assert close.sum() > 1000 and np.array_equal(got[close], full[close])
+    assert (got != full).sum() > n // 4  # the shortcut is taken
     om = omega[:5000] if per_state else omega  # elementwise: a part gives the same
     assert np.array_equal(level_side(ax1[:5000], x2[:5000], om, band), got[:5000], equal_nan=True)
