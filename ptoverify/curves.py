@@ -303,6 +303,11 @@ _TERM_BOUND = 0.5 * (1.0 + 1e-6)
 _TERM_FLOOR = 1e-300
 
 
+#: Below this many states :func:`level_side` computes the sum everywhere (for few
+#: states a numpy call's fixed cost outweighs the work it would save)
+SIDE_MIN = 1024
+
+
 def level_side(ax1: Array, x2: Array, omega: float | Array, band: float = 0.0) -> Array:
     """Return values that compare with 0 and +-band as ``ax1 + level_term(x2, omega)`` does.
 
@@ -338,6 +343,8 @@ def level_side(ax1: Array, x2: Array, omega: float | Array, band: float = 0.0) -
     >>> bool((np.sign(level_side(ax1, x2, 300.0)) == np.sign(full)).all())
     True
     """
+    if ax1.size < SIDE_MIN:  # few states: the fewest numpy calls
+        return ax1 + level_term(x2, omega)
     bound = x2 * x2
     bound /= omega
     bound *= _TERM_BOUND

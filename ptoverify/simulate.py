@@ -631,8 +631,10 @@ def simulate_segments(segments: list[Segment], plant: Plant, steps: int) -> Batc
     Each state's trajectory is bit for bit the one ``simulate_batch(law, plant, x1,
     x2, steps, mismatch=mismatch)`` gives for its segment (a segment with no or the
     identity mismatch is the nominal loop), but the samples are advanced for all
-    states at once and consecutive segments of the same law share one evaluation
-    of it per sample, so many small batches cost one run's per-sample overhead.
+    states at once and consecutive segments of the same law, or of laws of one
+    :class:`~ptoverify.laws.LawFamily` (the TO and PTO laws of a plant), share
+    one evaluation per sample, so many small batches cost one run's per-sample
+    overhead.
 
     Parameters
     ----------
@@ -662,6 +664,11 @@ def simulate_segments(segments: list[Segment], plant: Plant, steps: int) -> Batc
     True
     """
     return _simulate_mismatch(segments, plant, steps)
+
+
+def _kin(a: Law, b: Law) -> bool:
+    """Whether two laws are of one family (evaluated in one call, laws.LawFamily)."""
+    return a.family is not None and b.family is not None and a.family.key == b.family.key
 
 
 def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> BatchResult:
@@ -722,20 +729,32 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
     delay = cat("delay").astype(np.int64) if segs else np.zeros(0, np.int64)
     w_neg = -w_true
     g = -np.expm1(-a * T)
-    # one law evaluation per run of consecutive segments of the same law; the law
+    # one law evaluation per run of consecutive segments of the same law, or of laws
+    # of one family (laws.LawFamily: each state with its law's parameters); the law
     # sees the raw samples where no segment of the run measures them otherwise
     calls = []
     for seg in segs:
-        if calls and calls[-1][0] is seg["law"]:
+        law = seg["law"]
+        if calls and (calls[-1][1][-1]["law"] is law or _kin(calls[-1][1][-1]["law"], law)):
             calls[-1][1].append(seg)
         else:
-            calls.append((seg["law"], [seg]))
+            calls.append((law, [seg]))
     plan = []
     for law, run in calls:
         sl = slice(run[0]["sl"].start, run[-1]["sl"].stop)
         raw1 = all(seg["q"] == 0 for seg in run)
         raw2 = all(seg["noise"] is None and not seg["add_zero"] for seg in run)
-        plan.append((law.vector, sl, [seg for seg in run if not raw2], raw1, raw2))
+        if all(seg["law"] is law for seg in run):
+            fn, params = law.vector, ()
+        else:  # the family's function, its parameters one per state
+            fn = law.family.vector
+            params = tuple(
+                np.concatenate(
+                    [np.full(seg["x1"].shape[0], seg["law"].family.params[i]) for seg in run]
+                )
+                for i in range(len(law.family.params))
+            )
+        plan.append((fn, sl, [seg for seg in run if not raw2], raw1, raw2, params))
     # the quantizer q round(x1 / q), once per sample over consecutive segments of one
     # q: elementwise the same division, rounding and product as segment by segment;
     # states with q = 0 see x1 (copied, as the law's input for them may be y1 too)
@@ -774,7 +793,7 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
                     yq *= q
                 else:
                     y1[ss] = x1k[ss]
-        for vector, sl, run, raw1, raw2 in plan:
+        for vector, sl, run, raw1, raw2, params in plan:
             if not raw2:
                 for seg in run:
                     ss = seg["sl"]
@@ -785,7 +804,7 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
                     else:
                         y2[ss] = x2k[ss]
             uk_row[sl], rk_row[sl] = vector(
-                x1k[sl] if raw1 else y1[sl], x2k[sl] if raw2 else y2[sl]
+                x1k[sl] if raw1 else y1[sl], x2k[sl] if raw2 else y2[sl], *params
             )
         # uk = np.clip(applied, -w_true, w_true), the applied input picked per delay
         if mixed:  # U[max(k - delay, 0), state]
