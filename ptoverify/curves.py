@@ -193,7 +193,7 @@ def h(r: ArrayLike) -> Array:
 
 #: Up to this many series values per array are summed one by one in Python
 #: (:func:`_horner`, bit for bit); more, by numpy passes over all of them.
-FEW = 8
+FEW = 16
 
 
 def _h_block(r: Array) -> Array:

@@ -162,3 +162,16 @@ def test_level_side_compares_as_the_residual(band, per_state):
     assert (got != full).sum() > n // 4  # the shortcut is taken
     om = omega[:5000] if per_state else omega  # elementwise: a part gives the same
     assert np.array_equal(level_side(ax1[:5000], x2[:5000], om, band), got[:5000], equal_nan=True)
+
+
+def test_h_few_series_values_as_many():
+    """h's series in Python floats (few values) equals its numpy passes (many), bit for bit."""
+    from ptoverify.curves import FEW
+
+    rng = np.random.default_rng(11)
+    n = 64 * FEW
+    r = np.concatenate([rng.uniform(-0.199, 0.199, n), rng.uniform(0.2, 5.0, 500)])
+    many = h(r)  # hundreds of series values: numpy passes
+    for start in range(0, n, FEW):  # FEW series values at a time, with the rest
+        got = h(np.concatenate([r[start : start + FEW], r[n:]]))
+        assert np.array_equal(got, np.concatenate([many[start : start + FEW], many[n:]]))
