@@ -353,13 +353,13 @@ def stride_over_counts(
     R = R[: rows - 1]  # noqa: N806
     one_pass = R.dtype == np.int8 and Region.ZONE_N == Region.ZONE_P + 1
     counts = np.zeros(n, dtype=np.intp)
-    # a few whole columns at a time, copied contiguous (cache-sized; sigma at every
-    # sample of them, as the definition reads it, without flat indices of the grid)
+    # a few columns at a time (cache-sized boolean masks); sigma only at the two ends
+    # of the transitions that can be stride-overs (start outside the zones and the
+    # linear zone, land outside the linear zone), read in place from the views
     cols = max(1, STRIDE_BLOCK // rows)
     for j0 in range(0, n, cols):
         j1 = min(j0 + cols, n)
         x1 = np.ascontiguousarray(X1[:, j0:j1])
-        x2 = np.ascontiguousarray(X2[:, j0:j1])
         out = x1 >= d  # |x1| >= d
         out |= x1 <= -d
         r = R[:, j0:j1]
@@ -367,11 +367,17 @@ def stride_over_counts(
             zone = (r - np.int8(Region.ZONE_P)).view(np.uint8) <= 1
         else:
             zone = (r == Region.ZONE_P) | (r == Region.ZONE_N)
-        hit = out[:-1] & ~zone  # starts outside the zones and the linear zone
+        hit = np.greater(out[:-1], zone)  # starts outside the zones and the linear zone
         hit &= out[1:]  # lands outside the linear zone
+        f = np.flatnonzero(hit)  # k (j1 - j0) + j: the sample k of column j, in x1 too
+        if f.size == 0:
+            continue
+        x2 = np.ascontiguousarray(X2[:, j0:j1])
+        v0 = x2.take(f)
         # sigma's sides and comparisons with +-tol (ptoverify.curves.level_side)
-        sig = level_side((a * x1).ravel(), x2.ravel(), w, tol).reshape(x1.shape)
-        s0, s1, v0 = sig[:-1], sig[1:], x2[:-1]
+        s0 = level_side(a * x1.take(f), v0, w, tol)
+        f1 = f + (j1 - j0)  # the next sample
+        s1 = level_side(a * x1.take(f1), x2.take(f1), w, tol)
         on = s0 == 0
         n_side = s0 > 0
         n_side |= on & (v0 > 0)
@@ -380,12 +386,11 @@ def stride_over_counts(
         n_side &= s1 < -tol
         p_side &= s1 > tol
         n_side |= p_side
-        hit &= n_side
-        counts[j0:j1] = np.count_nonzero(hit, axis=0)
+        counts[j0:j1] += np.bincount(f[n_side] % (j1 - j0), minlength=j1 - j0)
     return counts
 
 
-STRIDE_BLOCK = 16384  #: samples per block of :func:`stride_over_counts`
+STRIDE_BLOCK = 65536  #: samples per block of :func:`stride_over_counts`
 
 
 def law_properties(
