@@ -621,6 +621,8 @@ def _fits(b: BatchResult, steps: int, n: int) -> bool:
     )
 
 
+DELAY_RUN = 512  #: states of one delay in a row read by a row slice, not a gather [-]
+
 Segment = tuple[Law, ArrayLike, ArrayLike, Mismatch | None]
 """One group of :func:`simulate_segments`: (law, x1 [mm], x2 [mm/s], mismatch)."""
 
@@ -770,15 +772,29 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
     # was running and held what x_0 commands); per distinct delay, a mask of its states
     values = np.unique(delay).tolist() if n else [0]
     base, mixed = int(values[0]), len(values) > 1
+    runs: list[tuple[int, int, int]] = []  # long runs of one delay: (start, stop, delay)
     if mixed:  # a gather U[max(k - delay, 0), state] (no masked operations: on an
-        # irregular mask they cost several times a gather)
+        # irregular mask they cost several times a gather), but a row slice for
+        # each long run of states of one delay
+        edges = [0, *(np.flatnonzero(np.diff(delay)) + 1).tolist(), n]
+        runs = [
+            (lo, hi, int(delay[lo]))
+            for lo, hi in zip(edges[:-1], edges[1:], strict=True)
+            if hi - lo >= DELAY_RUN
+        ]
         cols = np.arange(n, dtype=np.intp)
-        delay_i = delay.astype(np.intp)
+        if runs:  # the others, gathered then put in place
+            rest = np.ones(n, dtype=bool)
+            for lo, hi, _ in runs:
+                rest[lo:hi] = False
+            cols = np.flatnonzero(rest)
+        delay_i = delay[cols].astype(np.intp)
         offset = cols - delay_i * n  # k n + offset once k >= every delay
-        d_max = int(values[-1])
+        d_max = int(delay_i.max()) if cols.size else 0
+        w_neg_g = w_neg[cols] if runs else w_neg
         flat_u = U.reshape(-1)
-        pick = np.empty(n, dtype=np.intp)
-        gathered = np.empty(n)
+        pick = np.empty(cols.size, dtype=np.intp)
+        gathered = np.empty(cols.size)
     y1, y2 = np.empty(n), np.empty(n)
     uk, dv = np.empty(n), np.empty(n)
     for k in range(steps):
@@ -808,15 +824,22 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
             )
         # uk = np.clip(applied, -w_true, w_true), the applied input picked per delay
         if mixed:  # U[max(k - delay, 0), state]
-            if k >= d_max:
-                np.add(offset, k * n, out=pick)
-            else:
-                np.subtract(k, delay_i, out=pick)
-                np.maximum(pick, 0, out=pick)
-                pick *= n
-                pick += cols
-            np.take(flat_u, pick, out=gathered)
-            np.maximum(gathered, w_neg, out=uk)
+            for lo, hi, dl in runs:
+                np.maximum(U[max(k - dl, 0), lo:hi], w_neg[lo:hi], out=uk[lo:hi])
+            if cols.size:
+                if k >= d_max:
+                    np.add(offset, k * n, out=pick)
+                else:
+                    np.subtract(k, delay_i, out=pick)
+                    np.maximum(pick, 0, out=pick)
+                    pick *= n
+                    pick += cols
+                np.take(flat_u, pick, out=gathered)
+                if runs:
+                    np.maximum(gathered, w_neg_g, out=gathered)
+                    uk[cols] = gathered
+                else:
+                    np.maximum(gathered, w_neg, out=uk)
         else:
             np.maximum(U[max(k - base, 0)], w_neg, out=uk)
         np.minimum(uk, w_true, out=uk)

@@ -200,3 +200,27 @@ def test_one_family_in_one_call_equals_each_law_alone(n):
             assert np.array_equal(getattr(both, f)[:, cols], getattr(alone, f)), (law.name, f)
     zone = (both.region == Region.ZONE_P) | (both.region == Region.ZONE_N)
     assert n < 100 or zone.any(), "the switching zone must act"
+
+
+def test_long_delay_runs_and_mixed_delays_in_one_run():
+    """States of one delay in long runs (row slices) beside per-state delays (a gather)."""
+    from ptoverify.simulate import DELAY_RUN
+
+    rng = np.random.default_rng(9)
+    steps = 60
+    segments = []
+    for delay in (2, None, 0, 1, None):
+        n = DELAY_RUN + 3 if delay is not None else 7
+        m = _random_case(rng, n)
+        if delay is not None:
+            m = Mismatch(m.a_ratio, m.w_max_ratio, delay, m.position_quantum, 0.0, m.seed)
+        x1 = rng.uniform(-40.0, 40.0, n)
+        segments.append((LAWS["pd" if delay == 1 else "pto"], x1, -x1, m))
+    both = simulate_segments(segments, P, steps)
+    at = 0
+    for law, x1, x2, m in segments:
+        alone = simulate_batch(law, P, x1, x2, steps, mismatch=m)
+        cols = slice(at, at + x1.size)
+        at += x1.size
+        for f in ("x1", "x2", "u", "region"):
+            assert np.array_equal(getattr(both, f)[:, cols], getattr(alone, f)), (law.name, f)
