@@ -41,6 +41,7 @@ __all__ = [
     "h",
     "level_residual",
     "level_term",
+    "level_side",
     "switching_function",
     "level_curve_x1",
     "root_22",
@@ -192,7 +193,7 @@ def h(r: ArrayLike) -> Array:
 
 #: Up to this many series values per array are summed one by one in Python
 #: (:func:`_horner`, bit for bit); more, by numpy passes over all of them.
-FEW = 8
+FEW = 16
 
 
 def _h_block(r: Array) -> Array:
@@ -292,6 +293,80 @@ def level_term(x2: ArrayLike, omega: ArrayLike) -> Array:
     """
     x2, omega = np.asarray(x2, dtype=float), np.asarray(omega, dtype=float)
     return np.sign(x2) * omega * h(np.abs(x2) / omega)
+
+
+#: |level_term(x2, omega)| <= x2^2 / (2 omega), as h(r) <= r^2 / 2 for r >= 0; the bound
+#: :func:`level_side` uses, 1e-6 relative above it (the round-off of h, of the term and of
+#: the bound itself is below 1e-14 relative) plus an absolute floor below any term that
+#: the bound's underflow could hide [mm/s]
+_TERM_BOUND = 0.5 * (1.0 + 1e-6)
+_TERM_FLOOR = 1e-300
+
+
+#: Below this many states :func:`level_side` computes the sum everywhere (for few
+#: states a numpy call's fixed cost outweighs the work it would save)
+SIDE_MIN = 1024
+
+
+def level_side(ax1: Array, x2: Array, omega: float | Array, band: float = 0.0) -> Array:
+    """Return values that compare with 0 and +-band as ``ax1 + level_term(x2, omega)`` does.
+
+    Where |ax1| exceeds a bound on the term (x2^2 / (2 omega), 1e-6 relative
+    above it) plus 2 band, or where ax1 has the term's sign (x2's) and
+    |ax1| > band, the sum has the sign of ax1, is never 0 and is beyond
+    +-band, so ax1 is returned there; elsewhere (and where anything is NaN)
+    the sum itself, bit for bit.  The term, a logarithm and a 24-term
+    series near the curve's vertex, is then computed only near the curve.  Use
+    it only where the value is read through ``< 0``, ``== 0``, ``> 0``,
+    ``np.sign``, ``< -band`` and ``> band``.
+
+    Parameters
+    ----------
+    ax1 : ndarray, shape (n,)
+        a x1 [mm/s] (a [rad/s], x1 [mm]), as the caller forms it; not modified.
+    x2 : ndarray, shape (n,)
+        Velocity [mm/s].
+    omega : float or ndarray, shape (n,)
+        Input level of the curve [mm/s], omega > 0.
+    band : float
+        Band the values are compared with [mm/s], >= 0.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Values with those comparisons of ax1 + level_term(x2, omega) [mm/s].
+
+    Examples
+    --------
+    >>> ax1, x2 = np.array([188.5, 1e-3, 0.0]), np.array([-50.0, -50.0, 0.0])
+    >>> full = ax1 + level_term(x2, 300.0)
+    >>> bool((np.sign(level_side(ax1, x2, 300.0)) == np.sign(full)).all())
+    True
+    """
+    if ax1.size < SIDE_MIN:  # few states: the fewest numpy calls
+        return ax1 + level_term(x2, omega)
+    bound = x2 * x2
+    bound /= omega
+    bound *= _TERM_BOUND
+    bound += _TERM_FLOOR + 2.0 * band
+    mag = np.abs(ax1)
+    far = mag > bound  # False where anything is NaN: computed in full
+    # a x1 of x2's sign (the term's): no cancellation, |sum| >= |a x1| > band
+    same = ax1 * x2
+    same = same > 0
+    if band > 0.0:
+        same &= mag > band
+    far |= same
+    n_far = np.count_nonzero(far)
+    if n_far == far.size:
+        return ax1.copy()
+    if 4 * n_far < far.size:  # mostly near: the sum everywhere (no gather and scatter)
+        return ax1 + level_term(x2, omega)
+    near = np.flatnonzero(~far)
+    out = ax1.copy()
+    om = omega[near] if np.ndim(omega) else omega
+    out[near] = ax1[near] + level_term(x2[near], om)
+    return out
 
 
 def switching_function(x1: ArrayLike, x2: ArrayLike, a: float, w_max: float) -> Array:

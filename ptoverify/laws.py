@@ -19,12 +19,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import LAW_NAMES, Config
-from ptoverify.curves import blockwise, level_term, omega_c
+from ptoverify.curves import blockwise, level_side, omega_c
 from ptoverify.errors import InputError
 
 __all__ = [
     "Region",
     "Law",
+    "LawFamily",
     "to_law",
     "pd_law",
     "pto_law",
@@ -59,6 +60,32 @@ ScalarFn = Callable[[float, float], tuple[float, int]]
 
 
 @dataclass(frozen=True)
+class LawFamily:
+    """Laws that are one elementwise function with different parameters.
+
+    A batch that drives states with several laws of one family evaluates them
+    in one call, each state with its law's parameters
+    (:func:`ptoverify.simulate.simulate_segments`): per sample, one call's
+    fixed overhead in place of one per law.  Each state's input and region are
+    bit for bit those of its own law's vector path.
+
+    Attributes
+    ----------
+    key : tuple
+        Laws with equal keys belong to one family (their ``vector`` is the same function).
+    vector : callable
+        ``vector(x1, x2, *params) -> (u, region)`` on float arrays, each parameter
+        a float or an array of the states' shape.
+    params : tuple of float
+        This law's parameters.
+    """
+
+    key: tuple
+    vector: Callable[..., tuple[NDArray[np.float64], NDArray[np.int8]]]
+    params: tuple[float, ...]
+
+
+@dataclass(frozen=True)
 class Law:
     """A feedback law u = f(x1, x2), vectorized and scalar.
 
@@ -74,6 +101,8 @@ class Law:
         Saturation [mm/s] the law respects.
     note : str
         What the law is, in one line (says when a variant falls back).
+    family : LawFamily or None
+        The family the law belongs to (the TO and PTO laws of one plant), if any.
     """
 
     name: str
@@ -81,6 +110,7 @@ class Law:
     scalar: ScalarFn
     w_max: float
     note: str = ""
+    family: LawFamily | None = None
 
     def __call__(
         self, x1: ArrayLike, x2: ArrayLike
@@ -219,9 +249,13 @@ def to_law(cfg: Config) -> Law:
     a, w = cfg.plant.a, cfg.plant.w_max
 
     def vector(x1, x2):
-        # switching_function(x1, x2, a, w), which is a x1 + level_term(x2, w) bit for bit
-        u, region = _bang(a * x1 + level_term(x2, w), x2, w)
+        # the sign of switching_function(x1, x2, a, w) = a x1 + level_term(x2, w)
+        u, region = _bang(level_side(a * x1, x2, w), x2, w)
         return _origin(x1, x2, u, region)
+
+    # the PTO block with no linear zone (|x1| < 0 never holds) and no switching zone
+    # runs exactly this arithmetic: TO is a member of the PTO family
+    family = _pto_family(a, w, (0.0, 0.0, 0.0, math.nan))
 
     def scalar(x1: float, x2: float) -> tuple[float, int]:
         if x1 == 0.0 and x2 == 0.0:
@@ -231,7 +265,7 @@ def to_law(cfg: Config) -> Law:
             return w, int(Region.BANG_P)
         return -w, int(Region.BANG_N)
 
-    return Law("to", vector, scalar, w, "time-optimal bang-bang, eq. (12)")
+    return Law("to", vector, scalar, w, "time-optimal bang-bang, eq. (12)", family)
 
 
 def saturate_linear(v: NDArray[np.float64], w: float):
@@ -354,6 +388,78 @@ def omega_c_scalar(x1: float, x2: float, a: float) -> float:
     return abs(x2) / math.expm1(u)
 
 
+def _pto_block(a: float, w: float) -> Callable:
+    """Return the PTO law's elementwise function of a plant, eq. (35), parameters explicit.
+
+    ``block(x1, x2, g1, g2, dd, lv)``: linear gains k1 [1/s], k2 [-], linear-zone
+    half-width d [mm], switching-zone level [mm/s] (NaN: no zone), each a float or
+    one per state; on 1-D float arrays of one block (:func:`ptoverify.curves.blockwise`).
+    """
+
+    def block(x1, x2, g1, g2, dd, lv):
+        # each branch on the states it acts on (the linear zone first, as it takes
+        # precedence); the same elementwise arithmetic as evaluating every branch
+        # everywhere and selecting, so the result is unchanged.  g1, g2: the linear
+        # gains, dd: d, lv: the zone's level (NaN: no zone); floats or one per state
+        lin = np.abs(x1) < dd
+        n_lin = np.count_nonzero(lin)
+        if n_lin == lin.size:  # all in the linear zone: no masks
+            u, region = saturate_linear(-g1 * x1 - g2 * x2, w)
+            return _origin(x1, x2, u, region)
+        if 2 * n_lin >= lin.size:  # mostly linear: the linear input everywhere, the
+            # other states overwritten below (no gather and scatter of the linear ones)
+            with np.errstate(invalid="ignore", over="ignore"):  # only where overwritten
+                u, region = saturate_linear(-g1 * x1 - g2 * x2, w)
+        else:
+            u = np.empty(x1.shape)
+            region = np.empty(x1.shape, dtype=np.int8)
+            if n_lin:
+                if np.ndim(g1):
+                    g1, g2 = g1[lin], g2[lin]
+                u[lin], region[lin] = saturate_linear(-g1 * x1[lin] - g2 * x2[lin], w)
+        out = ~lin
+        if n_lin < lin.size:
+            y1, y2 = x1[out], x2[out]
+            sig = level_side(a * y1, y2, w)  # the sign of switching_function
+            uo, ro = _bang(sig, y2, w)
+            per = np.ndim(lv) > 0
+            if per or not math.isnan(lv):
+                # ((y2 < 0) & (sig > 0)) | ((y2 > 0) & (sig < 0)), in fewer passes
+                between = np.sign(y2)
+                between *= np.sign(sig)
+                between = between < 0
+                if per:
+                    lv = lv[out]
+                    between &= ~np.isnan(lv)
+                cand = np.flatnonzero(between)
+                if cand.size:
+                    c1, c2 = y1[cand], y2[cand]
+                    lc = lv[cand] if per else lv
+                    r0 = level_side(a * c1, c2, lc)  # the sign of level_residual
+                    zp = (c2 < 0) & (r0 <= 0)
+                    inz = zp | ((c2 > 0) & (r0 >= 0))
+                    if inz.any():  # closed form only where it is used
+                        wc = np.clip(omega_c(c1[inz], c2[inz], a), lc[inz] if per else lc, w)
+                        zpi = zp[inz]
+                        idx = cand[inz]
+                        uo[idx] = np.where(zpi, wc, -wc)
+                        ro[idx] = np.where(zpi, Region.ZONE_P, Region.ZONE_N)
+            u[out], region[out] = uo, ro
+        return _origin(x1, x2, u, region)
+
+    return block
+
+
+def _pto_family(a: float, w: float, params: tuple[float, ...]) -> LawFamily:
+    """Return the PTO family of a plant (:class:`LawFamily`), this member's ``params``."""
+    block = _pto_block(a, w)
+
+    def vector(x1, x2, *p):
+        return blockwise(block, x1, x2, *p)
+
+    return LawFamily(("pto-block", float(a), float(w)), vector, tuple(float(v) for v in params))
+
+
 def pto_law(
     cfg: Config,
     omega0: float | None,
@@ -406,56 +512,12 @@ def pto_law(
     zone = omega0 is not None and 0.0 < omega0 < w
     om = float(omega0) if zone else w
 
-    def block(x1, x2, g1=k1, g2=k2, dd=d, lv=om if zone else math.nan):
-        # each branch on the states it acts on (the linear zone first, as it takes
-        # precedence); the same elementwise arithmetic as evaluating every branch
-        # everywhere and selecting, so the result is unchanged.  g1, g2: the linear
-        # gains, dd: d, lv: the zone's level (NaN: no zone); floats or one per state
-        lin = np.abs(x1) < dd
-        n_lin = np.count_nonzero(lin)
-        if n_lin == lin.size:  # all in the linear zone: no masks
-            u, region = saturate_linear(-g1 * x1 - g2 * x2, w)
-            return _origin(x1, x2, u, region)
-        if 2 * n_lin >= lin.size:  # mostly linear: the linear input everywhere, the
-            # other states overwritten below (no gather and scatter of the linear ones)
-            with np.errstate(invalid="ignore", over="ignore"):  # only where overwritten
-                u, region = saturate_linear(-g1 * x1 - g2 * x2, w)
-        else:
-            u = np.empty(x1.shape)
-            region = np.empty(x1.shape, dtype=np.int8)
-            if n_lin:
-                if np.ndim(g1):
-                    g1, g2 = g1[lin], g2[lin]
-                u[lin], region[lin] = saturate_linear(-g1 * x1[lin] - g2 * x2[lin], w)
-        out = ~lin
-        if n_lin < lin.size:
-            y1, y2 = x1[out], x2[out]
-            sig = a * y1 + level_term(y2, w)  # switching_function, bit for bit
-            uo, ro = _bang(sig, y2, w)
-            per = np.ndim(lv) > 0
-            if per or not math.isnan(lv):
-                # ((y2 < 0) & (sig > 0)) | ((y2 > 0) & (sig < 0)), in fewer passes
-                between = np.sign(y2)
-                between *= np.sign(sig)
-                between = between < 0
-                if per:
-                    lv = lv[out]
-                    between &= ~np.isnan(lv)
-                cand = np.flatnonzero(between)
-                if cand.size:
-                    c1, c2 = y1[cand], y2[cand]
-                    lc = lv[cand] if per else lv
-                    r0 = a * c1 + level_term(c2, lc)  # level_residual, bit for bit
-                    zp = (c2 < 0) & (r0 <= 0)
-                    inz = zp | ((c2 > 0) & (r0 >= 0))
-                    if inz.any():  # closed form only where it is used
-                        wc = np.clip(omega_c(c1[inz], c2[inz], a), lc[inz] if per else lc, w)
-                        zpi = zp[inz]
-                        idx = cand[inz]
-                        uo[idx] = np.where(zpi, wc, -wc)
-                        ro[idx] = np.where(zpi, Region.ZONE_P, Region.ZONE_N)
-            u[out], region[out] = uo, ro
-        return _origin(x1, x2, u, region)
+    params = (k1, k2, d, om if zone else math.nan)
+    family = _pto_family(a, w, params)
+    pto_block = _pto_block(a, w)
+
+    def block(x1, x2, g1=k1, g2=k2, dd=d, lv=params[3]):
+        return pto_block(x1, x2, g1, g2, dd, lv)
 
     if gains is not None:
         return _state_gains_law(name, lambda x1, x2: blockwise(block, x1, x2, *gains), w)
@@ -483,7 +545,7 @@ def pto_law(
             return w, int(Region.BANG_P)
         return -w, int(Region.BANG_N)
 
-    return Law(name, vector, scalar, w, note or f"PTO eq. (35), omega0 = {om:g} mm/s")
+    return Law(name, vector, scalar, w, note or f"PTO eq. (35), omega0 = {om:g} mm/s", family)
 
 
 def pto_corrected_law(cfg: Config, *, gains: tuple[NDArray, NDArray] | None = None) -> Law:

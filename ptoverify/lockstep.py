@@ -8,7 +8,8 @@ integrator's fixed overhead per call).  Here each workload is a *job*, a
 generator that yields the simulations it needs next (:class:`Ask`) and is sent
 their trajectories; :func:`run_lockstep` gathers the asks of all jobs into
 rounds and runs each round as one :func:`ptoverify.simulate.simulate_segments`
-call, in which the asks of one law share one evaluation of it per sample.
+call, in which the asks of one law, and of the laws of one
+:class:`~ptoverify.laws.LawFamily`, share one evaluation per sample.
 
 Every trajectory is bit for bit the one :func:`ptoverify.simulate.simulate_batch`
 gives for its ask alone (states are independent), so what the jobs compute does
@@ -96,6 +97,11 @@ class LockstepRun:
     rounds: int = 0
     state_steps: int = 0
     seconds: dict[str, float] = field(default_factory=dict)
+
+
+def _family(law: Law) -> Any:
+    """Return the group of a law's asks: its family's key, else the law itself."""
+    return ("family", law.family.key) if law.family is not None else ("law", id(law))
 
 
 def run_lockstep(
@@ -193,11 +199,19 @@ def run_lockstep(
             size += ask.size
         taken = set(chosen)
         queue = [q for q in queue if q not in taken]
-        # the asks of one law next to each other: one evaluation of it per sample
-        order = {}
+        # the asks of one law next to each other, and the laws of one family
+        # (laws.LawFamily): one evaluation of them per sample
+        order: dict[Any, int] = {}
         for j, i in chosen:
-            order.setdefault(id(waiting[j][0][i].law), len(order))
-        chosen.sort(key=lambda q: order[id(waiting[q[0]][0][q[1]].law)])
+            law = waiting[j][0][i].law
+            order.setdefault(_family(law), len(order))
+            order.setdefault(id(law), len(order))
+        chosen.sort(
+            key=lambda q: (
+                order[_family(waiting[q[0]][0][q[1]].law)],
+                order[id(waiting[q[0]][0][q[1]].law)],
+            )
+        )
         asks = [waiting[j][0][i] for j, i in chosen]
         t = time.perf_counter()
         batch = simulate_segments([(a.law, a.x1, a.x2, a.mismatch) for a in asks], plant, steps)

@@ -42,7 +42,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ptoverify.config import Config
-from ptoverify.curves import switching_function
+from ptoverify.curves import level_side, switching_function
 from ptoverify.laws import Law, Region, make_law
 from ptoverify.simulate import BatchResult, simulate_batch
 from ptoverify.verdict import tie_band
@@ -350,8 +350,51 @@ def stride_over_counts(
     >>> counts.tolist() == crossing_masks(b.x1, b.x2, b.region, cfg)[0].sum(axis=0).tolist()
     True
     """
-    _, j, cross, lands_out = _crossings(X1, X2, R, cfg)
-    return np.bincount(j[cross & lands_out], minlength=X1.shape[1])
+    p = cfg.plant
+    a, w, d = p.a, p.w_max, cfg.pto.d
+    tol = tie_band(w, a, p.position_range)
+    rows, n = X1.shape
+    R = R[: rows - 1]  # noqa: N806
+    one_pass = R.dtype == np.int8 and Region.ZONE_N == Region.ZONE_P + 1
+    counts = np.zeros(n, dtype=np.intp)
+    # a few columns at a time (cache-sized boolean masks); sigma only at the two ends
+    # of the transitions that can be stride-overs (start outside the zones and the
+    # linear zone, land outside the linear zone), read in place from the views
+    cols = max(1, STRIDE_BLOCK // rows)
+    for j0 in range(0, n, cols):
+        j1 = min(j0 + cols, n)
+        x1 = np.ascontiguousarray(X1[:, j0:j1])
+        out = x1 >= d  # |x1| >= d
+        out |= x1 <= -d
+        r = R[:, j0:j1]
+        if one_pass:  # R in {ZONE_P, ZONE_N}
+            zone = (r - np.int8(Region.ZONE_P)).view(np.uint8) <= 1
+        else:
+            zone = (r == Region.ZONE_P) | (r == Region.ZONE_N)
+        hit = np.greater(out[:-1], zone)  # starts outside the zones and the linear zone
+        hit &= out[1:]  # lands outside the linear zone
+        f = np.flatnonzero(hit)  # k (j1 - j0) + j: the sample k of column j, in x1 too
+        if f.size == 0:
+            continue
+        x2 = np.ascontiguousarray(X2[:, j0:j1])
+        v0 = x2.take(f)
+        # sigma's sides and comparisons with +-tol (ptoverify.curves.level_side)
+        s0 = level_side(a * x1.take(f), v0, w, tol)
+        f1 = f + (j1 - j0)  # the next sample
+        s1 = level_side(a * x1.take(f1), x2.take(f1), w, tol)
+        on = s0 == 0
+        n_side = s0 > 0
+        n_side |= on & (v0 > 0)
+        p_side = s0 < 0
+        p_side |= on & (v0 < 0)
+        n_side &= s1 < -tol
+        p_side &= s1 > tol
+        n_side |= p_side
+        counts[j0:j1] += np.bincount(f[n_side] % (j1 - j0), minlength=j1 - j0)
+    return counts
+
+
+STRIDE_BLOCK = 65536  #: samples per block of :func:`stride_over_counts`
 
 
 #: The arrays of the last grid run finished in this process, for the next to write

@@ -621,6 +621,8 @@ def _fits(b: BatchResult, steps: int, n: int) -> bool:
     )
 
 
+DELAY_RUN = 512  #: states of one delay in a row read by a row slice, not a gather [-]
+
 Segment = tuple[Law, ArrayLike, ArrayLike, Mismatch | None]
 """One group of :func:`simulate_segments`: (law, x1 [mm], x2 [mm/s], mismatch)."""
 
@@ -631,8 +633,10 @@ def simulate_segments(segments: list[Segment], plant: Plant, steps: int) -> Batc
     Each state's trajectory is bit for bit the one ``simulate_batch(law, plant, x1,
     x2, steps, mismatch=mismatch)`` gives for its segment (a segment with no or the
     identity mismatch is the nominal loop), but the samples are advanced for all
-    states at once and consecutive segments of the same law share one evaluation
-    of it per sample, so many small batches cost one run's per-sample overhead.
+    states at once and consecutive segments of the same law, or of laws of one
+    :class:`~ptoverify.laws.LawFamily` (the TO and PTO laws of a plant), share
+    one evaluation per sample, so many small batches cost one run's per-sample
+    overhead.
 
     Parameters
     ----------
@@ -662,6 +666,11 @@ def simulate_segments(segments: list[Segment], plant: Plant, steps: int) -> Batc
     True
     """
     return _simulate_mismatch(segments, plant, steps)
+
+
+def _kin(a: Law, b: Law) -> bool:
+    """Whether two laws are of one family (evaluated in one call, laws.LawFamily)."""
+    return a.family is not None and b.family is not None and a.family.key == b.family.key
 
 
 def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> BatchResult:
@@ -722,20 +731,32 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
     delay = cat("delay").astype(np.int64) if segs else np.zeros(0, np.int64)
     w_neg = -w_true
     g = -np.expm1(-a * T)
-    # one law evaluation per run of consecutive segments of the same law; the law
+    # one law evaluation per run of consecutive segments of the same law, or of laws
+    # of one family (laws.LawFamily: each state with its law's parameters); the law
     # sees the raw samples where no segment of the run measures them otherwise
     calls = []
     for seg in segs:
-        if calls and calls[-1][0] is seg["law"]:
+        law = seg["law"]
+        if calls and (calls[-1][1][-1]["law"] is law or _kin(calls[-1][1][-1]["law"], law)):
             calls[-1][1].append(seg)
         else:
-            calls.append((seg["law"], [seg]))
+            calls.append((law, [seg]))
     plan = []
     for law, run in calls:
         sl = slice(run[0]["sl"].start, run[-1]["sl"].stop)
         raw1 = all(seg["q"] == 0 for seg in run)
         raw2 = all(seg["noise"] is None and not seg["add_zero"] for seg in run)
-        plan.append((law.vector, sl, [seg for seg in run if not raw2], raw1, raw2))
+        if all(seg["law"] is law for seg in run):
+            fn, params = law.vector, ()
+        else:  # the family's function, its parameters one per state
+            fn = law.family.vector
+            params = tuple(
+                np.concatenate(
+                    [np.full(seg["x1"].shape[0], seg["law"].family.params[i]) for seg in run]
+                )
+                for i in range(len(law.family.params))
+            )
+        plan.append((fn, sl, [seg for seg in run if not raw2], raw1, raw2, params))
     # the quantizer q round(x1 / q), once per sample over consecutive segments of one
     # q: elementwise the same division, rounding and product as segment by segment;
     # states with q = 0 see x1 (copied, as the law's input for them may be y1 too)
@@ -751,15 +772,29 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
     # was running and held what x_0 commands); per distinct delay, a mask of its states
     values = np.unique(delay).tolist() if n else [0]
     base, mixed = int(values[0]), len(values) > 1
+    runs: list[tuple[int, int, int]] = []  # long runs of one delay: (start, stop, delay)
     if mixed:  # a gather U[max(k - delay, 0), state] (no masked operations: on an
-        # irregular mask they cost several times a gather)
+        # irregular mask they cost several times a gather), but a row slice for
+        # each long run of states of one delay
+        edges = [0, *(np.flatnonzero(np.diff(delay)) + 1).tolist(), n]
+        runs = [
+            (lo, hi, int(delay[lo]))
+            for lo, hi in zip(edges[:-1], edges[1:], strict=True)
+            if hi - lo >= DELAY_RUN
+        ]
         cols = np.arange(n, dtype=np.intp)
-        delay_i = delay.astype(np.intp)
+        if runs:  # the others, gathered then put in place
+            rest = np.ones(n, dtype=bool)
+            for lo, hi, _ in runs:
+                rest[lo:hi] = False
+            cols = np.flatnonzero(rest)
+        delay_i = delay[cols].astype(np.intp)
         offset = cols - delay_i * n  # k n + offset once k >= every delay
-        d_max = int(values[-1])
+        d_max = int(delay_i.max()) if cols.size else 0
+        w_neg_g = w_neg[cols] if runs else w_neg
         flat_u = U.reshape(-1)
-        pick = np.empty(n, dtype=np.intp)
-        gathered = np.empty(n)
+        pick = np.empty(cols.size, dtype=np.intp)
+        gathered = np.empty(cols.size)
     y1, y2 = np.empty(n), np.empty(n)
     uk, dv = np.empty(n), np.empty(n)
     for k in range(steps):
@@ -774,7 +809,7 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
                     yq *= q
                 else:
                     y1[ss] = x1k[ss]
-        for vector, sl, run, raw1, raw2 in plan:
+        for vector, sl, run, raw1, raw2, params in plan:
             if not raw2:
                 for seg in run:
                     ss = seg["sl"]
@@ -785,19 +820,26 @@ def _simulate_mismatch(segments: list[Segment], plant: Plant, steps: int) -> Bat
                     else:
                         y2[ss] = x2k[ss]
             uk_row[sl], rk_row[sl] = vector(
-                x1k[sl] if raw1 else y1[sl], x2k[sl] if raw2 else y2[sl]
+                x1k[sl] if raw1 else y1[sl], x2k[sl] if raw2 else y2[sl], *params
             )
         # uk = np.clip(applied, -w_true, w_true), the applied input picked per delay
         if mixed:  # U[max(k - delay, 0), state]
-            if k >= d_max:
-                np.add(offset, k * n, out=pick)
-            else:
-                np.subtract(k, delay_i, out=pick)
-                np.maximum(pick, 0, out=pick)
-                pick *= n
-                pick += cols
-            np.take(flat_u, pick, out=gathered)
-            np.maximum(gathered, w_neg, out=uk)
+            for lo, hi, dl in runs:
+                np.maximum(U[max(k - dl, 0), lo:hi], w_neg[lo:hi], out=uk[lo:hi])
+            if cols.size:
+                if k >= d_max:
+                    np.add(offset, k * n, out=pick)
+                else:
+                    np.subtract(k, delay_i, out=pick)
+                    np.maximum(pick, 0, out=pick)
+                    pick *= n
+                    pick += cols
+                np.take(flat_u, pick, out=gathered)
+                if runs:
+                    np.maximum(gathered, w_neg_g, out=gathered)
+                    uk[cols] = gathered
+                else:
+                    np.maximum(gathered, w_neg, out=uk)
         else:
             np.maximum(U[max(k - base, 0)], w_neg, out=uk)
         np.minimum(uk, w_true, out=uk)

@@ -130,3 +130,48 @@ def test_root_k_against_scipy_lambertw():
     k = 1 - m
     ref = -1 - np.real(lambertw(-k * np.exp(-k), -1)) / k
     assert_allclose(root_k(m), ref, rtol=1e-12, err_msg="z = -1 - W_{-1}(-k e^{-k}) / k")
+
+
+@pytest.mark.parametrize("band", [0.0, 5.3e-6, 1e-2])
+@pytest.mark.parametrize("per_state", [True, False])
+def test_level_side_compares_as_the_residual(band, per_state):
+    """level_side: the sum's sign, zero and comparisons with +-band, and the sum near the curve."""
+    from ptoverify.curves import level_side, level_term
+
+    rng = np.random.default_rng(7)
+    n = 200_000
+    omega = 10.0 ** rng.uniform(0.0, 3.0, n) if per_state else 300.0
+    x2 = omega * rng.choice([-1.0, 1.0], n) * 10.0 ** rng.uniform(-12.0, 0.5, n)
+    term = level_term(x2, omega)
+    # a x1 near -term (on the curve, within a few ulps to a few bands), anywhere, 0, NaN
+    ax1 = -term * (1.0 + rng.choice([0.0, 1e-16, -1e-16, 1e-9, 1e-6, 1e-3, 1.0], n))
+    ax1 += rng.choice([0.0, band, -band, 2 * band, -2 * band, 3 * band], n)
+    ax1[::97] = rng.uniform(-1e3, 1e3, ax1[::97].size)
+    ax1[::101], x2[::103] = 0.0, 0.0
+    ax1[::211], x2[::223] = np.nan, np.nan
+    full = ax1 + level_term(x2, omega)
+    got = level_side(ax1, x2, omega, band)
+    for cmp in (np.sign(got) == np.sign(full), (got == 0) == (full == 0)):
+        assert (cmp | np.isnan(full)).all()
+    assert ((got < -band) == (full < -band)).all() and ((got > band) == (full > band)).all()
+    assert (np.isnan(got) == np.isnan(full)).all()
+    # a x1 itself or the sum, and the sum bit for bit in the close calls
+    assert ((got == ax1) | (got == full) | np.isnan(full)).all()
+    close = (ax1 * x2 <= 0) & (np.abs(full) <= 1e-9 * np.abs(term) + band)
+    assert close.sum() > 1000 and np.array_equal(got[close], full[close])
+    assert (got != full).sum() > n // 4  # the shortcut is taken
+    om = omega[:5000] if per_state else omega  # elementwise: a part gives the same
+    assert np.array_equal(level_side(ax1[:5000], x2[:5000], om, band), got[:5000], equal_nan=True)
+
+
+def test_h_few_series_values_as_many():
+    """h's series in Python floats (few values) equals its numpy passes (many), bit for bit."""
+    from ptoverify.curves import FEW
+
+    rng = np.random.default_rng(11)
+    n = 64 * FEW
+    r = np.concatenate([rng.uniform(-0.199, 0.199, n), rng.uniform(0.2, 5.0, 500)])
+    many = h(r)  # hundreds of series values: numpy passes
+    for start in range(0, n, FEW):  # FEW series values at a time, with the rest
+        got = h(np.concatenate([r[start : start + FEW], r[n:]]))
+        assert np.array_equal(got, np.concatenate([many[start : start + FEW], many[n:]]))

@@ -65,3 +65,24 @@ def test_pd_law_saturates():
 def test_unknown_law():
     with pytest.raises(InputError, match="unknown law"):
         make_law("bangbang", CFG)
+
+
+def test_family_vector_is_each_laws_vector():
+    """One call of the PTO family, each state with its law's parameters, bit for bit."""
+    rng = np.random.default_rng(5)
+    n = 3000
+    x1 = rng.uniform(-50.0, 50.0, n) * rng.uniform(0.0, 1.0, n) ** 3
+    x2 = rng.uniform(-350.0, 350.0, n) * rng.uniform(0.0, 1.0, n)
+    x1[:6] = [0.0, CFG.pto.d, -CFG.pto.d, np.nan, 1.0, np.inf]
+    x2[:6] = [0.0, 0.0, 1.0, 0.0, np.nan, 0.0]
+    laws = [make_law(name, CFG) for name in ("to", "pto", "pto-printed")]
+    pick = rng.integers(0, 3, n)
+    params = [np.array([laws[k].family.params[i] for k in pick]) for i in range(4)]
+    with np.errstate(invalid="ignore"):
+        u, region = laws[0].family.vector(x1, x2, *params)
+        for k, law in enumerate(laws):
+            mine = pick == k
+            want_u, want_r = law.vector(x1[mine], x2[mine])
+            assert np.array_equal(u[mine], want_u, equal_nan=True), law.name
+            assert np.array_equal(region[mine], want_r), law.name
+    assert {Region.ZONE_P, Region.ZONE_N, Region.LINEAR, Region.BANG_P} <= set(region.tolist())

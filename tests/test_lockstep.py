@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from ptoverify.config import paper_config
-from ptoverify.laws import make_law
+from ptoverify.laws import Region, make_law
 from ptoverify.lockstep import Ask, run_lockstep
 from ptoverify.plant import flow
 from ptoverify.robust import (
@@ -176,3 +176,51 @@ def test_study_parts_equal_the_parts_run_alone():
         assert _same({k: res.margins[law][k] for k in alone}, alone)
         starts = {p: grid_worst(res.maps["laws"][law], p) for p in s.properties}
         assert _same(res.worst[law], worst_cases(law, CFG, starts, s))
+
+
+@pytest.mark.parametrize("n", [4, 400])
+def test_one_family_in_one_call_equals_each_law_alone(n):
+    """TO, PTO and PTO-printed (one laws.LawFamily) run as one evaluation per sample."""
+    rng = np.random.default_rng(n)
+    steps = 200
+    segments = []
+    for name in ("to", "pto", "pto-printed", "pto", "to"):
+        x1 = rng.uniform(-50.0, 50.0, n) * rng.uniform(0.0, 1.0, n) ** 3  # many near 0
+        x2 = rng.uniform(-300.0, 300.0, n) * rng.uniform(0.0, 1.0, n)
+        x1[:2], x2[:2] = (0.0, CFG.pto.d), (0.0, 0.0)  # the origin; the linear zone's edge
+        segments.append((LAWS[name], x1, x2, _random_case(rng, n)))
+    assert LAWS["to"].family.key == LAWS["pto"].family.key == LAWS["pto-printed"].family.key
+    both = simulate_segments(segments, P, steps)
+    at = 0
+    for law, x1, x2, m in segments:
+        alone = simulate_batch(law, P, x1, x2, steps, mismatch=m)
+        cols = slice(at, at + n)
+        at += n
+        for f in ("x1", "x2", "u", "region"):
+            assert np.array_equal(getattr(both, f)[:, cols], getattr(alone, f)), (law.name, f)
+    zone = (both.region == Region.ZONE_P) | (both.region == Region.ZONE_N)
+    assert n < 100 or zone.any(), "the switching zone must act"
+
+
+def test_long_delay_runs_and_mixed_delays_in_one_run():
+    """States of one delay in long runs (row slices) beside per-state delays (a gather)."""
+    from ptoverify.simulate import DELAY_RUN
+
+    rng = np.random.default_rng(9)
+    steps = 60
+    segments = []
+    for delay in (2, None, 0, 1, None):
+        n = DELAY_RUN + 3 if delay is not None else 7
+        m = _random_case(rng, n)
+        if delay is not None:
+            m = Mismatch(m.a_ratio, m.w_max_ratio, delay, m.position_quantum, 0.0, m.seed)
+        x1 = rng.uniform(-40.0, 40.0, n)
+        segments.append((LAWS["pd" if delay == 1 else "pto"], x1, -x1, m))
+    both = simulate_segments(segments, P, steps)
+    at = 0
+    for law, x1, x2, m in segments:
+        alone = simulate_batch(law, P, x1, x2, steps, mismatch=m)
+        cols = slice(at, at + x1.size)
+        at += x1.size
+        for f in ("x1", "x2", "u", "region"):
+            assert np.array_equal(getattr(both, f)[:, cols], getattr(alone, f)), (law.name, f)
