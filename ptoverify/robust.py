@@ -84,7 +84,6 @@ __all__ = [
     "no_limit_cycle_margin",
     "worst_case",
     "worst_cases",
-    "choose_distinct",
     "grid_worst",
     "dask_runner",
     "check_dask_address",
@@ -880,107 +879,11 @@ def _distinct_others(rng: np.random.Generator, n_pop: int, k: int) -> NDArray[np
 
     ``rng.choice(n_pop - 1, k, replace=False)`` draws exactly what
     ``rng.choice(np.delete(np.arange(n_pop), i), k, replace=False)`` draws (the
-    choice depends only on the population size), shifted past i.  With the
-    default bit generator the draws of all members are made at once
-    (:func:`_choices_pcg64`); ``tests/test_robust.py`` compares them with
-    ``rng.choice``.
+    choice depends only on the population size), shifted past i.
     """
-    out = choose_distinct(rng, n_pop - 1, k, n_pop)
+    out = np.array([rng.choice(n_pop - 1, k, replace=False) for _ in range(n_pop)])
     out += out >= np.arange(n_pop)[:, None]
     return out
-
-
-def choose_distinct(rng: np.random.Generator, m: int, k: int, times: int) -> NDArray[np.int64]:
-    """Return ``times`` draws of ``rng.choice(m, k, replace=False)``, draw for draw.
-
-    The rows are what the calls return one after the other, and ``rng`` is left
-    where they leave it; with the default bit generator (PCG64) and k <= 3 the
-    words of all calls are read at once (:func:`_choices_pcg64`), otherwise the
-    calls are made.
-
-    Parameters
-    ----------
-    rng : numpy.random.Generator
-        The generator drawn from.
-    m : int
-        Population size (values 0 .. m - 1).
-    k : int
-        Values per draw, distinct, k <= m.
-    times : int
-        Draws.
-
-    Returns
-    -------
-    ndarray of int64, shape (times, k)
-        One draw per row.
-
-    Examples
-    --------
-    >>> a, b = np.random.default_rng(3), np.random.default_rng(3)
-    >>> rows = choose_distinct(a, 23, 2, 4)
-    >>> rows.tolist() == [b.choice(23, 2, replace=False).tolist() for _ in range(4)]
-    True
-    """
-    out = _choices_pcg64(rng, m, k, times)
-    if out is None:
-        out = np.array([rng.choice(m, k, replace=False) for _ in range(times)], dtype=np.int64)
-    return out.reshape(times, k)
-
-
-def _choices_pcg64(
-    rng: np.random.Generator, m: int, k: int, times: int
-) -> NDArray[np.int64] | None:
-    """Draw ``times`` calls of ``rng.choice(m, k, replace=False)`` at once, or return None.
-
-    What NumPy's ``Generator.choice`` does for a small population without
-    replacement: Floyd's algorithm (value j_i uniform in [0, m - k + i], taken
-    unless already chosen, then m - k + i is taken), then a Fisher-Yates shuffle
-    of the k values, every bounded integer by Lemire's method on the 32-bit
-    stream (a 64-bit output gives its low half, then its high half).  Here all
-    the 32-bit words are read at once and the generator's state is set to where
-    those calls leave it.  None (nothing drawn) unless the bit generator is PCG64
-    and 1 <= k <= 3, k < m < 10000; also None when a word would be rejected by
-    Lemire's method (probability below k m 2^-32 per call), the case its
-    shortcut leaves to ``rng.choice``.
-    """
-    bg = rng.bit_generator
-    if type(bg) is not np.random.PCG64 or not (1 <= k <= 3 and k < m < 10000):
-        return None
-    # bounds of each draw in order: Floyd's k values, then the shuffle's k - 1
-    per = [m - k + i + 1 for i in range(k)] + list(range(k, 1, -1))
-    need = times * len(per)
-    saved = bg.state
-    has = bool(saved["has_uint32"])
-    raws = (need - has + 1) // 2
-    raw = bg.random_raw(raws) if raws else np.zeros(0, np.uint64)
-    words = np.empty(2 * raws, np.uint64)
-    words[0::2] = raw & np.uint64(0xFFFFFFFF)
-    words[1::2] = raw >> np.uint64(32)
-    if has:
-        words = np.concatenate([[np.uint64(saved["uinteger"])], words])
-    left_over = words.size > need  # the high half of the last output, for the next call
-    excl = np.tile(np.array(per, dtype=np.uint64), times)
-    prod = words[:need] * excl  # < 2^32 * 2^14: exact in uint64
-    low = prod & np.uint64(0xFFFFFFFF)
-    threshold = (np.uint64(2**32) - excl) % excl
-    if np.any(low < threshold):  # Lemire's method would draw again: leave it to rng.choice
-        bg.state = saved
-        return None
-    val = (prod >> np.uint64(32)).astype(np.int64).reshape(times, len(per))
-    res = val[:, :k].copy()
-    for i in range(1, k):  # Floyd: a value already chosen is replaced by m - k + i
-        dup = (res[:, :i] == res[:, i : i + 1]).any(axis=1)
-        res[dup, i] = m - k + i
-    rows = np.arange(times)
-    for c, i in enumerate(range(k - 1, 0, -1)):  # Fisher-Yates: swap i with j in [0, i]
-        j = val[:, k + c]
-        a, b = res[rows, i].copy(), res[rows, j].copy()
-        res[rows, i], res[rows, j] = b, a
-    state = bg.state
-    state["has_uint32"] = int(left_over)
-    state["uinteger"] = int(words[-1]) if left_over else 0
-    bg.state = state
-    return res
 
 
 def _box_bounds(cfg: Config, prop: str) -> tuple[NDArray, NDArray]:

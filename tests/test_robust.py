@@ -270,25 +270,3 @@ def test_latin_hypercube_draws_as_scipy_does(seed, n, d):
     assert ((mine >= 0) & (mine < 1)).all()
     for col in mine.T:  # exactly one point per stratum [j/n, (j+1)/n)
         assert sorted(np.floor(col * n).astype(int)) == list(range(n))
-
-
-@pytest.mark.parametrize(
-    ("k", "m"), [(k, m) for k in (1, 2, 3) for m in (2, 3, 4, 23, 5000) if k <= m]
-)
-def test_choose_distinct_draws_as_choice_does(k, m):
-    """The rows are rng.choice's, draw for draw, and the generator continues alike."""
-    from ptoverify.robust import choose_distinct
-
-    for seed in range(40):
-        ref, mine = np.random.default_rng(seed), np.random.default_rng(seed)
-        for g in (ref, mine):  # start mid-stream, with and without a buffered 32-bit word
-            g.random(seed % 3)
-            g.integers(0, 7, seed % 2)
-        times = 1 + 7 * (seed % 5)
-        want = [ref.choice(m, k, replace=False).tolist() for _ in range(times)]
-        assert choose_distinct(mine, m, k, times).tolist() == want
-        assert mine.integers(0, 2**40, 3).tolist() == ref.integers(0, 2**40, 3).tolist()
-    other = np.random.Generator(np.random.MT19937(1))  # another bit generator: the calls
-    again = np.random.Generator(np.random.MT19937(1))
-    want = [again.choice(m, k, replace=False).tolist() for _ in range(3)]
-    assert choose_distinct(other, m, k, 3).tolist() == want
