@@ -33,6 +33,8 @@ import numpy as np
 import sympy as sp
 from sympy.printing.mathml import mathml
 
+from derivations.evaluate import shared_evaluator
+
 __all__ = [
     "EquationRecord",
     "Judgement",
@@ -394,14 +396,16 @@ def judge(
         raise ValueError(f"sampler does not draw {sorted(map(str, missing))}")
     f_p = sp.lambdify(syms, list(p_t), modules=_MODULES, docstring_limit=0)
     f_d = sp.lambdify(syms, list(d_t), modules=_MODULES, docstring_limit=0)
+    evaluate = shared_evaluator(f_p, f_d)  # the same values, repeated work done once
     worst, worst_err, n_ok = None, -1.0, 0
     n_drawn = min((len(v) for v in pts.values()), default=0)  # a sampler may filter points
     with mpmath.workdps(DPS):
         for i in range(n_drawn):
             args = [mpmath.mpf(float(pts[s][i])) for s in syms]
+            both = evaluate(*args)  # None: the joined code raised; the originals decide
             try:
-                vp = [_to_real(v) for v in f_p(*args)]
-                vd = [_to_real(v) for v in f_d(*args)]
+                vp = [_to_real(v) for v in (f_p(*args) if both is None else both[0])]
+                vd = [_to_real(v) for v in (f_d(*args) if both is None else both[1])]
             except (ValueError, ZeroDivisionError, TypeError):
                 continue
             if any(v is None for v in vp + vd):
