@@ -72,7 +72,7 @@ class SharedEvaluator:
 
 
 def _single_return(fn: Callable) -> tuple[ast.arguments, ast.expr] | None:
-    """The arguments and returned expression of a lambdified function of one statement."""
+    """Return the arguments and returned expression of a one-statement lambdified function."""
     code = getattr(fn, "__code__", None)
     lines = linecache.getlines(code.co_filename) if code is not None else []
     try:

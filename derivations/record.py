@@ -33,7 +33,7 @@ import numpy as np
 import sympy as sp
 from sympy.printing.mathml import mathml
 
-from derivations.evaluate import shared_evaluator
+from derivations.evaluate import SharedEvaluator, shared_evaluator
 
 __all__ = [
     "EquationRecord",
@@ -203,6 +203,7 @@ class Judgement:
     reason: str
 
 
+@lru_cache(maxsize=1024)
 def _log_abs_split(z: sp.Expr) -> sp.Expr:
     """log|z| as a sum over the irreducible factors of z, each with its sign removed.
 
@@ -250,6 +251,7 @@ def log_normal(expr: sp.Expr) -> sp.Expr:
     return sp.expand(sp.expand_log(expr.replace(sp.log, _log_abs_split), force=True))
 
 
+@lru_cache(maxsize=1024)
 def _rewrite_zero(diff: sp.Expr) -> bool | None:
     """Try to prove diff == 0 by cheap rewrites; False when they show it nonzero.
 
@@ -328,6 +330,16 @@ def _to_real(v: Any) -> float | None:
     return f if mpmath.isfinite(f) else None
 
 
+@lru_cache(maxsize=256)
+def _compiled(
+    syms: tuple[sp.Symbol, ...], p_t: tuple[sp.Expr, ...], d_t: tuple[sp.Expr, ...]
+) -> tuple[Callable, Callable, SharedEvaluator]:
+    """Lambdify (mpmath) and join the two sides; a comparison judged again reuses them."""
+    f_p = sp.lambdify(syms, list(p_t), modules=_MODULES, docstring_limit=0)
+    f_d = sp.lambdify(syms, list(d_t), modules=_MODULES, docstring_limit=0)
+    return f_p, f_d, shared_evaluator(f_p, f_d)  # the same values, repeated work done once
+
+
 def judge(
     printed: Any,
     derived: Any,
@@ -394,14 +406,13 @@ def judge(
     missing = free - set(syms)
     if missing:
         raise ValueError(f"sampler does not draw {sorted(map(str, missing))}")
-    f_p = sp.lambdify(syms, list(p_t), modules=_MODULES, docstring_limit=0)
-    f_d = sp.lambdify(syms, list(d_t), modules=_MODULES, docstring_limit=0)
-    evaluate = shared_evaluator(f_p, f_d)  # the same values, repeated work done once
+    f_p, f_d, evaluate = _compiled(tuple(syms), p_t, d_t)
     worst, worst_err, n_ok = None, -1.0, 0
     n_drawn = min((len(v) for v in pts.values()), default=0)  # a sampler may filter points
+    cols = [np.asarray(pts[s], dtype=float).tolist() for s in syms]  # Python floats
     with mpmath.workdps(DPS):
         for i in range(n_drawn):
-            args = [mpmath.mpf(float(pts[s][i])) for s in syms]
+            args = [mpmath.mpf(c[i]) for c in cols]
             both = evaluate(*args)  # None: the joined code raised; the originals decide
             try:
                 vp = [_to_real(v) for v in (f_p(*args) if both is None else both[0])]
@@ -417,7 +428,7 @@ def judge(
             if err > worst_err:
                 worst_err = err
                 worst = {
-                    "point": {str(s): float(pts[s][i]) for s in syms},
+                    "point": {str(s): c[i] for s, c in zip(syms, cols)},
                     "printed": [float(v) for v in vp],
                     "derived": [float(v) for v in vd],
                 }
