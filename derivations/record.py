@@ -152,8 +152,12 @@ class EquationRecord:
         return out
 
 
+@lru_cache(maxsize=1024)
 def _to_mathml(text: str) -> str:
-    """MathML of a '; '-separated list of SymPy expressions ('' if unparsable)."""
+    """MathML of a '; '-separated list of SymPy expressions ('' if unparsable).
+
+    Memoized: a definition's derived form is its printed one, rendered once.
+    """
     from derivations.printed import parse
 
     parts = []
