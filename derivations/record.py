@@ -34,6 +34,7 @@ import sympy as sp
 from sympy.printing.mathml import mathml
 
 from derivations.evaluate import SharedEvaluator, shared_evaluator
+from derivations.lambertw import lambertw
 
 __all__ = [
     "EquationRecord",
@@ -303,7 +304,7 @@ def _simplify_zero(diff: sp.Expr) -> bool | None:
 @lru_cache(maxsize=4096)
 def _lambertw_at(x: Any, k: int, prec: int) -> Any:
     with mpmath.workprec(prec):
-        return mpmath.lambertw(x, k)
+        return lambertw(x, k)  # mpmath's values, its branch-point series coefficients kept
 
 
 def _lambertw(x: Any, k: int = 0) -> Any:
