@@ -17,6 +17,8 @@ common           -- the flow of eq. (1) by dsolve, PlantNumbers, shared helpers
 section3         -- eqs. (3)-(12); minimum time and switch time (``mintime``)
 section4         -- eqs. (13)-(35); 15inv, 19c, 22c, 22W, 26W, 31W
 section5         -- eqs. (36)-(39); the stability claim (``39L``)
+evaluate         -- the judge's joined evaluation of both sides (repeats computed once)
+lambertw         -- mpmath's Lambert W, branch-point series coefficients kept
 
 Examples
 --------
@@ -70,7 +72,7 @@ def all_records(numbers: PlantNumbers) -> list[EquationRecord]:
 
     Ids "1" to "39" are all present; extras ("mintime", "15inv", "19c", "22c",
     "22W", "26W", "31W", "36Z", "39L") follow the equation they extend.  The
-    first call derives everything (about 2.5 s of one core); the symbolic part is
+    first call derives everything (about 2 s of one core); the symbolic part is
     cached, so a call for another plant only redoes the numeric examples.
 
     Parameters

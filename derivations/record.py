@@ -33,6 +33,9 @@ import numpy as np
 import sympy as sp
 from sympy.printing.mathml import mathml
 
+from derivations.evaluate import SharedEvaluator, shared_evaluator
+from derivations.lambertw import lambertw
+
 __all__ = [
     "EquationRecord",
     "Judgement",
@@ -150,8 +153,12 @@ class EquationRecord:
         return out
 
 
+@lru_cache(maxsize=1024)
 def _to_mathml(text: str) -> str:
-    """MathML of a '; '-separated list of SymPy expressions ('' if unparsable)."""
+    """MathML of a '; '-separated list of SymPy expressions ('' if unparsable).
+
+    Memoized: a definition's derived form is its printed one, rendered once.
+    """
     from derivations.printed import parse
 
     parts = []
@@ -201,6 +208,7 @@ class Judgement:
     reason: str
 
 
+@lru_cache(maxsize=1024)
 def _log_abs_split(z: sp.Expr) -> sp.Expr:
     """log|z| as a sum over the irreducible factors of z, each with its sign removed.
 
@@ -248,6 +256,7 @@ def log_normal(expr: sp.Expr) -> sp.Expr:
     return sp.expand(sp.expand_log(expr.replace(sp.log, _log_abs_split), force=True))
 
 
+@lru_cache(maxsize=1024)
 def _rewrite_zero(diff: sp.Expr) -> bool | None:
     """Try to prove diff == 0 by cheap rewrites; False when they show it nonzero.
 
@@ -295,7 +304,7 @@ def _simplify_zero(diff: sp.Expr) -> bool | None:
 @lru_cache(maxsize=4096)
 def _lambertw_at(x: Any, k: int, prec: int) -> Any:
     with mpmath.workprec(prec):
-        return mpmath.lambertw(x, k)
+        return lambertw(x, k)  # mpmath's values, its branch-point series coefficients kept
 
 
 def _lambertw(x: Any, k: int = 0) -> Any:
@@ -324,6 +333,16 @@ def _to_real(v: Any) -> float | None:
     except (TypeError, ValueError):
         return None
     return f if mpmath.isfinite(f) else None
+
+
+@lru_cache(maxsize=256)
+def _compiled(
+    syms: tuple[sp.Symbol, ...], p_t: tuple[sp.Expr, ...], d_t: tuple[sp.Expr, ...]
+) -> tuple[Callable, Callable, SharedEvaluator]:
+    """Lambdify (mpmath) and join the two sides; a comparison judged again reuses them."""
+    f_p = sp.lambdify(syms, list(p_t), modules=_MODULES, docstring_limit=0)
+    f_d = sp.lambdify(syms, list(d_t), modules=_MODULES, docstring_limit=0)
+    return f_p, f_d, shared_evaluator(f_p, f_d)  # the same values, repeated work done once
 
 
 def judge(
@@ -392,16 +411,17 @@ def judge(
     missing = free - set(syms)
     if missing:
         raise ValueError(f"sampler does not draw {sorted(map(str, missing))}")
-    f_p = sp.lambdify(syms, list(p_t), modules=_MODULES, docstring_limit=0)
-    f_d = sp.lambdify(syms, list(d_t), modules=_MODULES, docstring_limit=0)
+    f_p, f_d, evaluate = _compiled(tuple(syms), p_t, d_t)
     worst, worst_err, n_ok = None, -1.0, 0
     n_drawn = min((len(v) for v in pts.values()), default=0)  # a sampler may filter points
+    cols = [np.asarray(pts[s], dtype=float).tolist() for s in syms]  # Python floats
     with mpmath.workdps(DPS):
         for i in range(n_drawn):
-            args = [mpmath.mpf(float(pts[s][i])) for s in syms]
+            args = [mpmath.mpf(c[i]) for c in cols]
+            both = evaluate(*args)  # None: the joined code raised; the originals decide
             try:
-                vp = [_to_real(v) for v in f_p(*args)]
-                vd = [_to_real(v) for v in f_d(*args)]
+                vp = [_to_real(v) for v in (f_p(*args) if both is None else both[0])]
+                vd = [_to_real(v) for v in (f_d(*args) if both is None else both[1])]
             except (ValueError, ZeroDivisionError, TypeError):
                 continue
             if any(v is None for v in vp + vd):
@@ -413,7 +433,7 @@ def judge(
             if err > worst_err:
                 worst_err = err
                 worst = {
-                    "point": {str(s): float(pts[s][i]) for s in syms},
+                    "point": {str(s): c[i] for s, c in zip(syms, cols)},
                     "printed": [float(v) for v in vp],
                     "derived": [float(v) for v in vd],
                 }

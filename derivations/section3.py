@@ -374,14 +374,14 @@ def _rec_7_to_11() -> list[EquationRecord]:
 def _rec_12() -> EquationRecord:
     e = extremal()
     q = e["q"]
-    lam2_0 = e["lambda2_0"].subs(e["t1_symbol"], e["t1"]).subs(e["q_symbol"], q)
+    lam2_0 = e["lambda2_0"].xreplace({e["t1_symbol"]: e["t1"]}).xreplace({e["q_symbol"]: q})
     (p12,) = parsed("12")
     off = {S[n]: False for n in ("in_SP", "in_SN", "in_O", "in_l1", "in_l2")}
     law_N = rhs(p12, u).subs(dict(off, in_SN=True)).subs(S["in_SN"], True)
     law_P = rhs(p12, u).subs(dict(off, in_SP=True)).subs(S["in_SP"], True)
     derived_N = -wm * sp.sign(lam2_0)
     # odd symmetry: (x, u, lambda) extremal => (-x, -u, -lambda) extremal
-    derived_P = -wm * sp.sign(-lam2_0.subs({x1: -x1, x2: -x2}, simultaneous=True))
+    derived_P = -wm * sp.sign(-lam2_0.xreplace({x1: -x1, x2: -x2}))  # at once, as simultaneous
     jN = judge(law_N, derived_N, _state_sampler(+1), symbolic=False)
     jP = judge(law_P, derived_P, _state_sampler(-1), symbolic=False)
     # transversality: H = 0 at t_f (free final time) along the extremal

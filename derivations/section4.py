@@ -502,6 +502,18 @@ def _rec_18_19() -> list[EquationRecord]:
     return out
 
 
+def _linear_root(residual: sp.Expr, var: sp.Symbol) -> sp.Expr:
+    """Solve residual = 0 for var, residual linear in var or in 1/var (a definition).
+
+    ``solve`` of the numerator over one denominator: the root is that of the
+    residual where the denominator is nonzero (the judge checks it at random
+    points).  Solving the numerator spares ``solve`` its test of whether the root
+    zeroes a denominator, whose ``checksol`` imports ``sympy.physics.units``
+    (~0.1 s) and simplifies; the root is the same.
+    """
+    return sp.solve(sp.numer(sp.together(residual)), var, simplify=False, check=False)[0]
+
+
 def _rec_20_27() -> list[EquationRecord]:
     out = []
     (p19,) = parsed("19")
@@ -553,7 +565,7 @@ def _rec_20_27() -> list[EquationRecord]:
             "Substitution of (21) into (20)." + inh,
         )
     )
-    d23 = sp.solve(p21[0], tx20)[0]
+    d23 = sp.solve(p21[0], tx20, simplify=False, check=False)[0]  # linear, no denominator
     out.append(
         record_from(
             "23",
@@ -601,7 +613,7 @@ def _rec_20_27() -> list[EquationRecord]:
             "Substitution of (25) into (24)." + inh,
         )
     )
-    d27 = sp.solve(p25[1], w0)[0]
+    d27 = _linear_root(p25[1], w0)
 
     def s27(rng, n):
         pts = s20(rng, n)
@@ -686,7 +698,7 @@ def _rec_28_35() -> list[EquationRecord]:
             "Substitution of (30) into (29).",
         ),
     )
-    d32 = sp.solve(p30[1], wc)[0]
+    d32 = _linear_root(p30[1], wc)
     (p32,) = parsed("32")
 
     def s32(rng, n):

@@ -241,7 +241,10 @@ def _rec_39_lasalle() -> EquationRecord:
     s = sp.Symbol("s")
     charpoly = sp.expand((s * sp.eye(2) - Acl).det())
     # LaSalle: largest invariant set in {dV/dt = 0} = {x2 = 0} (1 + k2 > 0)
-    inv = sp.solve([x2, (Acl * sp.Matrix([x1, x2]))[1]], [x1, x2], dict=True)
+    # a linear system without denominators: solve's simplify and check (which import
+    # sympy.physics.units, ~0.1 s) have nothing to do
+    eqs = [x2, (Acl * sp.Matrix([x1, x2]))[1]]
+    inv = sp.solve(eqs, [x1, x2], dict=True, simplify=False, check=False)
     inv_ok = inv == [{x1: 0, x2: 0}]
     # Hurwitz at random (k1 > 0, 1 + k2 > 0): max real part of eigenvalues < 0
     ev = list(Acl.eigenvals())

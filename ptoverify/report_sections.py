@@ -494,7 +494,7 @@ def _expr_unit(text: str) -> str:
                 f = L if name in _LENGTH else (sp.Rational(L, S) if name in _SPEED else 1)
                 f = sp.Rational(1, S) if name == "a" else (S if name == "T" else f)
                 sub[s] = base[s] * f
-            return complex(e.subs(sub).evalf()).real
+            return complex(e.xreplace(sub).evalf()).real  # numbers for symbols: xreplace
 
         try:
             v0, vl, vs = scaled(1, 1), scaled(2, 1), scaled(1, 2)
