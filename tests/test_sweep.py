@@ -16,7 +16,7 @@ from ptoverify.laws import make_law
 from ptoverify.mintime import discrete_min_steps, min_time
 from ptoverify.ocp import TwoPhaseOCP
 from ptoverify.simulate import simulate_batch
-from ptoverify.sweep import SweepSettings, run_sweep, settle_steps, settling_times
+from ptoverify.sweep import SweepSettings, grid_states, run_sweep, settle_steps, settling_times
 
 SMALL = SweepSettings(n1=6, n2=5)
 
@@ -246,3 +246,60 @@ def test_full_sweep_runs_every_law():
     res = run_sweep(paper_config())
     assert res.x1.size >= 40000
     assert set(res.laws) == {"to", "pd", "pto", "pto-printed"}
+
+
+@pytest.mark.parametrize(("n1", "n2"), [(200, 200), (7, 5), (6, 1), (1, 1)])
+def test_grid_is_even_and_exactly_symmetric(n1, n2):
+    """The grid spans the envelope evenly (as linspace does, to round-off) and a state's
+    mirror through the origin is on it bit for bit (what the sweep's mirrored half needs)."""
+    p = paper_config().plant
+    X1, X2 = grid_states(p, n1, n2)
+    assert X1.shape == X2.shape == (n2, n1)
+    for v, n, r in ((X1[0], n1, p.position_range), (X2[:, 0], n2, p.w_max)):
+        ref = np.linspace(-r, r, n) if n > 1 else np.zeros(1)
+        assert_allclose(v, ref, rtol=0, atol=4 * np.finfo(float).eps * r)
+        assert np.array_equal(v[::-1], -v)
+        if n > 1:
+            assert v[0] == -r and v[-1] == r
+    assert np.array_equal(X1.ravel()[::-1], -X1.ravel())
+    assert np.array_equal(X2.ravel()[::-1], -X2.ravel())
+
+
+@pytest.mark.parametrize("name", ["to", "pd", "pto", "pto-printed"])
+def test_laws_are_odd_bit_for_bit(name):
+    """u(-x) == -u(x) exactly, at random states of every scale and on the axes: the premise
+    of simulating half of a symmetric grid."""
+    cfg = paper_config()
+    law = make_law(name, cfg)
+    rng = np.random.default_rng(5)
+    x1 = np.concatenate([rng.uniform(-60, 60, 30000) * s for s in (1, 1e-2, 1e-4, 1e-7)])
+    x2 = np.concatenate([rng.uniform(-320, 320, 30000) * s for s in (1, 1e-2, 1e-4, 1e-7)])
+    x1[::7], x2[::11] = 0.0, 0.0
+    u, r = law.vector(x1, x2)
+    u_m, r_m = law.vector(-x1, -x2)
+    assert np.array_equal(u_m, -u)
+
+
+def test_mirrored_half_equals_simulating_every_state():
+    """run_sweep simulates half of the symmetric grid and mirrors it: its settling times
+    equal settling_times over every state, for each law, both readings, odd and even counts."""
+    cfg = paper_config()
+    p = cfg.plant
+    for n1, n2 in ((9, 7), (8, 5)):
+        s = SweepSettings(n1=n1, n2=n2)
+        res = run_sweep(cfg, s)
+        vband = p.a * s.band
+        for name in s.laws:
+            ref = settling_times(
+                make_law(name, cfg),
+                p,
+                res.x1.ravel(),
+                res.x2.ravel(),
+                res.steps,
+                s.band,
+                vband,
+                s.hold,
+            )
+            got = res.laws[name]
+            assert np.array_equal(got.settle_time.ravel(), ref.time, equal_nan=True), name
+            assert np.array_equal(got.grid.settle_time.ravel(), ref.grid, equal_nan=True), name
