@@ -2,9 +2,9 @@
 
 ``collect(cfg)`` is the one step that computes.  It runs the report's
 independent stages (:data:`STAGES`): the SymPy derivations with the derivation
-gate, the closed loop (zones, poles, properties, Section 6 claims, the numeric
+gate, the closed loop (zones, properties, Section 6 claims, the numeric
 gates), the robustness study, the tuning comparison, the suboptimality sweep,
-the ground truth (with the environment) and the paper's figures.  Each stage
+the ground truth (with the environment), the paper's figures and the poles.  Each stage
 draws its own figures (:mod:`ptoverify.plots`, which only draws) from its own
 results, so nothing large travels between processes.  The stages share only
 the configuration, so they run in a pool of spawned Python processes
@@ -409,16 +409,15 @@ def _stage_tuning(cfg: Config, figdir: Path | None) -> dict[str, Any]:
 
 
 def _stage_figures(cfg: Config, figdir: Path | None) -> dict[str, Any]:
-    """Draw the paper's figures and the zone geometry; analyse the loops' poles.
+    """Draw the paper's figures and the zone geometry."""
+    return {"_files": [] if figdir is None else _plots().save_all(figure_inputs(cfg), figdir)}
 
-    The poles (python-control, which loads Matplotlib's pyplot) run where
-    pyplot is loaded anyway, with the two gates that read them.
-    """
+
+def _stage_poles(cfg: Config, figdir: Path | None) -> dict[str, Any]:
+    """Analyse the loops' poles (python-control), with the two gates that read them."""
     from ptoverify.checks import run_checks
 
-    out = {"poles": _poles(cfg), "_checks": run_checks(cfg, list(POLE_GATES))}
-    out["_files"] = [] if figdir is None else _plots().save_all(figure_inputs(cfg), figdir)
-    return out
+    return {"poles": _poles(cfg), "_checks": run_checks(cfg, list(POLE_GATES))}
 
 
 def _plots():
@@ -429,18 +428,20 @@ def _plots():
 
 #: The gate that needs SymPy: it runs in the derivations' stage, the others in ``core``.
 SYMBOLIC_GATE = "derivation-identities-vs-numerics"
-#: The gates that read the loops' poles: they run beside the poles (the figures' stage).
+#: The gates that read the loops' poles: they run beside the poles (their own stage).
 POLE_GATES = ("pd-sampled-stable", "linear-zone-sampled-stable")
 
-#: The report's stages, longest first (the order a pool starts them in).
+#: The report's stages, longest first as measured in a worker (the order a pool starts
+#: them in; the short ones last, so the workers end together).
 _STAGE_FUNCTIONS: dict[str, Callable[[Config, Path | None], dict[str, Any]]] = {
     "robustness": _stage_robust,
     "suboptimality sweep": _stage_sweep,
     "derivations": _stage_derivations,
+    "ground truth": _stage_ground_truth,
     "tuning": _stage_tuning,
     "closed loop, claims and gates": _stage_core,
-    "ground truth": _stage_ground_truth,
-    "figures and poles": _stage_figures,
+    "paper figures": _stage_figures,
+    "poles": _stage_poles,
 }
 _SKIP_STAGE = {"robust": "robustness", "tuning": "tuning"}
 
