@@ -270,3 +270,60 @@ def test_latin_hypercube_draws_as_scipy_does(seed, n, d):
     assert ((mine >= 0) & (mine < 1)).all()
     for col in mine.T:  # exactly one point per stratum [j/n, (j+1)/n)
         assert sorted(np.floor(col * n).astype(int)) == list(range(n))
+
+
+@pytest.mark.parametrize(
+    ("n1", "box"),
+    [
+        (7, {}),
+        (6, {"position_quantum": 0.02, "delay_samples": (0, 2), "a_ratio": (0.5, 2.0)}),
+    ],
+)
+def test_mirrored_maps_equal_simulating_every_state(monkeypatch, n1, box):
+    """Without noise the maps simulate one state of each mirrored pair: the maps equal
+    those with every state simulated, bit for bit, for every law (odd and even grids,
+    a coarse quantizer, delays, a wide box)."""
+    import ptoverify.robust as robust_mod
+
+    cfg = dataclasses.replace(CFG, robustness=dataclasses.replace(CFG.robustness, **box))
+    s = dataclasses.replace(TINY, n1=n1, n2=7, rest=10)
+    x1, x2 = map_states(cfg, s)
+    assert np.array_equal(np.sort(x1), np.sort(-x1)) and np.array_equal(np.sort(x2), np.sort(-x2))
+    halved = robust_maps(cfg, s)
+    monkeypatch.setattr(robust_mod, "mirror_pairs", lambda x1, x2: None)
+    assert robust_maps(cfg, s) == halved
+
+
+def test_noise_keeps_every_state_simulated(monkeypatch):
+    """Velocity noise is not odd (the same noise sequence for a state and its mirror):
+    the maps then do not pair states."""
+    import ptoverify.robust as robust_mod
+
+    asked = []
+    monkeypatch.setattr(robust_mod, "mirror_pairs", lambda x1, x2: asked.append(1))
+    cfg = dataclasses.replace(
+        CFG, robustness=dataclasses.replace(CFG.robustness, velocity_noise=1.0)
+    )
+    robust_maps(cfg, dataclasses.replace(TINY, laws=("pd",)))
+    assert asked == []
+
+
+@pytest.mark.parametrize("law_name", ["to", "pd", "pto", "pto-printed"])
+def test_mirrored_state_has_the_same_properties(law_name):
+    """The premise of the mirrored maps: from (-x1, -x2) every measured property equals
+    that from (x1, x2), bit for bit, on mismatched plants with a quantizer and delays."""
+    x1, x2 = map_states(CFG, dataclasses.replace(TINY, n1=9, n2=7, rest=10))
+    rng = np.random.default_rng(3)
+    n = x1.size
+    m = Mismatch(
+        a_ratio=rng.uniform(0.5, 2.0, n),
+        w_max_ratio=rng.uniform(0.8, 1.0, n),
+        delay_samples=rng.integers(0, 3, n),
+        position_quantum=0.02,
+    )
+    a = trajectory_properties(law_name, CFG, x1, x2, m)
+    b = trajectory_properties(law_name, CFG, -x1, -x2, m)
+    assert a.keys() == b.keys()
+    for k in a:
+        assert np.array_equal(a[k], b[k], equal_nan=True), k
+    assert np.nanmax(a["settling_ratio_nt"]) > 1.0
