@@ -291,7 +291,7 @@ def even_points(r: float, n: int) -> NDArray[np.float64]:
     Parameters
     ----------
     r : float
-        Half-width (the unit of the points).
+        Half-width [mm] or [mm/s] (the points are in its unit).
     n : int
         Number of points [-] (one point is 0).
 
