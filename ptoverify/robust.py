@@ -712,8 +712,15 @@ MARGIN_ASK_RATIOS = 16  #: ratios per simulation ask of a margin (so it rides be
 
 
 def _margin_job(fn: Law, cfg: Config, s: RobustSettings, *, rtol: float = 1e-3) -> Job:
-    """:func:`no_limit_cycle_margin` as a :mod:`ptoverify.lockstep` job (its asks ride along)."""
+    """:func:`no_limit_cycle_margin` as a :mod:`ptoverify.lockstep` job (its asks ride along).
+
+    The loop here is odd (no quantizer, delay or noise), so a state and its mirror
+    have the same limit cycle: one state of each mirrored pair is simulated.
+    """
     x1, x2 = map_states(cfg, s)
+    pairs = mirror_pairs(x1, x2)
+    if pairs:
+        x1, x2 = x1[pairs[0]], x2[pairs[0]]
     n = x1.size
 
     def clean(ratios: NDArray) -> Generator[list[Ask], list[BatchResult], NDArray[np.bool_]]:
