@@ -103,6 +103,11 @@ class Law:
         What the law is, in one line (says when a variant falls back).
     family : LawFamily or None
         The family the law belongs to (the TO and PTO laws of one plant), if any.
+    odd : bool
+        Whether u(-x1, -x2) == -u(x1, x2) bit for bit, so that a state's mirror has
+        the negated trajectory (true of the suite's laws, tested; a law built
+        elsewhere, a user's or a shifted one, is not assumed odd).  Only odd laws
+        let the sweep and the robustness maps simulate one state of a mirrored pair.
     """
 
     name: str
@@ -111,6 +116,7 @@ class Law:
     w_max: float
     note: str = ""
     family: LawFamily | None = None
+    odd: bool = False
 
     def __call__(
         self, x1: ArrayLike, x2: ArrayLike
@@ -265,7 +271,7 @@ def to_law(cfg: Config) -> Law:
             return w, int(Region.BANG_P)
         return -w, int(Region.BANG_N)
 
-    return Law("to", vector, scalar, w, "time-optimal bang-bang, eq. (12)", family)
+    return Law("to", vector, scalar, w, "time-optimal bang-bang, eq. (12)", family, odd=True)
 
 
 def saturate_linear(v: NDArray[np.float64], w: float):
@@ -338,7 +344,7 @@ def pd_law(cfg: Config, *, gains: tuple[NDArray, NDArray] | None = None) -> Law:
             return -w, int(Region.SATURATED)
         return v, int(Region.LINEAR)
 
-    return Law("pd", vector, scalar, w, f"PD u = sat(-{kp:g} x1 - {kd:g} x2)")
+    return Law("pd", vector, scalar, w, f"PD u = sat(-{kp:g} x1 - {kd:g} x2)", odd=True)
 
 
 def omega_c_scalar(x1: float, x2: float, a: float) -> float:
@@ -545,7 +551,8 @@ def pto_law(
             return w, int(Region.BANG_P)
         return -w, int(Region.BANG_N)
 
-    return Law(name, vector, scalar, w, note or f"PTO eq. (35), omega0 = {om:g} mm/s", family)
+    note = note or f"PTO eq. (35), omega0 = {om:g} mm/s"
+    return Law(name, vector, scalar, w, note, family, odd=True)
 
 
 def pto_corrected_law(cfg: Config, *, gains: tuple[NDArray, NDArray] | None = None) -> Law:

@@ -384,12 +384,13 @@ def _maps_job(
     """
     box = cfg.robustness
     cells = [(int(dl), float(wr), float(ar)) for dl in delays for wr in wrs for ar in ars]
-    # Without velocity noise the loop is odd (linear plants, odd laws, a quantizer
+    # Without velocity noise and with an odd law (Law.odd) the loop is odd (linear
+    # plants, a quantizer
     # q rint(x / q) and a clip at +-w that are odd, bit for bit), so a state's mirror
     # (-x1, -x2) has the negated trajectory and the same properties: one of each
     # mirrored pair is simulated and measured (tests/test_robust.py compares the
     # maps with every state simulated).
-    pairs = mirror_pairs(x1, x2) if box.velocity_noise == 0 else None
+    pairs = mirror_pairs(x1, x2) if box.velocity_noise == 0 and fn.odd else None
     reps, where = pairs if pairs else (np.arange(x1.size), np.arange(x1.size))
     y1, y2 = x1[reps], x2[reps]
     n = y1.size
@@ -714,11 +715,12 @@ MARGIN_ASK_RATIOS = 16  #: ratios per simulation ask of a margin (so it rides be
 def _margin_job(fn: Law, cfg: Config, s: RobustSettings, *, rtol: float = 1e-3) -> Job:
     """:func:`no_limit_cycle_margin` as a :mod:`ptoverify.lockstep` job (its asks ride along).
 
-    The loop here is odd (no quantizer, delay or noise), so a state and its mirror
-    have the same limit cycle: one state of each mirrored pair is simulated.
+    The loop here is odd for an odd law (``Law.odd``; no quantizer, delay or noise),
+    so a state and its mirror have the same limit cycle: one state of each
+    mirrored pair is simulated (every state for a law not known to be odd).
     """
     x1, x2 = map_states(cfg, s)
-    pairs = mirror_pairs(x1, x2)
+    pairs = mirror_pairs(x1, x2) if fn.odd else None
     if pairs:
         x1, x2 = x1[pairs[0]], x2[pairs[0]]
     n = x1.size

@@ -421,11 +421,13 @@ def _settling_odd(law, plant, x1, x2, steps, band, velocity_band, hold, chunk, b
     -u(x), tested in ``tests/test_sweep.py``), so the trajectory from -x0 is the
     negated trajectory from x0 and its settling times (a box symmetric about the
     origin) are equal.  When ``x1[::-1] == -x1`` and ``x2[::-1] == -x2`` exactly
-    (:func:`grid_states`), the first half (and the middle state) is simulated and
-    the second half is its mirror; otherwise every state is simulated.
+    (:func:`grid_states`) and the law is odd (``Law.odd``), the first half (and the
+    middle state) is simulated and the second half is its mirror; otherwise every
+    state is simulated.
     """
     n = x1.size
-    if n < 2 or not (np.array_equal(x1[::-1], -x1) and np.array_equal(x2[::-1], -x2)):
+    symmetric = np.array_equal(x1[::-1], -x1) and np.array_equal(x2[::-1], -x2)
+    if n < 2 or not (law.odd and symmetric):
         return _settling_chunks(law, plant, x1, x2, steps, band, velocity_band, hold, chunk, b)
     half = (n + 1) // 2  # with an odd count the middle state is its own mirror
     st, b = _settling_chunks(

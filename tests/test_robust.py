@@ -327,3 +327,30 @@ def test_mirrored_state_has_the_same_properties(law_name):
     for k in a:
         assert np.array_equal(a[k], b[k], equal_nan=True), k
     assert np.nanmax(a["settling_ratio_nt"]) > 1.0
+
+
+def _offset_pd(cfg):
+    """A law that is not odd: the PD law regulating to x1 = 0.3 mm (a user's factory)."""
+    base = make_law("pd", cfg)
+    return Law(
+        "pd-offset",
+        lambda x1, x2: base.vector(x1 - 0.3, x2),
+        lambda x1, x2: base.scalar(x1 - 0.3, x2),
+        base.w_max,
+    )
+
+
+def test_a_law_not_known_odd_has_every_state_simulated(monkeypatch):
+    """robust_maps and no_limit_cycle_margin take law factories; a law not known to be
+    odd (Law.odd False) is simulated from every state, not mirrored: the results equal
+    those with the pairing switched off."""
+    import ptoverify.robust as robust_mod
+
+    assert not _offset_pd(CFG).odd
+    assert all(make_law(name, CFG).odd for name in ("to", "pd", "pto", "pto-printed"))
+    s = dataclasses.replace(TINY, n1=7, n2=7, rest=10, laws=(_offset_pd,))
+    maps = robust_maps(CFG, s)
+    margin = no_limit_cycle_margin(_offset_pd, CFG, s)
+    monkeypatch.setattr(robust_mod, "mirror_pairs", lambda x1, x2: None)
+    assert robust_maps(CFG, s) == maps
+    assert no_limit_cycle_margin(_offset_pd, CFG, s) == margin
