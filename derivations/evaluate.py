@@ -104,6 +104,8 @@ class _Keys:
                 value = self.key(value, counted)
             elif isinstance(value, list):
                 value = tuple(self.key(v, counted) if isinstance(v, ast.AST) else v for v in value)
+            else:  # a constant: 2 == 2.0 == True, but they are different literals
+                value = (type(value).__name__, value)
             parts.append((name, value))
         k = self.ids.setdefault(tuple(parts), len(self.ids))
         self.of[id(node)] = k

@@ -560,3 +560,27 @@ def test_shared_evaluator_is_both_functions_bit_for_bit():
             assert ev(*bad) is None
             with pytest.raises(ZeroDivisionError):
                 f_p(*bad), f_d(*bad)
+
+
+def _generated(src: str, tag: str):
+    """A one-function module as lambdify makes it (source in linecache, its own locals)."""
+    import linecache
+
+    filename = f"<test-generated-{tag}>"
+    linecache.cache[filename] = (len(src), None, src.splitlines(True), filename)
+    local: dict = {}
+    exec(compile(src, filename, "exec"), {}, local)  # noqa: S102 - our own test source
+    return local["f"]
+
+
+def test_shared_evaluator_keeps_int_and_float_literals_apart():
+    """2 and 2.0 are equal but different literals: x**2 and x**2.0 are not one subexpression."""
+    from derivations.evaluate import shared_evaluator
+
+    p = _generated("def f(x):\n    return [x**2 + x**2 + 1]\n", "int")
+    d = _generated("def f(x):\n    return [x**2.0 + x**2.0 + 1]\n", "float")
+    ev = shared_evaluator(p, d)
+    assert ev.joined is not None
+    got = ev(3)
+    assert got == (p(3), d(3))
+    assert type(got[0][0]) is int and type(got[1][0]) is float
