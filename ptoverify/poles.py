@@ -28,6 +28,7 @@ import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Config
 from ptoverify.plant import zoh_matrices
@@ -37,6 +38,7 @@ __all__ = [
     "loop_poles",
     "all_loop_poles",
     "sampled_spectral_radius",
+    "spectral_radii",
     "critical_gain",
     "lyapunov_counterexample",
 ]
@@ -158,8 +160,37 @@ def sampled_spectral_radius(a: float, T: float, k_x1: float, k_x2: float) -> flo
     float
         Spectral radius [-]; < 1 means the sampled loop is stable.
     """
+    return float(spectral_radii(a, T, k_x1, k_x2)[0])
+
+
+def spectral_radii(a: float, T: float, k_x1: ArrayLike, k_x2: ArrayLike) -> NDArray[np.float64]:  # noqa: N803
+    """Spectral radius of the sampled linear loop Ad - Bd [k_x1, k_x2], per gain pair.
+
+    Many gain pairs in one stacked eigenvalue call (:func:`sampled_spectral_radius`
+    is the one-pair case).
+
+    Parameters
+    ----------
+    a : float
+        Bandwidth [rad/s].
+    T : float
+        Sampling period [s].
+    k_x1, k_x2 : array_like
+        Gains [1/s], [-] of u = -k_x1 x1 - k_x2 x2, one pair per entry.
+
+    Returns
+    -------
+    ndarray
+        Largest |z| per pair [-]; < 1 means the sampled loop is stable.
+
+    Examples
+    --------
+    >>> bool(spectral_radii(188.5, 0.002, [356.0], [0.62])[0] < 1.0)
+    True
+    """
     Ad, Bd = zoh_matrices(a, T)
-    return float(np.abs(np.linalg.eigvals(Ad - Bd @ np.array([[k_x1, k_x2]]))).max())
+    k = np.stack(np.broadcast_arrays(np.asarray(k_x1, float), np.asarray(k_x2, float)), axis=-1)
+    return np.abs(np.linalg.eigvals(Ad - Bd @ k.reshape(-1, 1, 2))).max(axis=-1)
 
 
 def loop_poles(name: str, a: float, T: float, k_x1: float, k_x2: float) -> LoopPoles:  # noqa: N803

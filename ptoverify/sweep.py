@@ -334,11 +334,17 @@ def mirror_pairs(x1: NDArray, x2: NDArray) -> tuple[NDArray[np.intp], NDArray[np
     >>> reps.tolist(), where.tolist()
     ([0, 1], [0, 1, 0])
     """
+    n = x1.size
+    if np.array_equal(x1[::-1], -x1) and np.array_equal(x2[::-1], -x2):
+        # states listed as their own mirror image (grid_states): pairs k, n - 1 - k
+        half = (n + 1) // 2
+        k = np.arange(n, dtype=np.intp)
+        return k[:half], np.minimum(k, n - 1 - k)
     at = {(a, b): k for k, (a, b) in enumerate(zip(x1.tolist(), x2.tolist(), strict=True))}
     mirror = [at.get((-a, -b)) for a, b in zip(x1.tolist(), x2.tolist(), strict=True)]
     if any(m is None for m in mirror):
         return None
-    first = np.minimum(np.arange(x1.size), np.array(mirror, dtype=np.intp))
+    first = np.minimum(np.arange(n), np.array(mirror, dtype=np.intp))
     reps, where = np.unique(first, return_inverse=True)
     return reps.astype(np.intp), where.astype(np.intp)
 
@@ -415,29 +421,23 @@ def settling_times(
 
 
 def _settling_odd(law, plant, x1, x2, steps, band, velocity_band, hold, chunk, b=None):
-    """:func:`_settling_chunks` on states that come in mirrored pairs, half of them simulated.
+    """:func:`_settling_chunks`, one state of each mirrored pair simulated.
 
-    The plant is linear and every law of the suite is odd bit for bit (u(-x) ==
-    -u(x), tested in ``tests/test_sweep.py``), so the trajectory from -x0 is the
-    negated trajectory from x0 and its settling times (a box symmetric about the
-    origin) are equal.  When ``x1[::-1] == -x1`` and ``x2[::-1] == -x2`` exactly
-    (:func:`grid_states`) and the law is odd (``Law.odd``), the first half (and the
-    middle state) is simulated and the second half is its mirror; otherwise every
-    state is simulated.
+    The plant is linear and the suite's laws are odd bit for bit (``Law.odd``;
+    tested in ``tests/test_sweep.py``), so the trajectory from -x0 is the negated
+    trajectory from x0 and its settling times (a box symmetric about the origin)
+    are equal.  For an odd law whose states pair up (:func:`mirror_pairs`; the
+    grid of :func:`grid_states` does), one of each pair is simulated and its
+    times are given to both; otherwise every state is simulated.
     """
-    n = x1.size
-    symmetric = np.array_equal(x1[::-1], -x1) and np.array_equal(x2[::-1], -x2)
-    if n < 2 or not (law.odd and symmetric):
+    pairs = mirror_pairs(x1, x2) if law.odd else None
+    if pairs is None:
         return _settling_chunks(law, plant, x1, x2, steps, band, velocity_band, hold, chunk, b)
-    half = (n + 1) // 2  # with an odd count the middle state is its own mirror
+    reps, where = pairs
     st, b = _settling_chunks(
-        law, plant, x1[:half], x2[:half], steps, band, velocity_band, hold, chunk, b
+        law, plant, x1[reps], x2[reps], steps, band, velocity_band, hold, chunk, b
     )
-
-    def full(v: NDArray) -> NDArray:
-        return np.concatenate([v, v[: n - half][::-1]])
-
-    return BatchSettling(full(st.time), full(st.grid), st.accuracy), b
+    return BatchSettling(st.time[where], st.grid[where], st.accuracy), b
 
 
 def _settling_chunks(law, plant, x1, x2, steps, band, velocity_band, hold, chunk, b=None):

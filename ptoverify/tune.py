@@ -55,7 +55,7 @@ from functools import lru_cache
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 from scipy.optimize import differential_evolution
 
 from ptoverify.config import Config, PDGains, PTOSettings
@@ -63,7 +63,7 @@ from ptoverify.errors import InputError
 from ptoverify.exact import STEP_FRACTION, TIGHT_BAND, settling_times_batch
 from ptoverify.laws import Law, Region, make_law, with_state_gains
 from ptoverify.mintime import discrete_min_steps_batch, min_time
-from ptoverify.plant import zoh_matrices
+from ptoverify.poles import spectral_radii
 from ptoverify.properties import (
     crossing_masks,
     default_steps,
@@ -89,7 +89,6 @@ __all__ = [
     "FairTunings",
     "fair_tunings",
     "grid_counts",
-    "spectral_radii",
 ]
 
 OBJECTIVES = ("settling_2pct", "settling_0p01mm", "worst_ratio_nt")
@@ -176,37 +175,6 @@ def tuned_config(cfg: Config, law: str, gains: dict[str, float]) -> Config:
 
 def _linear_gains(law: str, gains: dict[str, float]) -> tuple[float, float]:
     return (gains["kp"], gains["kd"]) if law == "pd" else (gains["k1"], gains["k2"])
-
-
-def spectral_radii(a: float, T: float, k_x1: ArrayLike, k_x2: ArrayLike) -> NDArray[np.float64]:  # noqa: N803
-    """Spectral radius of the sampled linear loop Ad - Bd [k_x1, k_x2], per gain pair.
-
-    The loop of :func:`ptoverify.poles.sampled_spectral_radius`, for many gain
-    pairs in one stacked eigenvalue call (the same matrices and LAPACK routine,
-    so the same values).
-
-    Parameters
-    ----------
-    a : float
-        Bandwidth [rad/s].
-    T : float
-        Sampling period [s].
-    k_x1, k_x2 : array_like
-        Gains [1/s], [-] of u = -k_x1 x1 - k_x2 x2, one pair per entry.
-
-    Returns
-    -------
-    ndarray
-        Largest |z| per pair [-]; < 1 means the sampled loop is stable.
-
-    Examples
-    --------
-    >>> bool(spectral_radii(188.5, 0.002, [356.0], [0.62])[0] < 1.0)
-    True
-    """
-    Ad, Bd = zoh_matrices(a, T)
-    k = np.stack(np.broadcast_arrays(np.asarray(k_x1, float), np.asarray(k_x2, float)), axis=-1)
-    return np.abs(np.linalg.eigvals(Ad - Bd @ k.reshape(-1, 1, 2))).max(axis=-1)
 
 
 def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:

@@ -62,6 +62,18 @@ def _random_case(rng, n):
     )
 
 
+def _assert_segments_run_alone(segments, steps):
+    """simulate_segments gives each segment exactly its own simulate_batch run."""
+    both = simulate_segments(segments, P, steps)
+    at = 0
+    for law, x1, x2, m in segments:
+        alone = simulate_batch(law, P, x1, x2, steps, mismatch=m)
+        cols = slice(at, at + x1.size)
+        at += x1.size
+        for f in ("x1", "x2", "u", "region"):
+            assert np.array_equal(getattr(both, f)[:, cols], getattr(alone, f)), (law.name, f, m)
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_segments_equal_each_case_alone_bit_for_bit(seed):
     """Random laws, states and mismatches (identity ones included) in one run."""
@@ -75,14 +87,7 @@ def test_segments_equal_each_case_alone_bit_for_bit(seed):
         x2 = rng.uniform(-300.0, 300.0, n) * rng.uniform(0.0, 1.0, n)
         m = None if rng.random() < 0.2 else _random_case(rng, n)
         segments.append((law, x1, x2, m))
-    both = simulate_segments(segments, P, steps)
-    at = 0
-    for law, x1, x2, m in segments:
-        alone = simulate_batch(law, P, x1, x2, steps, mismatch=m)
-        cols = slice(at, at + x1.size)
-        at += x1.size
-        for f in ("x1", "x2", "u", "region"):
-            assert np.array_equal(getattr(both, f)[:, cols], getattr(alone, f)), (law.name, f, m)
+    _assert_segments_run_alone(segments, steps)
 
 
 @pytest.mark.parametrize("seed", [3, 4])
@@ -216,11 +221,4 @@ def test_long_delay_runs_and_mixed_delays_in_one_run():
             m = Mismatch(m.a_ratio, m.w_max_ratio, delay, m.position_quantum, 0.0, m.seed)
         x1 = rng.uniform(-40.0, 40.0, n)
         segments.append((LAWS["pd" if delay == 1 else "pto"], x1, -x1, m))
-    both = simulate_segments(segments, P, steps)
-    at = 0
-    for law, x1, x2, m in segments:
-        alone = simulate_batch(law, P, x1, x2, steps, mismatch=m)
-        cols = slice(at, at + x1.size)
-        at += x1.size
-        for f in ("x1", "x2", "u", "region"):
-            assert np.array_equal(getattr(both, f)[:, cols], getattr(alone, f)), (law.name, f)
+    _assert_segments_run_alone(segments, steps)
