@@ -86,7 +86,6 @@ from functools import lru_cache
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ptoverify import metrics as mt
 from ptoverify.config import Config
@@ -1125,6 +1124,8 @@ def fair_comparison(cfg: Config, budget: TuneBudget | None = None) -> dict[str, 
     step = reference("step").amplitude
     a, w = cfg.plant.a, cfg.plant.w_max
     dist = (1.0 - STEP_FRACTION) * abs(step)  # to the edge of the 2 % band, from rest
+    from scipy.optimize import brentq
+
     floor = {
         "nt_s": float(discrete_min_steps_batch([-step], [0.0], cfg.plant).time_s[0]),
         "tf_s": float(min_time(np.array([-step]), np.array([0.0]), cfg.plant).t_f[0]),

@@ -49,7 +49,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import brentq
 
 from ptoverify.errors import InputError
 
@@ -480,6 +479,8 @@ def _crossing(p: _Pieces, k: int, s0: float, s1: float, level: float, what: str)
         return float(p.t0[k] + s1)
     # time resolution: 4 ulps of the piece's length (about 1e-18 s for T = 2 ms), so
     # bisection ends in about 50 steps even for a crossing next to s0
+    from scipy.optimize import brentq
+
     s = brentq(
         f,
         s0,
@@ -666,6 +667,8 @@ def _cross_generic(p, k, s0, s1, level, what):
         return float(p.t0[k] + (s0 if abs(f0) < abs(f1) else s1))
     # time resolution: 4 ulps of the piece's length (about 1e-18 s for T = 2 ms), so
     # bisection ends in about 50 steps even for a crossing next to s0
+    from scipy.optimize import brentq
+
     s = brentq(
         f,
         s0,

@@ -92,7 +92,7 @@ GROUND_TRUTH_STATES: tuple[tuple[float, float], ...] = (
     (-40.0, -290.0),
     (0.05, 0.0),
 )
-CONVERGENCE_INTERVALS = (10, 20, 40, 80, 100, 200, 400)
+CONVERGENCE_INTERVALS = (10, 20, 50, 100, 200)
 _TIMING_KEYS = {"seconds", "timings", "solve_time_s", "elapsed_s", "wall_s"}
 
 Progress = Callable[[str], None]
