@@ -72,7 +72,7 @@ from ptoverify.properties import (
     oscillating,
 )
 from ptoverify.simulate import reference, simulate_batch
-from ptoverify.sweep import SweepSettings, grid_states, settling_times
+from ptoverify.sweep import SweepSettings, grid_states, mirror_pairs, settling_times
 
 __all__ = [
     "OBJECTIVES",
@@ -581,6 +581,13 @@ def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
     without the other properties; the stride-overs are counted for the PTO only
     (0 for other laws).
 
+    For an odd law (``Law.odd``) only one state of each mirrored pair of the grid
+    is simulated (:func:`ptoverify.sweep.mirror_pairs`; the grid is symmetric
+    about the origin), and each trajectory counts for its mirror image too: the
+    plant is linear and the law odd bit for bit, so the mirror trajectory is the
+    negated one, whose limit-cycle test, crossings of l1 - o - l2 (sigma is odd
+    bit for bit) and landings outside the linear zone are the same.
+
     Parameters
     ----------
     cfg : Config
@@ -592,16 +599,48 @@ def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
     -------
     limit_cycles, stride_overs : int
         States that end in a sustained oscillation; transitions that stride over l1/l2.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> grid_counts(paper_config(), "pd")
+    (0, 0)
+    """
+    fn = make_law(law, cfg)
+    key = Config(name="grid", plant=cfg.plant, pto=PTOSettings(d=cfg.pto.d))  # what it depends on
+    x1, x2, weight = _gate_grid(key, fn.odd)
+    with grid_simulation(fn, cfg, x1, x2, default_steps(cfg)) as res:
+        return _grid_counts(cfg, law, res, weight)
+
+
+@lru_cache(maxsize=16)
+def _gate_grid(cfg: Config, odd: bool):
+    """States of the gates' grid to simulate, and how many grid states each stands for.
+
+    All of :func:`ptoverify.properties.initial_grid` (weights 1), or for an odd law
+    one state of each mirrored pair (weight 2; 1 for a state that is its own
+    mirror).  Memoized on what the grid depends on; the arrays are read-only.
     """
     x1, x2, _ = initial_grid(cfg)
-    steps = default_steps(cfg)
-    with grid_simulation(make_law(law, cfg), cfg, x1, x2, steps) as res:
-        return _grid_counts(cfg, law, res, steps)
+    pairs = mirror_pairs(x1, x2) if odd else None
+    if pairs is None:
+        weight = np.ones(x1.size, dtype=np.int64)
+    else:
+        reps, where = pairs
+        x1, x2, weight = x1[reps], x2[reps], np.bincount(where, minlength=reps.size)
+    for arr in (x1, x2, weight):
+        arr.flags.writeable = False
+    return x1, x2, weight
 
 
-def _grid_counts(cfg: Config, law: str, res, steps: int) -> tuple[int, int]:
-    """Count the limit cycles and stride-overs of :func:`grid_counts` on its grid run."""
-    cycles = int(oscillating(res.x1[-max(20, steps // 4) :], LIMIT_CYCLE_BAND).sum())
+def _grid_counts(cfg: Config, law: str, res, weight: NDArray[np.int64]) -> tuple[int, int]:
+    """Count the limit cycles and stride-overs of :func:`grid_counts` on its grid run.
+
+    ``weight``: how many grid states each simulated trajectory stands for.
+    """
+    steps = res.x1.shape[0] - 1
+    osc = oscillating(res.x1[-max(20, steps // 4) :], LIMIT_CYCLE_BAND)
+    cycles = int(weight[osc].sum())
     strides = 0
     if law == "pto":
         # a stride-over starts and lands outside the linear zone and does not start in the
@@ -615,7 +654,8 @@ def _grid_counts(cfg: Config, law: str, res, steps: int) -> tuple[int, int]:
                 np.stack([res.x1[k, j], res.x1[k + 1, j]]),
                 np.stack([res.x2[k, j], res.x2[k + 1, j]]),
             )
-            strides = int(crossing_masks(*pair, r[k, j][None, :], cfg)[0].sum())
+            stride = crossing_masks(*pair, r[k, j][None, :], cfg)[0][0]
+            strides = int(weight[j[stride]].sum())
     return cycles, strides
 
 
