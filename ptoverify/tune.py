@@ -61,15 +61,15 @@ from scipy.optimize import differential_evolution
 from ptoverify.config import Config, PDGains, PTOSettings
 from ptoverify.errors import InputError
 from ptoverify.exact import STEP_FRACTION, TIGHT_BAND, settling_times_batch
-from ptoverify.laws import Law, Region, make_law, with_state_gains
+from ptoverify.laws import Law, make_law, with_state_gains
 from ptoverify.mintime import discrete_min_steps_batch, min_time
 from ptoverify.poles import spectral_radii
 from ptoverify.properties import (
-    crossing_masks,
     default_steps,
     grid_simulation,
     initial_grid,
     oscillating,
+    stride_over_counts,
 )
 from ptoverify.simulate import reference, simulate_batch
 from ptoverify.sweep import SweepSettings, grid_states, mirror_pairs, settling_times
@@ -577,9 +577,10 @@ def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
 
     The two counts of :func:`ptoverify.properties.law_properties` that the tuning's
     constraints need, from the same pieces (its grid, horizon, simulation,
-    limit-cycle test over the last quarter of the horizon and crossing masks),
-    without the other properties; the stride-overs are counted for the PTO only
-    (0 for other laws).
+    limit-cycle test over the last quarter of the horizon, and the stride-overs of
+    its crossing masks as :func:`ptoverify.properties.stride_over_counts` counts
+    them), without the other properties; the stride-overs are counted for the PTO
+    only (0 for other laws).
 
     For an odd law (``Law.odd``) only one state of each mirrored pair of the grid
     is simulated (:func:`ptoverify.sweep.mirror_pairs`; the grid is symmetric
@@ -609,8 +610,12 @@ def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
     fn = make_law(law, cfg)
     key = Config(name="grid", plant=cfg.plant, pto=PTOSettings(d=cfg.pto.d))  # what it depends on
     x1, x2, weight = _gate_grid(key, fn.odd)
-    with grid_simulation(fn, cfg, x1, x2, default_steps(cfg)) as res:
-        return _grid_counts(cfg, law, res, weight)
+    steps = default_steps(cfg)
+    with grid_simulation(fn, cfg, x1, x2, steps) as res:
+        cycles = int(weight[oscillating(res.x1[-max(20, steps // 4) :], LIMIT_CYCLE_BAND)].sum())
+        if law != "pto":
+            return cycles, 0
+        return cycles, int(stride_over_counts(res.x1, res.x2, res.region, cfg) @ weight)
 
 
 @lru_cache(maxsize=16)
@@ -631,32 +636,6 @@ def _gate_grid(cfg: Config, odd: bool):
     for arr in (x1, x2, weight):
         arr.flags.writeable = False
     return x1, x2, weight
-
-
-def _grid_counts(cfg: Config, law: str, res, weight: NDArray[np.int64]) -> tuple[int, int]:
-    """Count the limit cycles and stride-overs of :func:`grid_counts` on its grid run.
-
-    ``weight``: how many grid states each simulated trajectory stands for.
-    """
-    steps = res.x1.shape[0] - 1
-    osc = oscillating(res.x1[-max(20, steps // 4) :], LIMIT_CYCLE_BAND)
-    cycles = int(weight[osc].sum())
-    strides = 0
-    if law == "pto":
-        # a stride-over starts and lands outside the linear zone and does not start in the
-        # switching zone (crossing_masks' src & ... & out[1:]): judge only those transitions,
-        # each as a one-transition record (crossing_masks works per transition)
-        out = np.abs(res.x1) >= cfg.pto.d
-        r = res.region
-        k, j = np.nonzero(out[:-1] & out[1:] & (r != Region.ZONE_P) & (r != Region.ZONE_N))
-        if k.size:
-            pair = (
-                np.stack([res.x1[k, j], res.x1[k + 1, j]]),
-                np.stack([res.x2[k, j], res.x2[k + 1, j]]),
-            )
-            stride = crossing_masks(*pair, r[k, j][None, :], cfg)[0][0]
-            strides = int(weight[j[stride]].sum())
-    return cycles, strides
 
 
 def _grid_ok(cfg: Config, law: str, c: Candidate) -> Candidate:
