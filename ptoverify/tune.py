@@ -60,7 +60,12 @@ from scipy.optimize import differential_evolution
 
 from ptoverify.config import Config, PDGains, PTOSettings
 from ptoverify.errors import InputError
-from ptoverify.exact import STEP_FRACTION, TIGHT_BAND, settling_times_batch
+from ptoverify.exact import (
+    STEP_FRACTION,
+    TIGHT_BAND,
+    settling_and_overshoot,
+    settling_times_batch,
+)
 from ptoverify.laws import Law, make_law, with_state_gains
 from ptoverify.mintime import discrete_min_steps_batch, min_time
 from ptoverify.poles import spectral_radii
@@ -202,6 +207,19 @@ def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:
 
     m, _ = run_simulation(cfg, law, signal).metrics()  # the very path of simulate --json
     return {k: math.nan if v is None else float(v) for k, v in m.items()}
+
+
+def _settling_overshoot(cfg: Config, law: str, signal: str) -> dict[str, float]:
+    """Overshoot and settling times of :func:`response_metrics`, bit for bit.
+
+    The same simulation and the same exact evaluation
+    (:func:`ptoverify.exact.settling_and_overshoot`), without the rise time and the
+    sample-grid readings that a candidate does not carry.
+    """
+    from ptoverify.commands import run_simulation
+
+    res = run_simulation(cfg, law, signal).result  # the very path of simulate --json
+    return settling_and_overshoot(res, cfg.plant, res.reference)
 
 
 #: Default state grid of :func:`worst_ratio_nt` (n1 x n2 over the envelope).  Even
@@ -368,11 +386,11 @@ def _evaluate(cfg, law, gains, signal, objective, max_overshoot, worst_ratio, me
             z = zone_for_law(tcfg, "corrected")
             omega0 = float(z.omega0) if z.omega0 is not None else None
         if memo is None:
-            m = response_metrics(tcfg, law, signal)
+            m = _settling_overshoot(tcfg, law, signal)
         else:
             k = (signal, _key(gains))
             if k not in memo:
-                memo[k] = response_metrics(tcfg, law, signal)
+                memo[k] = _settling_overshoot(tcfg, law, signal)
             m = memo[k]
     except InputError as exc:
         return Candidate(gains, math.inf, nan, nan, nan, False, reason=str(exc))

@@ -399,18 +399,18 @@ def test_fair_tunings_are_the_tunings_one_by_one():
 
 
 def test_reported_numbers_are_those_of_simulate_json():
-    from ptoverify.tune import evaluate
+    from ptoverify.tune import evaluate, response_metrics, tuned_config
 
     r = tune(CFG, "pd", "step", max_overshoot=0.02, maxiter=3, popsize=5)
     for c in [r.best, r.runner_up, *r.front]:
         if c is None:
             continue
+        got = (c.settling_2pct_s, c.overshoot_mm, c.settling_0p01mm_s)
         ref = evaluate(CFG, "pd", c.gains, max_overshoot=0.02)
-        assert (c.settling_2pct_s, c.overshoot_mm, c.settling_0p01mm_s) == (
-            ref.settling_2pct_s,
-            ref.overshoot_mm,
-            ref.settling_0p01mm_s,
-        )
+        assert got == (ref.settling_2pct_s, ref.overshoot_mm, ref.settling_0p01mm_s)
+        # every metric of the simulate --json path, bit for bit
+        m = response_metrics(tuned_config(CFG, "pd", c.gains), "pd", "step")
+        assert got == (m["settling_2pct_s"], m["overshoot_mm"], m["settling_0p01mm_s"])
 
 
 def test_tune_is_deterministic():
