@@ -252,7 +252,9 @@ def worst_ratio_nt(
     (:func:`~ptoverify.sweep.settling_times`); N* the fewest ZOH samples to the
     origin (:func:`~ptoverify.mintime.discrete_min_steps_batch`, computed once
     per plant and grid).  A law that does not settle from some grid state has
-    an infinite worst ratio (the tuner treats it as infeasible).
+    an infinite worst ratio (the tuner treats it as infeasible).  For an odd law
+    (``Law.odd``) one state of each mirrored pair of the grid is simulated, as the
+    sweep does: the mirror's trajectory is the negated one, its settling the same.
 
     Parameters
     ----------
@@ -279,16 +281,20 @@ def worst_ratio_nt(
         raise InputError("worst_ratio_nt: the grid needs at least 2 points per axis")
     p = cfg.plant
     x1, x2, nt, steps, hold = _envelope(p, n1, n2)
+    fn = make_law(law, cfg)
+    # an odd law: one state of each mirrored pair, whose time is its mirror's (as the sweep)
+    pairs = mirror_pairs(x1, x2) if fn.odd else None
+    reps, where = pairs if pairs is not None else (np.arange(x1.size), np.arange(x1.size))
     st = settling_times(
-        make_law(law, cfg),
+        fn,
         p,
-        x1,
-        x2,
+        x1[reps],
+        x2[reps],
         steps,
         SweepSettings().band,
         p.a * SweepSettings().band,
         hold * p.sample_time,
-    ).grid  # the sweep's sample-grid reading (its between-samples twin differs by < T)
+    ).grid[where]  # the sweep's sample-grid reading (its between-samples twin differs by < T)
     ok = np.isfinite(nt)
     if not np.isfinite(st[ok]).all():
         return math.inf
