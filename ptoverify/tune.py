@@ -1333,8 +1333,8 @@ def fair_tunings(cfg: Config, budget: TuneBudget | None = None) -> FairTunings:
     tuning shared by two bounds of equal value is run once.  A law's tunings run
     side by side on one shared screen (each gives what :func:`tune` gives alone).
     Results are cached per (configuration, budget): at the report's budget the
-    four tunings take about 1.5 s of CPU on the paper's plant, at the default
-    budget about 3.5 s.
+    four tunings take about 0.9 s of CPU on the paper's plant, at the default
+    budget about 1.7 s.
 
     Parameters
     ----------
