@@ -647,8 +647,9 @@ def _gate_grid(cfg: Config, odd: bool):
     """States of the gates' grid to simulate, and how many grid states each stands for.
 
     All of :func:`ptoverify.properties.initial_grid` (weights 1), or for an odd law
-    one state of each mirrored pair (weight 2; 1 for a state that is its own
-    mirror).  Memoized on what the grid depends on; the arrays are read-only.
+    one state of each mirrored pair (:func:`ptoverify.sweep.mirror_pairs`), weighted
+    by the number of grid states that are it or its mirror image (2 for a pair, 1
+    for the origin).  Memoized on what the grid depends on; the arrays are read-only.
     """
     x1, x2, _ = initial_grid(cfg)
     pairs = mirror_pairs(x1, x2) if odd else None
