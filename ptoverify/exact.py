@@ -74,6 +74,7 @@ __all__ = [
     "sine_phase",
     "exact_metrics",
     "metrics_from_arrays",
+    "settling_and_overshoot",
     "BatchSettling",
     "settling_times_batch",
 ]
@@ -1128,22 +1129,19 @@ def metrics_from_arrays(
     T = tr.period
     tt, y1, y2 = tr.t, tr.x1, tr.x2
     e_grid = sig.r(tt) - y1
-    big = STEP_FRACTION if step_fraction is None else step_fraction
-    band2 = big * abs(sig.amplitude)
     nan = math.nan
-    p = _pieces(tr, sig)
-    ev = _value(p, p.brk, "e")
+    band2, p, ev, core = _core_metrics(tr, sig, band, step_fraction)
     acc = _Accuracy(tr, sig)
     vals: dict[str, Compared] = {}
     details: dict[str, float] = {"band_2pct_mm": band2, "t_peak_s": nan}
     for key, b in (("settling_2pct_s", band2), ("settling_0p01mm_s", band)):
-        ex = _settling(p, b, ev) - float(tt[0]) if b > 0 else nan
+        ex = core[key]
         g = grid_settling_time(tt, e_grid, b) if b > 0 else nan
         err = acc.time(float(tt[0]) + ex, "e") if ex > 0 else (0.0 if ex == 0 else nan)
         vals[key] = Compared(ex, g, TIME_TOL_SAMPLES * T, err)
     if sig.kind in ("step", "ramp"):
         target = float(sig.r(tt[-1]))
-        ov, tp = overshoot(tr, target)
+        ov, tp = core["overshoot_mm"], core["t_peak_s"]
         g = grid_overshoot(y1, target, float(y1[0]))
         vals["overshoot_mm"] = Compared(ov, g, POSITION_TOL, acc.position)
         details["t_peak_s"] = tp
@@ -1174,6 +1172,84 @@ def metrics_from_arrays(
         err = acc.time(float(tt[0]) + ez, "e") if ez > 0 else (0.0 if ez == 0 else nan)
         vals["linear_zone_s"] = Compared(ez, gz, TIME_TOL_SAMPLES * T, err)
     return ExactMetrics(sig, {k: vals[k] for k in METRIC_KEYS}, details)
+
+
+def _core_metrics(tr: Trajectory, sig: Signal, band: float, step_fraction: float | None):
+    """Compute the exact settling times and overshoot of :func:`metrics_from_arrays`.
+
+    Returns the 2 % band [mm], the e-pieces and their values at the breaks (for the
+    rise time), and ``settling_2pct_s``, ``settling_0p01mm_s`` [s] (NaN for a band
+    <= 0), ``overshoot_mm`` [mm] and ``t_peak_s`` [s] (NaN unless a step or ramp).
+    """
+    nan = math.nan
+    big = STEP_FRACTION if step_fraction is None else step_fraction
+    band2 = big * abs(sig.amplitude)
+    t0 = float(tr.t[0])
+    p = _pieces(tr, sig)
+    ev = _value(p, p.brk, "e")
+    out = {
+        key: _settling(p, b, ev) - t0 if b > 0 else nan
+        for key, b in (("settling_2pct_s", band2), ("settling_0p01mm_s", band))
+    }
+    ov = tp = nan
+    if sig.kind in ("step", "ramp"):
+        ov, tp = overshoot(tr, float(sig.r(tr.t[-1])))
+    out.update(overshoot_mm=ov, t_peak_s=tp)
+    return band2, p, ev, out
+
+
+def settling_and_overshoot(
+    res: Any,
+    plant: Any,
+    reference: Any = None,
+    *,
+    band: float = TIGHT_BAND,
+    step_fraction: float = STEP_FRACTION,
+) -> dict[str, float]:
+    """Return the exact settling times and overshoot of a response, without other metrics.
+
+    The values of ``exact_metrics(res, plant, reference).exact()`` for these keys,
+    bit for bit (the same computation, without the sample-grid readings, the rise
+    time, the phase and the accuracy bounds): for callers that measure many
+    responses and need only these (the tuning's candidates).
+
+    Parameters
+    ----------
+    res : object
+        Has arrays ``t`` [s], ``x1`` [mm], ``x2`` [mm/s], ``u`` [mm/s] (see
+        :func:`exact_metrics`).
+    plant : Plant or float
+        Has ``a`` [rad/s], or is a.
+    reference : Signal, Reference-like or tuple, optional
+        The reference (see :func:`exact_metrics`).
+    band : float
+        Tight settling band [mm].
+    step_fraction : float
+        Classical band as a fraction of the reference's size |amplitude| [-].
+
+    Returns
+    -------
+    dict
+        ``overshoot_mm`` [mm] (NaN unless a step or ramp), ``settling_2pct_s`` and
+        ``settling_0p01mm_s`` [s] (NaN: never settles).
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> from ptoverify.laws import make_law
+    >>> from ptoverify.simulate import simulate
+    >>> cfg = paper_config()
+    >>> res = simulate(make_law("pd", cfg), cfg.plant, "step")
+    >>> full = exact_metrics(res, cfg.plant).exact()
+    >>> all(v == full[k] for k, v in settling_and_overshoot(res, cfg.plant).items())
+    True
+    """
+    if reference is None:
+        reference = getattr(res, "reference", None) or _infer(res)
+    a = plant if isinstance(plant, (int, float)) else plant.a
+    tr = Trajectory.from_samples(res.t, res.x1, res.x2, res.u, float(a))
+    core = _core_metrics(tr, as_signal(reference), band, step_fraction)[3]
+    return {k: core[k] for k in ("overshoot_mm", "settling_2pct_s", "settling_0p01mm_s")}
 
 
 class _Accuracy:

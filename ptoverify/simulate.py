@@ -426,20 +426,35 @@ def simulate(
     zero = np.zeros_like(r_dot)
     e2_off = zero if tracking == "none" else r_dot  # what the law subtracts from x2
     u_add = r_dot if tracking == "feedforward" else zero  # what is added to the law's output
-    x1, x2 = np.zeros(n + 1), np.zeros(n + 1)
-    u, region = np.zeros(n + 1), np.zeros(n + 1, dtype=np.int8)
     w, a, T = plant.w_max, plant.a, plant.sample_time
     g = -math.expm1(-a * T)
     law_scalar = law.scalar
+    # the loop on Python floats (the same IEEE double arithmetic as on numpy scalars,
+    # operation for operation, without their per-operation overhead)
+    rs, offs, adds = r.tolist(), e2_off.tolist(), u_add.tolist()
+    x1, x2, u, region = [0.0] * (n + 1), [0.0] * (n + 1), [0.0] * (n + 1), [0] * (n + 1)
+    x1k = x2k = 0.0
     for k in range(n + 1):
-        v, region[k] = law_scalar(float(x1[k] - r[k]), float(x2[k] - e2_off[k]))
-        uk = min(max(v + u_add[k], -w), w)
-        u[k] = uk
+        v, region[k] = law_scalar(x1k - rs[k], x2k - offs[k])
+        uk = u[k] = min(max(v + adds[k], -w), w)
         if k < n:
-            dv = x2[k] - uk
-            x1[k + 1] = x1[k] + uk * T + dv * g / a
-            x2[k + 1] = x2[k] - dv * g
-    return SimResult(law.name, ref, tracking, t, r, r_dot, x1, x2, r - x1, u, region)
+            dv = x2k - uk
+            x1k = x1[k + 1] = x1k + uk * T + dv * g / a
+            x2k = x2[k + 1] = x2k - dv * g
+    x1a = np.array(x1, dtype=float)
+    return SimResult(
+        law.name,
+        ref,
+        tracking,
+        t,
+        r,
+        r_dot,
+        x1a,
+        np.array(x2, dtype=float),
+        r - x1a,
+        np.array(u, dtype=float),
+        np.array(region, dtype=np.int8),
+    )
 
 
 @dataclass(frozen=True)

@@ -60,19 +60,24 @@ from scipy.optimize import differential_evolution
 
 from ptoverify.config import Config, PDGains, PTOSettings
 from ptoverify.errors import InputError
-from ptoverify.exact import STEP_FRACTION, TIGHT_BAND, settling_times_batch
-from ptoverify.laws import Law, Region, make_law, with_state_gains
+from ptoverify.exact import (
+    STEP_FRACTION,
+    TIGHT_BAND,
+    settling_and_overshoot,
+    settling_times_batch,
+)
+from ptoverify.laws import Law, make_law, with_state_gains
 from ptoverify.mintime import discrete_min_steps_batch, min_time
 from ptoverify.poles import spectral_radii
 from ptoverify.properties import (
-    crossing_masks,
     default_steps,
     grid_simulation,
     initial_grid,
     oscillating,
+    stride_over_counts,
 )
 from ptoverify.simulate import reference, simulate_batch
-from ptoverify.sweep import SweepSettings, grid_states, settling_times
+from ptoverify.sweep import SweepSettings, grid_states, mirror_pairs, settling_times
 
 __all__ = [
     "OBJECTIVES",
@@ -204,6 +209,19 @@ def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:
     return {k: math.nan if v is None else float(v) for k, v in m.items()}
 
 
+def _settling_overshoot(cfg: Config, law: str, signal: str) -> dict[str, float]:
+    """Overshoot and settling times of :func:`response_metrics`, bit for bit.
+
+    The same simulation and the same exact evaluation
+    (:func:`ptoverify.exact.settling_and_overshoot`), without the rise time and the
+    sample-grid readings that a candidate does not carry.
+    """
+    from ptoverify.commands import run_simulation
+
+    res = run_simulation(cfg, law, signal).result  # the very path of simulate --json
+    return settling_and_overshoot(res, cfg.plant, res.reference)
+
+
 #: Default state grid of :func:`worst_ratio_nt` (n1 x n2 over the envelope).  Even
 #: counts keep the origin (N* = 0) off the grid, as the sweep's.
 WORST_GRID = (20, 20)
@@ -234,7 +252,9 @@ def worst_ratio_nt(
     (:func:`~ptoverify.sweep.settling_times`); N* the fewest ZOH samples to the
     origin (:func:`~ptoverify.mintime.discrete_min_steps_batch`, computed once
     per plant and grid).  A law that does not settle from some grid state has
-    an infinite worst ratio (the tuner treats it as infeasible).
+    an infinite worst ratio (the tuner treats it as infeasible).  For an odd law
+    (``Law.odd``) one state of each mirrored pair of the grid is simulated, as the
+    sweep does: the mirror's trajectory is the negated one, its settling the same.
 
     Parameters
     ----------
@@ -261,16 +281,20 @@ def worst_ratio_nt(
         raise InputError("worst_ratio_nt: the grid needs at least 2 points per axis")
     p = cfg.plant
     x1, x2, nt, steps, hold = _envelope(p, n1, n2)
+    fn = make_law(law, cfg)
+    # an odd law: one state of each mirrored pair, whose time is its mirror's (as the sweep)
+    pairs = mirror_pairs(x1, x2) if fn.odd else None
+    reps, where = pairs if pairs is not None else (np.arange(x1.size), np.arange(x1.size))
     st = settling_times(
-        make_law(law, cfg),
+        fn,
         p,
-        x1,
-        x2,
+        x1[reps],
+        x2[reps],
         steps,
         SweepSettings().band,
         p.a * SweepSettings().band,
         hold * p.sample_time,
-    ).grid  # the sweep's sample-grid reading (its between-samples twin differs by < T)
+    ).grid[where]  # the sweep's sample-grid reading (its between-samples twin differs by < T)
     ok = np.isfinite(nt)
     if not np.isfinite(st[ok]).all():
         return math.inf
@@ -368,11 +392,11 @@ def _evaluate(cfg, law, gains, signal, objective, max_overshoot, worst_ratio, me
             z = zone_for_law(tcfg, "corrected")
             omega0 = float(z.omega0) if z.omega0 is not None else None
         if memo is None:
-            m = response_metrics(tcfg, law, signal)
+            m = _settling_overshoot(tcfg, law, signal)
         else:
             k = (signal, _key(gains))
             if k not in memo:
-                memo[k] = response_metrics(tcfg, law, signal)
+                memo[k] = _settling_overshoot(tcfg, law, signal)
             m = memo[k]
     except InputError as exc:
         return Candidate(gains, math.inf, nan, nan, nan, False, reason=str(exc))
@@ -577,9 +601,17 @@ def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
 
     The two counts of :func:`ptoverify.properties.law_properties` that the tuning's
     constraints need, from the same pieces (its grid, horizon, simulation,
-    limit-cycle test over the last quarter of the horizon and crossing masks),
-    without the other properties; the stride-overs are counted for the PTO only
-    (0 for other laws).
+    limit-cycle test over the last quarter of the horizon, and the stride-overs of
+    its crossing masks as :func:`ptoverify.properties.stride_over_counts` counts
+    them), without the other properties; the stride-overs are counted for the PTO
+    only (0 for other laws).
+
+    For an odd law (``Law.odd``) only one state of each mirrored pair of the grid
+    is simulated (:func:`ptoverify.sweep.mirror_pairs`; the grid is symmetric
+    about the origin), and each trajectory counts for its mirror image too: the
+    plant is linear and the law odd bit for bit, so the mirror trajectory is the
+    negated one, whose limit-cycle test, crossings of l1 - o - l2 (sigma is odd
+    bit for bit) and landings outside the linear zone are the same.
 
     Parameters
     ----------
@@ -592,31 +624,43 @@ def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
     -------
     limit_cycles, stride_overs : int
         States that end in a sustained oscillation; transitions that stride over l1/l2.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> grid_counts(paper_config(), "pd")
+    (0, 0)
+    """
+    fn = make_law(law, cfg)
+    key = Config(name="grid", plant=cfg.plant, pto=PTOSettings(d=cfg.pto.d))  # what it depends on
+    x1, x2, weight = _gate_grid(key, fn.odd)
+    steps = default_steps(cfg)
+    with grid_simulation(fn, cfg, x1, x2, steps) as res:
+        cycles = int(weight[oscillating(res.x1[-max(20, steps // 4) :], LIMIT_CYCLE_BAND)].sum())
+        if law != "pto":
+            return cycles, 0
+        return cycles, int(stride_over_counts(res.x1, res.x2, res.region, cfg) @ weight)
+
+
+@lru_cache(maxsize=16)
+def _gate_grid(cfg: Config, odd: bool):
+    """States of the gates' grid to simulate, and how many grid states each stands for.
+
+    All of :func:`ptoverify.properties.initial_grid` (weights 1), or for an odd law
+    one state of each mirrored pair (:func:`ptoverify.sweep.mirror_pairs`), weighted
+    by the number of grid states that are it or its mirror image (2 for a pair, 1
+    for the origin).  Memoized on what the grid depends on; the arrays are read-only.
     """
     x1, x2, _ = initial_grid(cfg)
-    steps = default_steps(cfg)
-    with grid_simulation(make_law(law, cfg), cfg, x1, x2, steps) as res:
-        return _grid_counts(cfg, law, res, steps)
-
-
-def _grid_counts(cfg: Config, law: str, res, steps: int) -> tuple[int, int]:
-    """Count the limit cycles and stride-overs of :func:`grid_counts` on its grid run."""
-    cycles = int(oscillating(res.x1[-max(20, steps // 4) :], LIMIT_CYCLE_BAND).sum())
-    strides = 0
-    if law == "pto":
-        # a stride-over starts and lands outside the linear zone and does not start in the
-        # switching zone (crossing_masks' src & ... & out[1:]): judge only those transitions,
-        # each as a one-transition record (crossing_masks works per transition)
-        out = np.abs(res.x1) >= cfg.pto.d
-        r = res.region
-        k, j = np.nonzero(out[:-1] & out[1:] & (r != Region.ZONE_P) & (r != Region.ZONE_N))
-        if k.size:
-            pair = (
-                np.stack([res.x1[k, j], res.x1[k + 1, j]]),
-                np.stack([res.x2[k, j], res.x2[k + 1, j]]),
-            )
-            strides = int(crossing_masks(*pair, r[k, j][None, :], cfg)[0].sum())
-    return cycles, strides
+    pairs = mirror_pairs(x1, x2) if odd else None
+    if pairs is None:
+        weight = np.ones(x1.size, dtype=np.int64)
+    else:
+        reps, where = pairs
+        x1, x2, weight = x1[reps], x2[reps], np.bincount(where, minlength=reps.size)
+    for arr in (x1, x2, weight):
+        arr.flags.writeable = False
+    return x1, x2, weight
 
 
 def _grid_ok(cfg: Config, law: str, c: Candidate) -> Candidate:
@@ -1290,8 +1334,8 @@ def fair_tunings(cfg: Config, budget: TuneBudget | None = None) -> FairTunings:
     tuning shared by two bounds of equal value is run once.  A law's tunings run
     side by side on one shared screen (each gives what :func:`tune` gives alone).
     Results are cached per (configuration, budget): at the report's budget the
-    four tunings take about 1.5 s of CPU on the paper's plant, at the default
-    budget about 3.5 s.
+    four tunings take about 0.9 s of CPU on the paper's plant, at the default
+    budget about 1.7 s.
 
     Parameters
     ----------

@@ -266,21 +266,77 @@ def principle_margin(
     shape = np.broadcast_shapes(om.shape, x2.shape)
     out = np.array(np.broadcast_to(m_fixed, shape))
     om = np.minimum(om, w)
-    if outer:  # columns x2 < 0
+
+    def l1_side(sel, xn, on, c1n, tn, mbn):  # out[sel]: the l1* side's margin, and m_b's
+        with np.errstate(all="ignore"):
+            l1s = np.where(on <= 0.0, -xn / a, level_curve_x1(xn, a, np.where(on <= 0.0, 1.0, on)))
+        lo = np.maximum(l1s, d)  # right piece: x1 >= max(l1*, d)
+        out[sel] = np.minimum(_side_margin(lo, np.inf, c1n, tn, a, d, reading), mbn)
+
+    if outer:  # columns x2 < 0; of each row, those where l1* may lie at x1 >= d
         cols = np.flatnonzero(x2 < 0)
-        sel = (slice(None), cols)
-        xn, on, c1n, tn, mbn = x2[cols], om, c1[cols], term[cols], m_b[cols]
+        for rows, n in _row_groups(_beyond_d(x2[cols], om[:, 0], a, d)):
+            c = cols[:n]
+            l1_side((rows[:, None], c), x2[c], om[rows], c1[c], term[c], m_b[c])
     else:
         x2b = np.broadcast_to(x2, shape)
         sel = x2b < 0
         xn, on = x2b[sel], np.broadcast_to(om, shape)[sel]
         c1n, tn = np.broadcast_to(c1, shape)[sel], np.broadcast_to(term, shape)[sel]
-        mbn = np.broadcast_to(m_b, shape)[sel]
-    with np.errstate(all="ignore"):
-        l1s = np.where(on <= 0.0, -xn / a, level_curve_x1(xn, a, np.where(on <= 0.0, 1.0, on)))
-    lo = np.maximum(l1s, d)  # right piece: x1 >= max(l1*, d)
-    out[sel] = np.minimum(_side_margin(lo, np.inf, c1n, tn, a, d, reading), mbn)
+        l1_side(sel, xn, on, c1n, tn, np.broadcast_to(m_b, shape)[sel])
     return out
+
+
+#: Relative headroom of the bound of :func:`_beyond_d` on l1*'s x1 (the round-off of
+#: the computed x1 and of the bound is below 1e-13 relative)
+_L1S_HEADROOM = 1.0 + 1e-6
+
+
+def _beyond_d(
+    xn: NDArray[np.float64], omegas: NDArray[np.float64], a: float, d: float
+) -> NDArray[np.intp]:
+    """Per omega0, how many leading velocities of ``xn`` may have l1* at x1 >= d.
+
+    At x2 < 0, l1* lies at x1 = omega0 h(|x2| / omega0) / a (:func:`level_curve_x1`)
+    and h(r) <= min(r, r^2 / 2) for r >= 0, so x1 <= min(|x2|, x2^2 / (2 omega0)) / a;
+    as computed, within 1e-13 relative of that bound (where r >= 0.2, r - log1p(r)
+    <= r exactly).  Where the bound times :data:`_L1S_HEADROOM` is below d, the
+    computed l1* is < d, the sources start at max(l1*, d) = d, and the margin there
+    is the omega0-free one that :func:`principle_margin` starts from: the side
+    margin cannot fall as its sources' left end moves right (the residual rises
+    with x1, and rounding is monotone), and the l1* side at x1 >= d is in that
+    margin already.  With ``xn`` ascending (x2 < 0, |x2| falling) such velocities
+    form a trailing run; the length of the rest is returned.  Where ``xn`` is not
+    ascending, or omega0 is not positive and finite, every velocity counts.
+    """
+    full = np.full(omegas.shape, xn.size, dtype=np.intp)
+    if xn.size < 2 or not (np.diff(xn) > 0).all():
+        return full
+    ax = -xn[::-1]  # |x2|, ascending
+    ad = a * d
+    n_lin = xn.size - np.searchsorted(ax * _L1S_HEADROOM, ad)  # |x2| (1 + 1e-6) >= a d
+    with np.errstate(all="ignore"):  # x2^2 (1 + 1e-6) >= 2 omega0 a d
+        n_quad = xn.size - np.searchsorted(ax * ax * _L1S_HEADROOM, 2.0 * omegas * ad)
+    ok = (omegas > 0) & np.isfinite(omegas)
+    return np.where(ok, np.minimum(n_lin, n_quad), full)
+
+
+def _row_groups(counts: NDArray[np.intp]) -> list[tuple[NDArray[np.intp], int]]:
+    """Group rows that need a leading run of ``counts`` columns (rows needing none left out).
+
+    Each group is computed over its longest run, less than twice its shortest (the
+    extra entries come out as they would anyway: the computation is elementwise).
+    """
+    order = np.argsort(-counts, kind="stable")
+    ranked = counts[order].tolist()
+    groups, i = [], 0
+    while i < len(ranked) and ranked[i] > 0:
+        j = i + 1
+        while j < len(ranked) and 2 * ranked[j] > ranked[i]:
+            j += 1
+        groups.append((order[i:j], ranked[i]))
+        i = j
+    return groups
 
 
 def _omega_free(plant, d: float, reading: str, x2: NDArray[np.float64]):

@@ -319,6 +319,32 @@ def test_duck_typed_result_and_inferred_reference():
         assert (math.isnan(a) and math.isnan(b)) or a == b, k
 
 
+def test_settling_and_overshoot_are_those_of_exact_metrics():
+    """The lean evaluation gives exact_metrics' values bit for bit (NaN where it does),
+    for every law and signal, at the paper's gains and at far-off ones (the sine's
+    overshoot is undefined: NaN)."""
+    from ptoverify.tune import tuned_config
+
+    cfgs = [
+        CFG,
+        tuned_config(CFG, "pd", {"kp": 2900.0, "kd": 0.0}),
+        tuned_config(CFG, "pd", {"kp": 12.0, "kd": 3.9}),
+        tuned_config(CFG, "pto", {"d": 0.3, "k1": 2500.0, "k2": 0.05}),
+    ]
+    seen_nan = False
+    for cfg in cfgs:
+        for law in ("to", "pd", "pto"):
+            for sig in ("step", "ramp", "sine"):
+                res = simulate(make_law(law, cfg), cfg.plant, sig)
+                full = exact.exact_metrics(res, cfg.plant, res.reference).exact()
+                lean = exact.settling_and_overshoot(res, cfg.plant, res.reference)
+                assert set(lean) == {"overshoot_mm", "settling_2pct_s", "settling_0p01mm_s"}
+                for k, v in lean.items():
+                    assert (math.isnan(v) and math.isnan(full[k])) or v == full[k], (law, sig, k)
+                    seen_nan |= math.isnan(v)
+    assert seen_nan
+
+
 @pytest.mark.parametrize("sig", ["step", "sine"])
 def test_json_metrics_follow_design_keys(sig):
     import json

@@ -273,6 +273,29 @@ def test_principle_margin_broadcast_rows_are_scalar_calls():
         assert same(pair, want)
 
 
+@pytest.mark.parametrize("reading", ["strict", "lenient"])
+def test_principle_margin_rows_on_a_sorted_grid_are_scalar_calls(reading):
+    """On ascending velocities the rows skip l1* where it provably lies inside |x1| < d
+    (_beyond_d); every row is still the scalar-omega0 margin bit for bit."""
+    for plant_cfg in (CFG, CFG.with_plant(a=30.0)):
+        w, a = plant_cfg.plant.w_max, plant_cfg.plant.a
+        x2 = np.linspace(-w, w, 801)
+        om = np.concatenate([[0.0, -1.0, np.nan, 1e-6 * w, w, 2.0 * w], RNG.uniform(0, w, 10)])
+        for d in (0.0, 0.2, 0.5, 1.0, 2.5, 6.0):
+            rows = zones.principle_margin(plant_cfg, om[:, None], x2, reading=reading, d=d)
+            for k, o in enumerate(om):
+                want = zones.principle_margin(plant_cfg, float(o), x2, reading=reading, d=d)
+                assert same(rows[k], want), (a, d, o)
+    # the skip is taken, and where it is, l1* is inside the linear zone (computed directly)
+    w, a, d = CFG.plant.w_max, CFG.plant.a, 0.5
+    xn = np.linspace(-w, 0.0, 4001)[:-1]
+    om = np.geomspace(1e-6 * w, w, 400)
+    reach = zones._beyond_d(xn, om, a, d)
+    assert reach.min() < xn.size // 2 and reach.max() > 0
+    skipped = np.arange(xn.size)[None, :] >= reach[:, None]
+    assert (level_curve_x1(xn[None, :], a, om[:, None])[skipped] < d).all()
+
+
 def test_smallest_d_depends_on_the_plant_only():
     base = zones.smallest_d(CFG)
     zones.clear_caches()

@@ -12,7 +12,7 @@ from numpy.testing import assert_allclose
 from ptoverify.cli import main
 from ptoverify.config import paper_config
 from ptoverify.exact import settling_times_batch
-from ptoverify.laws import make_law
+from ptoverify.laws import Region, make_law
 from ptoverify.mintime import discrete_min_steps, min_time
 from ptoverify.ocp import TwoPhaseOCP
 from ptoverify.simulate import simulate_batch
@@ -267,8 +267,9 @@ def test_grid_is_even_and_exactly_symmetric(n1, n2):
 
 @pytest.mark.parametrize("name", ["to", "pd", "pto", "pto-printed"])
 def test_laws_are_odd_bit_for_bit(name):
-    """u(-x) == -u(x) exactly, at random states of every scale and on the axes: the premise
-    of simulating half of a symmetric grid."""
+    """u(-x) == -u(x) exactly, and the regions are each other's mirror (P and N swap), at
+    random states of every scale and on the axes: the premise of simulating half of a
+    symmetric grid (the sweep's settling times, tune.grid_counts' zone and crossings)."""
     cfg = paper_config()
     law = make_law(name, cfg)
     rng = np.random.default_rng(5)
@@ -278,6 +279,10 @@ def test_laws_are_odd_bit_for_bit(name):
     u, r = law.vector(x1, x2)
     u_m, r_m = law.vector(-x1, -x2)
     assert np.array_equal(u_m, -u)
+    swap = {Region.BANG_P: Region.BANG_N, Region.ZONE_P: Region.ZONE_N}
+    swap |= {n: p for p, n in swap.items()}
+    mirror = np.array([swap.get(Region(c), Region(c)) for c in range(len(Region))])
+    assert np.array_equal(r_m, mirror[r])
 
 
 def test_mirrored_half_equals_simulating_every_state():

@@ -17,8 +17,9 @@ from ptoverify.errors import InputError
 from ptoverify.exact import exact_metrics
 from ptoverify.laws import make_law
 from ptoverify.mintime import discrete_min_steps, min_time
-from ptoverify.properties import law_properties
+from ptoverify.properties import initial_grid, law_properties
 from ptoverify.simulate import simulate
+from ptoverify.sweep import mirror_pairs
 from ptoverify.tune import (
     BOUNDS,
     TuneBudget,
@@ -297,17 +298,21 @@ def test_grid_counts_are_the_gate_properties(monkeypatch):
         assert cycles == lp.limit_cycles
         assert strides == (lp.stride_overs if law == "pto" else 0)
     assert tune_mod.grid_counts(CFG, "to")[0] > 0, "the sampled TO law chatters"
-    # a PTO without its zone on a plant where that strides over (the gate's own failing case)
-    stride_cfg = Config(
-        "stride",
-        Plant(a=100.0, w_max=100.0, sample_time=0.003, position_range=20.0),
-        PDGains(kp=50.0, kd=0.5),
-        PTOSettings(d=0.3, k1=50.0, k2=1.0),
-    )
+    # a PTO without its zone on plants where that strides over (the gate's own failing
+    # case): on a grid that is not exactly symmetric (every state simulated) and on one
+    # that is (one state of each mirrored pair simulated, counted for both)
     monkeypatch.setattr(tune_mod, "make_law", lambda name, c: pto_law(c, None))
-    lp = law_properties(pto_law(stride_cfg, None), stride_cfg)
-    assert lp.stride_overs > 0
-    assert tune_mod.grid_counts(stride_cfg, "pto") == (lp.limit_cycles, lp.stride_overs)
+    for position_range, symmetric in ((20.0, False), (25.0, True)):
+        stride_cfg = Config(
+            "stride",
+            Plant(a=100.0, w_max=100.0, sample_time=0.003, position_range=position_range),
+            PDGains(kp=50.0, kd=0.5),
+            PTOSettings(d=0.3, k1=50.0, k2=1.0),
+        )
+        assert (mirror_pairs(*initial_grid(stride_cfg)[:2]) is not None) == symmetric
+        lp = law_properties(pto_law(stride_cfg, None), stride_cfg)
+        assert lp.stride_overs > 0
+        assert tune_mod.grid_counts(stride_cfg, "pto") == (lp.limit_cycles, lp.stride_overs)
 
 
 def test_limit_cycle_band_is_the_gate_default():
@@ -394,18 +399,18 @@ def test_fair_tunings_are_the_tunings_one_by_one():
 
 
 def test_reported_numbers_are_those_of_simulate_json():
-    from ptoverify.tune import evaluate
+    from ptoverify.tune import evaluate, response_metrics, tuned_config
 
     r = tune(CFG, "pd", "step", max_overshoot=0.02, maxiter=3, popsize=5)
     for c in [r.best, r.runner_up, *r.front]:
         if c is None:
             continue
+        got = (c.settling_2pct_s, c.overshoot_mm, c.settling_0p01mm_s)
         ref = evaluate(CFG, "pd", c.gains, max_overshoot=0.02)
-        assert (c.settling_2pct_s, c.overshoot_mm, c.settling_0p01mm_s) == (
-            ref.settling_2pct_s,
-            ref.overshoot_mm,
-            ref.settling_0p01mm_s,
-        )
+        assert got == (ref.settling_2pct_s, ref.overshoot_mm, ref.settling_0p01mm_s)
+        # every metric of the simulate --json path, bit for bit
+        m = response_metrics(tuned_config(CFG, "pd", c.gains), "pd", "step")
+        assert got == (m["settling_2pct_s"], m["overshoot_mm"], m["settling_0p01mm_s"])
 
 
 def test_tune_is_deterministic():
