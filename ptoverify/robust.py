@@ -889,14 +889,90 @@ def latin_hypercube(rng: np.random.Generator, n: int, d: int) -> NDArray[np.floa
     return (perms.T - offsets) / n
 
 
+def choices_without_replacement(
+    rng: np.random.Generator, pop: int, k: int, times: int
+) -> NDArray[np.int64]:
+    """Draw ``rng.choice(pop, k, replace=False)`` ``times`` times, all at once, as NumPy draws.
+
+    NumPy's ``Generator.choice`` without replacement (no ``p``, ``shuffle=True``,
+    ``pop <= 10000`` or ``k <= pop // 50``) runs Floyd's algorithm, one bounded
+    integer per j = pop - k, ..., pop - 1 (the value, or j where the value was
+    picked already), then shuffles the k picks (Fisher-Yates, one bounded
+    integer per i = k - 1, ..., 1).  Each bounded integer in [0, r] (r < 2**32 - 1)
+    is Lemire's: the top 32 bits of a 32-bit draw times r + 1, unless the low 32
+    bits fall below (2**32 - 1 - r) mod (r + 1), which draws again.  Here the
+    2 k - 1 draws of every call are taken at once (``rng.integers`` of 32-bit
+    words, the same stream) and Floyd's and the shuffle's steps are done for
+    all calls together; where any draw would be redrawn (probability below
+    r 2**-32 per draw: about 5e-9 for the search's populations), the generator
+    is put back and the calls are made one by one.  Either way the result and
+    the generator's state afterwards are those of the loop of calls
+    (``tests/test_robust.py`` compares them).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Generator (advanced as the calls advance it).
+    pop : int
+        Population size [-].
+    k : int
+        Picks per call, ``k <= pop`` [-].
+    times : int
+        Number of calls [-].
+
+    Returns
+    -------
+    ndarray of int64, shape (times, k)
+        Row c: what the c-th call returns.
+
+    Examples
+    --------
+    >>> a, b = np.random.default_rng(3), np.random.default_rng(3)
+    >>> mine = choices_without_replacement(a, 23, 3, 5)
+    >>> ref = [b.choice(23, 3, replace=False).tolist() for _ in range(5)]
+    >>> mine.tolist() == ref, a.random() == b.random()
+    (True, True)
+    """
+    top = 0xFFFFFFFF
+    # Floyd's bounds r = pop - k .. pop - 1 and the shuffle's k - 1 .. 1 all draw
+    # (r >= 1) by Lemire's 32-bit method (r < 2**32 - 1) when Floyd's algorithm runs
+    if times > 0 and 1 <= pop - k and pop - 1 < top and (pop <= 10000 or k <= pop // 50):
+        state = rng.bit_generator.state
+        bounds = [pop - k + t for t in range(k)] + list(range(k - 1, 0, -1))
+        words = rng.integers(0, top + 1, size=(times, len(bounds)), dtype=np.uint32)
+        vals = []
+        for c, r in enumerate(bounds):  # Lemire: m = word (r + 1), the value m >> 32
+            m = words[:, c].astype(np.uint64) * np.uint64(r + 1)
+            if ((m & np.uint64(top)) < np.uint64((top - r) % (r + 1))).any():
+                break  # a draw NumPy draws again: the calls one by one, below
+            vals.append((m >> np.uint64(32)).astype(np.int64))
+        else:
+            picks = np.empty((times, k), dtype=np.int64)
+            for t in range(k):  # Floyd: the value, or j = pop - k + t where it is taken
+                taken = (picks[:, :t] == vals[t][:, None]).any(axis=1)
+                picks[:, t] = np.where(taken, pop - k + t, vals[t])
+            rows = np.arange(times)
+            for c, i in enumerate(range(k - 1, 0, -1)):  # the shuffle: swap picks i, j
+                j = vals[k + c]
+                held = picks[rows, j]
+                picks[rows, j] = picks[:, i]
+                picks[:, i] = held
+            return picks
+        rng.bit_generator.state = state
+    return np.array(
+        [rng.choice(pop, k, replace=False) for _ in range(times)], dtype=np.int64
+    ).reshape(times, k)
+
+
 def _distinct_others(rng: np.random.Generator, n_pop: int, k: int) -> NDArray[np.int64]:
     """Per member i, ``k`` distinct other members: ``rng.choice`` of the others, draw for draw.
 
     ``rng.choice(n_pop - 1, k, replace=False)`` draws exactly what
     ``rng.choice(np.delete(np.arange(n_pop), i), k, replace=False)`` draws (the
-    choice depends only on the population size), shifted past i.
+    choice depends only on the population size), shifted past i; the n_pop calls
+    are drawn together (:func:`choices_without_replacement`).
     """
-    out = np.array([rng.choice(n_pop - 1, k, replace=False) for _ in range(n_pop)])
+    out = choices_without_replacement(rng, n_pop - 1, k, n_pop)
     out += out >= np.arange(n_pop)[:, None]
     return out
 

@@ -13,6 +13,7 @@ from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import default_steps, initial_grid, law_properties, oscillating
 from ptoverify.robust import (
     RobustSettings,
+    choices_without_replacement,
     grid_worst,
     horizon_steps,
     latin_hypercube,
@@ -270,6 +271,27 @@ def test_latin_hypercube_draws_as_scipy_does(seed, n, d):
     assert ((mine >= 0) & (mine < 1)).all()
     for col in mine.T:  # exactly one point per stratum [j/n, (j+1)/n)
         assert sorted(np.floor(col * n).astype(int)) == list(range(n))
+
+
+@pytest.mark.parametrize("seed", range(40))
+@pytest.mark.parametrize(
+    ("pop", "k", "times"),
+    [(23, 2, 24), (23, 3, 24), (5, 4, 7), (2, 1, 3), (1, 1, 2), (20000, 5, 4), (3 * 10**9, 2, 40)],
+)
+def test_choices_without_replacement_draws_as_numpy_does(seed, pop, k, times):
+    """The search's batched draws equal NumPy's Generator.choice calls one by one, and
+    leave the generator where they leave it (an odd 32-bit draw first: a buffered half
+    word; the last case redraws often, Lemire's rejection, so it runs the calls)."""
+    mine_rng, ref_rng = np.random.default_rng(seed), np.random.default_rng(seed)
+    if seed % 2:
+        mine_rng.integers(0, 2**32, dtype=np.uint32), ref_rng.integers(0, 2**32, dtype=np.uint32)
+    mine = choices_without_replacement(mine_rng, pop, k, times)
+    ref = [ref_rng.choice(pop, k, replace=False).tolist() for _ in range(times)]
+    assert mine.tolist() == ref
+    assert mine_rng.integers(0, 2**32, dtype=np.uint32) == ref_rng.integers(
+        0, 2**32, dtype=np.uint32
+    )
+    assert mine_rng.random() == ref_rng.random()
 
 
 @pytest.mark.parametrize(
