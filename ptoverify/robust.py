@@ -57,7 +57,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Config, Plant
 from ptoverify.errors import ClusterError, InputError
@@ -65,7 +65,6 @@ from ptoverify.laws import Law, make_law
 from ptoverify.lockstep import Ask, Job, run_lockstep
 from ptoverify.mintime import min_time
 from ptoverify.plant import zoh_matrices
-from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import oscillating, stride_over_counts
 from ptoverify.reach import zonotope_steps_each
 from ptoverify.simulate import BatchResult, Mismatch, simulate_batch
@@ -81,6 +80,7 @@ __all__ = [
     "map_states",
     "robust_maps",
     "linear_loop_margin",
+    "linear_loop_radii",
     "no_limit_cycle_margin",
     "worst_case",
     "worst_cases",
@@ -597,25 +597,87 @@ def _linear_gains(law: str, cfg: Config) -> tuple[float, float] | None:
     return None
 
 
+EDGE_CHUNK = 64  #: scan points of :func:`_edge` tested per stacked eigenvalue call
+
+
 def _edge(
-    stable: Callable[[float], bool], toward: float, *, grid: int = 400, rtol: float = MARGIN_RTOL
+    stable: Callable[[NDArray], NDArray[np.bool_]],
+    toward: float,
+    *,
+    grid: int = 400,
+    rtol: float = MARGIN_RTOL,
 ) -> float | None:
     """Where ``stable`` first fails going from 1 toward ``toward`` (None: never in range).
 
-    Scans a geometric grid of ``grid`` points from 1 to ``toward``, then bisects
-    the first stable/unstable pair to ``rtol`` relative.
+    Scans a geometric grid of ``grid`` points from 1 to ``toward``
+    (:data:`EDGE_CHUNK` points per call of ``stable``, which tests an array of
+    ratios; the points beyond the first failure cannot change the edge), then
+    bisects the first stable/unstable pair to ``rtol`` relative.
     """
     pts = np.geomspace(1.0, toward, grid)
-    prev = 1.0
-    for r in pts[1:]:
-        if not stable(float(r)):
-            lo, hi = prev, float(r)
+    for at in range(1, grid, EDGE_CHUNK):
+        bad = np.flatnonzero(~stable(pts[at : at + EDGE_CHUNK]))
+        if bad.size:
+            j = at + int(bad[0])
+            lo, hi = float(pts[j - 1]), float(pts[j])  # pts[0] is 1.0
             while abs(hi - lo) > rtol * min(abs(lo), abs(hi)):
                 mid = math.sqrt(lo * hi)
-                lo, hi = (mid, hi) if stable(mid) else (lo, mid)
+                lo, hi = (mid, hi) if stable(np.array([mid]))[0] else (lo, mid)
             return lo
-        prev = float(r)
     return None
+
+
+def linear_loop_radii(
+    law: str, cfg: Config, a_ratio: ArrayLike, *, delay_samples: int = 0
+) -> NDArray[np.float64]:
+    """Spectral radius of the sampled linear loop at each a_true / a_design.
+
+    The loop of :func:`linear_loop_margin`: ``Ad - Bd K`` of the ZOH plant of
+    the true a (as :func:`ptoverify.poles.sampled_spectral_radius` forms it), or
+    with a one-sample delay ``[[Ad, Bd], [-K, 0]]``; all ratios in one stacked
+    eigenvalue call, each matrix as alone (LAPACK's ``geev`` per matrix).
+
+    Parameters
+    ----------
+    law : str
+        ``pd``, ``pto`` or ``pto-printed`` (a law with a linear loop).
+    cfg : Config
+        Nominal configuration (a [rad/s], T [s], the gains).
+    a_ratio : array_like, shape (n,)
+        a_true / a_design [-].
+    delay_samples : int
+        0 or 1 [samples].
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Largest |z| [-]; < 1 means stable.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> (linear_loop_radii("pd", paper_config(), [1.0, 10.0]) < 1.0).tolist()
+    [True, False]
+    """
+    gains = _linear_gains(law, cfg)
+    if gains is None or delay_samples not in (0, 1):
+        raise InputError(
+            f"linear_loop_radii: no linear loop for {law!r} with delay {delay_samples}"
+        )
+    a, T = cfg.plant.a, cfg.plant.sample_time
+    K = np.array([gains])  # noqa: N806
+
+    def loop(r: float) -> NDArray[np.float64]:
+        Ad, Bd = zoh_matrices(a * r, T)  # noqa: N806
+        if delay_samples == 0:
+            return Ad - Bd @ K
+        return np.block([[Ad, Bd], [-K, np.zeros((1, 1))]])
+
+    ratios = np.atleast_1d(np.asarray(a_ratio, dtype=float))
+    if ratios.size == 0:
+        return np.empty(0)
+    mats = np.stack([loop(float(r)) for r in ratios])
+    return np.abs(np.linalg.eigvals(mats)).max(axis=-1)
 
 
 def linear_loop_margin(law: str, cfg: Config, *, delay_samples: int = 0) -> dict[str, Any]:
@@ -623,8 +685,8 @@ def linear_loop_margin(law: str, cfg: Config, *, delay_samples: int = 0) -> dict
 
     The linear loop is PD's u = -kp x1 - kd x2 or the PTO's linear zone
     u = -k1 x1 - k2 x2 (eq. 34), unsaturated, on the ZOH plant with the true a
-    and the design T; stable means spectral radius < 1.  With a one-sample
-    computation delay the loop state is (x1, x2, u_{k-1}):
+    and the design T; stable means spectral radius < 1 (:func:`linear_loop_radii`).
+    With a one-sample computation delay the loop state is (x1, x2, u_{k-1}):
     z_{k+1} = [[Ad, Bd], [-K, 0]] z_k.
 
     Parameters
@@ -655,20 +717,13 @@ def linear_loop_margin(law: str, cfg: Config, *, delay_samples: int = 0) -> dict
         raise InputError(f"linear_loop_margin: delay_samples must be 0 or 1, got {delay_samples}")
     key = "linear_loop_a_ratio_stable" + ("_delay1" if delay_samples else "")
     note = key.replace("_a_ratio_stable", "_note")
-    gains = _linear_gains(law, cfg)
-    if gains is None:
+    if _linear_gains(law, cfg) is None:
         return {key: None, note: "no linear loop"}
-    a, T = cfg.plant.a, cfg.plant.sample_time
 
-    def stable(r: float) -> bool:
-        if delay_samples == 0:
-            return sampled_spectral_radius(a * r, T, *gains) < 1.0
-        Ad, Bd = zoh_matrices(a * r, T)
-        K = np.array([gains])  # noqa: N806
-        M = np.block([[Ad, Bd], [-K, np.zeros((1, 1))]])  # noqa: N806
-        return float(np.abs(np.linalg.eigvals(M)).max()) < 1.0
+    def stable(ratios: NDArray) -> NDArray[np.bool_]:
+        return linear_loop_radii(law, cfg, ratios, delay_samples=delay_samples) < 1.0
 
-    if not stable(1.0):
+    if not stable(np.array([1.0]))[0]:
         return {key: None, note: "unstable at the design point"}
     lo = _edge(stable, MARGIN_RANGE[0])
     hi = _edge(stable, MARGIN_RANGE[1])

@@ -18,6 +18,7 @@ from ptoverify.robust import (
     horizon_steps,
     latin_hypercube,
     linear_loop_margin,
+    linear_loop_radii,
     map_states,
     no_limit_cycle_margin,
     robust_maps,
@@ -151,6 +152,30 @@ def test_linear_margin_endpoints_against_independent_eigenvalues(law_name, gains
         assert unstable[(scan > hi)][0], "the ratio just beyond hi is stable"
     if lo is None:
         assert not unstable[scan <= 1.0].any()
+
+
+@pytest.mark.parametrize("law_name", ["pd", "pto"])
+def test_linear_loop_radii_against_scipy_and_one_by_one(law_name):
+    """The stacked radii: SciPy's ZOH loop (with and without the delay state), each
+    ratio bit for bit as alone, and without delay sampled_spectral_radius's value."""
+    from scipy.signal import cont2discrete
+
+    k1, k2 = (CFG.pd.kp, CFG.pd.kd) if law_name == "pd" else (CFG.pto.k1, CFG.pto.k2)
+    p = CFG.plant
+    ratios = np.geomspace(0.1, 10.0, 97)
+    for delay in (0, 1):
+        radii = linear_loop_radii(law_name, CFG, ratios, delay_samples=delay)
+        for r, got in zip(ratios, radii, strict=True):
+            a = p.a * r
+            A, B = np.array([[0.0, 1.0], [0.0, -a]]), np.array([[0.0], [a]])
+            Ad, Bd, *_ = cont2discrete((A, B, np.eye(2), np.zeros((2, 1))), p.sample_time)
+            K = np.array([[k1, k2]])
+            M = Ad - Bd @ K if delay == 0 else np.block([[Ad, Bd], [-K, np.zeros((1, 1))]])
+            assert abs(got - np.abs(np.linalg.eigvals(M)).max()) < 1e-12
+            alone = linear_loop_radii(law_name, CFG, [r], delay_samples=delay)[0]
+            assert got == alone
+            if delay == 0:
+                assert got == sampled_spectral_radius(a, p.sample_time, k1, k2)
 
 
 def test_linear_margin_of_to_is_none_and_unstable_design_is_reported():
