@@ -995,15 +995,17 @@ def choices_without_replacement(
         state = rng.bit_generator.state
         bounds = [pop - k + t for t in range(k)] + list(range(k - 1, 0, -1))
         words = rng.integers(0, top + 1, size=(times, len(bounds)), dtype=np.uint32)
-        vals = []
-        for c, r in enumerate(bounds):  # Lemire: m = word (r + 1), the value m >> 32
-            m = words[:, c].astype(np.uint64) * np.uint64(r + 1)
-            if ((m & np.uint64(top)) < np.uint64((top - r) % (r + 1))).any():
-                break  # a draw NumPy draws again: the calls one by one, below
-            vals.append((m >> np.uint64(32)).astype(np.int64))
-        else:
+        # Lemire: m = word (r + 1), the value m >> 32, redrawn where the low word is
+        # below (2**32 - 1 - r) mod (r + 1); every bound of every call at once
+        m = words.astype(np.uint64)
+        m *= np.array([r + 1 for r in bounds], dtype=np.uint64)
+        low = m & np.uint64(top)
+        if not (low < np.array([(top - r) % (r + 1) for r in bounds], dtype=np.uint64)).any():
+            m >>= np.uint64(32)
+            vals = m.astype(np.int64).T  # row c: the value of bound c in each call
             picks = np.empty((times, k), dtype=np.int64)
-            for t in range(k):  # Floyd: the value, or j = pop - k + t where it is taken
+            picks[:, 0] = vals[0]
+            for t in range(1, k):  # Floyd: the value, or j = pop - k + t where it is taken
                 taken = (picks[:, :t] == vals[t][:, None]).any(axis=1)
                 picks[:, t] = np.where(taken, pop - k + t, vals[t])
             rows = np.arange(times)
