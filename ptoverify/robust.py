@@ -433,7 +433,9 @@ def _map_task(
     order delay, w_max_ratio, a_ratio.
     """
     job = _maps_job(_law(law, cfg), cfg, x1, x2, ars, wrs, delays)
-    return run_lockstep([job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES).results[0]
+    return run_lockstep(
+        [job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES, reuse=True
+    ).results[0]
 
 
 def _map_axes(cfg: Config, s: RobustSettings) -> tuple[list[float], list[float], list[int]]:
@@ -760,7 +762,9 @@ def no_limit_cycle_margin(
     """
     s = settings or RobustSettings()
     job = _margin_job(_law(law, cfg), cfg, s, rtol=rtol)
-    return run_lockstep([job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES).results[0]
+    return run_lockstep(
+        [job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES, reuse=True
+    ).results[0]
 
 
 SCAN_CHUNK = 8  #: scan points of each side tested per step of :func:`_edges`
@@ -1093,7 +1097,7 @@ def worst_cases(
     """
     s = settings or RobustSettings()
     job = _searches_job([_law(law, cfg)], cfg, [starts], s)
-    run = run_lockstep([job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES)
+    run = run_lockstep([job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES, reuse=True)
     return run.results[0][0]
 
 
@@ -1495,6 +1499,7 @@ def run_robust(
         cfg.plant,
         horizon_steps(cfg),
         round_states=BATCH_STATES,
+        reuse=True,  # the jobs keep measured values only, never the trajectories
         on_round=lambda r, done, total: report(
             "maps, margins, worst cases", 0.1 + 0.9 * done / total
         ),
