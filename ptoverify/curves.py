@@ -210,7 +210,7 @@ def _put_series(out: Array, x: Array, where: NDArray[np.bool_], coef: Array, hco
     if count == 0:
         return
     if count <= FEW:  # a few values: no 2 x 20 numpy passes for them
-        idx = np.flatnonzero(where)
+        idx = where.ravel().nonzero()[0]  # np.flatnonzero, without its wrappers
         flat = out.reshape(-1)  # out is a fresh contiguous array: a view
         for i, v in zip(idx.tolist(), x.reshape(-1)[idx].tolist(), strict=True):
             flat[i] = _horner(v, hcoef)
@@ -304,8 +304,9 @@ _TERM_FLOOR = 1e-300
 
 
 #: Below this many states :func:`level_side` computes the sum everywhere (for few
-#: states a numpy call's fixed cost outweighs the work it would save)
-SIDE_MIN = 1024
+#: states a numpy call's fixed cost outweighs the work it would save; from a few
+#: dozen on, skipping the term's 24-term series where a x1 decides saves more)
+SIDE_MIN = 64
 
 
 def level_side(ax1: Array, x2: Array, omega: float | Array, band: float = 0.0) -> Array:
@@ -362,7 +363,7 @@ def level_side(ax1: Array, x2: Array, omega: float | Array, band: float = 0.0) -
         return ax1.copy()
     if 4 * n_far < far.size:  # mostly near: the sum everywhere (no gather and scatter)
         return ax1 + level_term(x2, omega)
-    near = np.flatnonzero(~far)
+    near = (~far).nonzero()[0]  # np.flatnonzero of the 1-D mask, without its wrappers
     out = ax1.copy()
     om = omega[near] if np.ndim(omega) else omega
     out[near] = ax1[near] + level_term(x2[near], om)
@@ -579,14 +580,14 @@ def _u_of_m_positive(m: Array) -> Array:
     k = 1.0 - m
     with np.errstate(all="ignore"):
         u = m * (2.0 + m * (2.0 / 3.0 + m * 4.0 / 9.0))
-        big = np.flatnonzero(m >= 0.25)  # the bound start, only where it is used
+        big = (m >= 0.25).ravel().nonzero()[0]  # the bound start, only where it is used
         if big.size:
             kb = k[big]
             bound = 2.0 * m[big] / kb
             for _ in range(3):
                 bound = np.log1p(bound / kb)
             u[big] = bound
-        keep = np.flatnonzero(m <= 1e-4)  # the series start is exact to ~m^3 already there
+        keep = (m <= 1e-4).ravel().nonzero()[0]  # the series start is exact to ~m^3 already there
         u_keep = u[keep]
         # two Halley steps u -= 2 f f' / (2 f'^2 - f f'') over all states (those in `keep`
         # are restored after), in place with the same roundings as f = u - k em1,
@@ -613,7 +614,7 @@ def _u_of_m_positive(m: Array) -> Array:
         np.multiply(k, em1, out=f)
         np.subtract(m, f, out=den)
         np.subtract(u, f, out=f)
-        small = np.flatnonzero(m < 0.5)
+        small = (m < 0.5).ravel().nonzero()[0]
         if small.size:
             f[small] = m[small] * em1[small] - _e2(u[small])
         f /= den

@@ -200,7 +200,7 @@ def _pick_sign(pos, w: float):
 
     (np.where on an irregular mask costs several times the arithmetic.)
     """
-    u = np.empty(np.shape(pos))
+    u = np.empty(pos.shape)
     if 0.0 < w < math.inf:  # 2 w is exact, 2 w - w = w and 0 - w = -w exactly
         np.multiply(pos, 2.0 * w, out=u)
         np.subtract(u, w, out=u)
@@ -211,7 +211,7 @@ def _pick_sign(pos, w: float):
 
 def _pick_region(pos, yes: Region, no: Region):
     """``np.where(pos, yes, no)`` as int8 codes, without branches (yes = no - 1 or no + 1)."""
-    region = np.empty(np.shape(pos), dtype=np.int8)
+    region = np.empty(pos.shape, dtype=np.int8)
     if yes == no - 1:
         np.subtract(_I8[no], pos, out=region)
     else:
@@ -420,12 +420,13 @@ def _pto_block(a: float, w: float) -> Callable:
             u = np.empty(x1.shape)
             region = np.empty(x1.shape, dtype=np.int8)
             if n_lin:
+                il = lin.nonzero()[0]  # indices: one search of the mask, then gathers
                 if np.ndim(g1):
-                    g1, g2 = g1[lin], g2[lin]
-                u[lin], region[lin] = saturate_linear(-g1 * x1[lin] - g2 * x2[lin], w)
-        out = ~lin
+                    g1, g2 = g1.take(il), g2.take(il)
+                u[il], region[il] = saturate_linear(-g1 * x1.take(il) - g2 * x2.take(il), w)
         if n_lin < lin.size:
-            y1, y2 = x1[out], x2[out]
+            out = (~lin).nonzero()[0]
+            y1, y2 = x1.take(out), x2.take(out)
             sig = level_side(a * y1, y2, w)  # the sign of switching_function
             uo, ro = _bang(sig, y2, w)
             per = np.ndim(lv) > 0
@@ -435,17 +436,19 @@ def _pto_block(a: float, w: float) -> Callable:
                 between *= np.sign(sig)
                 between = between < 0
                 if per:
-                    lv = lv[out]
+                    lv = lv.take(out)
                     between &= ~np.isnan(lv)
-                cand = np.flatnonzero(between)
+                cand = between.nonzero()[0]
                 if cand.size:
-                    c1, c2 = y1[cand], y2[cand]
-                    lc = lv[cand] if per else lv
+                    c1, c2 = y1.take(cand), y2.take(cand)
+                    lc = lv.take(cand) if per else lv
                     r0 = level_side(a * c1, c2, lc)  # the sign of level_residual
                     zp = (c2 < 0) & (r0 <= 0)
                     inz = zp | ((c2 > 0) & (r0 >= 0))
                     if inz.any():  # closed form only where it is used
-                        wc = np.clip(omega_c(c1[inz], c2[inz], a), lc[inz] if per else lc, w)
+                        # np.clip(omega_c, lc, w), without its wrapper
+                        wc = np.maximum(omega_c(c1[inz], c2[inz], a), lc[inz] if per else lc)
+                        np.minimum(wc, w, out=wc)
                         zpi = zp[inz]
                         idx = cand[inz]
                         uo[idx] = np.where(zpi, wc, -wc)

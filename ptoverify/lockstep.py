@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from ptoverify.config import Plant
 from ptoverify.laws import Law
-from ptoverify.simulate import BatchResult, Mismatch, simulate_segments
+from ptoverify.simulate import BatchResult, Mismatch, TrajectoryBuffers, simulate_segments
 
 __all__ = ["Ask", "Job", "LockstepRun", "run_lockstep", "ROUND_STATES"]
 
@@ -111,6 +111,7 @@ def run_lockstep(
     *,
     round_states: int = ROUND_STATES,
     on_round: Any = None,
+    reuse: bool = False,
 ) -> LockstepRun:
     """Run jobs to completion, their asks gathered into rounds of one simulation each.
 
@@ -132,6 +133,13 @@ def run_lockstep(
         Most states per round (an ask larger than this runs alone).
     on_round : callable, optional
         ``on_round(rounds_done, jobs_done, jobs_total)`` after each round (progress).
+    reuse : bool
+        Write every round's trajectories into the same memory
+        (:class:`ptoverify.simulate.TrajectoryBuffers`: the pages are faulted in
+        once, not at every round).  The trajectories sent to a job are then
+        overwritten by the next round, so they are valid only until the job
+        yields its next asks: for jobs that keep nothing of them (measured
+        values are new arrays).  The values simulated are the same.
 
     Returns
     -------
@@ -151,6 +159,7 @@ def run_lockstep(
     (1, [True, True])
     """
     out = LockstepRun([None] * len(jobs))
+    buffers = TrajectoryBuffers() if reuse else None
     waiting: dict[int, list] = {}  # job -> [asks, trajectories, still to simulate]
     queue: list[tuple[int, int]] = []  # (job, ask) in the order asked
     done = 0
@@ -214,7 +223,9 @@ def run_lockstep(
         )
         asks = [waiting[j][0][i] for j, i in chosen]
         t = time.perf_counter()
-        batch = simulate_segments([(a.law, a.x1, a.x2, a.mismatch) for a in asks], plant, steps)
+        batch = simulate_segments(
+            [(a.law, a.x1, a.x2, a.mismatch) for a in asks], plant, steps, buffers=buffers
+        )
         elapsed = time.perf_counter() - t
         out.rounds += 1
         out.state_steps += size * steps
@@ -231,6 +242,14 @@ def run_lockstep(
             w[2] -= 1
             if w[2] == 0:
                 ready.append((j, ask.stage))
+        if buffers is not None:  # a job still waiting keeps copies: the next round reuses
+            done_now = {j for j, _ in ready}
+            for j, i in chosen:
+                if j not in done_now:
+                    b = waiting[j][1][i]
+                    waiting[j][1][i] = BatchResult(
+                        b.x1.copy(), b.x2.copy(), b.u.copy(), b.region.copy(), b.mismatch
+                    )
         for j, stage in ready:
             sent = waiting.pop(j)[1]
             resume(j, sent, stage)

@@ -57,7 +57,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Config, Plant
 from ptoverify.errors import ClusterError, InputError
@@ -65,7 +65,6 @@ from ptoverify.laws import Law, make_law
 from ptoverify.lockstep import Ask, Job, run_lockstep
 from ptoverify.mintime import min_time
 from ptoverify.plant import zoh_matrices
-from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import oscillating, stride_over_counts
 from ptoverify.reach import zonotope_steps_each
 from ptoverify.simulate import BatchResult, Mismatch, simulate_batch
@@ -81,6 +80,7 @@ __all__ = [
     "map_states",
     "robust_maps",
     "linear_loop_margin",
+    "linear_loop_radii",
     "no_limit_cycle_margin",
     "worst_case",
     "worst_cases",
@@ -433,7 +433,9 @@ def _map_task(
     order delay, w_max_ratio, a_ratio.
     """
     job = _maps_job(_law(law, cfg), cfg, x1, x2, ars, wrs, delays)
-    return run_lockstep([job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES).results[0]
+    return run_lockstep(
+        [job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES, reuse=True
+    ).results[0]
 
 
 def _map_axes(cfg: Config, s: RobustSettings) -> tuple[list[float], list[float], list[int]]:
@@ -597,25 +599,87 @@ def _linear_gains(law: str, cfg: Config) -> tuple[float, float] | None:
     return None
 
 
+EDGE_CHUNK = 64  #: scan points of :func:`_edge` tested per stacked eigenvalue call
+
+
 def _edge(
-    stable: Callable[[float], bool], toward: float, *, grid: int = 400, rtol: float = MARGIN_RTOL
+    stable: Callable[[NDArray], NDArray[np.bool_]],
+    toward: float,
+    *,
+    grid: int = 400,
+    rtol: float = MARGIN_RTOL,
 ) -> float | None:
     """Where ``stable`` first fails going from 1 toward ``toward`` (None: never in range).
 
-    Scans a geometric grid of ``grid`` points from 1 to ``toward``, then bisects
-    the first stable/unstable pair to ``rtol`` relative.
+    Scans a geometric grid of ``grid`` points from 1 to ``toward``
+    (:data:`EDGE_CHUNK` points per call of ``stable``, which tests an array of
+    ratios; the points beyond the first failure cannot change the edge), then
+    bisects the first stable/unstable pair to ``rtol`` relative.
     """
     pts = np.geomspace(1.0, toward, grid)
-    prev = 1.0
-    for r in pts[1:]:
-        if not stable(float(r)):
-            lo, hi = prev, float(r)
+    for at in range(1, grid, EDGE_CHUNK):
+        bad = np.flatnonzero(~stable(pts[at : at + EDGE_CHUNK]))
+        if bad.size:
+            j = at + int(bad[0])
+            lo, hi = float(pts[j - 1]), float(pts[j])  # pts[0] is 1.0
             while abs(hi - lo) > rtol * min(abs(lo), abs(hi)):
                 mid = math.sqrt(lo * hi)
-                lo, hi = (mid, hi) if stable(mid) else (lo, mid)
+                lo, hi = (mid, hi) if stable(np.array([mid]))[0] else (lo, mid)
             return lo
-        prev = float(r)
     return None
+
+
+def linear_loop_radii(
+    law: str, cfg: Config, a_ratio: ArrayLike, *, delay_samples: int = 0
+) -> NDArray[np.float64]:
+    """Spectral radius of the sampled linear loop at each a_true / a_design.
+
+    The loop of :func:`linear_loop_margin`: ``Ad - Bd K`` of the ZOH plant of
+    the true a (as :func:`ptoverify.poles.sampled_spectral_radius` forms it), or
+    with a one-sample delay ``[[Ad, Bd], [-K, 0]]``; all ratios in one stacked
+    eigenvalue call, each matrix as alone (LAPACK's ``geev`` per matrix).
+
+    Parameters
+    ----------
+    law : str
+        ``pd``, ``pto`` or ``pto-printed`` (a law with a linear loop).
+    cfg : Config
+        Nominal configuration (a [rad/s], T [s], the gains).
+    a_ratio : array_like, shape (n,)
+        a_true / a_design [-].
+    delay_samples : int
+        0 or 1 [samples].
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Largest |z| [-]; < 1 means stable.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> (linear_loop_radii("pd", paper_config(), [1.0, 10.0]) < 1.0).tolist()
+    [True, False]
+    """
+    gains = _linear_gains(law, cfg)
+    if gains is None or delay_samples not in (0, 1):
+        raise InputError(
+            f"linear_loop_radii: no linear loop for {law!r} with delay {delay_samples}"
+        )
+    a, T = cfg.plant.a, cfg.plant.sample_time
+    K = np.array([gains])  # noqa: N806
+
+    def loop(r: float) -> NDArray[np.float64]:
+        Ad, Bd = zoh_matrices(a * r, T)  # noqa: N806
+        if delay_samples == 0:
+            return Ad - Bd @ K
+        return np.block([[Ad, Bd], [-K, np.zeros((1, 1))]])
+
+    ratios = np.atleast_1d(np.asarray(a_ratio, dtype=float))
+    if ratios.size == 0:
+        return np.empty(0)
+    mats = np.stack([loop(float(r)) for r in ratios])
+    return np.abs(np.linalg.eigvals(mats)).max(axis=-1)
 
 
 def linear_loop_margin(law: str, cfg: Config, *, delay_samples: int = 0) -> dict[str, Any]:
@@ -623,8 +687,8 @@ def linear_loop_margin(law: str, cfg: Config, *, delay_samples: int = 0) -> dict
 
     The linear loop is PD's u = -kp x1 - kd x2 or the PTO's linear zone
     u = -k1 x1 - k2 x2 (eq. 34), unsaturated, on the ZOH plant with the true a
-    and the design T; stable means spectral radius < 1.  With a one-sample
-    computation delay the loop state is (x1, x2, u_{k-1}):
+    and the design T; stable means spectral radius < 1 (:func:`linear_loop_radii`).
+    With a one-sample computation delay the loop state is (x1, x2, u_{k-1}):
     z_{k+1} = [[Ad, Bd], [-K, 0]] z_k.
 
     Parameters
@@ -655,20 +719,13 @@ def linear_loop_margin(law: str, cfg: Config, *, delay_samples: int = 0) -> dict
         raise InputError(f"linear_loop_margin: delay_samples must be 0 or 1, got {delay_samples}")
     key = "linear_loop_a_ratio_stable" + ("_delay1" if delay_samples else "")
     note = key.replace("_a_ratio_stable", "_note")
-    gains = _linear_gains(law, cfg)
-    if gains is None:
+    if _linear_gains(law, cfg) is None:
         return {key: None, note: "no linear loop"}
-    a, T = cfg.plant.a, cfg.plant.sample_time
 
-    def stable(r: float) -> bool:
-        if delay_samples == 0:
-            return sampled_spectral_radius(a * r, T, *gains) < 1.0
-        Ad, Bd = zoh_matrices(a * r, T)
-        K = np.array([gains])  # noqa: N806
-        M = np.block([[Ad, Bd], [-K, np.zeros((1, 1))]])  # noqa: N806
-        return float(np.abs(np.linalg.eigvals(M)).max()) < 1.0
+    def stable(ratios: NDArray) -> NDArray[np.bool_]:
+        return linear_loop_radii(law, cfg, ratios, delay_samples=delay_samples) < 1.0
 
-    if not stable(1.0):
+    if not stable(np.array([1.0]))[0]:
         return {key: None, note: "unstable at the design point"}
     lo = _edge(stable, MARGIN_RANGE[0])
     hi = _edge(stable, MARGIN_RANGE[1])
@@ -705,7 +762,9 @@ def no_limit_cycle_margin(
     """
     s = settings or RobustSettings()
     job = _margin_job(_law(law, cfg), cfg, s, rtol=rtol)
-    return run_lockstep([job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES).results[0]
+    return run_lockstep(
+        [job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES, reuse=True
+    ).results[0]
 
 
 SCAN_CHUNK = 8  #: scan points of each side tested per step of :func:`_edges`
@@ -889,14 +948,92 @@ def latin_hypercube(rng: np.random.Generator, n: int, d: int) -> NDArray[np.floa
     return (perms.T - offsets) / n
 
 
+def choices_without_replacement(
+    rng: np.random.Generator, pop: int, k: int, times: int
+) -> NDArray[np.int64]:
+    """Draw ``rng.choice(pop, k, replace=False)`` ``times`` times, all at once, as NumPy draws.
+
+    NumPy's ``Generator.choice`` without replacement (no ``p``, ``shuffle=True``,
+    ``pop <= 10000`` or ``k <= pop // 50``) runs Floyd's algorithm, one bounded
+    integer per j = pop - k, ..., pop - 1 (the value, or j where the value was
+    picked already), then shuffles the k picks (Fisher-Yates, one bounded
+    integer per i = k - 1, ..., 1).  Each bounded integer in [0, r] (r < 2**32 - 1)
+    is Lemire's: the top 32 bits of a 32-bit draw times r + 1, unless the low 32
+    bits fall below (2**32 - 1 - r) mod (r + 1), which draws again.  Here the
+    2 k - 1 draws of every call are taken at once (``rng.integers`` of 32-bit
+    words, the same stream) and Floyd's and the shuffle's steps are done for
+    all calls together; where any draw would be redrawn (probability below
+    r 2**-32 per draw: about 5e-9 for the search's populations), the generator
+    is put back and the calls are made one by one.  Either way the result and
+    the generator's state afterwards are those of the loop of calls
+    (``tests/test_robust.py`` compares them).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Generator (advanced as the calls advance it).
+    pop : int
+        Population size [-].
+    k : int
+        Picks per call, ``k <= pop`` [-].
+    times : int
+        Number of calls [-].
+
+    Returns
+    -------
+    ndarray of int64, shape (times, k)
+        Row c: what the c-th call returns.
+
+    Examples
+    --------
+    >>> a, b = np.random.default_rng(3), np.random.default_rng(3)
+    >>> mine = choices_without_replacement(a, 23, 3, 5)
+    >>> ref = [b.choice(23, 3, replace=False).tolist() for _ in range(5)]
+    >>> mine.tolist() == ref, a.random() == b.random()
+    (True, True)
+    """
+    top = 0xFFFFFFFF
+    # Floyd's bounds r = pop - k .. pop - 1 and the shuffle's k - 1 .. 1 all draw
+    # (r >= 1) by Lemire's 32-bit method (r < 2**32 - 1) when Floyd's algorithm runs
+    if times > 0 and 1 <= pop - k and pop - 1 < top and (pop <= 10000 or k <= pop // 50):
+        state = rng.bit_generator.state
+        bounds = [pop - k + t for t in range(k)] + list(range(k - 1, 0, -1))
+        words = rng.integers(0, top + 1, size=(times, len(bounds)), dtype=np.uint32)
+        # Lemire: m = word (r + 1), the value m >> 32, redrawn where the low word is
+        # below (2**32 - 1 - r) mod (r + 1); every bound of every call at once
+        m = words.astype(np.uint64)
+        m *= np.array([r + 1 for r in bounds], dtype=np.uint64)
+        low = m & np.uint64(top)
+        if not (low < np.array([(top - r) % (r + 1) for r in bounds], dtype=np.uint64)).any():
+            m >>= np.uint64(32)
+            vals = m.astype(np.int64).T  # row c: the value of bound c in each call
+            picks = np.empty((times, k), dtype=np.int64)
+            picks[:, 0] = vals[0]
+            for t in range(1, k):  # Floyd: the value, or j = pop - k + t where it is taken
+                taken = (picks[:, :t] == vals[t][:, None]).any(axis=1)
+                picks[:, t] = np.where(taken, pop - k + t, vals[t])
+            rows = np.arange(times)
+            for c, i in enumerate(range(k - 1, 0, -1)):  # the shuffle: swap picks i, j
+                j = vals[k + c]
+                held = picks[rows, j]
+                picks[rows, j] = picks[:, i]
+                picks[:, i] = held
+            return picks
+        rng.bit_generator.state = state
+    return np.array(
+        [rng.choice(pop, k, replace=False) for _ in range(times)], dtype=np.int64
+    ).reshape(times, k)
+
+
 def _distinct_others(rng: np.random.Generator, n_pop: int, k: int) -> NDArray[np.int64]:
     """Per member i, ``k`` distinct other members: ``rng.choice`` of the others, draw for draw.
 
     ``rng.choice(n_pop - 1, k, replace=False)`` draws exactly what
     ``rng.choice(np.delete(np.arange(n_pop), i), k, replace=False)`` draws (the
-    choice depends only on the population size), shifted past i.
+    choice depends only on the population size), shifted past i; the n_pop calls
+    are drawn together (:func:`choices_without_replacement`).
     """
-    out = np.array([rng.choice(n_pop - 1, k, replace=False) for _ in range(n_pop)])
+    out = choices_without_replacement(rng, n_pop - 1, k, n_pop)
     out += out >= np.arange(n_pop)[:, None]
     return out
 
@@ -960,7 +1097,7 @@ def worst_cases(
     """
     s = settings or RobustSettings()
     job = _searches_job([_law(law, cfg)], cfg, [starts], s)
-    run = run_lockstep([job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES)
+    run = run_lockstep([job], cfg.plant, horizon_steps(cfg), round_states=BATCH_STATES, reuse=True)
     return run.results[0][0]
 
 
@@ -1362,6 +1499,7 @@ def run_robust(
         cfg.plant,
         horizon_steps(cfg),
         round_states=BATCH_STATES,
+        reuse=True,  # the jobs keep measured values only, never the trajectories
         on_round=lambda r, done, total: report(
             "maps, margins, worst cases", 0.1 + 0.9 * done / total
         ),

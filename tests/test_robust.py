@@ -13,10 +13,12 @@ from ptoverify.poles import sampled_spectral_radius
 from ptoverify.properties import default_steps, initial_grid, law_properties, oscillating
 from ptoverify.robust import (
     RobustSettings,
+    choices_without_replacement,
     grid_worst,
     horizon_steps,
     latin_hypercube,
     linear_loop_margin,
+    linear_loop_radii,
     map_states,
     no_limit_cycle_margin,
     robust_maps,
@@ -152,6 +154,30 @@ def test_linear_margin_endpoints_against_independent_eigenvalues(law_name, gains
         assert not unstable[scan <= 1.0].any()
 
 
+@pytest.mark.parametrize("law_name", ["pd", "pto"])
+def test_linear_loop_radii_against_scipy_and_one_by_one(law_name):
+    """The stacked radii: SciPy's ZOH loop (with and without the delay state), each
+    ratio bit for bit as alone, and without delay sampled_spectral_radius's value."""
+    from scipy.signal import cont2discrete
+
+    k1, k2 = (CFG.pd.kp, CFG.pd.kd) if law_name == "pd" else (CFG.pto.k1, CFG.pto.k2)
+    p = CFG.plant
+    ratios = np.geomspace(0.1, 10.0, 97)
+    for delay in (0, 1):
+        radii = linear_loop_radii(law_name, CFG, ratios, delay_samples=delay)
+        for r, got in zip(ratios, radii, strict=True):
+            a = p.a * r
+            A, B = np.array([[0.0, 1.0], [0.0, -a]]), np.array([[0.0], [a]])
+            Ad, Bd, *_ = cont2discrete((A, B, np.eye(2), np.zeros((2, 1))), p.sample_time)
+            K = np.array([[k1, k2]])
+            M = Ad - Bd @ K if delay == 0 else np.block([[Ad, Bd], [-K, np.zeros((1, 1))]])
+            assert abs(got - np.abs(np.linalg.eigvals(M)).max()) < 1e-12
+            alone = linear_loop_radii(law_name, CFG, [r], delay_samples=delay)[0]
+            assert got == alone
+            if delay == 0:
+                assert got == sampled_spectral_radius(a, p.sample_time, k1, k2)
+
+
 def test_linear_margin_of_to_is_none_and_unstable_design_is_reported():
     assert linear_loop_margin("to", CFG)["linear_loop_a_ratio_stable"] is None
 
@@ -270,6 +296,27 @@ def test_latin_hypercube_draws_as_scipy_does(seed, n, d):
     assert ((mine >= 0) & (mine < 1)).all()
     for col in mine.T:  # exactly one point per stratum [j/n, (j+1)/n)
         assert sorted(np.floor(col * n).astype(int)) == list(range(n))
+
+
+@pytest.mark.parametrize("seed", range(40))
+@pytest.mark.parametrize(
+    ("pop", "k", "times"),
+    [(23, 2, 24), (23, 3, 24), (5, 4, 7), (2, 1, 3), (1, 1, 2), (20000, 5, 4), (3 * 10**9, 2, 40)],
+)
+def test_choices_without_replacement_draws_as_numpy_does(seed, pop, k, times):
+    """The search's batched draws equal NumPy's Generator.choice calls one by one, and
+    leave the generator where they leave it (an odd 32-bit draw first: a buffered half
+    word; the last case redraws often, Lemire's rejection, so it runs the calls)."""
+    mine_rng, ref_rng = np.random.default_rng(seed), np.random.default_rng(seed)
+    if seed % 2:
+        mine_rng.integers(0, 2**32, dtype=np.uint32), ref_rng.integers(0, 2**32, dtype=np.uint32)
+    mine = choices_without_replacement(mine_rng, pop, k, times)
+    ref = [ref_rng.choice(pop, k, replace=False).tolist() for _ in range(times)]
+    assert mine.tolist() == ref
+    assert mine_rng.integers(0, 2**32, dtype=np.uint32) == ref_rng.integers(
+        0, 2**32, dtype=np.uint32
+    )
+    assert mine_rng.random() == ref_rng.random()
 
 
 @pytest.mark.parametrize(
