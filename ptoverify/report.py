@@ -450,9 +450,9 @@ _STAGE_FUNCTIONS: dict[str, Callable[[Config, Path | None], dict[str, Any]]] = {
     "robustness": _stage_robust,
     "suboptimality sweep": _stage_sweep,
     "derivations": _stage_derivations,
-    "ground truth": _stage_ground_truth,
-    "tuning": _stage_tuning,
     "closed loop, claims and gates": _stage_core,
+    "tuning": _stage_tuning,
+    "ground truth": _stage_ground_truth,
     "paper figures": _stage_figures,
     "poles": _stage_poles,
 }
