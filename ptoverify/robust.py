@@ -49,6 +49,7 @@ search), the stride-overs from :func:`ptoverify.properties.stride_over_counts`.
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 import time
@@ -992,37 +993,70 @@ def choices_without_replacement(
     >>> mine.tolist() == ref, a.random() == b.random()
     (True, True)
     """
-    top = 0xFFFFFFFF
-    # Floyd's bounds r = pop - k .. pop - 1 and the shuffle's k - 1 .. 1 all draw
-    # (r >= 1) by Lemire's 32-bit method (r < 2**32 - 1) when Floyd's algorithm runs
-    if times > 0 and 1 <= pop - k and pop - 1 < top and (pop <= 10000 or k <= pop // 50):
-        state = rng.bit_generator.state
-        bounds = [pop - k + t for t in range(k)] + list(range(k - 1, 0, -1))
-        words = rng.integers(0, top + 1, size=(times, len(bounds)), dtype=np.uint32)
-        # Lemire: m = word (r + 1), the value m >> 32, redrawn where the low word is
-        # below (2**32 - 1 - r) mod (r + 1); every bound of every call at once
-        m = words.astype(np.uint64)
-        m *= np.array([r + 1 for r in bounds], dtype=np.uint64)
-        low = m & np.uint64(top)
-        if not (low < np.array([(top - r) % (r + 1) for r in bounds], dtype=np.uint64)).any():
-            m >>= np.uint64(32)
-            vals = m.astype(np.int64).T  # row c: the value of bound c in each call
-            picks = np.empty((times, k), dtype=np.int64)
-            picks[:, 0] = vals[0]
-            for t in range(1, k):  # Floyd: the value, or j = pop - k + t where it is taken
-                taken = (picks[:, :t] == vals[t][:, None]).any(axis=1)
-                picks[:, t] = np.where(taken, pop - k + t, vals[t])
-            rows = np.arange(times)
-            for c, i in enumerate(range(k - 1, 0, -1)):  # the shuffle: swap picks i, j
-                j = vals[k + c]
-                held = picks[rows, j]
-                picks[rows, j] = picks[:, i]
-                picks[:, i] = held
+    if times > 0 and _floyd_is_numpys():
+        picks = _floyd_batch(rng, pop, k, times)
+        if picks is not None:
             return picks
-        rng.bit_generator.state = state
     return np.array(
         [rng.choice(pop, k, replace=False) for _ in range(times)], dtype=np.int64
     ).reshape(times, k)
+
+
+def _floyd_batch(
+    rng: np.random.Generator, pop: int, k: int, times: int
+) -> NDArray[np.int64] | None:
+    """Draw as :func:`choices_without_replacement` does, all at once; or return None.
+
+    None (the generator left as it was) where NumPy would not run Floyd's
+    algorithm or a draw would be redrawn.
+    """
+    top = 0xFFFFFFFF
+    # Floyd's bounds r = pop - k .. pop - 1 and the shuffle's k - 1 .. 1 all draw
+    # (r >= 1) by Lemire's 32-bit method (r < 2**32 - 1) when Floyd's algorithm runs
+    if not (times > 0 and 1 <= pop - k and pop - 1 < top and (pop <= 10000 or k <= pop // 50)):
+        return None
+    state = rng.bit_generator.state
+    bounds = [pop - k + t for t in range(k)] + list(range(k - 1, 0, -1))
+    words = rng.integers(0, top + 1, size=(times, len(bounds)), dtype=np.uint32)
+    # Lemire: m = word (r + 1), the value m >> 32, redrawn where the low word is
+    # below (2**32 - 1 - r) mod (r + 1); every bound of every call at once
+    m = words.astype(np.uint64)
+    m *= np.array([r + 1 for r in bounds], dtype=np.uint64)
+    low = m & np.uint64(top)
+    if (low < np.array([(top - r) % (r + 1) for r in bounds], dtype=np.uint64)).any():
+        rng.bit_generator.state = state
+        return None
+    m >>= np.uint64(32)
+    vals = m.astype(np.int64).T  # row c: the value of bound c in each call
+    picks = np.empty((times, k), dtype=np.int64)
+    picks[:, 0] = vals[0]
+    for t in range(1, k):  # Floyd: the value, or j = pop - k + t where it is taken
+        taken = (picks[:, :t] == vals[t][:, None]).any(axis=1)
+        picks[:, t] = np.where(taken, pop - k + t, vals[t])
+    rows = np.arange(times)
+    for c, i in enumerate(range(k - 1, 0, -1)):  # the shuffle: swap picks i, j
+        j = vals[k + c]
+        held = picks[rows, j]
+        picks[rows, j] = picks[:, i]
+        picks[:, i] = held
+    return picks
+
+
+@functools.cache
+def _floyd_is_numpys() -> bool:
+    """Whether this NumPy's ``Generator.choice`` draws as :func:`_floyd_batch` does.
+
+    The batch follows NumPy's algorithm, which a NumPy release may change; it is
+    checked once per process on a few cases (draws and the generator's state
+    after them), and where it differs every draw is NumPy's own call.
+    """
+    for pop, k in ((23, 3), (7, 2), (200, 4)):
+        a, b = np.random.default_rng(pop), np.random.default_rng(pop)
+        mine = _floyd_batch(a, pop, k, 16)
+        ref = [b.choice(pop, k, replace=False).tolist() for _ in range(16)]
+        if mine is None or mine.tolist() != ref or a.random() != b.random():
+            return False
+    return True
 
 
 def _distinct_others(rng: np.random.Generator, n_pop: int, k: int) -> NDArray[np.int64]:

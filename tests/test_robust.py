@@ -319,6 +319,30 @@ def test_choices_without_replacement_draws_as_numpy_does(seed, pop, k, times):
     assert mine_rng.random() == ref_rng.random()
 
 
+def test_choices_fall_back_to_numpy_where_its_algorithm_differs(monkeypatch):
+    """The batch is checked against this NumPy's Generator.choice once per process; a
+    batch that draws differently (as a NumPy release changing its algorithm would) is
+    never used: every draw is then NumPy's own call."""
+    import ptoverify.robust as robust_mod
+
+    real = robust_mod._floyd_batch
+
+    def off_by_one(rng, pop, k, times):
+        picks = real(rng, pop, k, times)
+        return None if picks is None else (picks + 1) % pop
+
+    monkeypatch.setattr(robust_mod, "_floyd_batch", off_by_one)
+    robust_mod._floyd_is_numpys.cache_clear()
+    try:
+        assert not robust_mod._floyd_is_numpys()
+        mine_rng, ref_rng = np.random.default_rng(5), np.random.default_rng(5)
+        mine = choices_without_replacement(mine_rng, 23, 3, 24)
+        ref = [ref_rng.choice(23, 3, replace=False).tolist() for _ in range(24)]
+        assert mine.tolist() == ref and mine_rng.random() == ref_rng.random()
+    finally:
+        robust_mod._floyd_is_numpys.cache_clear()
+
+
 @pytest.mark.parametrize(
     ("n1", "box"),
     [
