@@ -1013,7 +1013,10 @@ def _floyd_batch(
     top = 0xFFFFFFFF
     # Floyd's bounds r = pop - k .. pop - 1 and the shuffle's k - 1 .. 1 all draw
     # (r >= 1) by Lemire's 32-bit method (r < 2**32 - 1) when Floyd's algorithm runs
-    if not (times > 0 and 1 <= pop - k and pop - 1 < top and (pop <= 10000 or k <= pop // 50)):
+    # (k = 0 draws nothing: NumPy's own call)
+    if not (
+        times > 0 and k >= 1 and 1 <= pop - k and pop - 1 < top and (pop <= 10000 or k <= pop // 50)
+    ):
         return None
     state = rng.bit_generator.state
     bounds = [pop - k + t for t in range(k)] + list(range(k - 1, 0, -1))

@@ -319,6 +319,16 @@ def test_choices_without_replacement_draws_as_numpy_does(seed, pop, k, times):
     assert mine_rng.random() == ref_rng.random()
 
 
+@pytest.mark.parametrize(("pop", "k", "times"), [(5, 0, 3), (0, 0, 2), (5, 0, 0), (4, 4, 3)])
+def test_choices_without_replacement_edge_sizes_draw_as_numpy_does(pop, k, times):
+    """No picks (k = 0) and every member (k = pop): NumPy's calls, one by one."""
+    mine_rng, ref_rng = np.random.default_rng(9), np.random.default_rng(9)
+    mine = choices_without_replacement(mine_rng, pop, k, times)
+    ref = [ref_rng.choice(pop, k, replace=False).tolist() for _ in range(times)]
+    assert mine.shape == (times, k) and mine.tolist() == ref
+    assert mine_rng.bit_generator.state == ref_rng.bit_generator.state
+
+
 def test_choices_fall_back_to_numpy_where_its_algorithm_differs(monkeypatch):
     """The batch is checked against this NumPy's Generator.choice once per process; a
     batch that draws differently (as a NumPy release changing its algorithm would) is
