@@ -315,9 +315,10 @@ def level_side(ax1: Array, x2: Array, omega: float | Array, band: float = 0.0) -
     Where |ax1| exceeds a bound on the term (x2^2 / (2 omega), 1e-6 relative
     above it) plus 2 band, or where ax1 has the term's sign (x2's) and
     |ax1| > band, the sum has the sign of ax1, is never 0 and is beyond
-    +-band, so ax1 is returned there; elsewhere (and where anything is NaN)
-    the sum itself, bit for bit.  The term, a logarithm and a 24-term
-    series near the curve's vertex, is then computed only near the curve.  Use
+    +-band, so ax1 is returned there; elsewhere (and where anything is NaN, or
+    x2 = +-inf, where the term is NaN) the sum itself, bit for bit.  The term, a
+    logarithm and a 24-term series near the curve's vertex, is then computed only
+    near the curve.  Use
     it only where the value is read through ``< 0``, ``== 0``, ``> 0``,
     ``np.sign``, ``< -band`` and ``> band``.
 
@@ -355,6 +356,7 @@ def level_side(ax1: Array, x2: Array, omega: float | Array, band: float = 0.0) -
     # a x1 of x2's sign (the term's): no cancellation, |sum| >= |a x1| > band
     same = ax1 * x2
     same = same > 0
+    same &= bound < math.inf  # not at x2 = +-inf, where the term (inf - inf) is NaN
     if band > 0.0:
         same &= mag > band
     far |= same

@@ -175,3 +175,36 @@ def test_h_few_series_values_as_many():
     for start in range(0, n, FEW):  # FEW series values at a time, with the rest
         got = h(np.concatenate([r[start : start + FEW], r[n:]]))
         assert np.array_equal(got, np.concatenate([many[start : start + FEW], many[n:]]))
+
+
+@pytest.mark.parametrize("n", [10, 100, 3000])
+def test_level_side_at_infinite_velocity_is_the_sum(n):
+    """At x2 = +-inf the sum is NaN (the term is inf - inf): level_side gives it for any
+    batch size, so a law's vector path answers as in batches of a few states and as its
+    scalar path there."""
+    from ptoverify.config import paper_config
+    from ptoverify.curves import level_side, level_term
+    from ptoverify.laws import make_law
+
+    rng = np.random.default_rng(3)
+    x2 = rng.uniform(-300.0, 300.0, n)
+    x2[::3] = np.inf
+    x2[1::3] = -np.inf
+    ax1 = np.where(rng.random(n) < 0.5, -1.0, 1.0) * rng.uniform(1.0, 100.0, n)
+    with np.errstate(invalid="ignore"):
+        full = ax1 + level_term(x2, 300.0)
+        got = level_side(ax1, x2, 300.0)
+    assert np.isnan(full[~np.isfinite(x2)]).all()
+    assert np.array_equal(np.isnan(got), np.isnan(full))
+    cfg = paper_config()
+    x1 = ax1 / cfg.plant.a
+    for name in ("to", "pto"):
+        law = make_law(name, cfg)
+        with np.errstate(invalid="ignore"):
+            u, r = law.vector(x1, x2)
+            few = [law.vector(x1[i : i + 10], x2[i : i + 10]) for i in range(0, n, 10)]
+        assert np.array_equal(u, np.concatenate([f[0] for f in few]))
+        assert np.array_equal(r, np.concatenate([f[1] for f in few]))
+        inf = np.flatnonzero(~np.isfinite(x2))
+        want = [law.scalar(float(x1[i]), float(x2[i])) for i in inf]
+        assert u[inf].tolist() == [w for w, _ in want] and r[inf].tolist() == [c for _, c in want]
