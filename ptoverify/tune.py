@@ -607,11 +607,12 @@ def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
     only (0 for other laws).
 
     For an odd law (``Law.odd``) only one state of each mirrored pair of the grid
-    is simulated (:func:`ptoverify.sweep.mirror_pairs`; the grid is symmetric
-    about the origin), and each trajectory counts for its mirror image too: the
-    plant is linear and the law odd bit for bit, so the mirror trajectory is the
-    negated one, whose limit-cycle test, crossings of l1 - o - l2 (sigma is odd
-    bit for bit) and landings outside the linear zone are the same.
+    is simulated (:func:`ptoverify.sweep.mirror_pairs`, where every grid state's
+    exact mirror is on the grid, as on the paper's; elsewhere, e.g. at a position
+    range of 20 or 30 mm, every state), and each trajectory counts for its mirror
+    image too: the plant is linear and the law odd bit for bit, so the mirror
+    trajectory is the negated one, whose limit-cycle test, crossings of l1 - o - l2
+    (sigma is odd bit for bit) and landings outside the linear zone are the same.
 
     Parameters
     ----------
