@@ -44,7 +44,8 @@ import platform
 import subprocess
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -326,9 +327,7 @@ def _stage_derivations(cfg: Config, figdir: Path | None) -> dict[str, Any]:
     # SymPy makes ~10^5 long-lived objects (its import and caches); the cyclic
     # collector's ~370 passes over them cost ~0.13 s of CPU here. It is paused for the
     # stage: the few cycles made (~25k objects, a few MB) are collected after it
-    collecting = gc.isenabled()
-    gc.disable()
-    try:
+    with _collector_paused():
         import derivations
         from ptoverify.checks import run_checks
         from ptoverify.report_sections import render_records
@@ -344,6 +343,15 @@ def _stage_derivations(cfg: Config, figdir: Path | None) -> dict[str, Any]:
             "_rendered": render_records(records),  # MathML and units: SymPy work, done here
             "_checks": run_checks(cfg, [SYMBOLIC_GATE]),
         }
+
+
+@contextmanager
+def _collector_paused() -> Iterator[None]:
+    """Pause the cyclic garbage collector for a stage (as it was before, after it)."""
+    collecting = gc.isenabled()
+    gc.disable()
+    try:
+        yield
     finally:
         if collecting:
             gc.enable()
@@ -408,17 +416,12 @@ def _stage_tuning(cfg: Config, figdir: Path | None) -> dict[str, Any]:
     # keys), which trigger ~120 collector passes, one of them over everything the
     # process holds (SciPy's and Matplotlib's objects): ~0.05 s of CPU for next to no
     # garbage cycles. It is paused for the stage, as for the derivations
-    collecting = gc.isenabled()
-    gc.disable()
-    try:
+    with _collector_paused():
         res = tuning_results(cfg)
         return {
             "tuning": res,
             "_files": [] if figdir is None else _plots().save_tuning(res, figdir),
         }
-    finally:
-        if collecting:
-            gc.enable()
 
 
 def _stage_figures(cfg: Config, figdir: Path | None) -> dict[str, Any]:

@@ -389,6 +389,8 @@ def settling_times(
     velocity_band: float,
     hold: float,
     chunk: int = CHUNK,
+    *,
+    mirror: bool = False,
 ) -> BatchSettling:
     """Settling times of ``law`` from each state, between samples and on the grid.
 
@@ -409,6 +411,9 @@ def settling_times(
     chunk : int
         At most this many states simulated at once, in chunks of nearly equal
         size (memory: about 25 bytes x chunk x steps).
+    mirror : bool
+        For an odd law (``Law.odd``) whose states pair up with their mirror images,
+        simulate one state of each pair (the same values; see :func:`mirror_pairs`).
 
     Returns
     -------
@@ -417,7 +422,8 @@ def settling_times(
         times T [s]; NaN where not settled (see
         :func:`ptoverify.exact.settling_times_batch`).
     """
-    return _settling_chunks(law, plant, x1, x2, steps, band, velocity_band, hold, chunk)[0]
+    run = _settling_odd if mirror else _settling_chunks
+    return run(law, plant, x1, x2, steps, band, velocity_band, hold, chunk)[0]
 
 
 def _settling_odd(law, plant, x1, x2, steps, band, velocity_band, hold, chunk, b=None):

@@ -281,20 +281,17 @@ def worst_ratio_nt(
         raise InputError("worst_ratio_nt: the grid needs at least 2 points per axis")
     p = cfg.plant
     x1, x2, nt, steps, hold = _envelope(p, n1, n2)
-    fn = make_law(law, cfg)
-    # an odd law: one state of each mirrored pair, whose time is its mirror's (as the sweep)
-    pairs = mirror_pairs(x1, x2) if fn.odd else None
-    reps, where = pairs if pairs is not None else (np.arange(x1.size), np.arange(x1.size))
     st = settling_times(
-        fn,
+        make_law(law, cfg),
         p,
-        x1[reps],
-        x2[reps],
+        x1,
+        x2,
         steps,
         SweepSettings().band,
         p.a * SweepSettings().band,
         hold * p.sample_time,
-    ).grid[where]  # the sweep's sample-grid reading (its between-samples twin differs by < T)
+        mirror=True,  # an odd law: one state of each mirrored pair, as the sweep
+    ).grid  # the sweep's sample-grid reading (its between-samples twin differs by < T)
     ok = np.isfinite(nt)
     if not np.isfinite(st[ok]).all():
         return math.inf

@@ -308,6 +308,19 @@ def test_mirrored_half_equals_simulating_every_state():
             got = res.laws[name]
             assert np.array_equal(got.settle_time.ravel(), ref.time, equal_nan=True), name
             assert np.array_equal(got.grid.settle_time.ravel(), ref.grid, equal_nan=True), name
+            half = settling_times(  # the public mirrored path (tune.worst_ratio_nt's)
+                make_law(name, cfg),
+                p,
+                res.x1.ravel(),
+                res.x2.ravel(),
+                res.steps,
+                s.band,
+                vband,
+                s.hold,
+                mirror=True,
+            )
+            assert np.array_equal(half.time, ref.time, equal_nan=True), name
+            assert np.array_equal(half.grid, ref.grid, equal_nan=True), name
 
 
 def test_mirror_pairs_spread_values_to_mirrors_and_refuse_unpaired_states():
