@@ -18,8 +18,8 @@ import time
 import numpy as np
 
 from ptoverify.config import Plant, paper_config
-from ptoverify.mintime import ZOHReach, discrete_min_steps, min_time
-from ptoverify.ocp import CollocationOCP, TwoPhaseOCP, convergence_study
+from ptoverify.model.mintime import ZOHReach, discrete_min_steps, min_time
+from ptoverify.model.ocp import CollocationOCP, TwoPhaseOCP, convergence_study
 
 PLANTS = {
     "paper": paper_config().plant,

@@ -51,15 +51,15 @@ if sys.path[0] != str(ROOT):
     sys.path.insert(0, str(ROOT))
 
 from ptoverify.config import paper_config  # noqa: E402
-from ptoverify.curves import blockwise, omega_c  # noqa: E402
-from ptoverify.laws import make_law  # noqa: E402
-from ptoverify.mintime import (  # noqa: E402
+from ptoverify.model.curves import blockwise, omega_c  # noqa: E402
+from ptoverify.model.laws import make_law  # noqa: E402
+from ptoverify.model.mintime import (  # noqa: E402
     ZOHReach,
     discrete_min_steps,
     discrete_min_steps_batch,
     min_time,
 )
-from ptoverify.simulate import simulate_batch  # noqa: E402
+from ptoverify.sim.simulate import simulate_batch  # noqa: E402
 
 TARGETS = {  # key: (target, ">=" or "<=")
     "law_vector_evals_per_s": (2e6, ">="),
@@ -255,7 +255,7 @@ def bench_sim(cfg, size: dict) -> float:
 # ---------------------------------------------------------------- solvers
 def bench_ocp(cfg, size: dict) -> dict:
     """Two-phase and collocation (N = 100, warm start) on the same states, wall time."""
-    from ptoverify.ocp import CollocationOCP, TwoPhaseOCP
+    from ptoverify.model.ocp import CollocationOCP, TwoPhaseOCP
 
     plant = cfg.plant
     rng = np.random.default_rng(21)
@@ -341,7 +341,7 @@ def bench_tune(cfg, size: dict) -> dict:
 
     Tuning is seconds to a minute, so it is timed once, not as a median.
     """
-    from ptoverify.tune import tune
+    from ptoverify.studies.tune import tune
 
     out = {}
     for law in ("pd", "pto"):
@@ -384,7 +384,7 @@ def bench_robust_maps(cfg, small: bool) -> dict:
     The same maps (bit for bit, asserted); the Dask figure includes starting and
     stopping its 2-process LocalCluster, as ``robust --dask local`` does.
     """
-    from ptoverify.robust import RobustSettings, dask_runner, horizon_steps, robust_maps
+    from ptoverify.studies.robust import RobustSettings, dask_runner, horizon_steps, robust_maps
 
     s = RobustSettings(n1=5, n2=5, rest=4, n_a=3, n_w=2) if small else RobustSettings()
     t0 = time.perf_counter()
@@ -419,7 +419,7 @@ def bench_robust_study(cfg, small: bool, repeat: int) -> dict:
     One warm-up study first (imports, the corrected zone, memoized per plant), as in
     the report, which has built the laws by then.
     """
-    from ptoverify.robust import RobustSettings, run_robust
+    from ptoverify.studies.robust import RobustSettings, run_robust
 
     s = (
         RobustSettings(n1=3, n2=3, rest=2, n_a=2, n_w=2, search_iterations=1, search_population=5)

@@ -22,7 +22,7 @@ import math
 @functools.lru_cache(maxsize=8)
 def _omega0(cfg) -> float:
     """Level of l1*, l2* [mm/s] (from the corrected zone construction)."""
-    from ptoverify.zones import corrected_zone
+    from ptoverify.model.zones import corrected_zone
 
     return corrected_zone(cfg, verify=False).omega0
 

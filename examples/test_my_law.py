@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from ptoverify.testing import assert_conforms
+from ptoverify.conform.testing import assert_conforms
 
 LAW = f"{Path(__file__).with_name('my_pto.py')}:pto"  # or "mypkg.control:pto"
 
@@ -24,7 +24,7 @@ def test_a_slow_law_is_rejected():
     """The helper fails loudly: a law 5 % short of w_max in the bang-bang region."""
     import numpy as np
 
-    from ptoverify.conform import reference_law
+    from ptoverify.conform.gate import reference_law
 
     def sluggish(x1, x2, cfg):  # vectorized, as numpy code usually is
         u = np.asarray(reference_law(x1, x2, cfg))

@@ -187,7 +187,7 @@ def _mintime_states(args: argparse.Namespace, cfg: Config) -> int:
 
 
 def _cmd_mintime(args: argparse.Namespace) -> int:
-    from ptoverify.groundtruth import verified_mintime
+    from ptoverify.studies.groundtruth import verified_mintime
 
     cfg = _config(args)
     if args.states is not None:
@@ -265,7 +265,7 @@ def _add_simulate(sub) -> None:
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
-    from ptoverify.commands import run_simulation
+    from ptoverify.sim.runs import run_simulation
 
     cfg = _config(args)
     if args.csv is not None and args.json:
@@ -474,7 +474,7 @@ def _add_tune(sub) -> None:
 
 
 def _cmd_tune(args: argparse.Namespace) -> int:
-    from ptoverify.tune import tune
+    from ptoverify.studies.tune import tune
 
     cfg = _config(args)
     res = tune(
@@ -586,14 +586,14 @@ def _add_check(sub) -> None:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from ptoverify.checks import run_checks, summarize
+    from ptoverify.studies.checks import run_checks, summarize
 
     cfg = _config(args)
     _check_junit(args)
     results = run_checks(cfg, args.gate, max_iter=args.max_iter, robust=args.robust)
     summary = summarize(results)
     if args.junit:
-        from ptoverify.junit import junit_xml
+        from ptoverify.conform.junit import junit_xml
 
         write_atomic(args.junit, junit_xml(results, "ptoverify.check", None, {"config": cfg.name}))
     if args.json:
@@ -642,7 +642,7 @@ def _add_sweep(sub) -> None:
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
-    from ptoverify.sweep import SweepSettings, run_sweep
+    from ptoverify.studies.sweep import SweepSettings, run_sweep
 
     cfg = _config(args)
     if args.grid < 2 or args.grid > 1000:
@@ -658,7 +658,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         result = res.to_json()
         if args.out is not None:
             tmp = make_temp(target)
-            from ptoverify.plots import save_sweep
+            from ptoverify.report.plots import save_sweep
 
             files = save_sweep(res, tmp)
             (tmp / "sweep.json").write_text(json.dumps(to_jsonable(result), indent=2) + "\n")
@@ -786,7 +786,7 @@ def _add_report(sub) -> None:
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
-    from ptoverify.report import stderr_progress, write_report
+    from ptoverify.report.collect import stderr_progress, write_report
 
     cfg = _config(args)
     if args.out is not None and Path(args.out).exists() and not Path(args.out).is_dir():
@@ -855,7 +855,7 @@ shows it; a law that raises, returns NaN/inf, or has memory is a finding), 2 bad
 shape returned, unreadable table).
 
 examples:
-  ptoverify conform --law ptoverify.conform:reference_law
+  ptoverify conform --law ptoverify.conform.gate:reference_law
   ptoverify conform --law examples/my_pto.py:pto --json
   ptoverify conform --emit-grid grid.csv      # fill in column u, then:
   ptoverify conform --table grid_with_u.csv
@@ -910,7 +910,7 @@ def _add_conform(sub) -> None:
 
 
 def _cmd_conform(args: argparse.Namespace) -> int:
-    from ptoverify import conform
+    from ptoverify.conform import gate as conform
 
     cfg = _config(args)
     rtol = conform.DEFAULT_RTOL if args.tolerance is None else args.tolerance
@@ -919,7 +919,7 @@ def _cmd_conform(args: argparse.Namespace) -> int:
     _check_junit(args)
     target = None
     if args.report is not None:
-        from ptoverify.conform_report import check_report_target
+        from ptoverify.report.conform_report import check_report_target
 
         if args.emit_grid:
             raise InputError("--report needs --law or --table, not --emit-grid")
@@ -940,7 +940,7 @@ def _cmd_conform(args: argparse.Namespace) -> int:
         raise InputError(f"--timeout must be in (0, 86400] s, got {args.timeout:g}")
     evidence = None
     if target is not None:
-        from ptoverify.conform_evidence import conform_with_evidence
+        from ptoverify.conform.evidence import conform_with_evidence
 
         result, evidence = conform_with_evidence(
             cfg, law=args.law, table=args.table, rtol=rtol, timeout=args.timeout
@@ -952,14 +952,14 @@ def _cmd_conform(args: argparse.Namespace) -> int:
     if args.law and result.law_output:
         print(result.law_output, end="", file=sys.stderr)
     if args.junit:
-        from ptoverify.junit import conform_verdicts, junit_xml
+        from ptoverify.conform.junit import conform_verdicts, junit_xml
 
         verdicts, states = conform_verdicts(result)
         props = {"config": cfg.name, "target": result.target, "mode": result.mode}
-        xml = junit_xml(verdicts, "ptoverify.conform", states, props, result.conforms)
+        xml = junit_xml(verdicts, "ptoverify.conform.gate", states, props, result.conforms)
         write_atomic(args.junit, xml)
     if target is not None:
-        from ptoverify.conform_report import write_conform_report
+        from ptoverify.report.conform_report import write_conform_report
 
         write_conform_report(result, evidence, cfg, target)
     if args.json:

@@ -4,173 +4,30 @@ The command line (:mod:`ptoverify.cli`) parses, calls one function per command
 and formats.  Where a command's work composes several numeric steps, the
 composition lives here, in the numeric layer (no printing, no files, no
 argument parsing): ``simulate`` -> :func:`run_simulation`, ``zone`` ->
-:func:`run_zone`.  ``mintime`` calls :func:`ptoverify.groundtruth.verified_mintime`,
-``check`` :func:`ptoverify.checks.run_checks`, ``sweep``
-:func:`ptoverify.sweep.run_sweep` directly.
+:func:`run_zone`.  ``mintime`` calls :func:`ptoverify.studies.groundtruth.verified_mintime`,
+``check`` :func:`ptoverify.studies.checks.run_checks`, ``sweep``
+:func:`ptoverify.studies.sweep.run_sweep` directly.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ptoverify.config import Config, Plant
+from ptoverify.config import Config
 from ptoverify.errors import InputError
-from ptoverify.exact import exact_metrics
-from ptoverify.laws import make_law
-from ptoverify.simulate import SimResult, reference, simulate
+from ptoverify.model.laws import make_law
+from ptoverify.sim.runs import MAX_DURATION_S, SimulationRun, run_simulation
 
 __all__ = [
-    "SimulationRun",
-    "run_simulation",
     "run_regulation",
     "run_robust_study",
     "run_zone",
     "mintime_states",
     "MAX_DURATION_S",
 ]
-
-#: Longest simulated time accepted from a user [s].
-MAX_DURATION_S = 100.0
-
-
-@dataclass(frozen=True, eq=False)
-class SimulationRun:
-    """A simulated closed loop with the law's note and its summary figures.
-
-    Attributes
-    ----------
-    result : SimResult
-        The sampled closed-loop response.
-    note : str
-        What the law is (e.g. which omega0 the PTO law uses).
-    plant : Plant
-        The simulated plant (a [rad/s] for the flow between samples).
-    """
-
-    result: SimResult
-    note: str
-    plant: Plant
-
-    def summary(self) -> dict[str, Any]:
-        """Return the summary of ``ptoverify simulate --json`` (without the series).
-
-        Returns
-        -------
-        dict
-            ``law``, ``signal``, ``feedforward``, ``note``, ``samples``,
-            ``final_error_mm`` [mm] and ``max_abs_error_second_half_mm`` [mm]
-            (largest |r - x1| over the second half of the samples).
-        """
-        res = self.result
-        tail = res.e[len(res.e) // 2 :]
-        return {
-            "law": res.law,
-            "signal": res.signal,
-            "feedforward": res.feedforward,
-            "note": self.note,
-            "samples": len(res.t),
-            "final_error_mm": float(res.e[-1]),
-            "max_abs_error_second_half_mm": float(np.abs(tail).max()),
-        }
-
-    def metrics(self) -> tuple[dict[str, float | None], dict[str, float | None]]:
-        """Return the DESIGN.md metrics between samples and the same on the sample grid.
-
-        Returns
-        -------
-        tuple of dict
-            ``overshoot_mm`` [mm], ``settling_2pct_s``, ``settling_0p01mm_s``,
-            ``rise_time_s`` [s], and ``phase_delay_deg`` [deg] for a sine (None where
-            undefined): measured on the exact trajectory, then on the samples.
-        """
-        em = exact_metrics(self.result, self.plant, self.result.reference)
-        return em.json_metrics(), em.json_metrics(grid=True)
-
-    def to_json(self) -> dict[str, Any]:
-        """Return the ``ptoverify simulate --json`` object: summary, metrics and ``series``."""
-        metrics, grid = self.metrics()
-        return {
-            **self.summary(),
-            "metrics": metrics,
-            "metrics_grid": grid,
-            "series": self.result.columns(),
-        }
-
-
-def run_simulation(
-    cfg: Config,
-    law: str,
-    signal: str,
-    *,
-    duration: float | None = None,
-    feedforward: bool = True,
-    step: float | None = None,
-    ramp_speed: float | None = None,
-    ramp_to: float | None = None,
-    amplitude: float | None = None,
-    frequency: float | None = None,
-) -> SimulationRun:
-    """Simulate a named law on a Section 6 reference (``ptoverify simulate``).
-
-    Parameters
-    ----------
-    cfg : Config
-        Configuration.
-    law : str
-        Law name (``to``, ``pd``, ``pto``, ``pto-printed``).
-    signal : str
-        Reference (``step``, ``ramp``, ``sine``).
-    duration : float, optional
-        Simulated time [s], in [T, ``MAX_DURATION_S``]; default per signal.
-    feedforward : bool
-        Feed the reference velocity forward.
-    step : float, optional
-        Step height [mm] (default Section 6's 5 mm).
-    ramp_speed, ramp_to : float, optional
-        Ramp speed [mm/s] and target [mm] (default 200 mm/s to 30 mm).
-    amplitude, frequency : float, optional
-        Sine amplitude [mm] and frequency [Hz] (default 5 mm, 5 Hz).
-
-    Returns
-    -------
-    SimulationRun
-        The response, the law's note and the summary.
-
-    Raises
-    ------
-    InputError
-        A duration outside (0, ``MAX_DURATION_S``] s or shorter than one sample.
-
-    Examples
-    --------
-    >>> from ptoverify.config import paper_config
-    >>> run = run_simulation(paper_config(), "pd", "step", duration=0.01)
-    >>> run.summary()["samples"]
-    6
-    """
-    if duration is not None:
-        if not 0 < duration <= MAX_DURATION_S:
-            raise InputError(f"--duration must be in (0, {MAX_DURATION_S:g}] s, got {duration:g}")
-        if duration < cfg.plant.sample_time:
-            raise InputError(
-                f"--duration {duration:g} s is shorter than one sample "
-                f"(T = {cfg.plant.sample_time:g} s)"
-            )
-    ref = reference(
-        signal,
-        step=step,
-        ramp_speed=ramp_speed,
-        ramp_to=ramp_to,
-        amplitude=amplitude,
-        frequency=frequency,
-    )
-    fn = make_law(law, cfg)
-    res = simulate(fn, cfg.plant, ref, duration=duration, feedforward=feedforward)
-    return SimulationRun(res, fn.note, cfg.plant)
 
 
 def run_zone(cfg: Config, *, verify: bool = True, outcome: bool = True) -> dict[str, Any]:
@@ -188,11 +45,11 @@ def run_zone(cfg: Config, *, verify: bool = True, outcome: bool = True) -> dict[
     Returns
     -------
     dict
-        :func:`ptoverify.zones.zone_summary`, plus ``outcome``
-        (:func:`ptoverify.properties.zone_outcome`) when asked.
+        :func:`ptoverify.model.zones.zone_summary`, plus ``outcome``
+        (:func:`ptoverify.studies.properties.zone_outcome`) when asked.
     """
-    from ptoverify.properties import zone_outcome
-    from ptoverify.zones import zone_summary
+    from ptoverify.model.zones import zone_summary
+    from ptoverify.studies.properties import zone_outcome
 
     result = zone_summary(cfg, verify=verify)
     if outcome:
@@ -213,10 +70,10 @@ def mintime_states(path: str, cfg: Config) -> dict[str, np.ndarray]:
     Returns
     -------
     dict
-        :func:`ptoverify.mintime.batch_table`: ``x1``, ``x2``, ``analytic_s``,
+        :func:`ptoverify.model.mintime.batch_table`: ``x1``, ``x2``, ``analytic_s``,
         ``switch_time_s``, ``discrete_steps``, ``discrete_s``.
     """
-    from ptoverify.mintime import batch_table
+    from ptoverify.model.mintime import batch_table
 
     return batch_table(path, cfg)
 
@@ -237,8 +94,8 @@ def run_regulation(
     """Regulate from ``x0`` to the origin, optionally on a mismatched plant (``simulate --x0``).
 
     The law is built from ``cfg`` (the design); the plant and measurement follow
-    the mismatch (:class:`ptoverify.simulate.Mismatch`).  The properties are those
-    of ``ptoverify robust`` (:func:`ptoverify.robust.trajectory_properties`), so a
+    the mismatch (:class:`ptoverify.sim.simulate.Mismatch`).  The properties are those
+    of ``ptoverify robust`` (:func:`ptoverify.studies.robust.trajectory_properties`), so a
     counterexample it reports is reproduced here number for number.
 
     Parameters
@@ -268,8 +125,8 @@ def run_regulation(
         ``law``, ``x0``, ``mismatch``, ``samples``, ``final_state``,
         ``properties`` and ``series`` (``t``, ``x1``, ``x2``, ``u``, ``region``).
     """
-    from ptoverify.robust import horizon_steps, trajectory_properties
-    from ptoverify.simulate import Mismatch, simulate_batch
+    from ptoverify.sim.simulate import Mismatch, simulate_batch
+    from ptoverify.studies.robust import horizon_steps, trajectory_properties
 
     for name, value, lo, hi in (
         ("--a-ratio", a_ratio, 0.01, 100.0),
@@ -356,7 +213,7 @@ def run_robust_study(
     dict
         ``box``, ``margins``, ``worst``, ``maps``, ``most_robust``, ``timings_s``, ``backend``.
     """
-    from ptoverify.robust import LAWS, RobustSettings, run_robust
+    from ptoverify.studies.robust import LAWS, RobustSettings, run_robust
 
     settings = RobustSettings(
         n1=grid,

@@ -48,7 +48,7 @@ __all__ = [
     "LAW_NAMES",
 ]
 
-#: The laws the suite implements (:func:`ptoverify.laws.make_law`), here so that naming
+#: The laws the suite implements (:func:`ptoverify.model.laws.make_law`), here so that naming
 #: them (the command line's choices) loads no numerics.
 LAW_NAMES: tuple[str, ...] = ("to", "pd", "pto", "pto-printed")
 

@@ -70,7 +70,7 @@ def random_states(plant: Plant, n: int, seed: int) -> np.ndarray:
 def zoh_reference(a: float, T: float) -> tuple[np.ndarray, np.ndarray]:  # noqa: N803
     """(Ad, Bd) of eq. (1) by ``scipy.signal.cont2discrete(method="zoh")``.
 
-    Independent of ``ptoverify.plant`` (scipy builds it from expm of the
+    Independent of ``ptoverify.model.plant`` (scipy builds it from expm of the
     augmented matrix): the reference for every one-sample map.  Computed once
     per (a, T) and returned read-only (the same matrices every call; the
     sample-by-sample reference simulations call this per sample).

@@ -1,11 +1,11 @@
 """A plain, vectorized copy of the reference PTO law, with seeded faults (mutation suite).
 
-The copy is written from the equations, independently of ``ptoverify.curves``
-and ``ptoverify.laws``: every curve is its own function with the paper's ln
+The copy is written from the equations, independently of ``ptoverify.model.curves``
+and ``ptoverify.model.laws``: every curve is its own function with the paper's ln
 form, omega_c uses scipy's Lambert W with a Newton polish, and each fault is
 a flag that makes one small edit.  ``make_law(faults)`` returns a callable
 ``u = f(x1, x2, cfg)`` for ``ptoverify conform``.  Only omega0 is taken from
-``ptoverify.zones`` (a design parameter a team reads from ``ptoverify zone``).
+``ptoverify.model.zones`` (a design parameter a team reads from ``ptoverify zone``).
 
 ``mutation_score()`` runs ``conform`` on every mutant and returns the score
 (``tests/test_conform_table_probes.py`` also evaluates each mutant at the
@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.special import lambertw
 
-from ptoverify.zones import zone_for_law
+from ptoverify.model.zones import zone_for_law
 
 #: fault flag -> what the edit does (the mutation suite runs one flag per mutant)
 MUTANTS: dict[str, str] = {
@@ -329,9 +329,9 @@ def mutation_score(cfg=None, sweep=(11, 11, 20), grid=None):
     detail : dict
         Mutant -> list of the properties that failed (empty: survived).
     """
-    from ptoverify.agreement import conformance_grid
     from ptoverify.config import paper_config
-    from ptoverify.conform import conform_callable
+    from ptoverify.conform.agreement import conformance_grid
+    from ptoverify.conform.gate import conform_callable
 
     cfg = paper_config() if cfg is None else cfg
     grid = conformance_grid(cfg) if grid is None else grid

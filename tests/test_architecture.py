@@ -19,15 +19,36 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("ptoverify", "derivations")
 
+#: The layers, bottom first.  A module may import modules of its own layer or
+#: of a layer below it, never above (DESIGN.md's layout).  The vocabulary
+#: modules at the top of the package (configuration, errors, verdicts, output
+#: folders, progress) sit at the bottom of the import order: every layer speaks
+#: them; the entry points (cli, commands, testing, __main__) sit on top.
+LAYERS = (
+    ("vocabulary", ("ptoverify", "ptoverify.config", "ptoverify.errors", "ptoverify.verdict")),
+    ("model", ("ptoverify.model",)),
+    ("sim", ("ptoverify.sim",)),
+    ("studies", ("ptoverify.studies",)),
+    ("conform", ("ptoverify.conform",)),
+    ("output", ("ptoverify.outdir", "ptoverify.progress")),
+    ("report", ("ptoverify.report",)),
+    ("entry", ("ptoverify.cli", "ptoverify.commands", "ptoverify.testing", "ptoverify.__main__")),
+)
+
 #: The output layer: everything else in ptoverify is numeric.
-OUTPUT = {
-    "ptoverify.conform_report",
-    "ptoverify.cli",
-    "ptoverify.__main__",
-    "ptoverify.report",
-    "ptoverify.report_sections",
-    "ptoverify.plots",
-}
+OUTPUT = {"ptoverify.cli", "ptoverify.__main__", "ptoverify.outdir", "ptoverify.progress"}
+
+
+def layer_of(module: str) -> int:
+    """Index in :data:`LAYERS` of the layer that holds ``module``."""
+    best, rank = -1, None
+    for i, (_, prefixes) in enumerate(LAYERS):
+        for p in prefixes:
+            if (module == p or module.startswith(p + ".")) and len(p) > best:
+                best, rank = len(p), i
+    if rank is None:
+        raise KeyError(module)
+    return rank
 
 
 def _module_name(path: Path) -> str:
@@ -165,7 +186,9 @@ def test_parser_sees_function_level_and_relative_imports(tmp_path, monkeypatch):
 
 def test_the_packages_are_found():
     mods = modules()
-    assert {"ptoverify", "ptoverify.cli", "ptoverify.plots", "derivations.section4"} <= set(mods)
+    assert {"ptoverify", "ptoverify.cli", "ptoverify.report.plots", "derivations.section4"} <= set(
+        mods
+    )
 
 
 # ------------------------------------------------------------------ the rules
@@ -182,20 +205,20 @@ PENDING: dict = {"cycles": [], "cli": set(), "plots": set(), "private": set()}
 #: Modules that compute: plots may import only their result types (CapWords
 #: names) and constants (UPPER_CASE), never a function that simulates or solves.
 COMPUTING = (
-    "ptoverify.simulate",
-    "ptoverify.plant",
-    "ptoverify.laws",
-    "ptoverify.zones",
-    "ptoverify.ocp",
-    "ptoverify.mintime",
-    "ptoverify.groundtruth",
-    "ptoverify.sweep",
-    "ptoverify.properties",
-    "ptoverify.conform",
-    "ptoverify.claims",
-    "ptoverify.agreement",
-    "ptoverify.userlaw",
-    "ptoverify.metrics",
+    "ptoverify.sim.simulate",
+    "ptoverify.model.plant",
+    "ptoverify.model.laws",
+    "ptoverify.model.zones",
+    "ptoverify.model.ocp",
+    "ptoverify.model.mintime",
+    "ptoverify.studies.groundtruth",
+    "ptoverify.studies.sweep",
+    "ptoverify.studies.properties",
+    "ptoverify.conform.gate",
+    "ptoverify.studies.claims",
+    "ptoverify.conform.agreement",
+    "ptoverify.conform.userlaw",
+    "ptoverify.sim.metrics",
 )
 
 
@@ -223,7 +246,7 @@ def test_derivations_import_nothing_from_ptoverify():
     assert offenders(lambda m: m.split(".")[0] == "derivations", _is(["ptoverify"])) == []
 
 
-_solver = _is(["ptoverify.ocp", "casadi"])
+_solver = _is(["ptoverify.model.ocp", "casadi"])
 
 
 def test_cli_imports_no_solver():
@@ -231,26 +254,61 @@ def test_cli_imports_no_solver():
 
 
 def test_plots_import_no_simulator():
-    assert offenders(lambda m: m == "ptoverify.plots", _simulator) == []
+    assert offenders(lambda m: m == "ptoverify.report.plots", _simulator) == []
 
 
 def test_simulator_rule_separates_results_from_computations():
-    assert _simulator("ptoverify.simulate", "SimResult", "ptoverify.simulate.SimResult") is False
-    assert _simulator("ptoverify.laws", "LAW_NAMES", "ptoverify.laws.LAW_NAMES") is False
-    assert _simulator("ptoverify.simulate", "simulate", "ptoverify.simulate.simulate") is True
-    assert _simulator("ptoverify.laws", "make_law", "ptoverify.laws.make_law") is True
-    assert _simulator("ptoverify.zones", "corrected_zone", "ptoverify.zones.corrected_zone")
-    assert _simulator("ptoverify.zones", None, "ptoverify.zones") is True
-    assert _simulator("ptoverify.curves", "h", "ptoverify.curves.h") is False
+    assert (
+        _simulator("ptoverify.sim.simulate", "SimResult", "ptoverify.sim.simulate.SimResult")
+        is False
+    )
+    assert (
+        _simulator("ptoverify.model.laws", "LAW_NAMES", "ptoverify.model.laws.LAW_NAMES") is False
+    )
+    assert (
+        _simulator("ptoverify.sim.simulate", "simulate", "ptoverify.sim.simulate.simulate") is True
+    )
+    assert _simulator("ptoverify.model.laws", "make_law", "ptoverify.model.laws.make_law") is True
+    assert _simulator(
+        "ptoverify.model.zones", "corrected_zone", "ptoverify.model.zones.corrected_zone"
+    )
+    assert _simulator("ptoverify.model.zones", None, "ptoverify.model.zones") is True
+    assert _simulator("ptoverify.model.curves", "h", "ptoverify.model.curves.h") is False
 
 
 def test_only_plots_imports_matplotlib():
-    assert offenders(lambda m: m != "ptoverify.plots", _is(["matplotlib"])) == []
+    assert offenders(lambda m: m != "ptoverify.report.plots", _is(["matplotlib"])) == []
 
 
 def test_numeric_modules_never_import_the_output_layer():
-    out = _is(sorted(OUTPUT))
-    assert offenders(lambda m: m not in OUTPUT, out) == []
+    out = _is(sorted(OUTPUT) + ["ptoverify.report"])
+    numeric = ("ptoverify.model", "ptoverify.sim", "ptoverify.studies", "ptoverify.conform")
+    assert offenders(lambda m: m.startswith(numeric), out) == []
+
+
+def test_every_module_has_a_layer():
+    assert [m for m in modules() if m.startswith("ptoverify")] and all(
+        layer_of(m) >= 0 for m in modules() if m.startswith("ptoverify")
+    )
+
+
+def test_layers_import_only_downward():
+    bad = []
+    for m in modules():
+        if not m.startswith("ptoverify"):
+            continue
+        for target, _, line in imports(m):
+            if target.startswith("ptoverify") and target in modules():
+                if layer_of(target) > layer_of(m):
+                    bad.append(f"{m}:{line} imports {target} ({LAYERS[layer_of(target)][0]})")
+    assert bad == []
+
+
+def test_layer_rule_catches_an_upward_import():
+    assert layer_of("ptoverify.model.laws") < layer_of("ptoverify.sim.simulate")
+    assert layer_of("ptoverify.studies.tune") < layer_of("ptoverify.commands")
+    assert layer_of("ptoverify.conform.gate") < layer_of("ptoverify.report.plots")
+    assert layer_of("ptoverify.config") < layer_of("ptoverify.model.plant")
 
 
 def test_no_private_name_imports():

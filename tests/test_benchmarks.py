@@ -12,11 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ptoverify.curves import BLOCK, omega_c
-from ptoverify.laws import make_law
-from ptoverify.mintime import min_time
-from ptoverify.plant import flow
-from ptoverify.simulate import simulate_batch
+from ptoverify.model.curves import BLOCK, omega_c
+from ptoverify.model.laws import make_law
+from ptoverify.model.mintime import min_time
+from ptoverify.model.plant import flow
+from ptoverify.sim.simulate import simulate_batch
 
 ROOT = Path(__file__).resolve().parent.parent
 

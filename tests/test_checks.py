@@ -1,7 +1,7 @@
 import json
 
-from ptoverify.checks import FAIL, GATES, PASS, UNVERIFIED, run_checks, summarize
 from ptoverify.cli import main
+from ptoverify.studies.checks import FAIL, GATES, PASS, UNVERIFIED, run_checks, summarize
 
 
 def test_core_gates_pass_on_paper(paper_cfg):

@@ -7,17 +7,17 @@ import math
 import numpy as np
 import pytest
 
-from ptoverify import claims as cl
-from ptoverify import exact
-from ptoverify import metrics as mt
 from ptoverify.config import paper_config
-from ptoverify.exact import Compared
-from ptoverify.laws import make_law
-from ptoverify.metrics import settling_time
-from ptoverify.plant import flow as plant_flow
-from ptoverify.plant import step as plant_step
-from ptoverify.simulate import simulate
-from ptoverify.tune import TuneBudget, fair_tunings
+from ptoverify.model.laws import make_law
+from ptoverify.model.plant import flow as plant_flow
+from ptoverify.model.plant import step as plant_step
+from ptoverify.sim import exact
+from ptoverify.sim import metrics as mt
+from ptoverify.sim.exact import Compared
+from ptoverify.sim.metrics import settling_time
+from ptoverify.sim.simulate import simulate
+from ptoverify.studies import claims as cl
+from ptoverify.studies.tune import TuneBudget, fair_tunings
 
 REQUIRED = {
     "step-to-oscillation",

@@ -222,7 +222,7 @@ def test_mintime_converged_but_inaccurate_ocp_is_not_truth(capsys):
 
 def test_internal_error_is_exit_1_one_line_not_bad_input(capsys, monkeypatch):
     """An injected bug in a numeric function is an internal error (exit 1), not exit 2."""
-    import ptoverify.groundtruth as gt
+    import ptoverify.studies.groundtruth as gt
 
     def broken(*args, **kwargs):
         return 1 / 0
@@ -238,7 +238,7 @@ def test_internal_error_is_exit_1_one_line_not_bad_input(capsys, monkeypatch):
 
 @pytest.mark.parametrize("where", ["before", "after"])
 def test_debug_shows_the_traceback(capsys, monkeypatch, where):
-    import ptoverify.groundtruth as gt
+    import ptoverify.studies.groundtruth as gt
 
     monkeypatch.setattr(gt, "min_time", lambda *a, **k: 1 / 0)
     argv = ["mintime", "5", "0"]
@@ -253,7 +253,7 @@ def test_debug_in_a_subprocess_prints_a_traceback(tmp_path):
     import sys
 
     code = (
-        "import sys, ptoverify.groundtruth as g\n"
+        "import sys, ptoverify.studies.groundtruth as g\n"
         "g.min_time = lambda *a, **k: 1 / 0\n"
         "from ptoverify.cli import main\n"
         "sys.exit(main(sys.argv[1:]))\n"
@@ -307,12 +307,12 @@ def test_cli_imports_no_solver_and_no_simulator():
     forbidden = {
         "casadi",
         "scipy",
-        "ptoverify.ocp",
-        "ptoverify.simulate",
-        "ptoverify.mintime",
-        "ptoverify.plant",
-        "ptoverify.properties",
-        "ptoverify.zones",
+        "ptoverify.model.ocp",
+        "ptoverify.sim.simulate",
+        "ptoverify.model.mintime",
+        "ptoverify.model.plant",
+        "ptoverify.studies.properties",
+        "ptoverify.model.zones",
     }
     assert not names & forbidden, names & forbidden
     private = [n for n in names if n.rsplit(".", 1)[-1][:1] == "_" and "__" not in n]
@@ -328,7 +328,7 @@ def test_building_the_parser_loads_no_numerics():
         "import sys\nfrom ptoverify.cli import build_parser\n"
         "build_parser().parse_args(['report', '--jobs', '2'])\n"
         "print(sorted(m for m in sys.modules if m.split('.')[0] in ('scipy', 'ptoverify')"
-        " and m in ('scipy', 'ptoverify.laws', 'ptoverify.curves')))"
+        " and m in ('scipy', 'ptoverify.model.laws', 'ptoverify.model.curves')))"
     )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from ptoverify.agreement import tie_band
 from ptoverify.cli import main
-from ptoverify.conform import (
+from ptoverify.conform.agreement import tie_band
+from ptoverify.conform.gate import (
     LawFault,
     UserLaw,
     closed_loop,
@@ -24,10 +24,10 @@ from ptoverify.conform import (
     reference_law_scalar,
     wrap_callable,
 )
-from ptoverify.curves import level_residual
-from ptoverify.laws import make_law
-from ptoverify.properties import default_steps, initial_grid
-from ptoverify.zones import zone_for_law
+from ptoverify.model.curves import level_residual
+from ptoverify.model.laws import make_law
+from ptoverify.model.zones import zone_for_law
+from ptoverify.studies.properties import default_steps, initial_grid
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -170,7 +170,7 @@ def test_grid_dense_near_every_boundary(paper_cfg):
 # ------------------------------------------------------------------ same definitions as check
 # ------------------------------------------------------------------ independent references
 def _zoh(cfg):
-    """ZOH matrices of x1' = x2, x2' = a (u - x2) from scipy (not ptoverify.simulate)."""
+    """ZOH matrices of x1' = x2, x2' = a (u - x2) from scipy (not ptoverify.sim.simulate)."""
     from scipy.signal import cont2discrete
 
     a, T = cfg.plant.a, cfg.plant.sample_time
@@ -182,7 +182,7 @@ def _zoh(cfg):
 
 
 def _sigma(x1, x2, a, level):
-    """Level curve through the origin, eqs. (9)/(11) written out (not ptoverify.curves)."""
+    """Level curve through the origin, eqs. (9)/(11) written out (not ptoverify.model.curves)."""
     with np.errstate(all="ignore"):
         neg = a * x1 + x2 + level * np.log(1.0 - np.minimum(x2, 0.0) / level)
         pos = a * x1 + x2 - level * np.log(1.0 + np.maximum(x2, 0.0) / level)
@@ -276,7 +276,7 @@ def test_law_raising_at_a_state_is_a_finding(capsys, tmp_path):
         def f(x1, x2, cfg):
             if x1 > 40.0:
                 raise RuntimeError("table lookup out of range")
-            from ptoverify.conform import reference_law_scalar
+            from ptoverify.conform.gate import reference_law_scalar
             return reference_law_scalar(x1, x2, cfg)
         """,
     )
@@ -341,7 +341,7 @@ def test_human_output_names_failures(tmp_path, paper_cfg):
         tmp_path,
         """
         def f(x1, x2, cfg):
-            from ptoverify.conform import reference_law
+            from ptoverify.conform.gate import reference_law
             return 1.001 * reference_law(x1, x2, cfg)
         """,
     )
@@ -359,7 +359,7 @@ def test_user_output_is_captured(tmp_path, paper_cfg):
         print("hello from import")
         def f(x1, x2, cfg):
             print("called")
-            from ptoverify.conform import reference_law
+            from ptoverify.conform.gate import reference_law
             return reference_law(x1, x2, cfg)
         """,
     )
@@ -374,9 +374,9 @@ def test_user_output_is_captured(tmp_path, paper_cfg):
     "spec",
     [
         "no_such_module_xyz:f",
-        "ptoverify.conform:no_such_function",
-        "ptoverify.conform:DEFAULT_RTOL",
-        "ptoverify.conform",
+        "ptoverify.conform.gate:no_such_function",
+        "ptoverify.conform.gate:DEFAULT_RTOL",
+        "ptoverify.conform.gate",
         "/nonexistent/law.py:f",
         ":f",
     ],
@@ -423,8 +423,8 @@ def test_bad_table_exit_2(capsys, tmp_path, text):
     [
         ["conform"],
         ["conform", "--table", "/nonexistent.csv"],
-        ["conform", "--law", "ptoverify.conform:reference_law", "--table", "x.csv"],
-        ["conform", "--law", "ptoverify.conform:reference_law", "--tolerance", "0"],
+        ["conform", "--law", "ptoverify.conform.gate:reference_law", "--table", "x.csv"],
+        ["conform", "--law", "ptoverify.conform.gate:reference_law", "--tolerance", "0"],
         ["conform", "--emit-grid", "/nonexistent/dir/grid.csv"],
     ],
 )
@@ -462,7 +462,7 @@ def test_reference_law_against_closed_form(paper_cfg):
 
 def test_tolerance_option_is_used(capsys, tmp_path, paper_cfg):
     """float32 output passes at 1e-6 w_max and fails at 1e-9 w_max (rounding ~6e-8 relative)."""
-    from ptoverify.agreement import probe_set
+    from ptoverify.conform.agreement import probe_set
 
     parts = probe_set(paper_cfg).values()
     x1, x2 = np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
@@ -481,7 +481,7 @@ def test_tolerance_option_is_used(capsys, tmp_path, paper_cfg):
 
 
 def test_dotted_attribute_and_file_path(tmp_path, paper_cfg):
-    from ptoverify.userlaw import load_callable
+    from ptoverify.conform.userlaw import load_callable
 
     path = write_law(
         tmp_path,
@@ -489,7 +489,7 @@ def test_dotted_attribute_and_file_path(tmp_path, paper_cfg):
         class Drive:
             @staticmethod
             def law(x1, x2, cfg):
-                from ptoverify.conform import reference_law
+                from ptoverify.conform.gate import reference_law
                 return reference_law(x1, x2, cfg)
         """,
     )

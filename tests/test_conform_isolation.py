@@ -33,7 +33,7 @@ def cli(*argv, timeout=HARD_S):
 def law_file(tmp_path, body):
     path = tmp_path / "law.py"
     path.write_text(
-        "import os, time, signal\nfrom ptoverify.conform import reference_law\n"
+        "import os, time, signal\nfrom ptoverify.conform.gate import reference_law\n"
         + textwrap.dedent(body)
     )
     return f"{path}:f"

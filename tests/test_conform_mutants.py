@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from pto_mutants import BENIGN, MEMORY, MUTANTS, make_law, mutation_score
 
-from ptoverify.agreement import agreement
-from ptoverify.conform import conform_callable, conformance_grid
+from ptoverify.conform.agreement import agreement
+from ptoverify.conform.gate import conform_callable, conformance_grid
 
 SWEEP = (11, 11, 20)  # 141 closed-loop states: every mutant is killed well inside this grid
 

@@ -12,10 +12,10 @@ import pytest
 from numpy.testing import assert_allclose
 
 from ptoverify.cli import main
-from ptoverify.commands import run_simulation
-from ptoverify.conform import reference_law
-from ptoverify.conform_evidence import du_map
-from ptoverify.conform_report import state
+from ptoverify.conform.evidence import du_map
+from ptoverify.conform.gate import reference_law
+from ptoverify.report.conform_report import state
+from ptoverify.sim.runs import run_simulation
 
 ROOT = Path(__file__).resolve().parents[1]
 TESTS = ROOT / "tests"

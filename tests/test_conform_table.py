@@ -9,10 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ptoverify import agreement as agreement_mod
-from ptoverify.agreement import read_table
 from ptoverify.cli import main
-from ptoverify.conform import MIN_PER_REGION, conformance_grid, reference_law
+from ptoverify.conform import agreement as agreement_mod
+from ptoverify.conform.agreement import read_table
+from ptoverify.conform.gate import MIN_PER_REGION, conformance_grid, reference_law
 from ptoverify.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[1]

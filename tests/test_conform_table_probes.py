@@ -13,8 +13,9 @@ import numpy as np
 import pytest
 from pto_mutants import BENIGN, MUTANTS, make_law
 
-from ptoverify import agreement as agreement_mod
-from ptoverify.agreement import (
+from ptoverify.cli import main
+from ptoverify.conform import agreement as agreement_mod
+from ptoverify.conform.agreement import (
     LATTICE,
     N_BAND,
     N_RANDOM,
@@ -23,11 +24,10 @@ from ptoverify.agreement import (
     table_coverage,
     tie_band,
 )
-from ptoverify.cli import main
-from ptoverify.conform import conform_callable, reference_law
-from ptoverify.curves import level_curve_x1
-from ptoverify.laws import Region
-from ptoverify.laws import make_law as make_ref
+from ptoverify.conform.gate import conform_callable, reference_law
+from ptoverify.model.curves import level_curve_x1
+from ptoverify.model.laws import Region
+from ptoverify.model.laws import make_law as make_ref
 
 BANDS = ("slow_band_x1", "slow_band_x2")
 
@@ -101,7 +101,7 @@ def test_random_states_fill_every_lattice_cell(paper_cfg):
 def test_band_states_hug_the_curves_and_edges(paper_cfg):
     """Every band state lies within max(2 d, 0.02 R) of l1/l2, l1*/l2* or x1 = +-d, some at 1e-5 mm."""
     p, d = paper_cfg.plant, paper_cfg.pto.d
-    from ptoverify.agreement import omega0_ref
+    from ptoverify.conform.agreement import omega0_ref
 
     b1, b2 = probe_set(paper_cfg)["band"]
     om = omega0_ref(paper_cfg)

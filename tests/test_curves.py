@@ -4,7 +4,7 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.optimize import brentq
 
-from ptoverify.curves import (
+from ptoverify.model.curves import (
     h,
     level_curve_x1,
     level_residual,
@@ -15,7 +15,7 @@ from ptoverify.curves import (
     root_k_bisect,
     switching_function,
 )
-from ptoverify.plant import flow
+from ptoverify.model.plant import flow
 
 
 def test_h_against_mpmath():
@@ -136,7 +136,7 @@ def test_root_k_against_scipy_lambertw():
 @pytest.mark.parametrize("per_state", [True, False])
 def test_level_side_compares_as_the_residual(band, per_state):
     """level_side: the sum's sign, zero and comparisons with +-band, and the sum near the curve."""
-    from ptoverify.curves import level_side, level_term
+    from ptoverify.model.curves import level_side, level_term
 
     rng = np.random.default_rng(7)
     n = 200_000
@@ -166,7 +166,7 @@ def test_level_side_compares_as_the_residual(band, per_state):
 
 def test_h_few_series_values_as_many():
     """h's series in Python floats (few values) equals its numpy passes (many), bit for bit."""
-    from ptoverify.curves import FEW
+    from ptoverify.model.curves import FEW
 
     rng = np.random.default_rng(11)
     n = 64 * FEW
@@ -183,8 +183,8 @@ def test_level_side_at_infinite_velocity_is_the_sum(n):
     batch size, so a law's vector path answers as in batches of a few states and as its
     scalar path there."""
     from ptoverify.config import paper_config
-    from ptoverify.curves import level_side, level_term
-    from ptoverify.laws import make_law
+    from ptoverify.model.curves import level_side, level_term
+    from ptoverify.model.laws import make_law
 
     rng = np.random.default_rng(3)
     x2 = rng.uniform(-300.0, 300.0, n)

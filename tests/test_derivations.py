@@ -20,9 +20,9 @@ from derivations.common import S, flow
 from derivations.printed import PRINTED, parse, printed
 from derivations.record import EquationRecord, judge
 from ptoverify.config import paper_config
-from ptoverify.curves import level_residual, omega_c, root_22, root_k
-from ptoverify.mintime import min_time
-from ptoverify.plant import flow as np_flow
+from ptoverify.model.curves import level_residual, omega_c, root_22, root_k
+from ptoverify.model.mintime import min_time
+from ptoverify.model.plant import flow as np_flow
 
 a, wm, T, t = S["a"], S["omega_m"], S["T"], S["t"]
 x1, x2, x10, x20 = S["x1"], S["x2"], S["x10"], S["x20"]

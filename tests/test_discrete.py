@@ -25,7 +25,7 @@ from numpy.testing import assert_allclose
 
 from ptoverify.config import Plant
 from ptoverify.errors import InputError
-from ptoverify.mintime import (
+from ptoverify.model.mintime import (
     ZOHReach,
     discrete_min_steps,
     discrete_min_steps_batch,

@@ -18,12 +18,12 @@ from numpy.testing import assert_allclose
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, curve_fit
 
-from ptoverify import exact
 from ptoverify.config import paper_config
 from ptoverify.errors import InputError
-from ptoverify.laws import make_law
-from ptoverify.plant import flow
-from ptoverify.simulate import Reference, reference, simulate
+from ptoverify.model.laws import make_law
+from ptoverify.model.plant import flow
+from ptoverify.sim import exact
+from ptoverify.sim.simulate import Reference, reference, simulate
 
 CFG = paper_config()
 PLANT = CFG.plant
@@ -323,7 +323,7 @@ def test_settling_and_overshoot_are_those_of_exact_metrics():
     """The lean evaluation gives exact_metrics' values bit for bit (NaN where it does),
     for every law and signal, at the paper's gains and at far-off ones (the sine's
     overshoot is undefined: NaN)."""
-    from ptoverify.tune import tuned_config
+    from ptoverify.studies.tune import tuned_config
 
     cfgs = [
         CFG,
@@ -403,8 +403,8 @@ def dense_last_out(x1, x2, u, a, T, b1, b2, per=PER_SWEEP):
 def sweep_records():
     """400 states of the sweep's grid (20 x 20), and 6 states of its 200 x 200 grid with
     excursions between in-band samples; the sweep's horizon; every law's records."""
-    from ptoverify.simulate import simulate_batch
-    from ptoverify.sweep import SweepSettings, grid_states, run_sweep
+    from ptoverify.sim.simulate import simulate_batch
+    from ptoverify.studies.sweep import SweepSettings, grid_states, run_sweep
 
     res = run_sweep(CFG, SweepSettings(n1=20, n2=20))
     G1, G2 = grid_states(PLANT, 200, 200)
@@ -466,7 +466,7 @@ def test_batch_settling_grid_bounds_on_sweep_records(sweep_records):
         ex, gr = st.time[ok], st.grid[ok]
         assert np.all((ex > gr - T) | (gr == 0.0)), f"{law}: exact more than a sample early"
         assert np.all(gr <= T * np.ceil(ex / T - 1e-9) + 1e-15), f"{law}: grid after exact's sample"
-        from ptoverify.sweep import settle_steps
+        from ptoverify.studies.sweep import settle_steps
 
         k = settle_steps(b.x1, b.x2, BAND1, BAND2, 0)
         assert np.array_equal(np.where(k >= 0, k * T, np.nan), st.grid, equal_nan=True)
@@ -513,7 +513,7 @@ def test_batch_settling_constructed_excursion_between_in_band_samples():
 def test_batch_settling_agrees_with_single_record_settling_time():
     """Position band only (velocity band huge): the batch equals ``settling_time`` of the
     regulation error e = 0 - x1 (pieces and brentq, another path) on PD and PTO records."""
-    from ptoverify.simulate import simulate_batch
+    from ptoverify.sim.simulate import simulate_batch
 
     rng = np.random.default_rng(3)
     x1s, x2s = rng.uniform(-50, 50, 30), rng.uniform(-300, 300, 30)

@@ -12,9 +12,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from ptoverify import curves, zones
 from ptoverify.config import PDGains, PTOSettings, paper_config
-from ptoverify.curves import (
+from ptoverify.model import curves, zones
+from ptoverify.model.curves import (
     h,
     level_curve_x1,
     level_residual,
@@ -23,7 +23,7 @@ from ptoverify.curves import (
     root_22,
     switching_function,
 )
-from ptoverify.laws import Region, make_law, pto_law, saturate_linear, with_state_gains
+from ptoverify.model.laws import Region, make_law, pto_law, saturate_linear, with_state_gains
 
 CFG = paper_config()
 RNG = np.random.default_rng(2024)

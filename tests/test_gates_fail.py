@@ -17,17 +17,17 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-import ptoverify.claims as claims_mod
-import ptoverify.curves as curves_mod
-import ptoverify.laws as laws_mod
-import ptoverify.mintime as mintime_mod
-import ptoverify.ocp as ocp_mod
-import ptoverify.plant as plant_mod
-import ptoverify.poles as poles_mod
-import ptoverify.robust as robust_mod
-import ptoverify.zones as zones_mod
-from ptoverify.checks import GATES, ROBUST_GATES, run_checks
+import ptoverify.model.curves as curves_mod
+import ptoverify.model.laws as laws_mod
+import ptoverify.model.mintime as mintime_mod
+import ptoverify.model.ocp as ocp_mod
+import ptoverify.model.plant as plant_mod
+import ptoverify.model.poles as poles_mod
+import ptoverify.model.zones as zones_mod
+import ptoverify.studies.claims as claims_mod
+import ptoverify.studies.robust as robust_mod
 from ptoverify.config import Config, PDGains, Plant, PTOSettings, Robustness, paper_config
+from ptoverify.studies.checks import GATES, ROBUST_GATES, run_checks
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED
 
 
@@ -35,7 +35,7 @@ from ptoverify.verdict import FAIL, PASS, UNVERIFIED
 def _fresh_memos():
     """Zones and properties are memoized per configuration: a perturbation must not see
     (or leave behind) a result computed without it."""
-    from ptoverify.properties import named_properties
+    from ptoverify.studies.properties import named_properties
 
     zones_mod.clear_caches()
     named_properties.cache_clear()

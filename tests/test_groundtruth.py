@@ -7,17 +7,17 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-import ptoverify.ocp as ocp_mod
-from ptoverify.checks import GATES
+import ptoverify.model.ocp as ocp_mod
 from ptoverify.cli import main
 from ptoverify.config import paper_config
 from ptoverify.errors import InputError
-from ptoverify.groundtruth import (
+from ptoverify.model.ocp import CollocationOCP, convergence_study
+from ptoverify.studies.checks import GATES
+from ptoverify.studies.groundtruth import (
     COLLOCATION_RESIM_REL,
     state_scale,
     verified_mintime,
 )
-from ptoverify.ocp import CollocationOCP, convergence_study
 from ptoverify.verdict import UNVERIFIED
 
 

@@ -4,7 +4,7 @@ import json
 import xml.etree.ElementTree as ET
 
 from ptoverify.cli import main
-from ptoverify.junit import conform_verdicts, junit_xml
+from ptoverify.conform.junit import conform_verdicts, junit_xml
 from ptoverify.verdict import Verdict
 
 
@@ -119,7 +119,7 @@ def test_conform_verdicts_carry_regions_properties_and_states():
     assert by["agreement/BANG_P"].status == "fail" and states["agreement/BANG_P"] == [30.5, -100.0]
     assert by["agreement/LINEAR"].passed and "agreement/LINEAR" not in states
     assert by["no-limit-cycle"].status == "unverified" and states["no-limit-cycle"] == [1.0, 2.0]
-    _, suite, cases = _cases(junit_xml(verdicts, "ptoverify.conform", states))
+    _, suite, cases = _cases(junit_xml(verdicts, "ptoverify.conform.gate", states))
     assert cases["agreement/BANG_P"][0] == "failure" and "30.5 mm" in cases["agreement/BANG_P"][1]
     assert cases["no-limit-cycle"][0] == "error"
     # a negative result that no property carries is still a red suite

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 
 from ptoverify.config import paper_config
 from ptoverify.errors import InputError
-from ptoverify.laws import Region, make_law
+from ptoverify.model.laws import Region, make_law
 
 CFG = paper_config()
 W = CFG.plant.w_max
@@ -39,7 +39,7 @@ def test_to_law_switches_on_the_curve(cfg):
     """Either side of l1 - o - l2, 1e-9 of the range away: +w_max left, -w_max right (eq. 12).
 
     The curve is evaluated in 50 digits from eqs. (9), (11), independently of
-    ``ptoverify.curves``; the offset is 1e-9 R [mm], far above the round-off of
+    ``ptoverify.model.curves``; the offset is 1e-9 R [mm], far above the round-off of
     the switching function (~1e-13 of its scale).
     """
     law = make_law("to", cfg)

@@ -15,10 +15,11 @@ import numpy as np
 import pytest
 
 from ptoverify.config import paper_config
-from ptoverify.laws import Region, make_law
-from ptoverify.lockstep import Ask, run_lockstep
-from ptoverify.plant import flow
-from ptoverify.robust import (
+from ptoverify.model.laws import Region, make_law
+from ptoverify.model.plant import flow
+from ptoverify.sim.lockstep import Ask, run_lockstep
+from ptoverify.sim.simulate import Mismatch, simulate_batch, simulate_segments
+from ptoverify.studies.robust import (
     RobustSettings,
     grid_worst,
     no_limit_cycle_margin,
@@ -26,7 +27,6 @@ from ptoverify.robust import (
     run_robust,
     worst_cases,
 )
-from ptoverify.simulate import Mismatch, simulate_batch, simulate_segments
 
 CFG = paper_config()
 P = CFG.plant
@@ -186,7 +186,7 @@ def _same(a, b) -> bool:
 
 def test_study_does_not_depend_on_round_size(monkeypatch):
     """Maps, margins and worst cases with rounds of one ask each equal the default rounds."""
-    import ptoverify.robust as robust_mod
+    import ptoverify.studies.robust as robust_mod
 
     box = dataclasses.replace(CFG.robustness, velocity_noise=1.0, delay_samples=(0, 2))
     cfg = dataclasses.replace(CFG, robustness=box)
@@ -236,7 +236,7 @@ def test_one_family_in_one_call_equals_each_law_alone(n):
 
 def test_long_delay_runs_and_mixed_delays_in_one_run():
     """States of one delay in long runs (row slices) beside per-state delays (a gather)."""
-    from ptoverify.simulate import DELAY_RUN
+    from ptoverify.sim.simulate import DELAY_RUN
 
     rng = np.random.default_rng(9)
     steps = 60

@@ -8,12 +8,12 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.signal import cont2discrete
 
-from ptoverify import exact
-from ptoverify import metrics as m
 from ptoverify.cli import main
-from ptoverify.laws import Region, make_law
-from ptoverify.plant import flow
-from ptoverify.simulate import SIGNALS, Reference, simulate
+from ptoverify.model.laws import Region, make_law
+from ptoverify.model.plant import flow
+from ptoverify.sim import exact
+from ptoverify.sim import metrics as m
+from ptoverify.sim.simulate import SIGNALS, Reference, simulate
 
 T = 0.002
 t = np.arange(0, 1.0 + T / 2, T)

@@ -3,9 +3,9 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.optimize import brentq
 
-from ptoverify.curves import switching_function
-from ptoverify.mintime import min_time
-from ptoverify.plant import flow
+from ptoverify.model.curves import switching_function
+from ptoverify.model.mintime import min_time
+from ptoverify.model.plant import flow
 
 
 def arc_by_arc(x1, x2, plant):

@@ -14,7 +14,7 @@ import pytest
 
 from ptoverify.cli import main
 from ptoverify.config import paper_config
-from ptoverify.mintime import discrete_min_steps, min_time
+from ptoverify.model.mintime import discrete_min_steps, min_time
 
 PLANT = paper_config().plant
 

@@ -19,11 +19,11 @@ from numpy.testing import assert_allclose
 
 from ptoverify.cli import main
 from ptoverify.config import Config, PDGains, PTOSettings, paper_config
-from ptoverify.curves import level_curve_x1
-from ptoverify.groundtruth import verified_mintime
-from ptoverify.mintime import min_time
-from ptoverify.ocp import CollocationOCP, TwoPhaseOCP, convergence_study, resimulate
-from ptoverify.plant import flow
+from ptoverify.model.curves import level_curve_x1
+from ptoverify.model.mintime import min_time
+from ptoverify.model.ocp import CollocationOCP, TwoPhaseOCP, convergence_study, resimulate
+from ptoverify.model.plant import flow
+from ptoverify.studies.groundtruth import verified_mintime
 
 
 @pytest.mark.parametrize("name", PLANTS)
@@ -239,7 +239,7 @@ def test_convergence_study_order():
 
 
 def test_convergence_figures(tmp_path):
-    from ptoverify.plots import plot_convergence, plot_switch_profiles
+    from ptoverify.report.plots import plot_convergence, plot_switch_profiles
 
     study = convergence_study(PLANTS["paper"], [(5.0, 0.0)], intervals=(10, 20))
     ax = plot_convergence(study)

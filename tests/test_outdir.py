@@ -156,7 +156,7 @@ def test_stale_temporaries_of_dead_runs_are_removed(tmp_path):
 _SIGTERM_SCRIPT = textwrap.dedent(
     """
     import sys, time
-    import ptoverify.plots as plots
+    import ptoverify.report.plots as plots
     from ptoverify.cli import main
 
     def slow_save(res, folder):

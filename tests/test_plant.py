@@ -3,7 +3,7 @@ from conftest import zoh_reference, zoh_step
 from numpy.testing import assert_allclose
 from scipy.integrate import solve_ivp
 
-from ptoverify.plant import flow, step, zoh_matrices
+from ptoverify.model.plant import flow, step, zoh_matrices
 
 
 def augmented_expm(a, u, t, x0):

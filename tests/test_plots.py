@@ -16,14 +16,14 @@ from matplotlib.figure import Figure
 from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
 
-from ptoverify import plots
 from ptoverify.config import paper_config
-from ptoverify.curves import level_residual
-from ptoverify.laws import LAW_NAMES, make_law
-from ptoverify.plant import flow
-from ptoverify.simulate import simulate, simulate_batch
-from ptoverify.sweep import SweepSettings, run_sweep
-from ptoverify.zones import zone_for_law
+from ptoverify.model.curves import level_residual
+from ptoverify.model.laws import LAW_NAMES, make_law
+from ptoverify.model.plant import flow
+from ptoverify.model.zones import zone_for_law
+from ptoverify.report import plots
+from ptoverify.sim.simulate import simulate, simulate_batch
+from ptoverify.studies.sweep import SweepSettings, run_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 CFG = paper_config()
@@ -63,10 +63,10 @@ def test_plotting_works_headless(tmp_path):
     png = tmp_path / "x.png"
     code = (
         "import sys, matplotlib\n"
-        "from ptoverify import plots\n"
+        "from ptoverify.report import plots\n"
         "print(matplotlib.get_backend().lower())\n"
-        "loaded = [m for m in ('ptoverify.simulate', 'ptoverify.zones', 'ptoverify.sweep',\n"
-        "    'ptoverify.mintime', 'ptoverify.ocp', 'ptoverify.plant') if m in sys.modules]\n"
+        "loaded = [m for m in ('ptoverify.sim.simulate', 'ptoverify.model.zones', 'ptoverify.studies.sweep',\n"
+        "    'ptoverify.model.mintime', 'ptoverify.model.ocp', 'ptoverify.model.plant') if m in sys.modules]\n"
         "print(','.join(loaded) or 'none')\n"
         f"plots.save_figure({str(png)!r}, lambda ax: ax.plot([0, 1], [1, 0]))\n"
     )
@@ -82,7 +82,7 @@ def test_plotting_works_headless(tmp_path):
 
 def test_plots_import_no_simulator_law_factory_or_zone_construction():
     """plots.py names no computing function (imports under TYPE_CHECKING are types)."""
-    tree = ast.parse((ROOT / "ptoverify" / "plots.py").read_text())
+    tree = ast.parse((ROOT / "ptoverify" / "report" / "plots.py").read_text())
     typing_only = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
@@ -94,9 +94,14 @@ def test_plots_import_no_simulator_law_factory_or_zone_construction():
         for alias in node.names
     }
     modules = {m for m, _ in imported}
-    forbidden = {"ptoverify.simulate", "ptoverify.zones", "ptoverify.plant", "ptoverify.mintime"}
+    forbidden = {
+        "ptoverify.sim.simulate",
+        "ptoverify.model.zones",
+        "ptoverify.model.plant",
+        "ptoverify.model.mintime",
+    }
     assert not modules & forbidden, modules & forbidden
-    assert ("ptoverify.laws", "make_law") not in imported
+    assert ("ptoverify.model.laws", "make_law") not in imported
     names = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
     for fn in ("simulate", "simulate_batch", "make_law", "corrected_zone", "zone_for_law", "flow"):
         assert fn not in names, f"plots.py calls {fn}"
@@ -311,7 +316,7 @@ def test_title_never_covers_the_offset_text(tmp_path):
 
 @pytest.mark.slow
 def test_save_all_writes_figures_2_to_14(tmp_path):
-    from ptoverify.report import figure_inputs
+    from ptoverify.report.collect import figure_inputs
 
     files = plots.save_all(figure_inputs(paper_config()), tmp_path)
     nums = {int(f.name[3:5]) for f in files if f.name.startswith("fig")}

@@ -8,11 +8,11 @@ import numpy as np  # noqa: E402
 from numpy.testing import assert_allclose, assert_array_equal  # noqa: E402
 
 from ptoverify.config import paper_config  # noqa: E402
-from ptoverify.curves import level_residual  # noqa: E402
-from ptoverify.laws import make_law  # noqa: E402
-from ptoverify.plots import plot_zone_geometry, zone_geometry_xlim  # noqa: E402
-from ptoverify.simulate import simulate_batch  # noqa: E402
-from ptoverify.zones import zone_for_law  # noqa: E402
+from ptoverify.model.curves import level_residual  # noqa: E402
+from ptoverify.model.laws import make_law  # noqa: E402
+from ptoverify.model.zones import zone_for_law  # noqa: E402
+from ptoverify.report.plots import plot_zone_geometry, zone_geometry_xlim  # noqa: E402
+from ptoverify.sim.simulate import simulate_batch  # noqa: E402
 
 
 def test_plot_zone_geometry(tmp_path):

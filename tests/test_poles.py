@@ -6,7 +6,7 @@ from conftest import zoh_reference
 from numpy.testing import assert_allclose
 
 from ptoverify.config import paper_config
-from ptoverify.poles import all_loop_poles, critical_gain, loop_poles, lyapunov_counterexample
+from ptoverify.model.poles import all_loop_poles, critical_gain, loop_poles, lyapunov_counterexample
 
 PAPER = paper_config()
 CONFIGS = {

@@ -5,8 +5,8 @@ import pytest
 from conftest import with_d
 
 from ptoverify.config import paper_config
-from ptoverify.laws import make_law
-from ptoverify.properties import initial_grid, law_properties, oscillating
+from ptoverify.model.laws import make_law
+from ptoverify.studies.properties import initial_grid, law_properties, oscillating
 
 PAPER = paper_config()
 
@@ -95,8 +95,8 @@ def test_oscillating_against_a_plain_reference():
 
 def _crossings_reference(X1, X2, R, cfg):
     """crossing_masks by its definition, sigma at every sample (curves.switching_function)."""
-    from ptoverify.curves import switching_function
-    from ptoverify.laws import Region
+    from ptoverify.model.curves import switching_function
+    from ptoverify.model.laws import Region
     from ptoverify.verdict import tie_band
 
     p, d = cfg.plant, cfg.pto.d
@@ -115,8 +115,8 @@ def _crossings_reference(X1, X2, R, cfg):
 @pytest.mark.parametrize("name", ["to", "pto-printed"])
 def test_crossing_masks_against_the_definition(name):
     """On sampled TO and PTO trajectories (which stride over and enter zones), and on a view."""
-    from ptoverify.properties import crossing_masks, stride_over_counts
-    from ptoverify.simulate import Mismatch, simulate_batch
+    from ptoverify.sim.simulate import Mismatch, simulate_batch
+    from ptoverify.studies.properties import crossing_masks, stride_over_counts
 
     cfg = CONFIGS["a30"]
     x1, x2, _ = initial_grid(cfg, 9, 9, 10)
@@ -133,8 +133,8 @@ def test_crossing_masks_against_the_definition(name):
 
 
 def test_grid_simulation_reuses_the_last_arrays_with_fresh_values():
-    from ptoverify.properties import grid_simulation
-    from ptoverify.simulate import simulate_batch
+    from ptoverify.sim.simulate import simulate_batch
+    from ptoverify.studies.properties import grid_simulation
 
     x1, x2, _ = initial_grid(PAPER, 11, 11, 5)
     laws = [make_law(name, PAPER) for name in ("to", "pd", "pto")]

@@ -11,9 +11,9 @@ from numpy.testing import assert_allclose
 
 from ptoverify.cli import main
 from ptoverify.config import paper_config
-from ptoverify.curves import bisect, h, level_residual, omega_c
-from ptoverify.laws import LAW_NAMES, Region, make_law, omega_c_scalar, pto_law
-from ptoverify.zones import corrected_zone, printed_zone
+from ptoverify.model.curves import bisect, h, level_residual, omega_c
+from ptoverify.model.laws import LAW_NAMES, Region, make_law, omega_c_scalar, pto_law
+from ptoverify.model.zones import corrected_zone, printed_zone
 
 PAPER = paper_config()
 A, W, T = PAPER.plant.a, PAPER.plant.w_max, PAPER.plant.sample_time

@@ -19,9 +19,9 @@ import pytest
 
 from ptoverify.config import Plant, paper_config
 from ptoverify.errors import InputError
-from ptoverify.mintime import ZOHReach, discrete_min_steps, discrete_min_steps_batch
-from ptoverify.plant import flow
-from ptoverify.reach import MARGIN, ZonotopeTable, zonotope_steps_each
+from ptoverify.model.mintime import ZOHReach, discrete_min_steps, discrete_min_steps_batch
+from ptoverify.model.plant import flow
+from ptoverify.model.reach import MARGIN, ZonotopeTable, zonotope_steps_each
 
 PLANTS = {  # a T = 0.015, 0.377, 4
     "small-aT": Plant(a=30.0, w_max=300.0, sample_time=0.0005, position_range=20.0),
@@ -147,7 +147,7 @@ def gauge_boundary_state(x1: float, x2: float, plant: Plant, n: int) -> tuple[fl
     """
     from scipy.optimize import linprog
 
-    from ptoverify.plant import zoh_matrices
+    from ptoverify.model.plant import zoh_matrices
 
     ad, bd = zoh_matrices(plant.a, plant.sample_time)
     scale = np.array([plant.a / plant.w_max, 1.0 / plant.w_max])
@@ -282,7 +282,7 @@ def test_gate_compares_zonotope_with_lp(monkeypatch, capsys):
     import json
     from dataclasses import replace
 
-    import ptoverify.mintime as mintime
+    import ptoverify.model.mintime as mintime
     from ptoverify.cli import main
 
     argv = ["check", "--gate", "discrete-limit-consistency", "--json"]
@@ -305,7 +305,7 @@ def test_gate_compares_zonotope_with_lp(monkeypatch, capsys):
 
 def test_any_start_gives_the_same_n_star():
     """The search does not trust its start: n0 above N* is tested and flagged, n0 = 1 works."""
-    from ptoverify.reach import zonotope_steps
+    from ptoverify.model.reach import zonotope_steps
 
     plant = PLANTS["paper"]
     x1, x2 = random_states(plant, 40, 10, seed=12)

@@ -38,8 +38,8 @@ def test_main_job_writes_an_ignored_folder():
 def test_readme_documents_every_command_and_gate(capsys):
     import pytest
 
-    from ptoverify.checks import GATES
     from ptoverify.cli import main
+    from ptoverify.studies.checks import GATES
 
     with pytest.raises(SystemExit):
         main(["--help"])

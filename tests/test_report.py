@@ -12,8 +12,8 @@ import pytest
 
 from ptoverify.cli import main
 from ptoverify.config import paper_config
-from ptoverify.render import Block, render_html
-from ptoverify.report import SKIPPABLE, write_report
+from ptoverify.report.collect import SKIPPABLE, write_report
+from ptoverify.report.render import Block, render_html
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -144,7 +144,7 @@ def test_unwritable_out_is_a_clean_error(tmp_path, capsys):
 
 def test_failed_run_leaves_nothing(tmp_path, monkeypatch):
     """An error in the middle of the run (here: a bad figure folder) leaves no folder."""
-    import ptoverify.report as rep
+    import ptoverify.report.collect as rep
 
     def boom(*args, **kwargs):
         raise RuntimeError("interrupted")
@@ -270,7 +270,7 @@ def unit_problems(sections) -> list[str]:
 def _sections(folder: Path):
     """The sections of a written report rebuilt from its results.json and records."""
     import derivations
-    from ptoverify.report import build_sections
+    from ptoverify.report.collect import build_sections
 
     data = json.loads((folder / "results.json").read_text())
     records = [derivations.EquationRecord.from_json(r) for r in data["derivations"]]
@@ -310,7 +310,7 @@ def test_report_sections_present_and_findings_first(two_reports):
 
 def test_unit_check_catches_a_bare_number():
     """The units check is not vacuous: a unitless numeric column is reported."""
-    from ptoverify.render import table
+    from ptoverify.report.render import table
 
     ok = table(["t [s]", "x"], [[1.5, "1.5 mm"]])
     bad = table(["t", "x"], [[1.5, "(1, 2)"]])
@@ -367,7 +367,7 @@ def test_headline_findings_follow_the_results():
     """Each sentence is generated: perturb a result and its sentence changes with it."""
     import copy
 
-    from ptoverify.report_sections import headline_findings
+    from ptoverify.report.sections import headline_findings
 
     base = _fake_results()
     found = headline_findings(base)
@@ -441,7 +441,7 @@ def test_worst_case_command_line_runs(capsys):
     """The command the robustness section prints is one `ptoverify simulate` accepts."""
     import shlex
 
-    from ptoverify.report_sections import simulate_command
+    from ptoverify.report.sections import simulate_command
 
     cmd = simulate_command(
         "pto",
@@ -461,7 +461,7 @@ def test_robust_map_places_each_cell():
     """The heat map's cell (w_max ratio i, a ratio j) holds that cell's value."""
     import numpy as np
 
-    from ptoverify.plots import plot_robust_map
+    from ptoverify.report.plots import plot_robust_map
 
     ars, wrs = [0.8, 1.0, 1.25], [0.9, 1.0]
     cells = [
@@ -484,7 +484,7 @@ def test_jobs_below_one_is_an_input_error(tmp_path, capsys):
 
 def test_pool_worker_error_keeps_its_type_and_trace():
     """A stage that raises in a worker process raises here, same type, with its trace."""
-    from ptoverify.report import _run_in_pool
+    from ptoverify.report.collect import _run_in_pool
 
     with pytest.raises(KeyError) as info:
         _run_in_pool(["no such stage"], paper_config(), None, 1, lambda *a: None)
@@ -500,7 +500,7 @@ def test_pool_from_an_unguarded_script(tmp_path):
     script = tmp_path / "plain.py"
     script.write_text(
         "from ptoverify.config import paper_config\n"
-        "from ptoverify.report import _run_in_pool\n"
+        "from ptoverify.report.collect import _run_in_pool\n"
         "print('script ran')\n"
         "try:\n"
         "    _run_in_pool(['no such stage'], paper_config(), None, 1, lambda *a: None)\n"

@@ -7,11 +7,12 @@ import numpy as np
 import pytest
 
 from ptoverify.config import Robustness, paper_config
-from ptoverify.laws import Law, make_law
-from ptoverify.plant import flow
-from ptoverify.poles import sampled_spectral_radius
-from ptoverify.properties import default_steps, initial_grid, law_properties, oscillating
-from ptoverify.robust import (
+from ptoverify.model.laws import Law, make_law
+from ptoverify.model.plant import flow
+from ptoverify.model.poles import sampled_spectral_radius
+from ptoverify.sim.simulate import Mismatch, simulate_batch
+from ptoverify.studies.properties import default_steps, initial_grid, law_properties, oscillating
+from ptoverify.studies.robust import (
     RobustSettings,
     choices_without_replacement,
     grid_worst,
@@ -25,7 +26,6 @@ from ptoverify.robust import (
     trajectory_properties,
     worst_case,
 )
-from ptoverify.simulate import Mismatch, simulate_batch
 
 CFG = paper_config()
 TINY = RobustSettings(n1=5, n2=5, rest=4, n_a=3, n_w=2, search_iterations=2, search_population=6)
@@ -273,7 +273,7 @@ def test_no_limit_cycle_margin_against_a_brute_force_scan():
 
 def test_maps_do_not_depend_on_batching(monkeypatch):
     """Cells simulated together or in batches of one cell give the same maps, bit for bit."""
-    import ptoverify.robust as robust_mod
+    import ptoverify.studies.robust as robust_mod
 
     s = dataclasses.replace(TINY, laws=("pto",))
     together = robust_maps(CFG, s)
@@ -333,7 +333,7 @@ def test_choices_fall_back_to_numpy_where_its_algorithm_differs(monkeypatch):
     """The batch is checked against this NumPy's Generator.choice once per process; a
     batch that draws differently (as a NumPy release changing its algorithm would) is
     never used: every draw is then NumPy's own call."""
-    import ptoverify.robust as robust_mod
+    import ptoverify.studies.robust as robust_mod
 
     real = robust_mod._floyd_batch
 
@@ -364,7 +364,7 @@ def test_mirrored_maps_equal_simulating_every_state(monkeypatch, n1, box):
     """Without noise the maps simulate one state of each mirrored pair: the maps equal
     those with every state simulated, bit for bit, for every law (odd and even grids,
     a coarse quantizer, delays, a wide box)."""
-    import ptoverify.robust as robust_mod
+    import ptoverify.studies.robust as robust_mod
 
     cfg = dataclasses.replace(CFG, robustness=dataclasses.replace(CFG.robustness, **box))
     s = dataclasses.replace(TINY, n1=n1, n2=7, rest=10)
@@ -378,7 +378,7 @@ def test_mirrored_maps_equal_simulating_every_state(monkeypatch, n1, box):
 def test_noise_keeps_every_state_simulated(monkeypatch):
     """Velocity noise is not odd (the same noise sequence for a state and its mirror):
     the maps then do not pair states."""
-    import ptoverify.robust as robust_mod
+    import ptoverify.studies.robust as robust_mod
 
     asked = []
     monkeypatch.setattr(robust_mod, "mirror_pairs", lambda x1, x2: asked.append(1))
@@ -425,7 +425,7 @@ def test_a_law_not_known_odd_has_every_state_simulated(monkeypatch):
     """robust_maps and no_limit_cycle_margin take law factories; a law not known to be
     odd (Law.odd False) is simulated from every state, not mirrored: the results equal
     those with the pairing switched off."""
-    import ptoverify.robust as robust_mod
+    import ptoverify.studies.robust as robust_mod
 
     assert not _offset_pd(CFG).odd
     assert all(make_law(name, CFG).odd for name in ("to", "pd", "pto", "pto-printed"))

@@ -14,9 +14,9 @@ import socket
 
 import pytest
 
-import ptoverify.robust as robust_mod
+import ptoverify.studies.robust as robust_mod
 from ptoverify.cli import main
-from ptoverify.robust import LAWS, PROPERTIES
+from ptoverify.studies.robust import LAWS, PROPERTIES
 
 SMALL = """\
 name = "small"

@@ -7,10 +7,10 @@ from numpy.testing import assert_allclose
 
 from ptoverify.cli import main
 from ptoverify.errors import InputError
-from ptoverify.laws import make_law
-from ptoverify.plant import step as plant_step
-from ptoverify.plant import zoh_matrices
-from ptoverify.simulate import (
+from ptoverify.model.laws import make_law
+from ptoverify.model.plant import step as plant_step
+from ptoverify.model.plant import zoh_matrices
+from ptoverify.sim.simulate import (
     SIGNALS,
     TRACKING,
     Reference,

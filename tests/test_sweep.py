@@ -11,12 +11,18 @@ from numpy.testing import assert_allclose
 
 from ptoverify.cli import main
 from ptoverify.config import paper_config
-from ptoverify.exact import settling_times_batch
-from ptoverify.laws import Region, make_law
-from ptoverify.mintime import discrete_min_steps, min_time
-from ptoverify.ocp import TwoPhaseOCP
-from ptoverify.simulate import simulate_batch
-from ptoverify.sweep import SweepSettings, grid_states, run_sweep, settle_steps, settling_times
+from ptoverify.model.laws import Region, make_law
+from ptoverify.model.mintime import discrete_min_steps, min_time
+from ptoverify.model.ocp import TwoPhaseOCP
+from ptoverify.sim.exact import settling_times_batch
+from ptoverify.sim.simulate import simulate_batch
+from ptoverify.studies.sweep import (
+    SweepSettings,
+    grid_states,
+    run_sweep,
+    settle_steps,
+    settling_times,
+)
 
 SMALL = SweepSettings(n1=6, n2=5)
 
@@ -324,7 +330,7 @@ def test_mirrored_half_equals_simulating_every_state():
 
 
 def test_mirror_pairs_spread_values_to_mirrors_and_refuse_unpaired_states():
-    from ptoverify.sweep import mirror_pairs
+    from ptoverify.studies.sweep import mirror_pairs
 
     rng = np.random.default_rng(2)
     a1, a2 = rng.normal(size=7), rng.normal(size=7)

@@ -11,16 +11,16 @@ from scipy.linalg import expm
 from scipy.signal import cont2discrete
 
 from ptoverify import cli
-from ptoverify.claims import fair_comparison
 from ptoverify.config import config_from_mapping, load_config, paper_config
 from ptoverify.errors import InputError
-from ptoverify.exact import exact_metrics
-from ptoverify.laws import make_law
-from ptoverify.mintime import discrete_min_steps, min_time
-from ptoverify.properties import initial_grid, law_properties
-from ptoverify.simulate import simulate
-from ptoverify.sweep import mirror_pairs
-from ptoverify.tune import (
+from ptoverify.model.laws import make_law
+from ptoverify.model.mintime import discrete_min_steps, min_time
+from ptoverify.sim.exact import exact_metrics
+from ptoverify.sim.simulate import simulate
+from ptoverify.studies.claims import fair_comparison
+from ptoverify.studies.properties import initial_grid, law_properties
+from ptoverify.studies.sweep import mirror_pairs
+from ptoverify.studies.tune import (
     BOUNDS,
     TuneBudget,
     fair_tunings,
@@ -276,7 +276,7 @@ def test_fair_comparison_bounds_constraints_and_floor():
 def test_spectral_radii_are_the_sampled_loop_radius():
     """The batched radii (poles.spectral_radii, which the tuning screens with) equal the
     eigenvalues of SciPy's ZOH loop for every gain pair, and the one-pair function."""
-    from ptoverify.poles import sampled_spectral_radius, spectral_radii
+    from ptoverify.model.poles import sampled_spectral_radius, spectral_radii
 
     rng = np.random.default_rng(8)
     k1, k2 = 10 ** rng.uniform(0, 3.6, 300), rng.uniform(-1, 10, 300)
@@ -288,9 +288,9 @@ def test_spectral_radii_are_the_sampled_loop_radius():
 
 
 def test_grid_counts_are_the_gate_properties(monkeypatch):
-    from ptoverify import tune as tune_mod
     from ptoverify.config import Config, PDGains, Plant, PTOSettings
-    from ptoverify.laws import pto_law
+    from ptoverify.model.laws import pto_law
+    from ptoverify.studies import tune as tune_mod
 
     for cfg, law in ((CFG, "pto"), (CFG, "pd"), (CFG, "to")):
         lp = law_properties(make_law(law, cfg), cfg)
@@ -318,14 +318,14 @@ def test_grid_counts_are_the_gate_properties(monkeypatch):
 def test_limit_cycle_band_is_the_gate_default():
     import inspect
 
-    from ptoverify.tune import LIMIT_CYCLE_BAND
+    from ptoverify.studies.tune import LIMIT_CYCLE_BAND
 
     assert inspect.signature(law_properties).parameters["band"].default == LIMIT_CYCLE_BAND
 
 
 @pytest.mark.parametrize("law, d", [("pd", None), ("pto", 0.3), ("pto", 1.0), ("pto", 2.3)])
 def test_screen_agrees_with_the_simulate_json_path(law, d):
-    from ptoverify import tune as tune_mod
+    from ptoverify.studies import tune as tune_mod
 
     rng = np.random.default_rng(9)
     if law == "pd":
@@ -356,7 +356,7 @@ def test_screen_agrees_with_the_simulate_json_path(law, d):
 
 
 def test_side_by_side_searches_are_the_searches_one_by_one(monkeypatch):
-    from ptoverify import tune as tune_mod
+    from ptoverify.studies import tune as tune_mod
 
     kw = {
         "max_overshoot": 0.05,
@@ -399,7 +399,7 @@ def test_fair_tunings_are_the_tunings_one_by_one():
 
 
 def test_reported_numbers_are_those_of_simulate_json():
-    from ptoverify.tune import evaluate, response_metrics, tuned_config
+    from ptoverify.studies.tune import evaluate, response_metrics, tuned_config
 
     r = tune(CFG, "pd", "step", max_overshoot=0.02, maxiter=3, popsize=5)
     for c in [r.best, r.runner_up, *r.front]:
@@ -420,7 +420,7 @@ def test_tune_is_deterministic():
 
 
 def test_batched_worst_ratios_are_worst_ratio_nt():
-    from ptoverify.tune import _worst_ratios, tuned_config
+    from ptoverify.studies.tune import _worst_ratios, tuned_config
 
     rng = np.random.default_rng(12)
     for law in ("pd", "pto"):
@@ -441,7 +441,7 @@ def test_batched_worst_ratios_are_worst_ratio_nt():
 
 
 def test_lockstep_merges_batches_and_stops_on_errors():
-    from ptoverify import tune as tune_mod
+    from ptoverify.studies import tune as tune_mod
 
     calls = []
 

@@ -15,9 +15,9 @@ from numpy.testing import assert_allclose
 from derivations.printed import SYMBOLS, printed
 from ptoverify.cli import main
 from ptoverify.config import paper_config
-from ptoverify.curves import level_curve_x1, level_residual
-from ptoverify.plant import flow
-from ptoverify.zones import (
+from ptoverify.model.curves import level_curve_x1, level_residual
+from ptoverify.model.plant import flow
+from ptoverify.model.zones import (
     PTOZone,
     corrected_zone,
     principle_margin,

@@ -90,7 +90,7 @@ def _function(single: bool):
 @functools.lru_cache(maxsize=8)
 def params(cfg) -> Params:
     """Return the C parameter block for a Config (omega0: the corrected zone's level)."""
-    from ptoverify.zones import corrected_zone
+    from ptoverify.model.zones import corrected_zone
 
     omega0 = corrected_zone(cfg, verify=False).omega0
     p = cfg.plant

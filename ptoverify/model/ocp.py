@@ -1,7 +1,7 @@
 """Minimum-time optimal control problems solved with CasADi and IPOPT.
 
 Two independent numerical references for the closed form of
-:mod:`ptoverify.mintime` (DESIGN.md, reference 2):
+:mod:`ptoverify.model.mintime` (DESIGN.md, reference 2):
 
 * :class:`TwoPhaseOCP` -- the input is fixed at -s w_max, then +s w_max; the
   phase durations t1, t2 >= 0 are the only variables and the state is exact
@@ -43,8 +43,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ptoverify.config import Plant
-from ptoverify.curves import switching_function
 from ptoverify.errors import InputError
+from ptoverify.model.curves import switching_function
 
 __all__ = [
     "OCPResult",
@@ -366,7 +366,7 @@ def resimulate(t: NDArray, u: NDArray, x1: float, x2: float, a: float) -> tuple[
         The state at t[-1].
     """
     dts = np.diff(t)
-    # eq. (7) interval by interval, as :func:`ptoverify.plant.flow` computes it (the
+    # eq. (7) interval by interval, as :func:`ptoverify.model.plant.flow` computes it (the
     # same operations in the same order, on Python floats: the same roundings),
     # with 1 - e^{-a dt} for all intervals at once
     gs = (-np.expm1(-a * dts)).tolist()
@@ -633,7 +633,7 @@ def convergence_study(
     ConvergenceStudy
         Errors, orders and the input profiles.
     """
-    from ptoverify.mintime import min_time
+    from ptoverify.model.mintime import min_time
 
     states = np.atleast_2d(np.asarray(states, dtype=float))
     ns = np.asarray(intervals, dtype=int)

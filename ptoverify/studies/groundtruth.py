@@ -29,9 +29,9 @@ import numpy as np
 
 from ptoverify.config import Config, Plant
 from ptoverify.errors import InputError
-from ptoverify.mintime import DiscreteMinTime, MinTime, discrete_min_steps, min_time
-from ptoverify.ocp import CollocationOCP, OCPResult, TwoPhaseOCP, resimulate
-from ptoverify.plant import flow
+from ptoverify.model.mintime import DiscreteMinTime, MinTime, discrete_min_steps, min_time
+from ptoverify.model.ocp import CollocationOCP, OCPResult, TwoPhaseOCP, resimulate
+from ptoverify.model.plant import flow
 
 __all__ = [
     "GroundTruth",
@@ -91,7 +91,7 @@ def verify_two_phase(res: OCPResult, x1: float, x2: float, plant: Plant) -> OCPR
     Parameters
     ----------
     res : OCPResult
-        Answer of :class:`~ptoverify.ocp.TwoPhaseOCP` from (x1, x2).
+        Answer of :class:`~ptoverify.model.ocp.TwoPhaseOCP` from (x1, x2).
     x1, x2 : float
         Initial position [mm] and velocity [mm/s] it was solved from.
     plant : Plant
@@ -121,7 +121,7 @@ def verify_collocation(res: OCPResult, x1: float, x2: float, plant: Plant) -> OC
     Parameters
     ----------
     res : OCPResult
-        Answer of :class:`~ptoverify.ocp.CollocationOCP` from (x1, x2), carrying
+        Answer of :class:`~ptoverify.model.ocp.CollocationOCP` from (x1, x2), carrying
         ``resim_error`` [mm] (its input applied to eq. 7).
     x1, x2 : float
         Initial position [mm] and velocity [mm/s] it was solved from.
@@ -264,9 +264,9 @@ def verified_mintime(
     max_iter : int, optional
         Cap on IPOPT iterations (default: the solvers' own caps).
     collocation : OCPResult, optional
-        The answer of a default :class:`~ptoverify.ocp.CollocationOCP` with
+        The answer of a default :class:`~ptoverify.model.ocp.CollocationOCP` with
         ``intervals`` from this state, already solved (e.g.
-        :attr:`ptoverify.ocp.ConvergenceStudy.results`): it is checked like a fresh
+        :attr:`ptoverify.model.ocp.ConvergenceStudy.results`): it is checked like a fresh
         one instead of solving the same NLP again.  Its input must re-simulate to
         its recorded end state from (x1, x2) (else ``ValueError``: an answer from
         another state or N); not with ``max_iter``.

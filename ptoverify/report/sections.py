@@ -1,7 +1,7 @@
 """The sections of the report, built from the JSON results as neutral blocks.
 
-Each function takes the JSON results of :func:`ptoverify.report.collect` (and
-the figure paths) and returns a list of :class:`ptoverify.render.Block`.  No
+Each function takes the JSON results of :func:`ptoverify.report.collect.collect` (and
+the figure paths) and returns a list of :class:`ptoverify.report.render.Block`.  No
 number is typed in here: every figure shown is read from the results, with its
 unit (``[-]`` marks a dimensionless number) and 4 significant digits (the full
 values are in ``results.json``).  Nothing here computes: the derivation and
@@ -15,7 +15,7 @@ import math
 import re
 from typing import Any
 
-from ptoverify.render import (
+from ptoverify.report.render import (
     Block,
     code,
     findings,
@@ -71,7 +71,7 @@ def headline_findings(res: dict[str, Any]) -> list[tuple[str, str, str]]:
     Parameters
     ----------
     res : dict
-        Output of :func:`ptoverify.report.collect` (JSON part).
+        Output of :func:`ptoverify.report.collect.collect` (JSON part).
 
     Returns
     -------
@@ -218,7 +218,7 @@ def c31_paper(res: dict[str, Any]) -> float | None:
     Parameters
     ----------
     res : dict
-        Output of :func:`ptoverify.report.collect` (JSON part).
+        Output of :func:`ptoverify.report.collect.collect` (JSON part).
 
     Returns
     -------
@@ -291,7 +291,7 @@ def headline(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     Parameters
     ----------
     res : dict
-        Output of :func:`ptoverify.report.collect` (JSON part).
+        Output of :func:`ptoverify.report.collect.collect` (JSON part).
     figures : dict
         Figure key -> relative path (``figures/x.png``).
 
@@ -606,7 +606,7 @@ def errata(res: dict[str, Any], records: list, rendered: dict | None = None) -> 
     Parameters
     ----------
     res : dict
-        Output of :func:`ptoverify.report.collect` (JSON part).
+        Output of :func:`ptoverify.report.collect.collect` (JSON part).
     records : list of derivations.EquationRecord
         The records the collect step derived (MathML of each form).
     rendered : dict, optional
@@ -1124,7 +1124,7 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     Parameters
     ----------
     res : dict
-        Output of :func:`ptoverify.report.collect` (JSON part).
+        Output of :func:`ptoverify.report.collect.collect` (JSON part).
     figures : dict
         Figure key -> relative path (``figures/x.png``).
 
@@ -1281,8 +1281,8 @@ def tuning(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     Parameters
     ----------
     res : dict
-        Output of :func:`ptoverify.report.collect` (JSON part); ``tuning`` is
-        :func:`ptoverify.claims.fair_comparison`.
+        Output of :func:`ptoverify.report.collect.collect` (JSON part); ``tuning`` is
+        :func:`ptoverify.studies.claims.fair_comparison`.
     figures : dict
         Figure key -> relative path (``figures/x.png``).
 

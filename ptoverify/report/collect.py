@@ -5,7 +5,7 @@ independent stages (:data:`STAGES`): the SymPy derivations with the derivation
 gate, the closed loop (zones, properties, Section 6 claims, the numeric
 gates), the robustness study, the tuning comparison, the suboptimality sweep,
 the ground truth (with the environment), the paper's figures and the poles.  Each stage
-draws its own figures (:mod:`ptoverify.plots`, which only draws) from its own
+draws its own figures (:mod:`ptoverify.report.plots`, which only draws) from its own
 results, so nothing large travels between processes.  The stages share only
 the configuration, so they run in a pool of spawned Python processes
 (``jobs``, default one per available CPU), longest first; with ``jobs=1`` they
@@ -14,11 +14,11 @@ way.  Work shared inside a stage (the corrected zone and its grid check, the
 corrected PTO's closed-loop properties, the claims) is memoized per frozen
 configuration in the numeric modules, and the properties section hands its
 PTO properties to the gates, so each runs once.  The sections
-(:mod:`ptoverify.report_sections`) render the JSON results; the neutral blocks
-are printed by :mod:`ptoverify.render`.
+(:mod:`ptoverify.report.sections`) render the JSON results; the neutral blocks
+are printed by :mod:`ptoverify.report.render`.
 
 Two stages are optional: the robustness study
-(:func:`ptoverify.robust.run_robust` at :data:`ROBUST_SETTINGS`, the command's
+(:func:`ptoverify.studies.robust.run_robust` at :data:`ROBUST_SETTINGS`, the command's
 defaults) and the tuning comparison (:func:`tuning_results`: PD and PTO tuned
 on the step under shared overshoot bounds, at the reduced search effort
 :data:`TUNE_SETTINGS`).  ``skip`` (the command's ``--skip robust,tuning``)
@@ -52,7 +52,7 @@ from typing import Any
 import numpy as np
 
 from ptoverify.config import Config
-from ptoverify.render import Section, render_html, render_markdown
+from ptoverify.report.render import Section, render_html, render_markdown
 
 __all__ = [
     "collect",
@@ -72,11 +72,11 @@ __all__ = [
 SKIPPABLE = ("robust", "tuning")
 
 #: Sizes of the report's robustness study: overrides of
-#: :class:`ptoverify.robust.RobustSettings`.  Empty: the report runs the same study as
+#: :class:`ptoverify.studies.robust.RobustSettings`.  Empty: the report runs the same study as
 #: ``ptoverify robust`` on its defaults (all four laws; a few seconds, `robust_study_s`).
 ROBUST_SETTINGS: dict[str, Any] = {}
 
-#: Search effort of the report's tunings (:class:`ptoverify.tune.TuneBudget`, fixed seed),
+#: Search effort of the report's tunings (:class:`ptoverify.studies.tune.TuneBudget`, fixed seed),
 #: reduced from ``ptoverify tune``'s defaults (30 generations, population factor 10, 9 d
 #: points, 4 refinements): the four tunings take a few seconds (benchmarks/README.md).
 TUNE_SETTINGS = {"maxiter": 15, "popsize": 8, "d_grid": 5, "d_refine": 2, "seed": 0}
@@ -116,8 +116,8 @@ def _clean(obj: Any) -> Any:
 
 # ------------------------------------------------------------------ collection
 def _ground_truth(cfg: Config) -> dict[str, Any]:
-    from ptoverify.groundtruth import verified_mintime
-    from ptoverify.ocp import convergence_study
+    from ptoverify.model.ocp import convergence_study
+    from ptoverify.studies.groundtruth import verified_mintime
 
     p = cfg.plant
     scale = (p.position_range / 50.0, p.w_max / 300.0)
@@ -161,7 +161,7 @@ def _ground_truth(cfg: Config) -> dict[str, Any]:
 
 
 def _poles(cfg: Config) -> dict[str, Any]:
-    from ptoverify.poles import all_loop_poles, lyapunov_counterexample
+    from ptoverify.model.poles import all_loop_poles, lyapunov_counterexample
 
     return {
         "loops": {k: v.to_json() for k, v in all_loop_poles(cfg).items()},
@@ -170,7 +170,7 @@ def _poles(cfg: Config) -> dict[str, Any]:
 
 
 def _properties(cfg: Config) -> dict[str, Any]:
-    from ptoverify.properties import all_properties
+    from ptoverify.studies.properties import all_properties
 
     return {k: v.to_json() for k, v in all_properties(cfg).items()}
 
@@ -256,19 +256,19 @@ def figure_inputs(cfg: Config) -> Any:
 
     Returns
     -------
-    ptoverify.plots.FigureInputs
+    ptoverify.report.plots.FigureInputs
         Open-loop arcs under +-w_max (Fig. 2), sampled TO trajectories (Fig. 3),
         the zones the PTO laws use (Figs. 4-6), the one-sample image of l1
         (Fig. 5), a fourth-quadrant trajectory per PTO variant (Fig. 6), every
         law's response to step, ramp and sine with and without feed-forward
         (Figs. 7-14), and sampled PTO trajectories for the zone geometry.
     """
-    from ptoverify.curves import level_curve_x1
-    from ptoverify.laws import LAW_NAMES, make_law
-    from ptoverify.plant import flow
-    from ptoverify.plots import FigureInputs, zone_geometry_xlim
-    from ptoverify.simulate import simulate, simulate_batch
-    from ptoverify.zones import zone_for_law
+    from ptoverify.model.curves import level_curve_x1
+    from ptoverify.model.laws import LAW_NAMES, make_law
+    from ptoverify.model.plant import flow
+    from ptoverify.model.zones import zone_for_law
+    from ptoverify.report.plots import FigureInputs, zone_geometry_xlim
+    from ptoverify.sim.simulate import simulate, simulate_batch
 
     p, d = cfg.plant, cfg.pto.d
     a, w, R = p.a, p.w_max, p.position_range
@@ -329,8 +329,8 @@ def _stage_derivations(cfg: Config, figdir: Path | None) -> dict[str, Any]:
     # stage: the few cycles made (~25k objects, a few MB) are collected after it
     with _collector_paused():
         import derivations
-        from ptoverify.checks import run_checks
-        from ptoverify.report_sections import render_records
+        from ptoverify.report.sections import render_records
+        from ptoverify.studies.checks import run_checks
 
         p = cfg.plant
         plant = derivations.PlantNumbers(
@@ -366,10 +366,10 @@ def _stage_ground_truth(cfg: Config, figdir: Path | None) -> dict[str, Any]:
 
 def _stage_core(cfg: Config, figdir: Path | None) -> dict[str, Any]:
     """Zones, poles, properties, claims and the numeric gates (they share memoized work)."""
-    from ptoverify.checks import GATES, GateContext, run_checks
-    from ptoverify.claims import evaluate_claims, response_metrics
-    from ptoverify.properties import all_properties
-    from ptoverify.zones import zone_summary
+    from ptoverify.model.zones import zone_summary
+    from ptoverify.studies.checks import GATES, GateContext, run_checks
+    from ptoverify.studies.claims import evaluate_claims, response_metrics
+    from ptoverify.studies.properties import all_properties
 
     props = all_properties(cfg)
     ctx = GateContext(cfg, given_pto_properties=props["pto"])
@@ -385,7 +385,7 @@ def _stage_core(cfg: Config, figdir: Path | None) -> dict[str, Any]:
 
 def _stage_sweep(cfg: Config, figdir: Path | None) -> dict[str, Any]:
     """Run the suboptimality sweep and draw its maps."""
-    from ptoverify.sweep import run_sweep
+    from ptoverify.studies.sweep import run_sweep
 
     sweep = run_sweep(cfg)
     return {
@@ -431,13 +431,13 @@ def _stage_figures(cfg: Config, figdir: Path | None) -> dict[str, Any]:
 
 def _stage_poles(cfg: Config, figdir: Path | None) -> dict[str, Any]:
     """Analyse the loops' poles (python-control), with the two gates that read them."""
-    from ptoverify.checks import run_checks
+    from ptoverify.studies.checks import run_checks
 
     return {"poles": _poles(cfg), "_checks": run_checks(cfg, list(POLE_GATES))}
 
 
 def _plots():
-    from ptoverify import plots
+    from ptoverify.report import plots
 
     return plots
 
@@ -529,8 +529,8 @@ def collect(
     InputError
         An unknown ``skip`` stage or ``jobs`` < 1.
     """
-    from ptoverify.checks import GATES, summarize
     from ptoverify.errors import InputError
+    from ptoverify.studies.checks import GATES, summarize
 
     bad = sorted(set(skip) - set(SKIPPABLE))
     if bad:
@@ -577,7 +577,7 @@ _WORKER = r"""
 import gc, os, pickle, sys, traceback
 answer = os.fdopen(os.dup(1), "wb")
 os.dup2(2, 1)
-from ptoverify.report import _run_stage
+from ptoverify.report.collect import _run_stage
 while True:
     try:
         task = pickle.load(sys.stdin.buffer)
@@ -691,7 +691,7 @@ def _robust(cfg: Config) -> dict[str, Any]:
     """Run the robustness study at :data:`ROBUST_SETTINGS` (JSON, settings included)."""
     from dataclasses import asdict
 
-    from ptoverify.robust import RobustSettings, run_robust
+    from ptoverify.studies.robust import RobustSettings, run_robust
 
     settings = RobustSettings(**ROBUST_SETTINGS)
     res = run_robust(cfg, settings).to_json()
@@ -701,7 +701,7 @@ def _robust(cfg: Config) -> dict[str, Any]:
 
 
 def tuning_results(cfg: Config) -> dict[str, Any]:
-    """Both laws at their best tuning: :func:`ptoverify.claims.fair_comparison`.
+    """Both laws at their best tuning: :func:`ptoverify.studies.claims.fair_comparison`.
 
     PD and PTO tuned on the step under each shared overshoot bound (the PTO's
     and the PD's own overshoot at the paper's gains), with the floor (t_f*,
@@ -716,10 +716,10 @@ def tuning_results(cfg: Config) -> dict[str, Any]:
     Returns
     -------
     dict
-        The keys of :func:`ptoverify.claims.fair_comparison` less its wall time.
+        The keys of :func:`ptoverify.studies.claims.fair_comparison` less its wall time.
     """
-    from ptoverify.claims import fair_comparison
-    from ptoverify.tune import TuneBudget
+    from ptoverify.studies.claims import fair_comparison
+    from ptoverify.studies.tune import TuneBudget
 
     res = fair_comparison(cfg, TuneBudget(**TUNE_SETTINGS))
     res.pop("seconds", None)
@@ -779,14 +779,14 @@ def build_sections(
         The derivation records :func:`collect` made (``res["_records"]``); when
         None they are taken from ``res``.
     rendered : dict, optional
-        :func:`ptoverify.report_sections.render_records` of them
+        :func:`ptoverify.report.sections.render_records` of them
         (``res["_rendered"]``), when already computed.
 
     Returns
     -------
     list of (str, str, list of Block)
     """
-    from ptoverify import report_sections as rs
+    from ptoverify.report import sections as rs
 
     recs = records if records is not None else res["_records"]
     parts = [

@@ -14,7 +14,7 @@ input for the margins: L(z) = K (zI - Ad)^-1 Bd (``control.stability_margins``).
 The saturation is ignored here: these are the small-signal loops.
 
 Independent reference: numpy eigenvalues of Ad - Bd K with Ad, Bd from
-:func:`ptoverify.plant.zoh_matrices` (closed form, not python-control).
+:func:`ptoverify.model.plant.zoh_matrices` (closed form, not python-control).
 
 Section 5's Lyapunov argument (eqs. 38-39) gives k1 > 0, 1 + k2 > 0 for the
 continuous loop (37).  :func:`lyapunov_counterexample` shows by computation that
@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Config
-from ptoverify.plant import zoh_matrices
+from ptoverify.model.plant import zoh_matrices
 
 __all__ = [
     "LoopPoles",

@@ -1,6 +1,6 @@
 """Closed-loop properties of the laws over a grid of initial states, by simulation.
 
-Every law is run with :func:`ptoverify.simulate.simulate_batch` (exact ZOH
+Every law is run with :func:`ptoverify.sim.simulate.simulate_batch` (exact ZOH
 flow) from an ``n1`` x ``n2`` grid over the envelope |x1| <= position_range,
 |x2| <= w_max (default 101 x 101 = 10,201 states) plus ``rest`` states at rest,
 x2 = 0, d <= |x1| <= position_range (the step responses).
@@ -42,9 +42,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ptoverify.config import Config
-from ptoverify.curves import level_side, switching_function
-from ptoverify.laws import Law, Region, make_law
-from ptoverify.simulate import BatchResult, simulate_batch
+from ptoverify.model.curves import level_side, switching_function
+from ptoverify.model.laws import Law, Region, make_law
+from ptoverify.sim.simulate import BatchResult, simulate_batch
 from ptoverify.verdict import tie_band
 
 __all__ = [
@@ -342,8 +342,8 @@ def stride_over_counts(
     Examples
     --------
     >>> from ptoverify.config import paper_config
-    >>> from ptoverify.laws import make_law
-    >>> from ptoverify.simulate import simulate_batch
+    >>> from ptoverify.model.laws import make_law
+    >>> from ptoverify.sim.simulate import simulate_batch
     >>> cfg = paper_config()
     >>> b = simulate_batch(make_law("to", cfg), cfg.plant, [40.0, 5.0], [0.0, 0.0], 100)
     >>> counts = stride_over_counts(b.x1, b.x2, b.region, cfg)
@@ -378,7 +378,7 @@ def stride_over_counts(
             continue
         x2 = np.ascontiguousarray(X2[:, j0:j1])
         v0 = x2.take(f)
-        # sigma's sides and comparisons with +-tol (ptoverify.curves.level_side)
+        # sigma's sides and comparisons with +-tol (ptoverify.model.curves.level_side)
         s0 = level_side(a * x1.take(f), v0, w, tol)
         f1 = f + (j1 - j0)  # the next sample
         s1 = level_side(a * x1.take(f1), x2.take(f1), w, tol)
@@ -566,7 +566,7 @@ def named_properties(cfg: Config, law: str) -> LawProperties:
     cfg : Config
         Configuration.
     law : str
-        Law name (:func:`ptoverify.laws.make_law`).
+        Law name (:func:`ptoverify.model.laws.make_law`).
 
     Returns
     -------

@@ -6,8 +6,8 @@ by the caller (``SimResult``, ``BatchResult``, ``PTOZone``, ``SweepResult``,
 None), and returns what it drew: a dict from legend label to artist.  As
 python-control's ``time_response_plot`` takes a ``TimeResponseData``, nothing
 here simulates, builds a law or constructs a zone; the curves l1, l2, l1*, l2*
-come from the pure functions of :mod:`ptoverify.curves`.  The report's collect
-step (:func:`ptoverify.report.collect`) computes the inputs once.  Nothing is
+come from the pure functions of :mod:`ptoverify.model.curves`.  The report's collect
+step (:func:`ptoverify.report.collect.collect`) computes the inputs once.  Nothing is
 shown; the backend is Agg unless the caller chose another one first.
 
 Speed (the report's thirty figures): the ``save_*`` functions draw each figure
@@ -62,15 +62,15 @@ from matplotlib.transforms import Bbox  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
 from ptoverify.config import Config, Plant  # noqa: E402
-from ptoverify.curves import h, level_curve_x1  # noqa: E402
-from ptoverify.laws import Region  # noqa: E402
-from ptoverify.metrics import TIGHT_BAND  # noqa: E402
+from ptoverify.model.curves import h, level_curve_x1  # noqa: E402
+from ptoverify.model.laws import Region  # noqa: E402
+from ptoverify.sim.metrics import TIGHT_BAND  # noqa: E402
 
 if TYPE_CHECKING:  # data types for annotations only: no simulator, no zone construction
-    from ptoverify.ocp import ConvergenceStudy
-    from ptoverify.simulate import BatchResult, SimResult
-    from ptoverify.sweep import SweepResult
-    from ptoverify.zones import PTOZone
+    from ptoverify.model.ocp import ConvergenceStudy
+    from ptoverify.model.zones import PTOZone
+    from ptoverify.sim.simulate import BatchResult, SimResult
+    from ptoverify.studies.sweep import SweepResult
 
 __all__ = [
     "FigureInputs",
@@ -509,7 +509,7 @@ def plot_sweep(
     Parameters
     ----------
     res : SweepResult
-        Output of :func:`ptoverify.sweep.run_sweep`.
+        Output of :func:`ptoverify.studies.sweep.run_sweep`.
     law : str
         Law name.
     which : {"tf", "nt"}
@@ -730,7 +730,7 @@ def plot_convergence(study: ConvergenceStudy, ax=None):
     Parameters
     ----------
     study : ConvergenceStudy
-        Output of :func:`ptoverify.ocp.convergence_study`.
+        Output of :func:`ptoverify.model.ocp.convergence_study`.
     ax : matplotlib Axes, optional
         Axes to draw on (a new figure when None).
 
@@ -760,7 +760,7 @@ def plot_switch_profiles(study: ConvergenceStudy, state: int = 0, ax=None, windo
     Parameters
     ----------
     study : ConvergenceStudy
-        Output of :func:`ptoverify.ocp.convergence_study`.
+        Output of :func:`ptoverify.model.ocp.convergence_study`.
     state : int
         Row of ``study.states`` to draw.
     ax : matplotlib Axes, optional
@@ -1330,7 +1330,7 @@ def save_sweep(res: SweepResult, outdir: str | Path) -> list[Path]:
     Parameters
     ----------
     res : SweepResult
-        Output of :func:`ptoverify.sweep.run_sweep`.
+        Output of :func:`ptoverify.studies.sweep.run_sweep`.
     outdir : str or Path
         Folder (created if missing).
 
@@ -1389,7 +1389,7 @@ def plot_robust_map(
     Parameters
     ----------
     maps : mapping
-        The ``maps`` of :meth:`ptoverify.robust.RobustResult.to_json`: axes
+        The ``maps`` of :meth:`ptoverify.studies.robust.RobustResult.to_json`: axes
         ``a_ratio``, ``w_max_ratio``, ``delay_samples`` and per law the cells
         (order delay, w_max_ratio, a_ratio).
     law : str
@@ -1439,7 +1439,7 @@ def save_robust(maps: Mapping, outdir: str | Path) -> list[Path]:
     Parameters
     ----------
     maps : mapping
-        The ``maps`` of :meth:`ptoverify.robust.RobustResult.to_json`.
+        The ``maps`` of :meth:`ptoverify.studies.robust.RobustResult.to_json`.
     outdir : str or Path
         Folder (created if missing).
 
@@ -1485,7 +1485,7 @@ def plot_pareto(tuning: Mapping, ax=None) -> dict:
     Parameters
     ----------
     tuning : mapping
-        :func:`ptoverify.claims.fair_comparison`: ``fronts`` (law -> candidates
+        :func:`ptoverify.studies.claims.fair_comparison`: ``fronts`` (law -> candidates
         with ``overshoot_mm`` [mm] and ``settling_2pct_s`` [s]), ``best`` (bound
         -> law -> candidate), ``paper`` (law -> metrics at the paper's gains),
         ``bounds_mm`` (bound -> [mm]) and ``floor`` (``tf_s``, ``nt_s``,
@@ -1546,7 +1546,7 @@ def save_tuning(tuning: Mapping, outdir: str | Path) -> list[Path]:
     Parameters
     ----------
     tuning : mapping
-        :func:`ptoverify.claims.fair_comparison` (as :func:`plot_pareto`).
+        :func:`ptoverify.studies.claims.fair_comparison` (as :func:`plot_pareto`).
     outdir : str or Path
         Folder (created if missing).
 
@@ -1633,7 +1633,7 @@ def save_ground_truth(study: ConvergenceStudy, outdir: str | Path) -> list[Path]
     Parameters
     ----------
     study : ConvergenceStudy
-        Output of :func:`ptoverify.ocp.convergence_study`.
+        Output of :func:`ptoverify.model.ocp.convergence_study`.
     outdir : str or Path
         Folder (created if missing).
 
@@ -1669,10 +1669,10 @@ def plot_du_map(
     Parameters
     ----------
     du_map : DuMap
-        Output of :func:`ptoverify.conform_evidence.du_map` (cell edges [mm],
+        Output of :func:`ptoverify.conform.evidence.du_map` (cell edges [mm],
         [mm/s], largest |du| per cell [mm/s], NaN where no state was judged).
     bounds : Boundaries
-        Output of :func:`ptoverify.conform_evidence.boundaries`: the curves l1,
+        Output of :func:`ptoverify.conform.evidence.boundaries`: the curves l1,
         l2, l1*, l2* (x1 [mm], x2 [mm/s]) and d [mm].
     ax : matplotlib Axes, optional
         Where to draw.
@@ -1785,7 +1785,7 @@ def save_conform_figures(
     Parameters
     ----------
     evidence : ConformEvidence
-        Output of :func:`ptoverify.conform_evidence.conform_with_evidence`.
+        Output of :func:`ptoverify.conform.evidence.conform_with_evidence`.
     outdir : str or Path
         Folder (created if missing).
     marks : mapping of str to (float, float), optional

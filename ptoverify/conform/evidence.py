@@ -1,10 +1,10 @@
 """The evidence behind a ``conform`` verdict, for ``conform --report`` (numeric layer).
 
 :func:`conform_with_evidence` runs the conformance exactly as ``conform`` does
-(:func:`ptoverify.conform.conform_spec` for a ``--law``, isolated in its child
-process; :func:`ptoverify.conform.conform_table` for a ``--table``) and keeps
+(:func:`ptoverify.conform.gate.conform_spec` for a ``--law``, isolated in its child
+process; :func:`ptoverify.conform.gate.conform_table` for a ``--table``) and keeps
 what a reviewer needs to see why the law conforms or not.  Nothing here draws
-or writes (:mod:`ptoverify.conform_report` does).
+or writes (:mod:`ptoverify.report.conform_report` does).
 
 Decisions:
 
@@ -20,15 +20,15 @@ Map of |u - u_ref|
     outside it (counted), is the agreement's max |du|.
 Region boundaries
     l1, l2 (level w_max, eqs. 9, 11) and l1*, l2* (level omega0 of the
-    corrected zone, eqs. 13, 14) from :func:`ptoverify.curves.level_curve_x1`,
-    omega0 from :mod:`ptoverify.zones` (via :func:`ptoverify.agreement.omega0_ref`,
+    corrected zone, eqs. 13, 14) from :func:`ptoverify.model.curves.level_curve_x1`,
+    omega0 from :mod:`ptoverify.model.zones` (via :func:`ptoverify.conform.agreement.omega0_ref`,
     the level the reference law uses); the linear zone |x1| < d.
 Responses
-    The Section 6 step, ramp and sine (:data:`ptoverify.simulate.SIGNALS`,
+    The Section 6 step, ramp and sine (:data:`ptoverify.sim.simulate.SIGNALS`,
     feed-forward tracking) of the user law, simulated with
-    :func:`ptoverify.simulate.simulate` calling the law through the same child
+    :func:`ptoverify.sim.simulate.simulate` calling the law through the same child
     process as the conformance, next to the reference law's; metrics exact
-    between samples (:func:`ptoverify.exact.exact_metrics`).  A table has no
+    between samples (:func:`ptoverify.sim.exact.exact_metrics`).  A table has no
     responses (u is known only at its states).
 Settling against N* T
     Over the settling sweep of the ``settling-vs-discrete-limit`` property
@@ -45,12 +45,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ptoverify.agreement import omega0_ref, reference, ties
 from ptoverify.config import Config
-from ptoverify.conform import ConformResult, as_law, conform_spec, conform_table
-from ptoverify.curves import level_curve_x1
-from ptoverify.exact import exact_metrics
-from ptoverify.simulate import SIGNALS, SimResult, simulate
+from ptoverify.conform.agreement import omega0_ref, reference, ties
+from ptoverify.conform.gate import ConformResult, as_law, conform_spec, conform_table
+from ptoverify.model.curves import level_curve_x1
+from ptoverify.sim.exact import exact_metrics
+from ptoverify.sim.simulate import SIGNALS, SimResult, simulate
 
 __all__ = [
     "DuMap",
@@ -339,7 +339,7 @@ def settling_summary(settling: dict) -> dict:
     Parameters
     ----------
     settling : dict
-        :func:`ptoverify.conform.settling_states`.
+        :func:`ptoverify.conform.gate.settling_states`.
 
     Returns
     -------

@@ -7,14 +7,14 @@ saturation over the law's w_max, a computation delay of whole samples, an
 encoder quantum on x1 and Gaussian noise on the measured x2.
 
 Per trajectory (regulation to the origin from x0, by
-:func:`ptoverify.simulate.simulate_batch` with a :class:`Mismatch`):
+:func:`ptoverify.sim.simulate.simulate_batch` with a :class:`Mismatch`):
 
 stride_overs
     Stride-overs of the law's own switching curves (the design a and w_max:
-    the curves the law decides with), :func:`ptoverify.properties.crossing_masks`.
+    the curves the law decides with), :func:`ptoverify.studies.properties.crossing_masks`.
 limit_cycle_mm
     Peak |x1| over the last quarter of the horizon when the trajectory
-    oscillates there (:func:`ptoverify.properties.oscillating`), else 0 [mm].
+    oscillates there (:func:`ptoverify.studies.properties.oscillating`), else 0 [mm].
 overshoot_mm
     From rest (x2 = 0, |x1| >= d): the largest excursion beyond the origin
     on the side opposite to x1_0, at the samples [mm].
@@ -36,15 +36,15 @@ so the searched value is never below the grid's worst.
 How the study runs.  Its simulations are sequential workloads (a generation
 needs the previous one, a margin bracket the previous bracket), each small; a
 small batch costs what a large one does per sample.  So :func:`run_robust`
-runs them as :mod:`ptoverify.lockstep` jobs: every law's maps, then the
+runs them as :mod:`ptoverify.sim.lockstep` jobs: every law's maps, then the
 searches of all laws, one simulation per round, and the no-limit-cycle margin
 scans riding along in those rounds (each law is then evaluated 18 times 385
 samples in all: its maps and 17 search generations).  Every trajectory is bit
 for bit the one it has simulated alone, so the results do not depend on the
 grouping (tested); ``timings_s`` books each round's time to the stages of its
 states.  N* of the true plants comes from
-:func:`ptoverify.reach.zonotope_steps_each` (a plant per state, one vectorized
-search), the stride-overs from :func:`ptoverify.properties.stride_over_counts`.
+:func:`ptoverify.model.reach.zonotope_steps_each` (a plant per state, one vectorized
+search), the stride-overs from :func:`ptoverify.studies.properties.stride_over_counts`.
 """
 
 from __future__ import annotations
@@ -62,14 +62,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Config, Plant
 from ptoverify.errors import ClusterError, InputError
-from ptoverify.laws import Law, make_law
-from ptoverify.lockstep import Ask, Job, run_lockstep
-from ptoverify.mintime import min_time
-from ptoverify.plant import zoh_matrices
-from ptoverify.properties import oscillating, stride_over_counts
-from ptoverify.reach import zonotope_steps_each
-from ptoverify.simulate import BatchResult, Mismatch, simulate_batch
-from ptoverify.sweep import even_points, mirror_pairs, settle_steps
+from ptoverify.model.laws import Law, make_law
+from ptoverify.model.mintime import min_time
+from ptoverify.model.plant import zoh_matrices
+from ptoverify.model.reach import zonotope_steps_each
+from ptoverify.sim.lockstep import Ask, Job, run_lockstep
+from ptoverify.sim.simulate import BatchResult, Mismatch, simulate_batch
+from ptoverify.studies.properties import oscillating, stride_over_counts
+from ptoverify.studies.sweep import even_points, mirror_pairs, settle_steps
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED, Verdict
 
 __all__ = [
@@ -172,7 +172,7 @@ def _n_star(x1: NDArray, x2: NDArray, a_ratio: NDArray, w_ratio: NDArray, plant:
     """N* of each state for its own true plant (a_ratio, w_max_ratio), nan where not found.
 
     One vectorized zonotope search for every mix of plants
-    (:func:`ptoverify.reach.zonotope_steps_each`), started from the continuous
+    (:func:`ptoverify.model.reach.zonotope_steps_each`), started from the continuous
     bound ceil(t_f* / T) of the true plant (t_f* in the plant's dimensionless time,
     min_time of the unit plant; the start only changes the number of tests).
     """
@@ -377,7 +377,7 @@ def _maps_job(
     wrs: list[float],
     delays: list[int],
 ) -> Job:
-    """Every map cell of one law (a :mod:`ptoverify.lockstep` job returning the cells).
+    """Every map cell of one law (a :mod:`ptoverify.sim.lockstep` job returning the cells).
 
     All (delay, w, a) cells times all states in one ask per :data:`BATCH_STATES`
     states, each state with its cell's a_ratio, w_max_ratio and delay; cells in
@@ -636,7 +636,7 @@ def linear_loop_radii(
     """Spectral radius of the sampled linear loop at each a_true / a_design.
 
     The loop of :func:`linear_loop_margin`: ``Ad - Bd K`` of the ZOH plant of
-    the true a (as :func:`ptoverify.poles.sampled_spectral_radius` forms it), or
+    the true a (as :func:`ptoverify.model.poles.sampled_spectral_radius` forms it), or
     with a one-sample delay ``[[Ad, Bd], [-K, 0]]``; all ratios in one stacked
     eigenvalue call, each matrix as alone (LAPACK's ``geev`` per matrix).
 
@@ -773,7 +773,7 @@ MARGIN_ASK_RATIOS = 16  #: ratios per simulation ask of a margin (so it rides be
 
 
 def _margin_job(fn: Law, cfg: Config, s: RobustSettings, *, rtol: float = 1e-3) -> Job:
-    """:func:`no_limit_cycle_margin` as a :mod:`ptoverify.lockstep` job (its asks ride along).
+    """:func:`no_limit_cycle_margin` as a :mod:`ptoverify.sim.lockstep` job (its asks ride along).
 
     The loop here is odd for an odd law (``Law.odd``; no quantizer, delay or noise),
     so a state and its mirror have the same limit cycle: one state of each
@@ -1149,7 +1149,7 @@ def _searches_job(
     starts: list[dict[str, list[dict[str, Any]]]],
     s: RobustSettings,
 ) -> Job:
-    """Run the worst-case searches of several laws as one :mod:`ptoverify.lockstep` job.
+    """Run the worst-case searches of several laws as one :mod:`ptoverify.sim.lockstep` job.
 
     Each law's search is its own coroutine (:func:`_de_search`, with its own
     seeded generator, so its result does not depend on the others); at each
@@ -1525,7 +1525,7 @@ def run_robust(
         cells = robust_maps(cfg, s, runner=dask_runner(dask))["laws"]
         timings["maps"] = time.perf_counter() - t1
     # every law's maps, search and margin scan advance together: one simulation per
-    # round, in which the margin scans ride along (ptoverify.lockstep)
+    # round, in which the margin scans ride along (ptoverify.sim.lockstep)
     fns = [_law(law, cfg) for law in s.laws]
     given = [cells[law] for law in s.laws] if dask else None
     jobs = [_study_job(fns, cfg, s, given)]

@@ -11,7 +11,7 @@ Decisions (also in ``ptoverify conform --help``):
 
 Loading and isolation
     ``MODULE:FUNCTION`` imports exactly the named module; ``path/file.py:FUNCTION``
-    loads exactly that file (:func:`ptoverify.userlaw.load_callable`).  From the
+    loads exactly that file (:func:`ptoverify.conform.userlaw.load_callable`).  From the
     command line (:func:`conform_spec`) the law is loaded and called in a child
     process (multiprocessing ``spawn``), its stdout/stderr captured, its address
     space limited (RLIMIT_AS, 4 GiB, where the OS has it), the whole conformance
@@ -36,9 +36,9 @@ Determinism (``pure-function``, every mode)
     5, 8, 13, 21 and 34 states must give bit-identical u, and once more after all other
     calls.  A latch, a cache, a debounce, a delay or a call counter shows here;
     after this finding the other properties are ``not_run``.
-Agreement (:mod:`ptoverify.agreement`) where the law is used
+Agreement (:mod:`ptoverify.conform.agreement`) where the law is used
     |u - u_ref| <= ``rtol`` w_max (default 1e-6) at the probe set
-    (:func:`ptoverify.agreement.probe_set`, what ``--emit-grid`` writes): the
+    (:func:`ptoverify.conform.agreement.probe_set`, what ``--emit-grid`` writes): the
     conformance grid, ``N_RANDOM`` = 100000 seeded random states (one jittered
     state in each cell of a 200 x 200 lattice over the envelope, the rest
     uniform) and ``N_BAND`` = 80000 seeded states in a band around l1/l2,
@@ -51,7 +51,7 @@ Odd symmetry
     on a mirrored tie the law must pick the mirrored branch.
 Closed loop (callable only)
     The sweep of ``check`` (101 x 101 + 200 states vectorized, 21 x 21 + 40
-    scalar) with :mod:`ptoverify.properties`' definitions: stride-overs, limit
+    scalar) with :mod:`ptoverify.studies.properties`' definitions: stride-overs, limit
     cycles or not settled within 1e-3 mm, |u| <= w_max; settling against the
     discrete-time limit N* (worst excess <= E_ref + max(2, ceil(E_ref / 2))
     samples, E_ref the reference's worst; ``unverified`` if N* is unknown).
@@ -85,7 +85,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ptoverify.agreement import (
+from ptoverify.config import Config
+from ptoverify.conform.agreement import (
     DEFAULT_RTOL,
     LATTICE,
     MATCH_TOL,
@@ -104,10 +105,7 @@ from ptoverify.agreement import (
     table_coverage,
     ties,
 )
-from ptoverify.config import Config
-from ptoverify.errors import InputError
-from ptoverify.laws import Law, Region
-from ptoverify.userlaw import (
+from ptoverify.conform.userlaw import (
     DEFAULT_TIMEOUT_S,
     IsolatedLaw,
     LawAborted,
@@ -116,6 +114,8 @@ from ptoverify.userlaw import (
     load_callable,
     wrap_callable,
 )
+from ptoverify.errors import InputError
+from ptoverify.model.laws import Law, Region
 from ptoverify.verdict import FAIL, NOT_RUN, PASS, UNVERIFIED, Verdict
 
 __all__ = [
@@ -319,9 +319,9 @@ def _settle_steps(X1: NDArray, band: float) -> NDArray[np.float64]:
 @functools.lru_cache(maxsize=8)
 def _settling_reference(cfg: Config) -> dict:
     """Settling sweep states, their N*, and the reference's settling steps (cached)."""
-    from ptoverify.mintime import discrete_min_steps_batch
-    from ptoverify.properties import default_steps, initial_grid
-    from ptoverify.simulate import simulate_batch
+    from ptoverify.model.mintime import discrete_min_steps_batch
+    from ptoverify.sim.simulate import simulate_batch
+    from ptoverify.studies.properties import default_steps, initial_grid
 
     x1, x2, _ = initial_grid(cfg, 11, 11, 20)
     dm = discrete_min_steps_batch(x1, x2, cfg.plant)
@@ -344,7 +344,7 @@ def _settling_reference(cfg: Config) -> dict:
 
 
 def _settling(law: Law, cfg: Config, visited: list) -> tuple[Verdict, list[dict]]:
-    from ptoverify.simulate import simulate_batch
+    from ptoverify.sim.simulate import simulate_batch
 
     name = "settling-vs-discrete-limit"
     ref = _settling_reference(cfg)
@@ -397,7 +397,7 @@ def settling_states(cfg: Config, x1_user: NDArray) -> dict:
         Configuration.
     x1_user : ndarray, shape (steps + 1, n)
         Positions [mm] of the user law's settling sweep (the second
-        :class:`~ptoverify.simulate.BatchResult` that :func:`closed_loop` visits).
+        :class:`~ptoverify.sim.simulate.BatchResult` that :func:`closed_loop` visits).
 
     Returns
     -------
@@ -440,10 +440,10 @@ def closed_loop(
     cfg : Config
         Configuration.
     sweep : (n1, n2, rest), optional
-        Sweep grid (:func:`ptoverify.properties.initial_grid`); default
+        Sweep grid (:func:`ptoverify.studies.properties.initial_grid`); default
         101 x 101 + 200 vectorized, 21 x 21 + 40 scalar.
     visited : list, optional
-        Receives the :class:`~ptoverify.simulate.BatchResult` of each sweep
+        Receives the :class:`~ptoverify.sim.simulate.BatchResult` of each sweep
         (the states the law was used at, for the agreement).
 
     Returns
@@ -454,8 +454,13 @@ def closed_loop(
     failures : list of dict
         Failing properties with the first initial state that shows each.
     """
-    from ptoverify.properties import crossing_masks, default_steps, initial_grid, oscillating
-    from ptoverify.simulate import simulate_batch
+    from ptoverify.sim.simulate import simulate_batch
+    from ptoverify.studies.properties import (
+        crossing_masks,
+        default_steps,
+        initial_grid,
+        oscillating,
+    )
 
     visited = [] if visited is None else visited
     law = as_law(user, cfg)
@@ -612,7 +617,7 @@ class ConformResult:
     mode_reason : str
         Why the mode was chosen.
     agreement : dict
-        Agreement with the reference (:func:`ptoverify.agreement.agreement`),
+        Agreement with the reference (:func:`ptoverify.conform.agreement.agreement`),
         with ``sources`` (states per source) and ``gap`` (largest unprobed disc).
     properties : dict of str to Verdict
         Every property, in evaluation order.
@@ -803,7 +808,7 @@ def conform_callable(
         Agreement grid; default :func:`conformance_grid`.
     n_random, n_band : int
         Seeded random states over the envelope, and around the curves and
-        |x1| = d (:func:`ptoverify.agreement.probe_set`).
+        |x1| = d (:func:`ptoverify.conform.agreement.probe_set`).
 
     Returns
     -------

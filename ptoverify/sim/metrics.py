@@ -2,13 +2,13 @@
 
 The functions here are pure numpy functions of sampled arrays: they look at
 the controller's samples t_k = k T only.  :func:`summarize` reports the time
-metrics of a :class:`~ptoverify.simulate.SimResult` on the exact continuous
-trajectory between the samples (:mod:`ptoverify.exact`: overshoot, settling,
+metrics of a :class:`~ptoverify.sim.simulate.SimResult` on the exact continuous
+trajectory between the samples (:mod:`ptoverify.sim.exact`: overshoot, settling,
 rise time, linear-zone entry, sine phase), with the sample-grid value of the
 same definition beside each under the key suffixed ``_grid``.  The sample-grid
 definitions of settling, overshoot and rise time are
-:func:`ptoverify.exact.grid_settling_time`, :func:`~ptoverify.exact.grid_overshoot`
-and :func:`~ptoverify.exact.grid_rise_time`, exported here under their older
+:func:`ptoverify.sim.exact.grid_settling_time`, :func:`~ptoverify.sim.exact.grid_overshoot`
+and :func:`~ptoverify.sim.exact.grid_rise_time`, exported here under their older
 names :func:`settling_time`, :func:`overshoot`, :func:`rise_time`: one
 definition of each.
 
@@ -42,13 +42,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ptoverify.exact import STEP_FRACTION, TIGHT_BAND, exact_metrics
-from ptoverify.exact import grid_overshoot as overshoot
-from ptoverify.exact import grid_rise_time as rise_time
-from ptoverify.exact import grid_settling_time as settling_time
+from ptoverify.sim.exact import STEP_FRACTION, TIGHT_BAND, exact_metrics
+from ptoverify.sim.exact import grid_overshoot as overshoot
+from ptoverify.sim.exact import grid_rise_time as rise_time
+from ptoverify.sim.exact import grid_settling_time as settling_time
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ptoverify.simulate import SimResult
+    from ptoverify.sim.simulate import SimResult
 
 __all__ = [
     "TIGHT_BAND",
@@ -273,7 +273,7 @@ def time_to_linear_zone(
     t : array_like
         Sample times [s].
     region : array_like of int
-        :class:`~ptoverify.laws.Region` code of each sample.
+        :class:`~ptoverify.model.laws.Region` code of each sample.
     codes : tuple of int, optional
         Codes that count as the linear zone; default LINEAR and SATURATED
         (eq. 34 or PD, clipped or not).
@@ -288,7 +288,7 @@ def time_to_linear_zone(
     >>> time_to_linear_zone([0.0, 0.1, 0.2], [2, 3, 5])
     0.2
     """
-    from ptoverify.laws import Region
+    from ptoverify.model.laws import Region
 
     codes = (Region.LINEAR, Region.SATURATED) if codes is None else codes
     t, region = _arr(t), np.asarray(region)
@@ -332,7 +332,7 @@ def summarize(
     """All metrics of one simulated response, by name (units in the names).
 
     The time metrics are measured on the exact continuous trajectory between
-    the samples (:func:`ptoverify.exact.exact_metrics`); each has its
+    the samples (:func:`ptoverify.sim.exact.exact_metrics`); each has its
     sample-grid value beside it under the same key suffixed ``_grid`` (the
     same definition restricted to the samples), so a reader sees both where
     they differ: ``settling_tight_s``, ``settling_2pct_s``, ``overshoot_mm``,
@@ -372,8 +372,8 @@ def summarize(
     Examples
     --------
     >>> from ptoverify.config import paper_config
-    >>> from ptoverify.laws import make_law
-    >>> from ptoverify.simulate import simulate
+    >>> from ptoverify.model.laws import make_law
+    >>> from ptoverify.sim.simulate import simulate
     >>> cfg = paper_config()
     >>> s = summarize(simulate(make_law("pd", cfg), cfg.plant, "step"), cfg.plant)
     >>> s["overshoot_mm"] >= s["overshoot_mm_grid"]

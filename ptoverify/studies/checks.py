@@ -74,8 +74,8 @@ class GateContext:
         """Closed-loop properties of the corrected PTO law over the default grid."""
         if self.given_pto_properties is not None:
             return self.given_pto_properties
-        from ptoverify.laws import make_law
-        from ptoverify.properties import law_properties
+        from ptoverify.model.laws import make_law
+        from ptoverify.studies.properties import law_properties
 
         return law_properties(make_law("pto", self.cfg), self.cfg)
 
@@ -143,7 +143,7 @@ def _zoh_vs_integrator(ctx: GateContext) -> Verdict:
     """Exact one-sample map against an adaptive ODE integrator at rtol 1e-12."""
     from scipy.integrate import solve_ivp
 
-    from ptoverify.plant import step
+    from ptoverify.model.plant import step
 
     cfg = ctx.cfg
     p = cfg.plant
@@ -177,7 +177,7 @@ def _zoh_vs_integrator(ctx: GateContext) -> Verdict:
 @gate("roots-closed-form-vs-bisection", "1")
 def _roots(ctx: GateContext) -> Verdict:
     """Lambert-W closed forms of eqs. (22), (26)/(31) against bisection to the last bit."""
-    from ptoverify.curves import root_22, root_22_bisect, root_k, root_k_bisect
+    from ptoverify.model.curves import root_22, root_22_bisect, root_k, root_k_bisect
 
     rng = np.random.default_rng(13)
     b0 = np.concatenate([rng.uniform(0, 20, 2000), 10 ** rng.uniform(-12, 2, 2000)])
@@ -196,8 +196,8 @@ def _roots(ctx: GateContext) -> Verdict:
 @gate("mintime-closed-form-vs-propagation", "1")
 def _mintime_propagation(ctx: GateContext) -> Verdict:
     """Closed-form t_f and switch: the two arcs of the exact flow end at the origin."""
-    from ptoverify.mintime import min_time
-    from ptoverify.plant import flow
+    from ptoverify.model.mintime import min_time
+    from ptoverify.model.plant import flow
 
     cfg = ctx.cfg
     p = cfg.plant
@@ -220,7 +220,7 @@ def _mintime_propagation(ctx: GateContext) -> Verdict:
 @gate("input-bound", "mm/s")
 def _input_bound(ctx: GateContext) -> Verdict:
     """|u| <= w_max for every law over a dense random cloud of states."""
-    from ptoverify.laws import LAW_NAMES, make_law
+    from ptoverify.model.laws import LAW_NAMES, make_law
 
     cfg = ctx.cfg
     x1, x2 = _random_states(cfg, 200000, 15, 2.0)
@@ -251,7 +251,7 @@ def _input_bound(ctx: GateContext) -> Verdict:
 @gate("odd-symmetry", "mm/s")
 def _odd_symmetry(ctx: GateContext) -> Verdict:
     """u(-x) = -u(x) for every law (the plant is odd, so the laws must be)."""
-    from ptoverify.laws import LAW_NAMES, make_law
+    from ptoverify.model.laws import LAW_NAMES, make_law
 
     cfg = ctx.cfg
     x1, x2 = _random_states(cfg, 100000, 16, 1.5)
@@ -277,11 +277,11 @@ def _ocp_vs_closed_form(
 ) -> Verdict:
     """Worst relative t_f difference of a verified OCP answer from the closed form.
 
-    ``verify`` is the a-posteriori check of :mod:`ptoverify.groundtruth` (the one
+    ``verify`` is the a-posteriori check of :mod:`ptoverify.studies.groundtruth` (the one
     definition of a verified answer): an answer that did not converge, or converged
     but fails its check, makes the gate ``unverified``.
     """
-    from ptoverify.mintime import min_time
+    from ptoverify.model.mintime import min_time
 
     x1, x2 = _gt_states(cfg, n, seed)
     mt = min_time(x1, x2, cfg.plant)
@@ -303,8 +303,8 @@ def _ocp_vs_closed_form(
 @gate("mintime-closed-form-vs-two-phase", "1")
 def _two_phase(ctx: GateContext) -> Verdict:
     """CasADi two-phase OCP (IPOPT) against the closed-form minimum time."""
-    from ptoverify.groundtruth import verify_two_phase
-    from ptoverify.ocp import TwoPhaseOCP
+    from ptoverify.model.ocp import TwoPhaseOCP
+    from ptoverify.studies.groundtruth import verify_two_phase
 
     cfg = ctx.cfg
     return _ocp_vs_closed_form(
@@ -323,8 +323,8 @@ def _two_phase(ctx: GateContext) -> Verdict:
 @gate("mintime-closed-form-vs-collocation", "1")
 def _collocation(ctx: GateContext) -> Verdict:
     """CasADi Radau collocation (N = 100) against the closed-form minimum time."""
-    from ptoverify.groundtruth import verify_collocation
-    from ptoverify.ocp import CollocationOCP
+    from ptoverify.model.ocp import CollocationOCP
+    from ptoverify.studies.groundtruth import verify_collocation
 
     cfg = ctx.cfg
     return _ocp_vs_closed_form(
@@ -344,7 +344,12 @@ def _collocation(ctx: GateContext) -> Verdict:
 @gate("discrete-limit-consistency", "1")
 def _discrete(ctx: GateContext) -> Verdict:
     """N*: N* T >= t_f*, the sequence reaches the origin, N* - 1 infeasible, zonotope = LP."""
-    from ptoverify.mintime import ZOHReach, discrete_min_steps, discrete_min_steps_batch, min_time
+    from ptoverify.model.mintime import (
+        ZOHReach,
+        discrete_min_steps,
+        discrete_min_steps_batch,
+        min_time,
+    )
 
     cfg = ctx.cfg
     x1, x2 = _gt_states(cfg, 25, 23)
@@ -432,8 +437,8 @@ def _derivations(ctx: GateContext) -> Verdict:
 
     from derivations.common import S, flow
     from derivations.section3 import min_time_closed_form
-    from ptoverify.mintime import min_time
-    from ptoverify.plant import flow as flow_num
+    from ptoverify.model.mintime import min_time
+    from ptoverify.model.plant import flow as flow_num
 
     cfg = ctx.cfg
     p = cfg.plant
@@ -477,7 +482,7 @@ def _derivations(ctx: GateContext) -> Verdict:
 @gate("zone-corrected-valid", "1")
 def _zone_valid(ctx: GateContext) -> Verdict:
     """Check that the corrected zone exists, acts, and holds on the grid."""
-    from ptoverify.zones import corrected_zone
+    from ptoverify.model.zones import corrected_zone
 
     cfg = ctx.cfg
     z = corrected_zone(cfg)
@@ -525,7 +530,7 @@ def _no_limit_cycle(ctx: GateContext) -> Verdict:
 
 
 def _loop_gate(name: str, which: str, cfg: Config) -> Verdict:
-    from ptoverify.poles import all_loop_poles
+    from ptoverify.model.poles import all_loop_poles
 
     lp = all_loop_poles(cfg)[which]
     radius = max(lp.sampled_moduli)
@@ -573,7 +578,7 @@ def _claims_computed(ctx: GateContext) -> Verdict:
     The verdicts themselves (reproduced or not) are findings of the report, not
     gate failures; this gate fails when a claim could not be measured.
     """
-    from ptoverify.claims import evaluate_claims
+    from ptoverify.studies.claims import evaluate_claims
 
     cfg = ctx.cfg
     allowed = {"reproduced", "not reproduced", "ambiguous"}
@@ -666,10 +671,10 @@ def robust_verdicts(cfg: Config) -> list[Verdict]:
     -------
     list of Verdict
         ``robust-no-limit-cycle`` and ``robust-settling``
-        (:func:`ptoverify.robust.robust_gates`); both ``unverified`` when the
+        (:func:`ptoverify.studies.robust.robust_gates`); both ``unverified`` when the
         study could not be computed.
     """
-    from ptoverify.robust import GATE_LAW, RobustSettings, robust_gates, run_robust
+    from ptoverify.studies.robust import GATE_LAW, RobustSettings, robust_gates, run_robust
 
     settings = RobustSettings(
         laws=(GATE_LAW,), properties=("limit_cycle_mm", "settling_ratio_nt"), margins=False

@@ -7,11 +7,11 @@ small batch costs what a large one does per sample (the law's and the
 integrator's fixed overhead per call).  Here each workload is a *job*, a
 generator that yields the simulations it needs next (:class:`Ask`) and is sent
 their trajectories; :func:`run_lockstep` gathers the asks of all jobs into
-rounds and runs each round as one :func:`ptoverify.simulate.simulate_segments`
+rounds and runs each round as one :func:`ptoverify.sim.simulate.simulate_segments`
 call, in which the asks of one law, and of the laws of one
-:class:`~ptoverify.laws.LawFamily`, share one evaluation per sample.
+:class:`~ptoverify.model.laws.LawFamily`, share one evaluation per sample.
 
-Every trajectory is bit for bit the one :func:`ptoverify.simulate.simulate_batch`
+Every trajectory is bit for bit the one :func:`ptoverify.sim.simulate.simulate_batch`
 gives for its ask alone (states are independent), so what the jobs compute does
 not depend on how their asks were grouped into rounds.
 
@@ -31,8 +31,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ptoverify.config import Plant
-from ptoverify.laws import Law
-from ptoverify.simulate import BatchResult, Mismatch, TrajectoryBuffers, simulate_segments
+from ptoverify.model.laws import Law
+from ptoverify.sim.simulate import BatchResult, Mismatch, TrajectoryBuffers, simulate_segments
 
 __all__ = ["Ask", "Job", "LockstepRun", "run_lockstep", "ROUND_STATES"]
 
@@ -135,7 +135,7 @@ def run_lockstep(
         ``on_round(rounds_done, jobs_done, jobs_total)`` after each round (progress).
     reuse : bool
         Write every round's trajectories into the same memory
-        (:class:`ptoverify.simulate.TrajectoryBuffers`: the pages are faulted in
+        (:class:`ptoverify.sim.simulate.TrajectoryBuffers`: the pages are faulted in
         once, not at every round).  The trajectories sent to a job are then
         overwritten by the next round, so they are valid only until the job
         yields its next asks: for jobs that keep nothing of them (measured
@@ -149,7 +149,7 @@ def run_lockstep(
     Examples
     --------
     >>> from ptoverify.config import paper_config
-    >>> from ptoverify.laws import pd_law
+    >>> from ptoverify.model.laws import pd_law
     >>> cfg = paper_config()
     >>> def job(x0):
     ...     (b,) = yield [Ask(pd_law(cfg), np.array([x0]), np.array([0.0]))]

@@ -2,8 +2,8 @@
 
 Each claim holds the paper's wording (and number, where it gives one); the
 paper's values live only here.  The measured value is computed by simulating
-the sampled closed loop (:func:`~ptoverify.simulate.simulate`) and applying
-:mod:`ptoverify.metrics`; nothing in the measured column is typed in.
+the sampled closed loop (:func:`~ptoverify.sim.simulate.simulate`) and applying
+:mod:`ptoverify.sim.metrics`; nothing in the measured column is typed in.
 
 Readings
 --------
@@ -51,9 +51,9 @@ verdicts and the rule texts read them from there.
 * "Faster", "more stable", "quicker": strict inequalities of the metric.
 * Time metrics (settling, rise time), overshoots and phase delays are measured
   between the samples, on the exact continuous trajectory
-  (:mod:`ptoverify.exact`), and every verdict is decided on those values.  Two
+  (:mod:`ptoverify.sim.exact`), and every verdict is decided on those values.  Two
   exact values closer than the sum of their accuracies (:attr:`Compared.accuracy
-  <ptoverify.exact.Compared.accuracy>`: brentq's tolerance and the round-off of
+  <ptoverify.sim.exact.Compared.accuracy>`: brentq's tolerance and the round-off of
   the flow over the crossed signal's slope, ~1e-15 s here) are a true tie: the
   strict inequality does not hold, and the reading lists the tie in ``ties`` and
   its detail.  The same rule is also applied to the sample-grid values (which
@@ -71,7 +71,7 @@ time ratio.  With ``evaluate_claims(tuned=True)`` the claims of
 :data:`TUNED_CLAIMS` get three more readings (``Reading.gains``), each under the
 primary reading otherwise: the PD retuned (best 2 % settling of the step) to the
 PTO's paper-gain overshoot, the PTO at the paper's gains; and both laws at their
-best tuning (:func:`ptoverify.tune.fair_tunings`) under a shared overshoot bound,
+best tuning (:func:`ptoverify.studies.tune.fair_tunings`) under a shared overshoot bound,
 once the PTO's paper-gain overshoot and once the PD's.  Their common verdict is
 ``verdict_tuned``; ``verdict`` stays that of the paper's gains.
 """
@@ -87,14 +87,14 @@ from typing import Any
 
 import numpy as np
 
-from ptoverify import metrics as mt
 from ptoverify.config import Config
-from ptoverify.exact import Compared, ExactMetrics, exact_metrics
-from ptoverify.laws import Law, make_law
-from ptoverify.metrics import STEP_FRACTION
-from ptoverify.mintime import discrete_min_steps_batch, min_time
-from ptoverify.simulate import SimResult, reference, simulate
-from ptoverify.tune import (
+from ptoverify.model.laws import Law, make_law
+from ptoverify.model.mintime import discrete_min_steps_batch, min_time
+from ptoverify.sim import metrics as mt
+from ptoverify.sim.exact import Compared, ExactMetrics, exact_metrics
+from ptoverify.sim.metrics import STEP_FRACTION
+from ptoverify.sim.simulate import SimResult, reference, simulate
+from ptoverify.studies.tune import (
     FAIR_BOUNDS,
     Candidate,
     FairTunings,
@@ -103,7 +103,7 @@ from ptoverify.tune import (
     pareto_front,
     worst_ratio_nt,
 )
-from ptoverify.tune import response_metrics as tune_response_metrics
+from ptoverify.studies.tune import response_metrics as tune_response_metrics
 
 __all__ = [
     "Reading",
@@ -147,7 +147,7 @@ class Reading:
         None: the paper's gains.  ``pd-retuned``: the PD tuned to the PTO's
         paper-gain overshoot, the PTO at the paper's gains.  ``best@pto-paper``,
         ``best@pd-paper``: both laws at their best tuning under the shared
-        overshoot bound of that name (:data:`ptoverify.tune.FAIR_BOUNDS`).
+        overshoot bound of that name (:data:`ptoverify.studies.tune.FAIR_BOUNDS`).
     bound_mm : float or None
         The overshoot bound of a tuned reading [mm].
     """
@@ -406,7 +406,7 @@ class _Ctx:
         return amp > band and rev >= 2, amp, rev
 
     def metric(self, law: str, signal: str, key: str) -> Compared:
-        """Return a time metric of a response, exact and on the grid (:mod:`ptoverify.exact`)."""
+        """Return a time metric of a response, exact and on the grid (:mod:`ptoverify.sim.exact`)."""
         name = self.pto if law == "pto" else law
         tracking = self.tracking if signal != "step" else "feed-forward"
         frac = self.reading.band if self.reading.band is not None else mt.STEP_FRACTION
@@ -434,7 +434,7 @@ class _Ctx:
         """Whether law_a's metric is strictly below law_b's; a true tie is recorded and is not.
 
         Exact values tie within the sum of their accuracies
-        (:meth:`ptoverify.exact.Compared.compare`), grid values only when equal.
+        (:meth:`ptoverify.sim.exact.Compared.compare`), grid values only when equal.
         """
         a, b = self.metric(law_a, signal, key), self.metric(law_b, signal, key)
         order = a.compare(b, grid=self.grid)
@@ -957,11 +957,11 @@ def evaluate_claims(
         ``paper_value`` (``dataclasses.replace``) is judged against that value.
     tuned : bool
         Also judge the claims of :data:`TUNED_CLAIMS` at the best tuning of
-        both laws (:func:`ptoverify.tune.fair_tunings`: minutes, memoized):
+        both laws (:func:`ptoverify.studies.tune.fair_tunings`: minutes, memoized):
         readings with ``gains`` set, summarized in ``verdict_tuned``.
         ``ptoverify check`` leaves this off (see :data:`TUNED_CLAIMS`).
     budget : TuneBudget, optional
-        Search effort of the tunings (default :class:`~ptoverify.tune.TuneBudget`).
+        Search effort of the tunings (default :class:`~ptoverify.studies.tune.TuneBudget`).
 
     Returns
     -------
@@ -1055,7 +1055,7 @@ def response_metrics(cfg: Config) -> dict[str, dict[str, dict[str, float]]]:
     """Metrics of every Section 6 response under the primary reading, exact and on the grid.
 
     The responses the claims are measured on (a as configured, feed-forward),
-    summarized by :func:`ptoverify.metrics.summarize`: each time metric between
+    summarized by :func:`ptoverify.sim.metrics.summarize`: each time metric between
     samples with its sample-grid twin under ``<key>_grid``, and the linear-zone
     entry with the law's zone (PTO: |r - x1| <= d; PD: linear everywhere, 0;
     TO: none, NaN).  For a report to show both values where they differ.
@@ -1099,7 +1099,7 @@ def fair_comparison(cfg: Config, budget: TuneBudget | None = None) -> dict[str, 
     cfg : Config
         Configuration (plant and the paper's gains).
     budget : TuneBudget, optional
-        Search effort of the tunings; default :class:`~ptoverify.tune.TuneBudget`.
+        Search effort of the tunings; default :class:`~ptoverify.studies.tune.TuneBudget`.
 
     Returns
     -------
@@ -1116,7 +1116,7 @@ def fair_comparison(cfg: Config, budget: TuneBudget | None = None) -> dict[str, 
         the gate grid), by increasing overshoot; ``best``: bound name -> law ->
         the best tuned gains with ``settling_2pct_s``, ``overshoot_mm``,
         ``rise_time_s``, ``settling_0p01mm_s`` and ``worst_ratio_nt`` (over the
-        :data:`~ptoverify.tune.WORST_GRID` envelope grid); ``claims``: one entry per claim
+        :data:`~ptoverify.studies.tune.WORST_GRID` envelope grid); ``claims``: one entry per claim
         judged at the best tuning (``id``, ``verdict``, ``sentence``,
         ``readings``); ``evaluations``, ``seconds``, ``budget``.
     """

@@ -19,8 +19,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import LAW_NAMES, Config
-from ptoverify.curves import blockwise, level_side, omega_c
 from ptoverify.errors import InputError
+from ptoverify.model.curves import blockwise, level_side, omega_c
 
 __all__ = [
     "Region",
@@ -65,7 +65,7 @@ class LawFamily:
 
     A batch that drives states with several laws of one family evaluates them
     in one call, each state with its law's parameters
-    (:func:`ptoverify.simulate.simulate_segments`): per sample, one call's
+    (:func:`ptoverify.sim.simulate.simulate_segments`): per sample, one call's
     fixed overhead in place of one per law.  Each state's input and region are
     bit for bit those of its own law's vector path.
 
@@ -158,7 +158,7 @@ def h_scalar(r: float) -> float:
 
 
 def sigma_scalar(x1: float, x2: float, a: float, omega: float) -> float:
-    """Scalar :func:`ptoverify.curves.level_residual` (eqs. 9, 11, 13, 14).
+    """Scalar :func:`ptoverify.model.curves.level_residual` (eqs. 9, 11, 13, 14).
 
     Parameters
     ----------
@@ -399,7 +399,7 @@ def _pto_block(a: float, w: float) -> Callable:
 
     ``block(x1, x2, g1, g2, dd, lv)``: linear gains k1 [1/s], k2 [-], linear-zone
     half-width d [mm], switching-zone level [mm/s] (NaN: no zone), each a float or
-    one per state; on 1-D float arrays of one block (:func:`ptoverify.curves.blockwise`).
+    one per state; on 1-D float arrays of one block (:func:`ptoverify.model.curves.blockwise`).
     """
 
     def block(x1, x2, g1, g2, dd, lv):
@@ -592,7 +592,7 @@ def pto_corrected_law(cfg: Config, *, gains: tuple[NDArray, NDArray] | None = No
 
 def _corrected(cfg: Config):
     """Return the corrected zone the ``pto`` law of ``cfg`` uses (``zones.zone_for_law``)."""
-    from ptoverify.zones import zone_for_law
+    from ptoverify.model.zones import zone_for_law
 
     return zone_for_law(cfg, "corrected")
 
@@ -621,7 +621,7 @@ def pto_printed_law(cfg: Config) -> Law:
     Law
         ``pto-printed``.
     """
-    from ptoverify.zones import zone_for_law
+    from ptoverify.model.zones import zone_for_law
 
     z = zone_for_law(cfg, "printed")
     if z.usable:

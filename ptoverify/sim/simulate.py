@@ -36,7 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Plant
 from ptoverify.errors import InputError
-from ptoverify.laws import Law
+from ptoverify.model.laws import Law
 
 __all__ = [
     "TRACKING",
@@ -329,7 +329,7 @@ class SimResult:
     u : ndarray
         Input held from each sample to the next [mm/s] (the last is computed, not applied).
     region : ndarray of int8
-        :class:`~ptoverify.laws.Region` code of each sample.
+        :class:`~ptoverify.model.laws.Region` code of each sample.
     """
 
     law: str
@@ -402,7 +402,7 @@ def simulate(
     Examples
     --------
     >>> from ptoverify.config import paper_config
-    >>> from ptoverify.laws import pd_law
+    >>> from ptoverify.model.laws import pd_law
     >>> cfg = paper_config()
     >>> res = simulate(pd_law(cfg), cfg.plant, "step")
     >>> bool(abs(res.e[-1]) < 1e-6), res.tracking
@@ -584,7 +584,7 @@ def simulate_batch(
     Examples
     --------
     >>> from ptoverify.config import paper_config
-    >>> from ptoverify.laws import pd_law
+    >>> from ptoverify.model.laws import pd_law
     >>> cfg = paper_config()
     >>> b = simulate_batch(pd_law(cfg), cfg.plant, [5.0], [0.0], 300)
     >>> bool(abs(b.x1[-1, 0]) < 1e-6)
@@ -656,7 +656,7 @@ def simulate_segments(
     x2, steps, mismatch=mismatch)`` gives for its segment (a segment with no or the
     identity mismatch is the nominal loop), but the samples are advanced for all
     states at once and consecutive segments of the same law, or of laws of one
-    :class:`~ptoverify.laws.LawFamily` (the TO and PTO laws of a plant), share
+    :class:`~ptoverify.model.laws.LawFamily` (the TO and PTO laws of a plant), share
     one evaluation per sample, so many small batches cost one run's per-sample
     overhead.
 
@@ -681,7 +681,7 @@ def simulate_segments(
     Examples
     --------
     >>> from ptoverify.config import paper_config
-    >>> from ptoverify.laws import pd_law, to_law
+    >>> from ptoverify.model.laws import pd_law, to_law
     >>> cfg = paper_config()
     >>> m = Mismatch(a_ratio=0.9, delay_samples=1)
     >>> both = simulate_segments([(pd_law(cfg), [5.0], [0.0], None),
@@ -700,14 +700,14 @@ class TrajectoryBuffers:
     sample) are carved from flat buffers kept here, grown when a run needs
     more.  Fresh arrays of that size are new pages from the kernel at every
     run, and faulting them in and zeroing them costs a sizeable share of a
-    run; here a sequence of runs (the rounds of :func:`ptoverify.lockstep.run_lockstep`)
+    run; here a sequence of runs (the rounds of :func:`ptoverify.sim.lockstep.run_lockstep`)
     pays it once.  A run's trajectories are overwritten by the next run given
     the same buffers, so use them only where nothing keeps them that long.
 
     Examples
     --------
     >>> from ptoverify.config import paper_config
-    >>> from ptoverify.laws import pd_law
+    >>> from ptoverify.model.laws import pd_law
     >>> cfg, buf = paper_config(), TrajectoryBuffers()
     >>> seg = [(pd_law(cfg), [5.0], [0.0], Mismatch(a_ratio=0.9))]
     >>> first = simulate_segments(seg, cfg.plant, 50, buffers=buf).x1.copy()

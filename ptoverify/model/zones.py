@@ -60,8 +60,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ptoverify.config import Config, PTOSettings
-from ptoverify.curves import level_curve_x1, level_residual, level_term, root_22, root_k
-from ptoverify.plant import flow
+from ptoverify.model.curves import level_curve_x1, level_residual, level_term, root_22, root_k
+from ptoverify.model.plant import flow
 from ptoverify.verdict import tie_band
 
 __all__ = [

@@ -137,7 +137,7 @@ def conform_verdicts(result: Any) -> tuple[list[Verdict], dict[str, Sequence[flo
     Parameters
     ----------
     result : ConformResult
-        The outcome of :func:`ptoverify.conform.conform_callable` or ``conform_table``.
+        The outcome of :func:`ptoverify.conform.gate.conform_callable` or ``conform_table``.
 
     Returns
     -------

@@ -30,9 +30,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Plant
-from ptoverify.curves import blockwise, h
 from ptoverify.errors import InputError
-from ptoverify.reach import DiscreteLimit
+from ptoverify.model.curves import blockwise, h
+from ptoverify.model.reach import DiscreteLimit
 
 __all__ = [
     "MinTime",
@@ -198,7 +198,7 @@ class ZOHReach:
     """
 
     def __init__(self, plant: Plant):
-        from ptoverify.plant import zoh_matrices
+        from ptoverify.model.plant import zoh_matrices
 
         self.plant = plant
         _, bd = zoh_matrices(plant.a, plant.sample_time)
@@ -280,7 +280,7 @@ def _polish(A: NDArray, b: NDArray, v: NDArray) -> NDArray[np.float64]:
 
 
 def _simulate_zoh(x1: float, x2: float, u: NDArray, plant: Plant) -> tuple[float, float]:
-    from ptoverify.plant import flow
+    from ptoverify.model.plant import flow
 
     for uk in u:
         x1, x2 = flow(x1, x2, uk, plant.sample_time, plant.a)
@@ -389,13 +389,13 @@ def discrete_min_steps_batch(
 ) -> DiscreteLimit:
     """N* for many states at once: exact 2-D zonotope membership, vectorized.
 
-    The production path for many states (:mod:`ptoverify.reach`: the states
+    The production path for many states (:mod:`ptoverify.model.reach`: the states
     that reach the origin in N ZOH samples with |u_k| <= w_max form a 2-D
     zonotope, tested facet by facet; N* by exponential search and bisection on
     N from ceil(t_f* / T), per state).  No LP and no input sequence:
     :func:`discrete_min_steps` (linear programs) is its independent reference.
     A state counts as reaching the origin in N samples if it does so with
-    |u_k| <= (1 + 1e-9) w_max (:data:`ptoverify.reach.MARGIN`, the LP's own
+    |u_k| <= (1 + 1e-9) w_max (:data:`ptoverify.model.reach.MARGIN`, the LP's own
     acceptance rule), so states on a boundary in exact arithmetic are inside.
 
     Parameters
@@ -428,7 +428,7 @@ def discrete_min_steps_batch(
     """
     from dataclasses import replace
 
-    from ptoverify.reach import zonotope_steps
+    from ptoverify.model.reach import zonotope_steps
 
     x1, x2 = np.broadcast_arrays(np.asarray(x1, dtype=float), np.asarray(x2, dtype=float))
     if not (np.isfinite(x1).all() and np.isfinite(x2).all()):

@@ -7,11 +7,11 @@ constraints for every law:
 * the sampled linear loop (PD, or the PTO's linear zone, eq. 34) is stable
   (spectral radius < 1 on the ZOH plant);
 * no limit cycle, and for the PTO no stride-over, from any state of the gates'
-  grid (:func:`ptoverify.properties.law_properties`, 101 x 101 + 200 states;
+  grid (:func:`ptoverify.studies.properties.law_properties`, 101 x 101 + 200 states;
   :func:`grid_counts` computes just these two counts, the same way).
 
 The PTO's omega0 always comes from the corrected construction for the
-candidate's d (:func:`ptoverify.zones.corrected_zone`); a d for which no zone can
+candidate's d (:func:`ptoverify.model.zones.corrected_zone`); a d for which no zone can
 be built is infeasible.
 
 Method (a non-smooth objective, so no gradients): PD by
@@ -29,14 +29,14 @@ Speed, and what it does not change:
 
 * Each generation of differential evolution is one batch (scipy's
   ``vectorized=True``, so ``updating="deferred"``), and on the step a batch is
-  one :func:`ptoverify.simulate.simulate_batch` run with per-state gains
+  one :func:`ptoverify.sim.simulate.simulate_batch` run with per-state gains
   (:class:`_StepScreen`).  The searches at several d (the grid, each
   golden-section pair) run side by side with their batches merged
   (:func:`_lockstep`); so do the two tunings of a law in :func:`fair_tunings`.
   A candidate's screened numbers do not depend on its batch, so the outcome is
   deterministic for a seed.
 * The screen agrees with ``simulate --json`` (scalar simulation,
-  :mod:`ptoverify.exact`) to round-off, not bit for bit.  Every candidate tune
+  :mod:`ptoverify.sim.exact`) to round-off, not bit for bit.  Every candidate tune
   reports (best, runner-up, front) is re-measured on the ``simulate --json``
   path, and the best is the first, in the screen's order, that meets the bound
   there too; so ``simulate --config tuned.toml`` reproduces its figures exactly.
@@ -60,24 +60,24 @@ from scipy.optimize import differential_evolution
 
 from ptoverify.config import Config, PDGains, PTOSettings
 from ptoverify.errors import InputError
-from ptoverify.exact import (
+from ptoverify.model.laws import Law, make_law, with_state_gains
+from ptoverify.model.mintime import discrete_min_steps_batch, min_time
+from ptoverify.model.poles import spectral_radii
+from ptoverify.sim.exact import (
     STEP_FRACTION,
     TIGHT_BAND,
     settling_and_overshoot,
     settling_times_batch,
 )
-from ptoverify.laws import Law, make_law, with_state_gains
-from ptoverify.mintime import discrete_min_steps_batch, min_time
-from ptoverify.poles import spectral_radii
-from ptoverify.properties import (
+from ptoverify.sim.simulate import reference, simulate_batch
+from ptoverify.studies.properties import (
     default_steps,
     grid_simulation,
     initial_grid,
     oscillating,
     stride_over_counts,
 )
-from ptoverify.simulate import reference, simulate_batch
-from ptoverify.sweep import SweepSettings, grid_states, mirror_pairs, settling_times
+from ptoverify.studies.sweep import SweepSettings, grid_states, mirror_pairs, settling_times
 
 __all__ = [
     "OBJECTIVES",
@@ -185,7 +185,7 @@ def _linear_gains(law: str, gains: dict[str, float]) -> tuple[float, float]:
 def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:
     """Settling (2 % and 0.01 mm), overshoot and rise time of ``law`` on ``signal``.
 
-    Measured between samples, on the exact trajectory (:mod:`ptoverify.exact`),
+    Measured between samples, on the exact trajectory (:mod:`ptoverify.sim.exact`),
     exactly as ``ptoverify simulate --json`` reports them in ``metrics``.
 
     Parameters
@@ -203,7 +203,7 @@ def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:
         ``settling_2pct_s`` [s], ``settling_0p01mm_s`` [s], ``overshoot_mm`` [mm],
         ``rise_time_s`` [s]; NaN where undefined (never settles).
     """
-    from ptoverify.commands import run_simulation
+    from ptoverify.sim.runs import run_simulation
 
     m, _ = run_simulation(cfg, law, signal).metrics()  # the very path of simulate --json
     return {k: math.nan if v is None else float(v) for k, v in m.items()}
@@ -213,10 +213,10 @@ def _settling_overshoot(cfg: Config, law: str, signal: str) -> dict[str, float]:
     """Overshoot and settling times of :func:`response_metrics`, bit for bit.
 
     The same simulation and the same exact evaluation
-    (:func:`ptoverify.exact.settling_and_overshoot`), without the rise time and the
+    (:func:`ptoverify.sim.exact.settling_and_overshoot`), without the rise time and the
     sample-grid readings that a candidate does not carry.
     """
-    from ptoverify.commands import run_simulation
+    from ptoverify.sim.runs import run_simulation
 
     res = run_simulation(cfg, law, signal).result  # the very path of simulate --json
     return settling_and_overshoot(res, cfg.plant, res.reference)
@@ -247,10 +247,10 @@ def worst_ratio_nt(
     """Worst settling time / (N* T) of ``law`` over an n1 x n2 grid of the envelope.
 
     The suboptimality the paper is about, with the sweep's definitions
-    (:mod:`ptoverify.sweep`): settled = |x1| <= 0.01 mm and |x2| <= a 0.01 mm/s
+    (:mod:`ptoverify.studies.sweep`): settled = |x1| <= 0.01 mm and |x2| <= a 0.01 mm/s
     from a sample on, for at least the hold (0.05 s), read on the sample grid
-    (:func:`~ptoverify.sweep.settling_times`); N* the fewest ZOH samples to the
-    origin (:func:`~ptoverify.mintime.discrete_min_steps_batch`, computed once
+    (:func:`~ptoverify.studies.sweep.settling_times`); N* the fewest ZOH samples to the
+    origin (:func:`~ptoverify.model.mintime.discrete_min_steps_batch`, computed once
     per plant and grid).  A law that does not settle from some grid state has
     an infinite worst ratio (the tuner treats it as infeasible).  For an odd law
     (``Law.odd``) one state of each mirrored pair of the grid is simulated, as the
@@ -304,7 +304,7 @@ def _worst_ratios(
     """:func:`worst_ratio_nt` of many gain sets, the states of several in one simulation.
 
     Each gain set's grid states are simulated with a law whose gains are one per
-    state (:func:`ptoverify.laws.with_state_gains`); the evaluation is per state, so
+    state (:func:`ptoverify.model.laws.with_state_gains`); the evaluation is per state, so
     every value is that of :func:`worst_ratio_nt` for the gain set alone.
     """
     p = cfg.plant
@@ -384,7 +384,7 @@ def _evaluate(cfg, law, gains, signal, objective, max_overshoot, worst_ratio, me
     omega0 = None
     try:
         if law == "pto":
-            from ptoverify.zones import zone_for_law
+            from ptoverify.model.zones import zone_for_law
 
             z = zone_for_law(tcfg, "corrected")
             omega0 = float(z.omega0) if z.omega0 is not None else None
@@ -421,7 +421,7 @@ def _evaluate(cfg, law, gains, signal, objective, max_overshoot, worst_ratio, me
 
 
 def _overshoot_batch(t, X1, X2, U, a: float, target: float) -> NDArray[np.float64]:
-    """Overshoot between samples of many records at once (:func:`ptoverify.exact.overshoot`).
+    """Overshoot between samples of many records at once (:func:`ptoverify.sim.exact.overshoot`).
 
     The same closed form per sample interval, x1 extremal at s* = ln(1 - x2k/u)/a
     when 0 < s* < T_k, on arrays of shape (steps + 1, n); the screen of
@@ -456,15 +456,15 @@ class _StepScreen:
     """Step responses of gain sets of one law, measured in batches and memoized.
 
     A call measures every new gain set of its argument in one simulation: the
-    Section 6 step (:data:`ptoverify.simulate.SIGNALS`) as one
-    :func:`ptoverify.simulate.simulate_batch` run of the law with per-state gains
-    (:func:`ptoverify.laws.with_state_gains`; each PTO candidate acts with the zone
+    Section 6 step (:data:`ptoverify.sim.simulate.SIGNALS`) as one
+    :func:`ptoverify.sim.simulate.simulate_batch` run of the law with per-state gains
+    (:func:`ptoverify.model.laws.with_state_gains`; each PTO candidate acts with the zone
     of its own d), in absolute coordinates with the law fed x1 - r as
-    :func:`ptoverify.simulate.simulate` does.  Overshoot and settling are read
+    :func:`ptoverify.sim.simulate.simulate` does.  Overshoot and settling are read
     between samples (:func:`_overshoot_batch`,
-    :func:`ptoverify.exact.settling_times_batch`); the 0.01 mm settling only with
+    :func:`ptoverify.sim.exact.settling_times_batch`); the 0.01 mm settling only with
     ``tight``.  These agree with :func:`evaluate` (the scalar simulation and
-    :mod:`ptoverify.exact`, the path of ``simulate --json``) to round-off, not bit
+    :mod:`ptoverify.sim.exact`, the path of ``simulate --json``) to round-off, not bit
     for bit: :func:`tune` re-measures on that path every candidate it reports.
     Tunings of one law on one configuration may share a screen.
     """
@@ -495,7 +495,7 @@ class _StepScreen:
                 out[i] = _Raw("sampled linear loop unstable", nan, nan, nan, None)
                 continue
             if law == "pto" and d not in omega0 and d not in failed:
-                from ptoverify.zones import zone_for_law
+                from ptoverify.model.zones import zone_for_law
 
                 try:
                     z = zone_for_law(tuned_config(cfg, law, gains), "corrected")
@@ -589,22 +589,22 @@ def _screened(
 
 
 #: Window and band of the gates' limit-cycle test (the defaults of
-#: :func:`ptoverify.properties.law_properties`; a test holds them equal).
+#: :func:`ptoverify.studies.properties.law_properties`; a test holds them equal).
 LIMIT_CYCLE_BAND = 1e-3  # [mm]
 
 
 def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
     """Limit cycles and stride-overs of ``law`` on the gates' grid.
 
-    The two counts of :func:`ptoverify.properties.law_properties` that the tuning's
+    The two counts of :func:`ptoverify.studies.properties.law_properties` that the tuning's
     constraints need, from the same pieces (its grid, horizon, simulation,
     limit-cycle test over the last quarter of the horizon, and the stride-overs of
-    its crossing masks as :func:`ptoverify.properties.stride_over_counts` counts
+    its crossing masks as :func:`ptoverify.studies.properties.stride_over_counts` counts
     them), without the other properties; the stride-overs are counted for the PTO
     only (0 for other laws).
 
     For an odd law (``Law.odd``) only one state of each mirrored pair of the grid
-    is simulated (:func:`ptoverify.sweep.mirror_pairs`, where every grid state's
+    is simulated (:func:`ptoverify.studies.sweep.mirror_pairs`, where every grid state's
     exact mirror is on the grid, as on the paper's; elsewhere, e.g. at a position
     range of 20 or 30 mm, every state), and each trajectory counts for its mirror
     image too: the plant is linear and the law odd bit for bit, so the mirror
@@ -644,8 +644,8 @@ def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
 def _gate_grid(cfg: Config, odd: bool):
     """States of the gates' grid to simulate, and how many grid states each stands for.
 
-    All of :func:`ptoverify.properties.initial_grid` (weights 1), or for an odd law
-    one state of each mirrored pair (:func:`ptoverify.sweep.mirror_pairs`), weighted
+    All of :func:`ptoverify.studies.properties.initial_grid` (weights 1), or for an odd law
+    one state of each mirrored pair (:func:`ptoverify.studies.sweep.mirror_pairs`), weighted
     by the number of grid states that are it or its mirror image (2 for a pair, 1
     for the origin).  Memoized on what the grid depends on; the arrays are read-only.
     """

@@ -5,10 +5,10 @@ For every initial state of a grid over the envelope |x1| <= position_range,
 simulation, exact ZOH flow, all states at once).  Its settling time is
 divided by two lower bounds:
 
-* t_f*, the continuous minimum time (closed form, :func:`~ptoverify.mintime.min_time`);
+* t_f*, the continuous minimum time (closed form, :func:`~ptoverify.model.mintime.min_time`);
 * N* T, the discrete-time limit: the fewest ZOH samples from which the origin
   can be reached exactly with |u_k| <= w_max
-  (:func:`~ptoverify.mintime.discrete_min_steps_batch`: exact 2-D zonotope
+  (:func:`~ptoverify.model.mintime.discrete_min_steps_batch`: exact 2-D zonotope
   membership, about 10^6 states/s; the LP search is its reference in the tests).
 
 Decisions (the issue is silent on them):
@@ -17,12 +17,12 @@ Decisions (the issue is silent on them):
   corners.  An even count per axis keeps the origin (t_f* = 0) off the grid.
   States are simulated in chunks of 4,096 (the trajectories of one chunk are
   held in memory, never the whole grid's).
-* Settled: |x1| <= ``band`` (0.01 mm, :data:`~ptoverify.metrics.TIGHT_BAND`)
+* Settled: |x1| <= ``band`` (0.01 mm, :data:`~ptoverify.sim.metrics.TIGHT_BAND`)
   and |x2| <= ``velocity_band`` (default a * band: a state coasting with
   u = 0 from the velocity band moves at most x2 / a = band further) on the
   continuous trajectory, from some time on until the end of the horizon.  The
   settling time is the last exit from that box, found exactly between samples
-  on the ZOH flow (:func:`ptoverify.exact.settling_times_batch`), including
+  on the ZOH flow (:func:`ptoverify.sim.exact.settling_times_batch`), including
   excursions out of the box between two samples that are both inside it.  A
   ratio can fall slightly below 1: settling to a band is easier than reaching
   the origin exactly.
@@ -57,11 +57,11 @@ from numpy.typing import NDArray
 
 from ptoverify.config import Config, Plant
 from ptoverify.errors import InputError
-from ptoverify.exact import BatchSettling, settling_times_batch
-from ptoverify.laws import LAW_NAMES, make_law
-from ptoverify.metrics import TIGHT_BAND
-from ptoverify.mintime import discrete_min_steps_batch, min_time
-from ptoverify.simulate import simulate_batch
+from ptoverify.model.laws import LAW_NAMES, make_law
+from ptoverify.model.mintime import discrete_min_steps_batch, min_time
+from ptoverify.sim.exact import BatchSettling, settling_times_batch
+from ptoverify.sim.metrics import TIGHT_BAND
+from ptoverify.sim.simulate import simulate_batch
 
 __all__ = [
     "SweepSettings",
@@ -420,7 +420,7 @@ def settling_times(
     BatchSettling
         ``time``: exact last exit from the box [s]; ``grid``: :func:`settle_steps`
         times T [s]; NaN where not settled (see
-        :func:`ptoverify.exact.settling_times_batch`).
+        :func:`ptoverify.sim.exact.settling_times_batch`).
     """
     run = _settling_odd if mirror else _settling_chunks
     return run(law, plant, x1, x2, steps, band, velocity_band, hold, chunk)[0]

@@ -6,7 +6,7 @@ for Markdown).  :func:`render_html` and :func:`render_markdown` print them.
 Every text that reaches the HTML goes through :func:`html.escape`; equations
 arrive as raw fragments of SymPy's presentation MathML (``derivations.render_html``).
 
-Used by :mod:`ptoverify.report` and :mod:`ptoverify.report_sections`, which
+Used by :mod:`ptoverify.report.collect` and :mod:`ptoverify.report.sections`, which
 both import it and not each other.
 """
 

@@ -1,6 +1,6 @@
 """User laws for ``ptoverify conform``: loading, vectorized/scalar detection, faults.
 
-Decisions (see also :mod:`ptoverify.conform`):
+Decisions (see also :mod:`ptoverify.conform.gate`):
 
 * ``MODULE:FUNCTION`` imports exactly the named module with
   :func:`importlib.import_module` (importable from ``sys.path`` as it stands;
@@ -29,8 +29,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ptoverify.agreement import failure
 from ptoverify.config import Config
+from ptoverify.conform.agreement import failure
 from ptoverify.errors import InputError
 
 __all__ = [

@@ -1,6 +1,6 @@
 """Conformance grid, tables, and agreement with the reference PTO law, region by region.
 
-Part of ``ptoverify conform`` (:mod:`ptoverify.conform` has the command's
+Part of ``ptoverify conform`` (:mod:`ptoverify.conform.gate` has the command's
 decisions).  Here:
 
 * :func:`conformance_grid`: a fixed grid dense near l1, l2, l1*, l2* (the zone
@@ -32,9 +32,9 @@ from numpy.typing import NDArray
 
 from ptoverify import verdict
 from ptoverify.config import Config
-from ptoverify.curves import level_curve_x1, level_residual, root_22, switching_function
 from ptoverify.errors import InputError
-from ptoverify.laws import Law, Region, make_law
+from ptoverify.model.curves import level_curve_x1, level_residual, root_22, switching_function
+from ptoverify.model.laws import Law, Region, make_law
 
 __all__ = [
     "DEFAULT_RTOL",
@@ -81,7 +81,7 @@ def tie_band(cfg: Config) -> float:
 
 def omega0_ref(cfg: Config) -> float | None:
     """omega0 [mm/s] the reference uses, None when it has no switching zone."""
-    from ptoverify.zones import zone_for_law
+    from ptoverify.model.zones import zone_for_law
 
     z = zone_for_law(cfg, "corrected")
     ok = z.usable and not z.degenerate and 0.0 < z.omega0 < cfg.plant.w_max

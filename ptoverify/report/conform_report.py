@@ -10,7 +10,7 @@ with one rename (:mod:`ptoverify.outdir`), so it is never half-written.
 What it shows, in order: the verdict with the first failing property and
 state; every property with measured / limit / unit and its first failing
 state; the agreement per reference region; the map of |u - u_ref| with the
-region boundaries (:mod:`ptoverify.conform_evidence`); the closed-loop
+region boundaries (:mod:`ptoverify.conform.evidence`); the closed-loop
 properties and settling / (N* T); the step, ramp and sine responses next to
 the reference (a ``--table`` has none, and the report says so); every failure.
 
@@ -28,10 +28,10 @@ from typing import Any
 import numpy as np
 
 from ptoverify.config import Config
-from ptoverify.conform import ConformResult
-from ptoverify.conform_evidence import ConformEvidence
+from ptoverify.conform.evidence import ConformEvidence
+from ptoverify.conform.gate import ConformResult
 from ptoverify.errors import InputError
-from ptoverify.render import Block, Section, render_html, render_markdown
+from ptoverify.report.render import Block, Section, render_html, render_markdown
 
 __all__ = ["check_report_target", "write_conform_report", "build_sections", "quantity", "state"]
 
@@ -455,7 +455,7 @@ def write_conform_report(
     result : ConformResult
         The verdict.
     ev : ConformEvidence
-        Output of :func:`ptoverify.conform_evidence.conform_with_evidence`.
+        Output of :func:`ptoverify.conform.evidence.conform_with_evidence`.
     cfg : Config
         Configuration.
     target : Path
@@ -468,7 +468,7 @@ def write_conform_report(
     """
     from ptoverify import __version__
     from ptoverify.outdir import discard, make_temp, publish
-    from ptoverify.plots import save_conform_figures
+    from ptoverify.report.plots import save_conform_figures
 
     r = result
     tmp = make_temp(target)

@@ -179,7 +179,7 @@ def as_signal(ref: Any) -> Signal:
     ref : Signal, object or tuple
         A :class:`Signal`; any object with ``name`` (or ``kind``), ``amplitude``
         and ``rate`` (or ``speed``, ``frequency``) attributes, as
-        ``ptoverify.simulate.Reference``; or a tuple
+        ``ptoverify.sim.simulate.Reference``; or a tuple
         ``(kind, amplitude[, rate])``.
 
     Returns
@@ -516,7 +516,7 @@ def overshoot(tr: Trajectory, target: float) -> tuple[float, float]:
 
     Examples
     --------
-    >>> from ptoverify.plant import flow
+    >>> from ptoverify.model.plant import flow
     >>> x1, x2 = flow(0.0, 20.0, -1.0, 0.1, 100.0)  # one sample of 0.1 s
     >>> tr = Trajectory.from_samples([0.0, 0.1], [0.0, x1], [20.0, x2], [-1.0], 100.0)
     >>> ov, tp = overshoot(tr, 0.15)  # both samples are below 0.15 mm
@@ -840,7 +840,7 @@ def grid_settling_time(t: ArrayLike, e: ArrayLike, band: float, *, hold: float =
     up to the end of the record.  A record that ends outside the band, or whose
     settled tail is shorter than ``hold``, has not settled: NaN.  This is the
     sample-grid twin of :func:`settling_time` (the ``grid`` value of
-    :class:`Compared`), and ``ptoverify.metrics.settling_time``.
+    :class:`Compared`), and ``ptoverify.sim.metrics.settling_time``.
 
     Parameters
     ----------
@@ -875,7 +875,7 @@ def grid_settling_time(t: ArrayLike, e: ArrayLike, band: float, *, hold: float =
 def grid_overshoot(x: ArrayLike, target: float, start: float = 0.0) -> float:
     """Overshoot on the samples: largest excursion past the target, in the direction of travel.
 
-    The sample-grid twin of :func:`overshoot` (and ``ptoverify.metrics.overshoot``).
+    The sample-grid twin of :func:`overshoot` (and ``ptoverify.sim.metrics.overshoot``).
 
     Parameters
     ----------
@@ -911,7 +911,7 @@ def grid_rise_time(
 ) -> float:
     """Rise time on the samples, from ``low`` to ``high`` of the way from ``start`` to target.
 
-    The sample-grid twin of :func:`rise_time` (and ``ptoverify.metrics.rise_time``):
+    The sample-grid twin of :func:`rise_time` (and ``ptoverify.sim.metrics.rise_time``):
     the first sample at or past the high level minus the first at or past the low level.
 
     Parameters
@@ -1236,8 +1236,8 @@ def settling_and_overshoot(
     Examples
     --------
     >>> from ptoverify.config import paper_config
-    >>> from ptoverify.laws import make_law
-    >>> from ptoverify.simulate import simulate
+    >>> from ptoverify.model.laws import make_law
+    >>> from ptoverify.sim.simulate import simulate
     >>> cfg = paper_config()
     >>> res = simulate(make_law("pd", cfg), cfg.plant, "step")
     >>> full = exact_metrics(res, cfg.plant).exact()
@@ -1305,8 +1305,8 @@ def exact_metrics(res: Any, plant: Any, reference: Any = None, **kwargs: Any) ->
     Examples
     --------
     >>> from ptoverify.config import paper_config
-    >>> from ptoverify.laws import make_law
-    >>> from ptoverify.simulate import simulate
+    >>> from ptoverify.model.laws import make_law
+    >>> from ptoverify.sim.simulate import simulate
     >>> cfg = paper_config()
     >>> res = simulate(make_law("pd", cfg), cfg.plant, "step")
     >>> m = exact_metrics(res, cfg.plant)
@@ -1344,7 +1344,7 @@ class BatchSettling:
         tail is shorter than ``hold``.
     grid : ndarray, shape (n,)
         Sample-grid settling time [s]: k T for the first sample k after the last
-        sample outside the box (``ptoverify.sweep.settle_steps``); NaN likewise,
+        sample outside the box (``ptoverify.studies.sweep.settle_steps``); NaN likewise,
         with the hold counted in whole samples, ceil(hold / T).
     accuracy : float
         Bound on the error of :attr:`time` [s] (see :func:`settling_times_batch`).
@@ -1399,7 +1399,7 @@ def settling_times_batch(
     hold : float
         Shortest settled tail that counts [s]: settled only if
         t_end - time >= hold - 1e-9 T (the grid value: whole samples,
-        ceil(hold / T - 1e-9), as ``ptoverify.sweep``).
+        ceil(hold / T - 1e-9), as ``ptoverify.studies.sweep``).
 
     Returns
     -------

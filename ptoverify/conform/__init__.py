@@ -1,0 +1,11 @@
+"""The conformance layer: gate a third-party PTO implementation against the reference.
+
+Catalogue
+---------
+gate       conform: the verdict for a callable or a table
+agreement  conformance grid (--emit-grid), CSV tables, per-region agreement
+userlaw    loading a user law, isolated in a child process
+evidence   the evidence behind a conform verdict (maps, responses, settling / N* T)
+testing    assert_conforms, for a team's own pytest suite (re-exported as ptoverify.testing)
+junit      JUnit XML from verdicts (check --junit, conform --junit)
+"""
