@@ -19,7 +19,7 @@ import numpy as np
 from ptoverify.config import Config
 from ptoverify.errors import InputError
 from ptoverify.model.laws import make_law
-from ptoverify.sim.runs import MAX_DURATION_S, SimulationRun, run_simulation
+from ptoverify.sim.runs import MAX_DURATION_S
 
 __all__ = [
     "run_regulation",
