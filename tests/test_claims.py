@@ -348,7 +348,7 @@ def test_response_metrics_show_exact_and_grid_for_every_section6_response():
         assert set(by_sig) == {"step", "ramp", "sine"}
         for sig, m in by_sig.items():
             exact_keys = [k for k in m if k + "_grid" in m]
-            assert "settling_tight_s" in exact_keys and "linear_zone_s" in exact_keys
+            assert "settling_0p01mm_s" in exact_keys and "linear_zone_s" in exact_keys
             if sig != "sine":
                 assert m["overshoot_mm"] >= m["overshoot_mm_grid"], (law, sig)
             if law.startswith("pto"):

@@ -216,7 +216,7 @@ def test_summarize_time_metrics_between_samples(paper_cfg, law, sig):
     T = paper_cfg.plant.T
     if sig != "sine":
         assert s["overshoot_mm"] >= s["overshoot_mm_grid"] >= 0.0
-    for key in ("settling_tight_s", "settling_2pct_s", "linear_zone_s"):
+    for key in ("settling_0p01mm_s", "settling_2pct_s", "linear_zone_s"):
         if key in s and math.isfinite(s[key + "_grid"]):
             assert s[key + "_grid"] - T <= s[key] <= s[key + "_grid"], f"{key} {s[key]}"
     grid_zone = m.time_to_linear_zone(res.t, res.region)

@@ -53,6 +53,7 @@ import numpy as np
 
 from ptoverify.config import Config
 from ptoverify.report.render import Section, render_html, render_markdown
+from ptoverify.report.results import TOP_LEVEL, Results, wrap
 
 __all__ = [
     "collect",
@@ -761,8 +762,34 @@ def _summary(out: dict[str, Any], gates: dict[str, Any]) -> dict[str, Any]:
 
 
 # ------------------------------------------------------------------ sections
+def results_view(public: dict[str, Any]) -> Results:
+    """Return the strict view of ``results.json`` that the sections read.
+
+    Parameters
+    ----------
+    public : dict
+        The JSON object written to ``results.json``.
+
+    Returns
+    -------
+    Results
+        Read-only; a missing field raises, never renders as a blank.
+
+    Raises
+    ------
+    ValueError
+        When a key of :data:`ptoverify.report.results.TOP_LEVEL` is missing or an
+        unknown one is present (a bug of the report, not bad input).
+    """
+    missing = [k for k in TOP_LEVEL if k not in public]
+    extra = sorted(set(public) - set(TOP_LEVEL))
+    if missing or extra:
+        raise ValueError(f"results.json keys: missing {missing}, unexpected {extra}")
+    return wrap(public)
+
+
 def build_sections(
-    res: dict[str, Any],
+    res: Results,
     figures: dict[str, str],
     records: list | None = None,
     rendered: dict | None = None,
@@ -771,8 +798,8 @@ def build_sections(
 
     Parameters
     ----------
-    res : dict
-        Output of :func:`collect` (JSON part).
+    res : Results
+        The strict view of ``results.json`` (:func:`results_view`).
     figures : dict
         Figure key -> relative path (``figures/x.png``).
     records : list of derivations.EquationRecord, optional
@@ -867,7 +894,9 @@ def write_report(
             "generated": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         }
         title = f"ptoverify verification report: {cfg.name}"
-        sections = build_sections(public, figures, res["_records"], res.get("_rendered"))
+        sections = build_sections(
+            results_view(public), figures, res["_records"], res.get("_rendered")
+        )
         (tmp / "results.json").write_text(
             json.dumps(public, indent=1, sort_keys=True, allow_nan=False) + "\n"
         )

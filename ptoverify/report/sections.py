@@ -129,7 +129,7 @@ def _finding_zone(res: dict[str, Any]) -> tuple[str, str, str] | None:
         f"The switching zone as printed is {'valid' if pr['valid'] else 'invalid'}: "
         f"omega0 = {qty(pr['omega0'], 'mm/s')} {where}; the corrected construction gives "
         f"omega0 = {qty(co['omega0'], 'mm/s')} ({'valid' if co['valid'] else 'invalid'}, "
-        f"{fmt(co.get('grid_violations'))} violations in {fmt(co.get('grid_points'))} grid "
+        f"{fmt(co['grid_violations'])} violations in {fmt(co['grid_points'])} grid "
         "states).",
         "zone",
         "zone geometry",
@@ -137,16 +137,16 @@ def _finding_zone(res: dict[str, Any]) -> tuple[str, str, str] | None:
 
 
 def _finding_settling(res: dict[str, Any]) -> tuple[str, str, str] | None:
-    step = {law: m["step"] for law, m in res.get("responses", {}).items()}
+    step = {law: m["step"] for law, m in res["responses"].items()}
     timed = {
         law: m["settling_2pct_s"]
         for law, m in step.items()
-        if m.get("settling_2pct_s") is not None and math.isfinite(m["settling_2pct_s"])
+        if m["settling_2pct_s"] is not None and math.isfinite(m["settling_2pct_s"])
     }
     sw = {
         law: v
         for law, v in res["sweep"]["laws"].items()
-        if v.get("percentiles_ratio_nt", {}).get("p50") is not None
+        if v["percentiles_ratio_nt"]["p50"] is not None
     }
     if not timed or not sw:
         return None
@@ -193,8 +193,8 @@ def _finding_claims(res: dict[str, Any]) -> tuple[str, str, str] | None:
     first = fail[0]
     parts = f"; {_claim_value_sentence(first)}" if first["measured"] is not None else ""
     tuned = ""
-    t = res.get("tuning")
-    c31 = next((c for c in (t or {}).get("claims", []) if c["id"] == "step-pd-31-percent"), None)
+    t = res["tuning"]
+    c31 = next((c for c in (t["claims"] if t else ()) if c["id"] == "step-pd-31-percent"), None)
     if c31 is not None:
         best = [r["measured"] for r in c31["readings"] if "best-tuned" in r["label"]]
         if best:
@@ -210,6 +210,11 @@ def _finding_claims(res: dict[str, Any]) -> tuple[str, str, str] | None:
         "claims",
         "claims with every reading",
     )
+
+
+def _count(counts: Any, verdict: str) -> int:
+    """Return how many claims have ``verdict`` (0 when the tally has no such verdict)."""
+    return counts[verdict] if verdict in counts else 0
 
 
 def c31_paper(res: dict[str, Any]) -> float | None:
@@ -235,11 +240,11 @@ def _claim_value_sentence(c: dict[str, Any]) -> str:
 
 
 def _finding_robust(res: dict[str, Any]) -> tuple[str, str, str] | None:
-    rob = res.get("robust")
+    rob = res["robust"]
     if not rob:
         return None
-    m = rob["margins"].get("pto", {})
-    iv = m.get("linear_loop_a_ratio_stable_delay1")
+    m = rob["margins"]["pto"] if "pto" in rob["margins"] else None
+    iv = None if m is None else m["linear_loop_a_ratio_stable_delay1"]
     if iv is None:
         lin = (
             "with a one-sample computation delay the PTO's linear zone is unstable even at the "
@@ -250,8 +255,8 @@ def _finding_robust(res: dict[str, Any]) -> tuple[str, str, str] | None:
             "with a one-sample computation delay the PTO's linear zone stays stable for "
             f"a_true / a_design in {_interval(iv)}"
         )
-    best = rob.get("most_robust", {})
-    if best.get("law"):
+    best = rob["most_robust"]
+    if best["law"]:
         w = best["log_width"]
         nxt = sorted((v for k, v in w.items() if k != best["law"]), reverse=True)
         by = f", {fmt(w[best['law']] - nxt[0])} [-] wider than the next" if nxt else ""
@@ -369,9 +374,9 @@ def summary(res: dict[str, Any]) -> list[Block]:
         [
             c["name"],
             c["status"],
-            qty(c["measured"], _GATE_UNITS.get(c.get("unit", ""), c.get("unit", ""))),
-            c.get("comparison", "<="),
-            qty(c["limit"], _GATE_UNITS.get(c.get("unit", ""), c.get("unit", ""))),
+            qty(c["measured"], _GATE_UNITS.get(c["unit"], c["unit"])),
+            c["comparison"],
+            qty(c["limit"], _GATE_UNITS.get(c["unit"], c["unit"])),
         ]
         for c in res["checks"]
     ]
@@ -419,8 +424,8 @@ def summary(res: dict[str, Any]) -> list[Block]:
         blocks.append(
             Block(
                 "p",
-                text=f"Section 6 claims not reproduced ({s['claim_verdicts'].get('not reproduced', 0)}) "
-                f"or holding under some readings only ({s['claim_verdicts'].get('ambiguous', 0)}). "
+                text=f"Section 6 claims not reproduced ({_count(s['claim_verdicts'], 'not reproduced')}) "
+                f"or holding under some readings only ({_count(s['claim_verdicts'], 'ambiguous')}). "
                 "'measured' is the primary reading (feed-forward, a = 2 pi f, corrected PTO), "
                 "between samples; the range spans every reading.",
             )
@@ -535,11 +540,11 @@ def _eq_links(head: str, ids: set[str]) -> str:
 def _counterexample_rows(ce: dict[str, Any], unit: str) -> tuple[list[str], list[list[str]]]:
     """Table rows of a counterexample: its point (with units), printed and derived values."""
     cols = [("random admissible point", ce)]
-    if isinstance(ce.get("at_plant"), dict):
+    if "at_plant" in ce and ce["at_plant"]:
         cols.append(("at this report's plant", ce["at_plant"]))
     names: list[str] = []
     for _, c in cols:
-        names += [k for k in c.get("point", {}) if k not in names]
+        names += [k for k in c["point"] if k not in names]
     extra = [k for k in ce if k not in ("point", "printed", "derived", "at_plant")]
     rows = []
     for n in names:
@@ -548,9 +553,7 @@ def _counterexample_rows(ce: dict[str, Any], unit: str) -> tuple[list[str], list
             [
                 f"{n}",
                 *[
-                    qty(c.get("point", {}).get(n), u)
-                    if u
-                    else fmt(c.get("point", {}).get(n)) + " (unit as in the paper)"
+                    qty(c["point"][n], u) if u else fmt(c["point"][n]) + " (unit as in the paper)"
                     for _, c in cols
                 ],
             ]
@@ -559,7 +562,7 @@ def _counterexample_rows(ce: dict[str, Any], unit: str) -> tuple[list[str], list
         u = "mm, mm/s" if isinstance(ce[n], list) and len(ce[n]) == 2 else ""
         rows.append([n.replace("_", " "), f"{fmt(ce[n])} {u}".strip(), *["" for _ in cols[1:]]])
     for which in ("printed", "derived"):
-        vals = [c.get(which) for _, c in cols]
+        vals = [c[which] for _, c in cols]
         vals = [v[0] if isinstance(v, list) and len(v) == 1 else v for v in vals]
         rows.append(
             [
@@ -634,7 +637,7 @@ def errata(res: dict[str, Any], records: list, rendered: dict | None = None) -> 
         done = rendered.get(r["id"], {})
         ml = done.get("mathml", {})
         unit = done.get("unit") or _expr_unit(r["derived"]) or _expr_unit(r["printed"])
-        head, rows = _counterexample_rows(r.get("counterexample") or {}, unit)
+        head, rows = _counterexample_rows(r["counterexample"] or {}, unit)
         tb = table(head, rows)
         forms = []
         for key, label in (
@@ -642,7 +645,7 @@ def errata(res: dict[str, Any], records: list, rendered: dict | None = None) -> 
             ("derived", "derived"),
             ("corrected", "corrected"),
         ):
-            if r.get(key):
+            if r[key]:
                 m = ml.get(key, "")
                 body = _MATH.format(m) if m else f"<code>{html.escape(r[key])}</code>"
                 forms.append(f"<tr><th>{label}</th><td>{body}</td></tr>")
@@ -803,10 +806,10 @@ def zone(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 [
                     key.replace("_", " "),
                     v["omega0"],
-                    v.get("x20_tilde"),
-                    v.get("margin_mm_s"),
+                    v["x20_tilde"],
+                    v["margin_mm_s"],
                     v["valid"],
-                    v.get("degenerate"),
+                    v["degenerate"],
                     v["reason"],
                 ]
             )
@@ -824,8 +827,6 @@ def zone(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             rows,
         )
     ]
-    for name, o in (z.get("outcome") or {}).items():
-        blocks.append(Block("p", text=f"Closed-loop outcome of {name}: {fmt(o)}"))
     blocks += image(figures, "zone_geometry", "Zone geometry, sampled trajectories by region")
     for key in sorted(figures):
         if key.startswith(("fig04", "fig05", "fig06")):
@@ -915,8 +916,7 @@ _PROPERTY_COLUMNS = (
 def properties(res: dict[str, Any]) -> list[Block]:
     """Stride-overs, limit cycles, chattering, |u| over the grid."""
     rows = [
-        [_law(law), *[p.get(k) for k, _ in _PROPERTY_COLUMNS]]
-        for law, p in res["properties"].items()
+        [_law(law), *[p[k] for k, _ in _PROPERTY_COLUMNS]] for law, p in res["properties"].items()
     ]
     return [table(["law", *[h for _, h in _PROPERTY_COLUMNS]], rows)]
 
@@ -925,7 +925,7 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     """Every claim: what is measured, paper value, value between samples and on the grid."""
     rows = []
     for c in res["claims"]:
-        differs = not _same(c["measured"], c.get("measured_grid"))
+        differs = not _same(c["measured"], c["measured_grid"])
         rows.append(
             [
                 f"Sec. {c['section']}",
@@ -934,25 +934,25 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 measured_quantity(c),
                 _claim_qty(c["paper_value"], c["unit"]),
                 _claim_qty(c["measured"], c["unit"]),
-                _claim_qty(c.get("measured_grid"), c["unit"]) if differs else "same",
+                _claim_qty(c["measured_grid"], c["unit"]) if differs else "same",
                 c["verdict"],
-                c.get("verdict_grid") or "n/a",
+                c["verdict_grid"] or "n/a",
                 c["detail"],
             ]
         )
     readings = []
     for c in res["claims"]:
         for r in c["readings"]:
-            differs = not _same(r["measured"], r.get("measured_grid"))
+            differs = not _same(r["measured"], r["measured_grid"])
             readings.append(
                 [
                     c["id"],
                     r["label"],
                     _claim_qty(r["measured"], c["unit"]),
-                    _claim_qty(r.get("measured_grid"), c["unit"]) if differs else "same",
+                    _claim_qty(r["measured_grid"], c["unit"]) if differs else "same",
                     r["verdict"],
-                    r.get("verdict_grid") or "n/a",
-                    ", ".join(r.get("ties") or []) or "none",
+                    r["verdict_grid"] or "n/a",
+                    ", ".join(r["ties"] or []) or "none",
                 ]
             )
     blocks = [
@@ -992,7 +992,7 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             readings,
         ),
     ]
-    resp = res.get("responses")
+    resp = res["responses"]
     if resp:
         keys = (
             ("settling_2pct_s", "2 % settling"),
@@ -1005,7 +1005,7 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             m = by["step"]
             cells = []
             for k, _ in keys:
-                ex, gr = m.get(k), m.get(f"{k}_grid")
+                ex, gr = m[k], m[f"{k}_grid"]
                 val = _ms(ex) if k.endswith("_s") else qty(ex, "mm")
                 if gr is not None and not _same(ex, gr):
                     val += f" (grid {_ms(gr) if k.endswith('_s') else qty(gr, 'mm')})"
@@ -1030,15 +1030,15 @@ def sweep(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     sw = res["sweep"]
     rows = []
     for law, v in sw["laws"].items():
-        ptf = v.get("percentiles_ratio_tf") or {}
-        pnt = v.get("percentiles_ratio_nt") or {}
+        ptf = v["percentiles_ratio_tf"] or {}
+        pnt = v["percentiles_ratio_nt"] or {}
         rows.append(
             [
                 _law(law),
                 qty(100 * v["fraction_settled"], "%"),
-                *[ptf.get(k) for k in ("p50", "p95", "p99", "max")],
+                *[ptf[k] for k in ("p50", "p95", "p99", "max")],
                 v["worst_state_tf"],
-                *[pnt.get(k) for k in ("p50", "p95", "p99", "max")],
+                *[pnt[k] for k in ("p50", "p95", "p99", "max")],
                 v["worst_state_nt"],
             ]
         )
@@ -1113,8 +1113,8 @@ def simulate_command(law: str, worst: dict[str, Any]) -> str:
     )
     x1, x2 = worst["state"]
     parts = ["ptoverify simulate", f"--law {law}", f"--x0 {float(x1)!r} {float(x2)!r}"]
-    p = worst.get("params") or {}
-    parts += [f"{flag} {p[k]!r}" for k, flag in flags if p.get(k) is not None]
+    p = worst["params"] or {}
+    parts += [f"{flag} {p[k]!r}" for k, flag in flags if p[k] is not None]
     return " ".join(parts)
 
 
@@ -1132,7 +1132,7 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     -------
     list of Block
     """
-    rob = res.get("robust")
+    rob = res["robust"]
     if not rob:
         return [
             Block(
@@ -1141,7 +1141,7 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 "`ptoverify robust` runs the study.",
             )
         ]
-    box, st = rob["box"], rob.get("settings", {})
+    box, st = rob["box"], rob["settings"]
     maps = rob["maps"]
     blocks = [
         Block(
@@ -1154,8 +1154,8 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             f"Laws: {', '.join(_law(k) for k in maps['laws'])}. "
             f"Maps: {len(maps['a_ratio'])} x {len(maps['w_max_ratio'])} perturbations per delay, "
             f"{maps['states']} initial states each (settings: "
-            f"{st.get('n1')} x {st.get('n2')} grid + {st.get('rest')} at rest, worst-case search "
-            f"{st.get('search_iterations')} generations of {st.get('search_population')}; "
+            f"{st['n1']} x {st['n2']} grid + {st['rest']} at rest, worst-case search "
+            f"{st['search_iterations']} generations of {st['search_population']}; "
             "as `ptoverify robust` with this configuration).",
         )
     ]
@@ -1164,18 +1164,18 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
         rows.append(
             [
                 _law(law),
-                _interval(m.get("linear_loop_a_ratio_stable"))
-                if m.get("linear_loop_a_ratio_stable")
-                else m.get("linear_loop_note") or "n/a",
-                _interval(m.get("linear_loop_a_ratio_stable_delay1"))
-                if m.get("linear_loop_a_ratio_stable_delay1")
-                else m.get("linear_loop_note_delay1") or "n/a",
-                _interval(m.get("no_limit_cycle_a_ratio"))
-                if m.get("no_limit_cycle_a_ratio")
-                else m.get("no_limit_cycle_note") or "n/a",
+                _interval(m["linear_loop_a_ratio_stable"])
+                if m["linear_loop_a_ratio_stable"]
+                else m["linear_loop_note"] or "n/a",
+                _interval(m["linear_loop_a_ratio_stable_delay1"])
+                if m["linear_loop_a_ratio_stable_delay1"]
+                else m["linear_loop_note_delay1"] or "n/a",
+                _interval(m["no_limit_cycle_a_ratio"])
+                if m["no_limit_cycle_a_ratio"]
+                else m["no_limit_cycle_note"] or "n/a",
             ]
         )
-    best = rob.get("most_robust", {})
+    best = rob["most_robust"]
     blocks += [
         Block(
             "p",
@@ -1193,7 +1193,7 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             rows,
         ),
     ]
-    if best.get("law"):
+    if best["law"]:
         blocks.append(
             Block(
                 "p",
@@ -1219,30 +1219,26 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     for law, by in rob["worst"].items():
         for prop, w in by.items():
             words, unit = _PROP_WORDS.get(prop, (prop, "-"))
-            p = w.get("params") or {}
+            p = w["params"] or {}
             wrows.append(
                 [
                     _law(law),
                     words,
-                    "unbounded (never settles)"
-                    if w.get("grid_unbounded")
-                    else qty(w.get("grid"), unit),
-                    "unbounded (never settles)"
-                    if w.get("unbounded")
-                    else qty(w.get("searched"), unit),
+                    "unbounded (never settles)" if w["grid_unbounded"] else qty(w["grid"], unit),
+                    "unbounded (never settles)" if w["unbounded"] else qty(w["searched"], unit),
                     f"({fmt(w['state'][0])} mm, {fmt(w['state'][1])} mm/s)"
-                    if w.get("state")
+                    if w["state"]
                     else "n/a",
-                    f"a ratio {fmt(p.get('a_ratio'))} [-], w_max ratio {fmt(p.get('w_max_ratio'))} "
-                    f"[-], delay {fmt(p.get('delay_samples'))} samples",
+                    f"a ratio {fmt(p['a_ratio'])} [-], w_max ratio {fmt(p['w_max_ratio'])} "
+                    f"[-], delay {fmt(p['delay_samples'])} samples",
                 ]
             )
             bad = (
-                w.get("searched") is not None
+                w["searched"] is not None
                 and w["searched"] > 0
                 and prop in ("stride_overs", "limit_cycle_mm")
             )
-            if bad and w.get("state"):
+            if bad and w["state"]:
                 cmds.append(
                     f"# {_law(law)}: {words} {qty(w['searched'], unit)}\n"
                     + simulate_command(law, w)
@@ -1290,7 +1286,7 @@ def tuning(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     -------
     list of Block
     """
-    t = res.get("tuning")
+    t = res["tuning"]
     if not t:
         return [
             Block(
@@ -1299,9 +1295,9 @@ def tuning(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 "`ptoverify tune --law pd|pto` runs the search.",
             )
         ]
-    fl, bud = t["floor"], t.get("budget", {})
+    fl, bud = t["floor"], t["budget"]
     bounds = "; ".join(
-        f"{t['bound_meaning'].get(k, k)}: {qty(v, 'mm')}" for k, v in t["bounds_mm"].items()
+        f"{t['bound_meaning'][k]}: {qty(v, 'mm')}" for k, v in t["bounds_mm"].items()
     )
     blocks = [
         Block(
@@ -1310,8 +1306,8 @@ def tuning(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             "settling time of the step (between samples) under each shared overshoot bound ("
             f"{bounds}), with a stable sampled linear loop and, for the PTO, no stride-over and "
             "no limit cycle over the gate's grid (omega0 from the corrected construction for its "
-            f"d). Differential evolution, seed {bud.get('seed')}, {bud.get('maxiter')} "
-            f"generations, population factor {bud.get('popsize')} ({t['evaluations']} "
+            f"d). Differential evolution, seed {bud['seed']}, {bud['maxiter']} "
+            f"generations, population factor {bud['popsize']} ({t['evaluations']} "
             "candidates; `ptoverify tune` searches longer). The floor of any 2 % settling time: "
             f"the least 2 % band entry {_ms(fl['band_entry_s'])}; the exact arrival needs "
             f"t_f* = {_ms(fl['tf_s'])} (continuous) and N* T = {_ms(fl['nt_s'])} (sampled).",
@@ -1324,11 +1320,11 @@ def tuning(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 "paper's gains",
                 _law(law),
                 "as configured",
-                _ms(m.get("settling_2pct_s")),
-                qty(m.get("overshoot_mm"), "mm"),
-                _ms(m.get("rise_time_s")),
-                _ms(m.get("settling_0p01mm_s")),
-                qty(m.get("worst_ratio_nt"), "-"),
+                _ms(m["settling_2pct_s"]),
+                qty(m["overshoot_mm"], "mm"),
+                _ms(m["rise_time_s"]),
+                _ms(m["settling_0p01mm_s"]),
+                qty(m["worst_ratio_nt"], "-"),
             ]
         )
     for name, by in t["best"].items():
@@ -1338,11 +1334,11 @@ def tuning(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                     f"best, overshoot <= {qty(t['bounds_mm'][name], 'mm')}",
                     _law(law),
                     _gains(b["gains"]),
-                    _ms(b.get("settling_2pct_s")),
-                    qty(b.get("overshoot_mm"), "mm"),
-                    _ms(b.get("rise_time_s")),
-                    _ms(b.get("settling_0p01mm_s")),
-                    qty(b.get("worst_ratio_nt"), "-"),
+                    _ms(b["settling_2pct_s"]),
+                    qty(b["overshoot_mm"], "mm"),
+                    _ms(b["rise_time_s"]),
+                    _ms(b["settling_0p01mm_s"]),
+                    qty(b["worst_ratio_nt"], "-"),
                 ]
             )
     blocks += [
@@ -1401,7 +1397,7 @@ def environment(res: dict[str, Any]) -> list[Block]:
     """Versions, configuration (with units), commit, date."""
     env = res["environment"]
     rows = [[k, v] for k, v in env.items() if k != "config"]
-    rows.append(["generated", res.get("meta", {}).get("generated")])
+    rows.append(["generated", res["meta"]["generated"]])
     cfg_rows = []
     for sec, vals in env["config"].items():
         for k, v in vals.items() if isinstance(vals, dict) else [("", vals)]:

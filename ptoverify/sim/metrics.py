@@ -335,7 +335,7 @@ def summarize(
     the samples (:func:`ptoverify.sim.exact.exact_metrics`); each has its
     sample-grid value beside it under the same key suffixed ``_grid`` (the
     same definition restricted to the samples), so a reader sees both where
-    they differ: ``settling_tight_s``, ``settling_2pct_s``, ``overshoot_mm``,
+    they differ: ``settling_0p01mm_s``, ``settling_2pct_s``, ``overshoot_mm``,
     ``rise_time_s`` (step), ``linear_zone_s``, ``phase_delay_deg`` and
     ``amplitude_ratio`` (sine).  The other metrics are properties of the
     sampled sequence and have no ``_grid`` twin: ``steady_amplitude_mm`` and
@@ -393,7 +393,7 @@ def summarize(
     def both(key: str, name: str) -> None:
         out[key], out[key + "_grid"] = m[name].exact, m[name].grid
 
-    both("settling_tight_s", "settling_0p01mm_s")
+    both("settling_0p01mm_s", "settling_0p01mm_s")
     if d is None:
         out["linear_zone_s"] = out["linear_zone_s_grid"] = time_to_linear_zone(t, res.region)
     else:

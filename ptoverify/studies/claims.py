@@ -558,7 +558,7 @@ def _ramp_pto_smooth(c: _Ctx, cl: _Claim) -> Outcome:
         float(rev),
         {
             "error_reversals": rev,
-            "settling_tight_s": ts,
+            "settling_0p01mm_s": ts,
             "overshoot_mm": c.overshoot("pto", "ramp"),
         },
         ok,
