@@ -270,12 +270,12 @@ def unit_problems(sections) -> list[str]:
 def _sections(folder: Path):
     """The sections of a written report rebuilt from its results.json and records."""
     import derivations
-    from ptoverify.report.collect import build_sections
+    from ptoverify.report.collect import build_sections, results_view
 
     data = json.loads((folder / "results.json").read_text())
     records = [derivations.EquationRecord.from_json(r) for r in data["derivations"]]
     figures = {Path(f).stem: f for f in data["meta"]["figures"]}
-    return build_sections(data, figures, records)
+    return build_sections(results_view(data), figures, records)
 
 
 @pytest.mark.slow
@@ -512,3 +512,82 @@ def test_pool_from_an_unguarded_script(tmp_path):
     )
     assert res.returncode == 0, res.stderr[-2000:]
     assert res.stdout.split() == ["script", "ran", "stage", "error", "arrived"], res.stdout
+
+
+# ------------------------------------------------------------------ typed, traced results
+def _texts_shown(folder: Path) -> list[str]:
+    """Every table cell and headline sentence of a written report, rebuilt from its JSON."""
+    from ptoverify.report import sections as rs
+    from ptoverify.report.collect import results_view
+
+    data = json.loads((folder / "results.json").read_text())
+    texts = [s for s, _, _ in rs.headline_findings(results_view(data))]
+    for _anchor, _title, blocks in _sections(folder):
+        for b in blocks:
+            if b.kind == "table":
+                texts += [str(c) for row in b.rows for c in row]
+    return texts
+
+
+@pytest.mark.slow
+def test_every_number_in_tables_and_headline_traces_to_results_json(two_reports):
+    from traceability import untraced
+
+    for folder in two_reports:
+        data = json.loads((folder / "results.json").read_text())
+        texts = _texts_shown(folder)
+        assert len(texts) > 200, "the check must see the report's tables"
+        bad = untraced(texts, data)
+        assert not bad, "numbers shown that no results.json field holds:\n" + "\n".join(
+            f"{n}: {t[:120]}" for n, t in bad[:20]
+        )
+
+
+def test_traceability_flags_a_number_no_field_holds():
+    from traceability import untraced
+
+    results = {"step": {"settling_s": 0.03771}, "note": "PD takes 36.4 % more"}
+    assert untraced(["37.71 ms", "PD takes 36.4 % more"], results) == []
+    assert untraced(["37.72 ms"], results) == [("37.72", "37.72 ms")]
+    assert untraced(["worst 4.5 [-]"], results) == [("4.5", "worst 4.5 [-]")]
+
+
+@pytest.mark.slow
+def test_a_renamed_result_field_fails_the_report_not_a_blank_cell(two_reports):
+    """The class of the 'never' table: a section asks for a field the results do not hold."""
+    from ptoverify.report.collect import build_sections, results_view
+    from ptoverify.report.results import MissingField
+
+    data = json.loads((two_reports[0] / "results.json").read_text())
+    step = data["responses"]["pd"]["step"]
+    step["settling_tight_s"] = step.pop("settling_0p01mm_s")
+    with pytest.raises(MissingField, match=r"results\.responses\.pd\.step has no field"):
+        build_sections(results_view(data), {}, [])
+
+
+@pytest.mark.slow
+def test_results_json_follows_its_schema(two_reports):
+    import jsonschema
+
+    schema = json.loads((ROOT / "ptoverify" / "report" / "results.schema.json").read_text())
+    jsonschema.Draft202012Validator.check_schema(schema)
+    for folder in (*two_reports, ROOT / "reports" / "paper"):
+        data = json.loads((folder / "results.json").read_text())
+        jsonschema.validate(data, schema)
+    data = json.loads((two_reports[0] / "results.json").read_text())
+    data["sweep"]["laws"]["pto"]["worst_ratio_nt"] = "4.5"
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(data, schema)
+
+
+def test_results_view_is_strict_and_read_only():
+    from ptoverify.report.results import MissingField, Results
+
+    r = Results({"a": {"b": [1, {"c": None}]}})
+    assert r.a.b[1].c is None and r["a"]["b"][0] == 1
+    with pytest.raises(MissingField, match=r"results\.a\.b\[1\] has no field 'd'"):
+        _ = r.a.b[1].d
+    with pytest.raises(MissingField):
+        r.a.get("b")  # no defaults: a renamed field can never read as missing
+    with pytest.raises(AttributeError):
+        r.a = 1

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import html
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -97,7 +98,7 @@ def fmt(v: Any, digits: int = 4) -> str:
         return f"{v:.{digits}g}"
     if isinstance(v, (list, tuple)):
         return "(" + ", ".join(fmt(x, digits) for x in v) + ")"
-    if isinstance(v, dict):
+    if isinstance(v, Mapping):
         return "; ".join(f"{k} = {fmt(x, digits)}" for k, x in v.items())
     return str(v)
 

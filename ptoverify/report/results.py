@@ -18,7 +18,7 @@ TOP_LEVEL     the keys every ``results.json`` has, in order
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 __all__ = ["Results", "MissingField", "TOP_LEVEL", "wrap"]
@@ -182,3 +182,8 @@ class Results:
         import copy
 
         return copy.deepcopy(self._data)
+
+
+# A Mapping for isinstance checks (formatters print it as "k = v; ..."), without
+# inheriting Mapping's ``get``: a default would hide a renamed field.
+Mapping.register(Results)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import html
 import math
 import re
+from collections.abc import Mapping
 from typing import Any
 
 from ptoverify.report.render import (
@@ -258,11 +259,9 @@ def _finding_robust(res: dict[str, Any]) -> tuple[str, str, str] | None:
     best = rob["most_robust"]
     if best["law"]:
         w = best["log_width"]
-        nxt = sorted((v for k, v in w.items() if k != best["law"]), reverse=True)
-        by = f", {fmt(w[best['law']] - nxt[0])} [-] wider than the next" if nxt else ""
         tail = (
             f"; the most robust linear loop is {_law(best['law'])} (ln(hi / lo) = "
-            f"{fmt(w[best['law']])} [-] without delay{by})"
+            f"{fmt(w[best['law']])} [-] without delay)"
         )
     else:
         tail = ""
@@ -559,11 +558,11 @@ def _counterexample_rows(ce: dict[str, Any], unit: str) -> tuple[list[str], list
             ]
         )
     for n in extra:
-        u = "mm, mm/s" if isinstance(ce[n], list) and len(ce[n]) == 2 else ""
+        u = "mm, mm/s" if isinstance(ce[n], (list, tuple)) and len(ce[n]) == 2 else ""
         rows.append([n.replace("_", " "), f"{fmt(ce[n])} {u}".strip(), *["" for _ in cols[1:]]])
     for which in ("printed", "derived"):
         vals = [c[which] for _, c in cols]
-        vals = [v[0] if isinstance(v, list) and len(v) == 1 else v for v in vals]
+        vals = [v[0] if isinstance(v, (list, tuple)) and len(v) == 1 else v for v in vals]
         rows.append(
             [
                 f"{which} form, evaluated",
@@ -853,7 +852,7 @@ def poles(res: dict[str, Any]) -> list[Block]:
             ]
         )
     ce = res["poles"]["lyapunov_counterexample"]
-    scalars = {k: v for k, v in ce.items() if not isinstance(v, (dict, list))}
+    scalars = {k: v for k, v in ce.items() if not isinstance(v, (Mapping, list, tuple))}
     return [
         table(
             [
@@ -1114,7 +1113,7 @@ def simulate_command(law: str, worst: dict[str, Any]) -> str:
     x1, x2 = worst["state"]
     parts = ["ptoverify simulate", f"--law {law}", f"--x0 {float(x1)!r} {float(x2)!r}"]
     p = worst["params"] or {}
-    parts += [f"{flag} {p[k]!r}" for k, flag in flags if p[k] is not None]
+    parts += [f"{flag} {p[k]!r}" for k, flag in flags if k in p and p[k] is not None]
     return " ".join(parts)
 
 
@@ -1400,10 +1399,10 @@ def environment(res: dict[str, Any]) -> list[Block]:
     rows.append(["generated", res["meta"]["generated"]])
     cfg_rows = []
     for sec, vals in env["config"].items():
-        for k, v in vals.items() if isinstance(vals, dict) else [("", vals)]:
+        for k, v in vals.items() if isinstance(vals, Mapping) else [("", vals)]:
             key = f"{sec}.{k}" if k else sec
             unit = CONFIG_UNITS.get(key)
-            if isinstance(v, (int, float, list)) and not isinstance(v, bool):
+            if isinstance(v, (int, float, list, tuple)) and not isinstance(v, bool):
                 cell = qty(v, unit) if unit is not None else f"{fmt(v)} (unit not recorded)"
             else:
                 cell = fmt(v)
