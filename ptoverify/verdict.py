@@ -81,6 +81,8 @@ class Verdict:
         How ``measured`` must relate to ``limit`` to pass: ``<=``, ``>=`` or ``<``.
     unit : str
         Unit of ``measured`` and ``limit`` (``"1"`` when dimensionless, ``""`` unknown).
+    description : str
+        What the gate or property checks, in one sentence (``""`` when not given).
     """
 
     name: str
@@ -90,6 +92,7 @@ class Verdict:
     detail: str
     comparison: str = "<="
     unit: str = ""
+    description: str = ""
 
     @property
     def passed(self) -> bool:

@@ -817,6 +817,7 @@ def build_sections(
 
     recs = records if records is not None else res["_records"]
     parts = [
+        ("verdict", "Verdict: the paper's standing", rs.verdict(res)),
         ("findings", "Headline findings", rs.headline(res, figures)),
         ("summary", "Summary: gates, errata, claims", rs.summary(res)),
         ("errata", "Errata in the paper", rs.errata(res, recs, rendered)),
@@ -831,7 +832,7 @@ def build_sections(
         ("tuning", "Can any tuning reproduce the paper?", rs.tuning(res, figures)),
         ("environment", "Environment", rs.environment(res)),
     ]
-    return [(a, t if i == 0 else f"{i}. {t}", b) for i, (a, t, b) in enumerate(parts)]
+    return [(a, t if i < 2 else f"{i - 1}. {t}", b) for i, (a, t, b) in enumerate(parts)]
 
 
 # ------------------------------------------------------------------ writing

@@ -65,6 +65,38 @@ def _ms(seconds: float | None) -> str:
     return qty(1e3 * seconds, "ms")
 
 
+# ------------------------------------------------------------------ verdict
+def verdict(res: Any) -> list[Block]:
+    """Show the paper's standing in one screen: the drive engineer's and the reviewer's verdicts.
+
+    Parameters
+    ----------
+    res : Results
+        The results (:class:`ptoverify.report.results.Results`).
+
+    Returns
+    -------
+    list of Block
+    """
+    from ptoverify.report.standing import adoption, engineer_rows, reviewer_rows
+
+    return [
+        Block("p", text=adoption(res)),
+        table(["question (drive engineer)", "answer", "evidence"], engineer_rows(res)),
+        table(
+            ["claim of the paper (reviewer)", "standing", "condition", "paper", "measured"],
+            reviewer_rows(res),
+        ),
+        Block(
+            "p",
+            text="'holds': every reading tried reproduces the claim; 'fails': none does; "
+            "'depends': some do, and the condition names what decides it. Readings: the "
+            "bandwidth's a as 2 pi f or as f in rad/s, the settling band, the PTO's zone as "
+            "printed or corrected, the tracking, the tuning (see section claims).",
+        ),
+    ]
+
+
 # ------------------------------------------------------------------ headline
 def headline_findings(res: dict[str, Any]) -> list[tuple[str, str, str]]:
     """Return the report's headline: at most six one-sentence findings, each from the results.
@@ -105,7 +137,7 @@ def _finding_errata(res: dict[str, Any]) -> tuple[str, str, str] | None:
     down = _downstream_ids(first["inherits"])
     tail = (
         f"; the first, eq. ({first['id']}), changes {len(down)} downstream equation groups "
-        f"({', '.join(down)})"
+        f"({'; '.join(down)})"
         if down
         else f"; the first is eq. ({first['id']})"
     )
@@ -137,80 +169,87 @@ def _finding_zone(res: dict[str, Any]) -> tuple[str, str, str] | None:
     )
 
 
-def _finding_settling(res: dict[str, Any]) -> tuple[str, str, str] | None:
-    step = {law: m["step"] for law, m in res["responses"].items()}
-    timed = {
-        law: m["settling_2pct_s"]
-        for law, m in step.items()
-        if m["settling_2pct_s"] is not None and math.isfinite(m["settling_2pct_s"])
-    }
-    sw = {
-        law: v
-        for law, v in res["sweep"]["laws"].items()
-        if v["percentiles_ratio_nt"]["p50"] is not None
-    }
-    if not timed or not sw:
+def _finding_settling(res: Any) -> tuple[str, str, str] | None:
+    """State which law settles the step first, under each reading of a and at best tuning.
+
+    Both numbers stand in the same sentence, so the finding cannot overstate.
+    """
+    from ptoverify.report.standing import _step_readings, _value_words
+
+    step = _step_readings(res)
+    if not step:
         return None
-    fast = min(timed, key=timed.get)
-    others = ", ".join(
-        f"{_law(k)} {_ms(v)}" for k, v in sorted(timed.items(), key=lambda kv: kv[1]) if k != fast
-    )
-    never = [k for k in step if k not in timed]
-    env = min(sw, key=lambda k: sw[k]["percentiles_ratio_nt"]["p50"])
-    pe = sw[env]["percentiles_ratio_nt"]
-    rest = "; ".join(
-        f"{_law(k)} {fmt(v['percentiles_ratio_nt']['p50'])} [-] (p95 "
-        f"{fmt(v['percentiles_ratio_nt']['p95'])} [-])"
-        for k, v in sw.items()
-        if k != env
-    )
-    grid = res["sweep"]["grid"]
-    return (
-        f"{_law(fast)} settles fastest from the step (2 % band, between samples: "
-        f"{_ms(timed[fast])}; {others}"
-        + (f"; {', '.join(_law(k) for k in never)} never" if never else "")
-        + f"), and over the envelope ({grid[0]} x {grid[1]} states) {_law(env)} has the "
-        f"lowest settling / (N* T): median {fmt(pe['p50'])} [-], p95 {fmt(pe['p95'])} [-] "
-        f"(vs {rest}).",
-        "sweep",
-        "responses and suboptimality maps",
-    )
-
-
-def _finding_claims(res: dict[str, Any]) -> tuple[str, str, str] | None:
-    cl = res["claims"]
-    fail = [
-        c
-        for c in cl
-        if c["readings"] and all(r["verdict"] == "not reproduced" for r in c["readings"])
-    ]
-    ok = sum(c["verdict"] == "reproduced" for c in cl)
-    if not fail:
-        return (
-            f"No Section 6 claim fails under every reading ({ok} of {len(cl)} reproduced).",
-            "claims",
-            "claims",
+    parts = []
+    for a, r in step.items():
+        v = r["values"]
+        pd, pto = v["settling_pd_s"], v["settling_pto_s"]
+        if pd is None or pto is None:
+            continue
+        fast = "PD" if pd < pto else "the corrected PTO"
+        parts.append(
+            f"under {_value_words('a', a)} {fast} settles first (PD {_ms(pd)}, PTO {_ms(pto)})"
         )
-    first = fail[0]
-    parts = f"; {_claim_value_sentence(first)}" if first["measured"] is not None else ""
-    tuned = ""
-    t = res["tuning"]
-    c31 = next((c for c in (t["claims"] if t else ()) if c["id"] == "step-pd-31-percent"), None)
-    if c31 is not None:
-        best = [r["measured"] for r in c31["readings"] if "best-tuned" in r["label"]]
-        if best:
-            tuned = (
-                "; with both laws at their best tuning under a shared overshoot bound, PD's "
-                "settling time exceeds the PTO's by "
-                + " and ".join(qty(v, "%") for v in best)
-                + f" (paper: {qty(c31_paper(res), '%')}; {c31['verdict']})"
-            )
-    return (
-        f"{len(fail)} of {len(cl)} Section 6 claims fail under every reading tried "
-        f"({', '.join(c['id'] for c in fail)}){parts}{tuned}.",
-        "claims",
-        "claims with every reading",
+    if not parts:
+        return None
+    text = "At the paper's gains the 5 mm step's 2 % settling depends on the reading: " + (
+        "; ".join(parts)
     )
+    t = res["tuning"]
+    if t is not None:
+        tuned = [
+            f"PD {_ms(by['pd']['settling_2pct_s'])} vs PTO {_ms(by['pto']['settling_2pct_s'])} "
+            f"at overshoot <= {qty(t['bounds_mm'][name], 'mm')}"
+            for name, by in t["best"].items()
+            if "pd" in by and "pto" in by
+        ]
+        if tuned:
+            text += "; at each law's best tuning (a = 2 pi f): " + "; ".join(tuned)
+    sw = res["sweep"]["laws"]
+    if "pd" in sw and "pto" in sw:
+        pd, pto = sw["pd"]["percentiles_ratio_nt"], sw["pto"]["percentiles_ratio_nt"]
+        grid = res["sweep"]["grid"]
+        text += (
+            f". Over the envelope ({grid[0]} x {grid[1]} states, paper's gains) settling / (N* T) "
+            f"has median PD {fmt(pd['p50'])} [-], PTO {fmt(pto['p50'])} [-]"
+        )
+    return (text + ".", "sweep", "responses and suboptimality maps")
+
+
+def _finding_claims(res: Any) -> tuple[str, str, str] | None:
+    from ptoverify.report.standing import claim_standing
+
+    cl = res["claims"]
+    fail = [c for c in cl if claim_standing(c)[0] == "fails"]
+    depends = [c for c in cl if claim_standing(c)[0] == "depends"]
+    text = (
+        f"Of {len(cl)} Section 6 claims, {len(fail)} fail under every reading tried and "
+        f"{len(depends)} hold under some readings only (see the verdict table)"
+    )
+    c31 = next((c for c in cl if c["id"] == "step-pd-31-percent"), None)
+    if c31 is not None and c31["measured"] is not None:
+        more = c31["measured"]
+        text += (
+            f"; the headline claim that PD needs {qty(c31['paper_value'], '%')} more settling "
+            f"time than the PTO measures PD needing {qty(abs(more), '%')} "
+            f"{'more' if more >= 0 else 'less'} at the paper's gains (a = 2 pi f)"
+        )
+        t = res["tuning"]
+        c31t = next(
+            (c for c in (t["claims"] if t else ()) if c["id"] == "step-pd-31-percent"), None
+        )
+        if c31t is not None:
+            best = [r for r in c31t["readings"] if "best-tuned" in r["label"]]
+            if best:
+                text += (
+                    "; at both laws' best tuning they settle alike ("
+                    + "; ".join(
+                        f"PD {_ms(r['values']['settling_pd_s'])} vs PTO "
+                        f"{_ms(r['values']['settling_pto_s'])}"
+                        for r in best
+                    )
+                    + ")"
+                )
+    return (text + ".", "claims", "claims with every reading")
 
 
 def _count(counts: Any, verdict: str) -> int:
@@ -240,41 +279,45 @@ def _claim_value_sentence(c: dict[str, Any]) -> str:
     return f"{c['id']} measures {qty(c['measured'] * scale, unit)}{paper}"
 
 
-def _finding_robust(res: dict[str, Any]) -> tuple[str, str, str] | None:
+def _finding_robust(res: Any) -> tuple[str, str, str] | None:
+    from ptoverify.report.standing import _interval
+
     rob = res["robust"]
-    if not rob:
+    if rob is None or "pto" not in rob["margins"]:
         return None
-    m = rob["margins"]["pto"] if "pto" in rob["margins"] else None
-    iv = None if m is None else m["linear_loop_a_ratio_stable_delay1"]
-    if iv is None:
-        lin = (
-            "with a one-sample computation delay the PTO's linear zone is unstable even at the "
-            "design bandwidth (a_true / a_design = 1 [-])"
-        )
-    else:
-        lin = (
-            "with a one-sample computation delay the PTO's linear zone stays stable for "
-            f"a_true / a_design in {_interval(iv)}"
-        )
-    best = rob["most_robust"]
-    if best["law"]:
-        w = best["log_width"]
-        tail = (
-            f"; the most robust linear loop is {_law(best['law'])} (ln(hi / lo) = "
-            f"{fmt(w[best['law']])} [-] without delay)"
-        )
-    else:
-        tail = ""
-    return (lin[0].upper() + lin[1:] + tail + ".", "robustness", "robustness")
+    m = rob["margins"]["pto"]
+    d1, nd = m["linear_loop_a_ratio_stable_delay1"], m["linear_loop_a_ratio_stable"]
+    text = f"Without delay the PTO's linear zone is stable for a_true / a_design in {_interval(nd)}"
+    if "pd" in rob["margins"]:
+        pd = rob["margins"]["pd"]
+        text += f" (PD: {_interval(pd['linear_loop_a_ratio_stable'])})"
+    text += "; with a one-sample computation delay it is " + (
+        f"stable for {_interval(d1)}" if d1 else "unstable even at the design bandwidth"
+    )
+    if "pd" in rob["margins"]:
+        text += f" (PD: {_interval(rob['margins']['pd']['linear_loop_a_ratio_stable_delay1'])})"
+    return (text + ".", "robustness", "robustness")
 
 
 def _finding_gates(res: dict[str, Any]) -> tuple[str, str, str]:
     g = res["summary"]["gates"]
     failed = [c["name"] for c in res["checks"] if c["status"] != "pass"]
+    rob = res["robust"]
+    delay = (
+        rob is not None
+        and "pto" in rob["margins"]
+        and rob["margins"]["pto"]["linear_loop_a_ratio_stable_delay1"] is None
+    )
     return (
-        f"{g['pass']} of {g['total']} verification gates pass ({g['fail']} fail, "
-        f"{g['unverified']} unverified)"
+        f"{g['pass']} of {g['total']} verification gates pass on the nominal plant "
+        f"({g['fail']} fail, {g['unverified']} unverified)"
         + (f": not passing {', '.join(failed)}" if failed else "")
+        + (
+            "; the gates assume no computation delay, and with one sample of delay the PTO's "
+            "linear zone is unstable (section robustness)"
+            if delay
+            else ""
+        )
         + ".",
         "summary",
         "gate table",
@@ -518,9 +561,9 @@ def _downstream_ids(inherits: list[str]) -> list[str]:
     """Return the equation labels ('17', '20-27', '36, 35') that an erratum changes."""
     out = []
     for item in inherits:
-        head = item.split(":", 1)[0].strip()
-        if re.fullmatch(r"[\w\-, ]+", head):
-            out.append(head)
+        head, _, what = item.partition(":")
+        if re.fullmatch(r"[\w\-, ]+", head.strip()) and not what.strip().startswith("unchanged"):
+            out.append(head.strip())
     return out
 
 

@@ -119,8 +119,9 @@ def gate(name: str, unit: str) -> Callable[[Callable[[GateContext], Verdict]], G
                     None,
                     f"could not be computed: {type(exc).__name__}: {exc}",
                 )
-            return dataclasses.replace(res, unit=unit)
+            return dataclasses.replace(res, unit=unit, description=description)
 
+        description = (fn.__doc__ or "").strip().splitlines()[0] if fn.__doc__ else ""
         GATES[name] = safe
         GATE_UNITS[name] = unit
         return safe

@@ -1,0 +1,314 @@
+"""The paper's standing in one screen: a verdict for the reviewer and one for the drive engineer.
+
+Both tables are read off the results (:class:`ptoverify.report.results.Results`),
+never typed in: every number they show is a field of ``results.json``.
+
+- :func:`reviewer_rows`: every Section 6 claim as *holds*, *fails* or *depends*; a
+  claim that depends names the reading it depends on (the bandwidth reading of a,
+  the band, the PTO variant, the tracking, the tuning) when one of them decides it.
+- :func:`engineer_rows`: adopt or not, and under which conditions: which zone, the
+  settling time against PD at the paper's gains under both readings of a and at the
+  best tuning, delay and bandwidth tolerance, the closed-loop properties, and the
+  baselines a drive already runs where the results hold them.
+
+Catalogue
+---------
+claim_standing  holds / fails / depends, with what it depends on
+reviewer_rows   the reviewer's table rows
+engineer_rows   the drive engineer's table rows (question, answer, evidence)
+adoption        the one-sentence recommendation
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from ptoverify.report.render import fmt, qty
+
+__all__ = ["claim_standing", "reviewer_rows", "engineer_rows", "adoption", "READING_WORDS"]
+
+#: How each reading dimension of a claim reads in words.
+READING_WORDS: dict[str, dict[Any, str]] = {
+    "a": {"2pi*f": "a = 2 pi f (30 Hz read as a frequency)", "f": "a = f (30 read as rad/s)"},
+    "pto": {"corrected": "the corrected PTO", "printed": "the PTO as printed"},
+    "tracking": {
+        "feed-forward": "feed-forward",
+        "none": "no feed-forward",
+        "error": "the law on the error, no feed-forward",
+    },
+    "gains": {},
+    "band": {},
+}
+
+
+def _ms(seconds: float | None) -> str:
+    return "never" if seconds is None else qty(1e3 * seconds, "ms")
+
+
+def _value_words(dim: str, value: Any) -> str:
+    words = READING_WORDS.get(dim, {})
+    if value in words:
+        return words[value]
+    if dim == "band" and isinstance(value, float):
+        return f"the {fmt(100 * value)} % band"
+    if dim == "gains" and value is None:
+        return "the paper's gains"
+    if dim == "gains":
+        return f"tuning {value}"
+    return f"{dim} = {fmt(value)}"
+
+
+def claim_standing(claim: Mapping) -> tuple[str, str]:
+    """Return ``(standing, condition)`` of one claim: holds, fails or depends.
+
+    Parameters
+    ----------
+    claim : Mapping
+        One entry of ``results.json``'s ``claims`` (``readings``, each with its
+        ``reading`` dimensions and ``verdict``).
+
+    Returns
+    -------
+    tuple of str
+        ``holds`` (every reading reproduces it), ``fails`` (none does) or
+        ``depends``; the condition names the dimension that decides a claim that
+        depends (every reading with the named values reproduces it and no other
+        does), else how many readings reproduce it.
+
+    Examples
+    --------
+    >>> r = lambda a, v: {"reading": {"a": a, "band": 0.02}, "verdict": v}
+    >>> claim_standing({"readings": [r("2pi*f", "not reproduced"), r("f", "reproduced")]})
+    ('depends', 'holds only with a = f (30 read as rad/s)')
+    """
+    readings = list(claim["readings"])
+    ok = [r["verdict"] == "reproduced" for r in readings]
+    if readings and all(ok):
+        return "holds", "under every reading tried"
+    if not any(ok):
+        return "fails", f"under every reading tried ({len(readings)})"
+    dims = list(dict.fromkeys(k for r in readings for k in r["reading"]))
+    for dim in dims:
+        values = {}
+        for r, good in zip(readings, ok, strict=True):
+            values.setdefault(_key(r["reading"][dim] if dim in r["reading"] else None), []).append(
+                good
+            )
+        if len(values) > 1 and all(all(v) or not any(v) for v in values.values()):
+            holding = [k for k, v in values.items() if all(v)]
+            words = " or ".join(_value_words(dim, _unkey(k)) for k in holding)
+            return "depends", f"holds only with {words}"
+    return "depends", f"holds under {sum(ok)} of {len(readings)} readings"
+
+
+def _key(value: Any) -> Any:
+    return tuple(value) if isinstance(value, (list, tuple)) else value
+
+
+def _unkey(value: Any) -> Any:
+    return list(value) if isinstance(value, tuple) else value
+
+
+def reviewer_rows(res: Mapping) -> list[list[str]]:
+    """Rows ``[claim, standing, condition, paper, measured]`` for every claim.
+
+    Parameters
+    ----------
+    res : Mapping
+        The results (:class:`ptoverify.report.results.Results`).
+
+    Returns
+    -------
+    list of list of str
+        One row per claim; ``measured`` is the primary reading's value with its unit.
+    """
+    rows = []
+    for c in res["claims"]:
+        standing, cond = claim_standing(c)
+        unit = c["unit"]
+        rows.append(
+            [
+                c["claim"],
+                standing,
+                cond,
+                qty(c["paper_value"], unit) if c["paper_value"] is not None else "qualitative",
+                qty(c["measured"], unit) if c["measured"] is not None else "see the claims table",
+            ]
+        )
+    return rows
+
+
+def _step_readings(res: Mapping) -> dict[str, Mapping]:
+    """Return the 31 % claim's readings at the paper's gains, 2 % band, corrected PTO, by a."""
+    out: dict[str, Mapping] = {}
+    for c in res["claims"]:
+        if c["id"] != "step-pd-31-percent":
+            continue
+        for r in c["readings"]:
+            rd = r["reading"]
+            if rd["band"] == 0.02 and rd["pto"] == "corrected" and rd["gains"] is None:
+                out.setdefault(rd["a"], r)
+    return out
+
+
+def _faster(pto: float | None, pd: float | None, sample: float) -> str:
+    if pto is None or pd is None:
+        return "no verdict (a law never settles)"
+    if abs(pto - pd) <= sample:
+        return "ties PD (within one sample)"
+    return "beats PD" if pto < pd else "loses to PD"
+
+
+def engineer_rows(res: Mapping) -> list[list[str]]:
+    """Rows ``[question, answer, evidence]`` a drive engineer acts on.
+
+    Parameters
+    ----------
+    res : Mapping
+        The results (:class:`ptoverify.report.results.Results`).
+
+    Returns
+    -------
+    list of list of str
+    """
+    cfg = res["environment"]["config"]
+    T = cfg["plant"]["sample_time"]  # noqa: N806 - the paper's symbol
+    z = res["zone"]
+    pr, co = z["printed"], z["corrected"]
+    rows = [
+        [
+            "Which switching zone?",
+            "the corrected one" if co["valid"] else "neither is valid",
+            f"printed omega0 = {qty(pr['omega0'], 'mm/s')} "
+            f"({'valid' if pr['valid'] else 'invalid'}); corrected omega0 = "
+            f"{qty(co['omega0'], 'mm/s')} ({'valid' if co['valid'] else 'invalid'})",
+        ]
+    ]
+    step = _step_readings(res)
+    if step:
+        parts, verdicts = [], []
+        for a, r in step.items():
+            v = r["values"]
+            verdicts.append(_faster(v["settling_pto_s"], v["settling_pd_s"], T))
+            parts.append(
+                f"{_value_words('a', a)}: PTO {_ms(v['settling_pto_s'])}, "
+                f"PD {_ms(v['settling_pd_s'])}"
+            )
+        answer = (
+            verdicts[0]
+            if len(set(verdicts)) == 1
+            else "depends on the reading of a: "
+            + "; ".join(f"{_value_words('a', a)}: {w}" for a, w in zip(step, verdicts, strict=True))
+        )
+        rows.append(
+            ["Faster than PD at the paper's gains (step, 2 % band)?", answer, "; ".join(parts)]
+        )
+    t = res["tuning"]
+    if t is not None:
+        parts, verdicts = [], []
+        for name, by in t["best"].items():
+            if "pd" in by and "pto" in by:
+                pd, pto = by["pd"]["settling_2pct_s"], by["pto"]["settling_2pct_s"]
+                verdicts.append(_faster(pto, pd, T))
+                parts.append(
+                    f"overshoot <= {qty(t['bounds_mm'][name], 'mm')}: PTO {_ms(pto)}, PD {_ms(pd)}"
+                )
+        if parts:
+            answer = verdicts[0] if len(set(verdicts)) == 1 else "; ".join(verdicts)
+            rows.append(
+                ["At each law's best tuning (same overshoot bound)?", answer, "; ".join(parts)]
+            )
+    rob = res["robust"]
+    if rob is not None and "pto" in rob["margins"]:
+        m = rob["margins"]["pto"]
+        d1 = m["linear_loop_a_ratio_stable_delay1"]
+        rows.append(
+            [
+                "Tolerates a one-sample computation delay?",
+                "yes" if d1 is not None else "no: needs delay compensation or lower gains",
+                "PTO linear zone with one sample of delay: "
+                + (
+                    f"stable for a_true / a_design in {_interval(d1)}"
+                    if d1
+                    else m["linear_loop_note_delay1"]
+                ),
+            ]
+        )
+        nd = m["linear_loop_a_ratio_stable"]
+        pd_nd = (
+            rob["margins"]["pd"]["linear_loop_a_ratio_stable"] if "pd" in rob["margins"] else None
+        )
+        rows.append(
+            [
+                "Tolerates a bandwidth other than the design value?",
+                f"a_true / a_design in {_interval(nd)}" if nd else m["linear_loop_note"],
+                f"PTO linear loop stable for {_interval(nd)}; PD for {_interval(pd_nd)}",
+            ]
+        )
+    p = res["properties"]["pto"] if "pto" in res["properties"] else None
+    if p is not None:
+        clean = p["stride_overs"] == 0 and p["limit_cycles"] == 0 and p["chattering"] == 0
+        rows.append(
+            [
+                "Stride-overs, limit cycles, chattering (sampled grid)?",
+                "none found" if clean else "found",
+                f"{p['states']} grid states: {p['stride_overs']} stride-overs, "
+                f"{p['limit_cycles']} limit cycles, {p['chattering']} chattering "
+                "(sampled: see the proofs for the continuum where they ran)",
+            ]
+        )
+    base = [law for law in ("ptos", "cascade-p") if law in res["responses"]]
+    rows.append(
+        [
+            "Better than PTOS or the cascade P loop?",
+            "see the baselines" if base else "not compared: these laws are not in this report",
+            ", ".join(base) if base else "the suite does not run them in this report",
+        ]
+    )
+    return rows
+
+
+def _interval(iv: Any) -> str:
+    """Return an a_true / a_design interval in words (an open end: no limit found)."""
+    if not iv:
+        return "no interval (unstable at the design point)"
+    lo, hi = iv
+    if lo is None and hi is None:
+        return "the whole searched range"
+    if lo is None:
+        return f"[no lower limit found, {fmt(hi)}]"
+    if hi is None:
+        return f"[{fmt(lo)}, no upper limit found]"
+    return f"[{fmt(lo)}, {fmt(hi)}]"
+
+
+def adoption(res: Mapping) -> str:
+    """Return the one-sentence recommendation for a drive engineer.
+
+    Parameters
+    ----------
+    res : Mapping
+        The results (:class:`ptoverify.report.results.Results`).
+
+    Returns
+    -------
+    str
+        Adopt or not, and the conditions, from the rows of :func:`engineer_rows`.
+    """
+    rows = {r[0]: r[1] for r in engineer_rows(res)}
+    parts = []
+    zone = rows["Which switching zone?"]
+    parts.append("use the corrected zone" if zone == "the corrected one" else "no valid zone")
+    tuned = rows.get("At each law's best tuning (same overshoot bound)?")
+    if tuned:
+        parts.append(f"at this design point the corrected PTO {tuned.replace('PD', 'a tuned PD')}")
+    delay = rows.get("Tolerates a one-sample computation delay?")
+    if delay and delay != "yes":
+        parts.append("it needs delay compensation")
+    verdict = (
+        "Adopt only with care" if any("loses" in p or "needs" in p for p in parts) else "Adopt"
+    )
+    if zone != "the corrected one":
+        verdict = "Do not adopt"
+    return f"{verdict}: " + "; ".join(parts) + "."
