@@ -426,8 +426,50 @@ def _stage_tuning(cfg: Config, figdir: Path | None) -> dict[str, Any]:
 
 
 def _stage_figures(cfg: Config, figdir: Path | None) -> dict[str, Any]:
-    """Draw the paper's figures and the zone geometry."""
-    return {"_files": [] if figdir is None else _plots().save_all(figure_inputs(cfg), figdir)}
+    """Draw the paper's figures and the zone geometry; write the responses as CSV traces."""
+    if figdir is None:
+        return {"_files": []}
+    inputs = figure_inputs(cfg)
+    traces = write_traces(inputs.sims, figdir.parent / TRACE_DIR)
+    return {"_files": _plots().save_all(inputs, figdir), "_traces": traces}
+
+
+#: Folder of the report's CSV traces (one per law and signal, with feed-forward).
+TRACE_DIR = "traces"
+
+
+def write_traces(sims: dict, folder: Path) -> list[str]:
+    """Write every law's step, ramp and sine response (feed-forward) as a CSV file.
+
+    Parameters
+    ----------
+    sims : dict
+        ``(signal, feedforward) -> law -> SimResult`` (:func:`figure_inputs`).
+    folder : Path
+        Where to write ``<law>_<signal>.csv`` (created).
+
+    Returns
+    -------
+    list of str
+        The paths written, relative to the report folder (``traces/pd_step.csv``).
+    """
+    import csv
+
+    folder.mkdir(parents=True, exist_ok=True)
+    out = []
+    for (signal, ff), by_law in sims.items():
+        if not ff:
+            continue
+        for law, res in by_law.items():
+            cols = res.columns()
+            name = f"{law}_{signal}.csv"
+            with open(folder / name, "w", newline="") as fh:
+                w = csv.writer(fh)
+                w.writerow(list(cols))
+                for row in zip(*cols.values(), strict=True):
+                    w.writerow([repr(float(v)) if k != "region" else v for k, v in zip(cols, row)])
+            out.append(f"{folder.name}/{name}")
+    return sorted(out)
 
 
 def _stage_poles(cfg: Config, figdir: Path | None) -> dict[str, Any]:
@@ -555,10 +597,12 @@ def collect(
 
     out: dict[str, Any] = {"derivations": None, "robust": None, "tuning": None}
     files: list[Path] = []
+    traces: list[str] = []
     checks = []
     for name in names:
         part = done[name][0]
         files += part.pop("_files", [])
+        traces += part.pop("_traces", [])
         checks += part.pop("_checks", [])
         out.update(part)
     order = list(GATES)
@@ -567,6 +611,7 @@ def collect(
     out["skipped"] = sorted(set(skip))
     out["summary"] = _summary(out, summarize(checks))
     out["_files"] = files
+    out["_traces"] = traces
     out["_timings"] = {name: done[name][1] for name in names}
     out["_jobs"] = jobs
     return out
@@ -762,6 +807,33 @@ def _summary(out: dict[str, Any], gates: dict[str, Any]) -> dict[str, Any]:
 
 
 # ------------------------------------------------------------------ sections
+#: The paper this report verifies, by its title.
+PAPER_TITLE = "Approximate Time-Optimal Control Considering System Bandwidth and Saturation"
+
+
+def downloads_intro(traces: list[str]) -> str:
+    """Return the paragraph under the title: the paper verified and the files to download.
+
+    Parameters
+    ----------
+    traces : list of str
+        The CSV traces written (relative paths).
+
+    Returns
+    -------
+    str
+        Markdown-style text with links (the HTML renders them as links too).
+    """
+    links = ", ".join(f"[{Path(t).stem.replace('_', ' ')}]({t})" for t in traces)
+    text = (
+        f'Verifies the PTO law of the paper "{PAPER_TITLE}" against its own equations, '
+        "exact minimum times and simulation. Every number below is computed; the paper's "
+        "values appear only as claims. Downloads: [results.json](results.json) (every number "
+        "of this report)"
+    )
+    return text + (f"; CSV traces (t, r, x1, x2, e, u, region): {links}." if links else ".")
+
+
 def results_view(public: dict[str, Any]) -> Results:
     """Return the strict view of ``results.json`` that the sections read.
 
@@ -891,18 +963,21 @@ def write_report(
         )
         public["meta"] = {
             "name": cfg.name,
+            "paper": PAPER_TITLE,
             "figures": sorted(figures.values()),
+            "traces": res["_traces"],
             "generated": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         }
-        title = f"ptoverify verification report: {cfg.name}"
+        title = f"Verification of the paper's PTO law: configuration '{cfg.name}'"
+        intro = downloads_intro(res["_traces"])
         sections = build_sections(
             results_view(public), figures, res["_records"], res.get("_rendered")
         )
         (tmp / "results.json").write_text(
             json.dumps(public, indent=1, sort_keys=True, allow_nan=False) + "\n"
         )
-        (tmp / "index.html").write_text(render_html(sections, title))
-        (tmp / "report.md").write_text(render_markdown(sections, title))
+        (tmp / "index.html").write_text(render_html(sections, title, intro))
+        (tmp / "report.md").write_text(render_markdown(sections, title, intro))
         publish(tmp, out, config_hash=cfg.digest(), name=cfg.name, default=default)
         tmp = None
     finally:

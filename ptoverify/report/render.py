@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import html
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -286,6 +287,17 @@ def link(anchor: str, text: str) -> Block:
     )
 
 
+def _links(text: str) -> str:
+    """Escape text and turn Markdown links ``[text](href)`` into HTML links."""
+    out, pos = [], 0
+    for m in re.finditer(r"\[([^\]]+)\]\(([^)\s]+)\)", text):
+        out.append(html.escape(text[pos : m.start()]))
+        out.append(f'<a href="{html.escape(m.group(2))}">{html.escape(m.group(1))}</a>')
+        pos = m.end()
+    out.append(html.escape(text[pos:]))
+    return "".join(out)
+
+
 def md_cell(text: str) -> str:
     """Escape a Markdown table cell (pipes, newlines).
 
@@ -354,7 +366,7 @@ def _html_block(b: Block) -> str:
     return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
 
 
-def render_html(sections: list[Section], title: str) -> str:
+def render_html(sections: list[Section], title: str, intro: str = "") -> str:
     """Render the sections as one offline HTML page (MathML, escaped text).
 
     Parameters
@@ -363,6 +375,8 @@ def render_html(sections: list[Section], title: str) -> str:
         Anchor, heading and blocks of each section, in order.
     title : str
         Page title.
+    intro : str
+        A paragraph under the title; ``[text](href)`` becomes a link.
 
     Returns
     -------
@@ -380,7 +394,9 @@ def render_html(sections: list[Section], title: str) -> str:
         "<!DOCTYPE html>",
         '<html lang="en"><head><meta charset="utf-8">',
         f"<title>{html.escape(title)}</title><style>{CSS}</style></head><body>",
-        f"<h1>{html.escape(title)}</h1><nav>{nav}</nav>",
+        f"<h1>{html.escape(title)}</h1>",
+        f"<p>{_links(intro)}</p>" if intro else "",
+        f"<nav>{nav}</nav>",
     ]
     for anchor, heading, blocks in sections:
         parts.append(f'<section id="{anchor}"><h2>{html.escape(heading)}</h2>')
@@ -390,8 +406,53 @@ def render_html(sections: list[Section], title: str) -> str:
     return "\n".join(parts) + "\n"
 
 
-def render_markdown(sections: list[Section], title: str) -> str:
-    """Render the sections as Markdown (equations as plain text).
+#: Longest inline code span (a raw SymPy form) the Markdown shows in full [characters].
+MD_CODE_MAX = 200
+#: Tables longer than this [rows] are folded into a collapsible block in the Markdown.
+MD_FOLD_ROWS = 20
+
+
+def md_slug(heading: str) -> str:
+    """Return the anchor a code-hosting site gives a Markdown heading.
+
+    Parameters
+    ----------
+    heading : str
+        The heading text.
+
+    Returns
+    -------
+    str
+        Lower case; letters, digits, hyphens and underscores kept; spaces become hyphens.
+
+    Examples
+    --------
+    >>> md_slug("1. Summary: gates, errata, claims")
+    '1-summary-gates-errata-claims'
+    """
+    s = "".join(c for c in heading.lower() if c.isalnum() or c in " -_")
+    return s.replace(" ", "-")
+
+
+def _md_code(text: str, anchor: str) -> str:
+    """Shorten inline code spans longer than :data:`MD_CODE_MAX` (full form in the HTML)."""
+
+    def cut(m: re.Match) -> str:
+        body = m.group(1)
+        if len(body) <= MD_CODE_MAX:
+            return m.group(0)
+        return f"`{body[:MD_CODE_MAX]}...` ([full form](index.html#{anchor}))"
+
+    return re.sub(r"`([^`]+)`", cut, text)
+
+
+def render_markdown(sections: list[Section], title: str, intro: str = "") -> str:
+    """Render the sections as Markdown that reads on a code-hosting site.
+
+    A table of contents links every section; equations are plain text, and an
+    inline form longer than :data:`MD_CODE_MAX` characters is cut with a link to
+    the HTML; a table of more than :data:`MD_FOLD_ROWS` rows is folded into a
+    collapsible block.
 
     Parameters
     ----------
@@ -399,23 +460,44 @@ def render_markdown(sections: list[Section], title: str) -> str:
         Anchor, heading and blocks of each section, in order.
     title : str
         Page title.
+    intro : str
+        A paragraph under the title (the paper's title, the downloads).
 
     Returns
     -------
     str
         The Markdown text.
+
+    Examples
+    --------
+    >>> md = render_markdown([("s", "1. A", [Block("p", text="x")])], "t")
+    >>> "- [1. A](#1-a)" in md
+    True
     """
     lines = [f"# {title}", ""]
-    for _anchor, heading, blocks in sections:
+    if intro:
+        lines += [intro, ""]
+    lines += ["Contents:", ""]
+    lines += [f"- [{heading}](#{md_slug(heading)})" for _a, heading, _b in sections]
+    lines.append("")
+    for anchor, heading, blocks in sections:
         lines += [f"## {heading}", ""]
         for b in blocks:
             if b.kind in ("p", "raw"):
-                lines += [b.text, ""]
+                lines += [_md_code(b.text, anchor), ""]
             elif b.kind == "img":
-                lines += [f"![{b.text}]({b.html})", ""]
+                lines += [f"![{b.text}]({b.html})", "", f"*{b.text}*", ""]
             else:
-                lines.append("| " + " | ".join(md_cell(h) for h in b.headers) + " |")
-                lines.append("|" + "---|" * len(b.headers))
-                lines += ["| " + " | ".join(md_cell(c) for c in r) + " |" for r in b.rows]
-                lines.append("")
+                rows = ["| " + " | ".join(md_cell(h) for h in b.headers) + " |"]
+                rows.append("|" + "---|" * len(b.headers))
+                rows += [
+                    "| " + " | ".join(_md_code(md_cell(c), anchor) for c in r) + " |"
+                    for r in b.rows
+                ]
+                if len(b.rows) > MD_FOLD_ROWS:
+                    summary = f"{len(b.rows)} rows: {', '.join(b.headers[:3])}, ..."
+                    lines += ["<details>", f"<summary>{html.escape(summary)}</summary>", ""]
+                    lines += rows + ["", "</details>", ""]
+                else:
+                    lines += rows + [""]
     return "\n".join(lines) + "\n"

@@ -65,6 +65,76 @@ def _ms(seconds: float | None) -> str:
     return qty(1e3 * seconds, "ms")
 
 
+#: Caption (a sentence, also the alt text) of each figure the report can show, by file stem.
+CAPTIONS: dict[str, str] = {
+    "fig02_trajectories": "Fig. 2: open-loop trajectories under u = +w_max and -w_max with the "
+    "switching curves l1 and l2.",
+    "fig03_saturation": "Fig. 3: sampled TO trajectories from the envelope's edge, with the "
+    "velocity saturating at w_max.",
+    "convergence": "Relative error of the collocation minimum time against the closed form, "
+    "for each state, as the number of intervals N grows.",
+    "collocation_switch": "The collocation input near the switch time, beside the closed-form "
+    "bang-bang input.",
+    "zone_geometry": "The switching zone: l1, l2, the corrected l1* and l2*, the printed curve "
+    "(19), the linear zone, and sampled PTO trajectories coloured by region.",
+    "fig04_zones_corrected": "Fig. 4 redrawn with the corrected construction: the switching zone "
+    "between l1 and its widened curve, and the linear zone.",
+    "fig04_zones_printed": "Fig. 4 as printed (eqs. 19-27): the zone the printed omega0 gives.",
+    "fig05_l1_image_corrected": "Fig. 5, corrected: the image of l1 after one sample under "
+    "-w_max lies inside the corrected zone.",
+    "fig05_l1_image_printed": "Fig. 5 as printed: the image of l1 after one sample against the "
+    "printed curve (19).",
+    "fig06_trajectory_pto": "Fig. 6 with the corrected PTO: a fourth-quadrant trajectory enters "
+    "the switching zone and slides to the linear zone.",
+    "fig06_trajectory_pto-printed": "Fig. 6 with the PTO as printed: the same start; the printed "
+    "zone is empty, so the law acts as TO outside the linear zone.",
+    "fig07_step_position": "Fig. 7: position response of every law to the 5 mm step.",
+    "fig08_step_error": "Fig. 8: position error of every law after the 5 mm step.",
+    "fig09_ramp_position": "Fig. 9: position tracking of the ramp, with velocity feed-forward.",
+    "fig09_ramp_position_noff": "Fig. 9: position tracking of the ramp, without feed-forward.",
+    "fig10_ramp_velocity": "Fig. 10: velocity during the ramp, with feed-forward.",
+    "fig10_ramp_velocity_noff": "Fig. 10: velocity during the ramp, without feed-forward.",
+    "fig11_ramp_error": "Fig. 11: ramp tracking error, with feed-forward.",
+    "fig11_ramp_error_noff": "Fig. 11: ramp tracking error, without feed-forward.",
+    "fig12_sine_position": "Fig. 12: position tracking of the sine, with feed-forward.",
+    "fig12_sine_position_noff": "Fig. 12: position tracking of the sine, without feed-forward.",
+    "fig13_sine_velocity": "Fig. 13: velocity while tracking the sine, with feed-forward.",
+    "fig13_sine_velocity_noff": "Fig. 13: velocity while tracking the sine, without feed-forward.",
+    "fig14_sine_states": "Fig. 14: error and velocity-error phase portrait on the sine, with "
+    "feed-forward.",
+    "fig14_sine_states_noff": "Fig. 14: error and velocity-error phase portrait on the sine, "
+    "without feed-forward.",
+    "sweep_ratio_tf": "Settling time over the minimum time t_f*, per law, over the envelope of "
+    "initial states (the colour scale says where it clips).",
+    "sweep_ratio_nt": "Settling time over the sampled limit N* T, per law, over the envelope of "
+    "initial states (the colour scale says where it clips).",
+    "robust_limit_cycles": "States ending in a limit cycle, per law (rows) and delay (columns), "
+    "over a_true / a_design and the w_max ratio.",
+    "robust_settling_nt": "Worst settling / (N* T) over the states, per law and delay (never: "
+    "some state never settles).",
+    "tuning_pareto": "Settling against overshoot on the step: the Pareto fronts of PD and PTO "
+    "over every candidate evaluated, the best tunings (stars), the paper's gains (squares) and "
+    "the floor.",
+}
+
+
+def figure(figures: dict[str, str], key: str) -> list[Block]:
+    """Return the figure ``key`` with its sentence caption (none when it was not drawn).
+
+    Parameters
+    ----------
+    figures : dict
+        Figure key -> relative path (``figures/x.png``).
+    key : str
+        The figure's file stem; it must have a caption in :data:`CAPTIONS`.
+
+    Returns
+    -------
+    list of Block
+    """
+    return image(figures, key, CAPTIONS[key])
+
+
 # ------------------------------------------------------------------ verdict
 def verdict(res: Any) -> list[Block]:
     """Show the paper's standing in one screen: the drive engineer's and the reviewer's verdicts.
@@ -415,6 +485,8 @@ def summary(res: dict[str, Any]) -> list[Block]:
     rows = [
         [
             c["name"],
+            "perturbed plant" if c["name"].startswith("robust-") else "nominal plant",
+            c["description"],
             c["status"],
             qty(c["measured"], _GATE_UNITS.get(c["unit"], c["unit"])),
             c["comparison"],
@@ -423,7 +495,7 @@ def summary(res: dict[str, Any]) -> list[Block]:
         for c in res["checks"]
     ]
     blocks = [
-        table(["gate", "status", "measured", "must be", "limit"], rows),
+        table(["gate", "plant", "what it checks", "status", "measured", "must be", "limit"], rows),
         Block(
             "p",
             text="[-] marks a dimensionless number (a relative error, a count ratio or "
@@ -830,10 +902,10 @@ def ground_truth(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             text=f"Collocation convergence over N = {fmt(conv['intervals'])} intervals: observed "
             f"order {fmt(conv['order'], 3)} [-] (per state {fmt(conv['order_per_state'], 3)} [-]).",
         ),
-        *image(figures, "fig02_trajectories", "Fig. 2: trajectories under +-w_max, l1 and l2"),
-        *image(figures, "fig03_saturation", "Fig. 3: trajectories with velocity saturation"),
-        *image(figures, "convergence", "Collocation t_f error against N"),
-        *image(figures, "collocation_switch", "Collocation input near the switch"),
+        *figure(figures, "fig02_trajectories"),
+        *figure(figures, "fig03_saturation"),
+        *figure(figures, "convergence"),
+        *figure(figures, "collocation_switch"),
     ]
 
 
@@ -869,10 +941,10 @@ def zone(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             rows,
         )
     ]
-    blocks += image(figures, "zone_geometry", "Zone geometry, sampled trajectories by region")
+    blocks += figure(figures, "zone_geometry")
     for key in sorted(figures):
         if key.startswith(("fig04", "fig05", "fig06")):
-            blocks += image(figures, key, key.replace("_", " "))
+            blocks += figure(figures, key)
     return blocks
 
 
@@ -1063,7 +1135,7 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
         ]
     for key in sorted(figures):
         if key.startswith(("fig07", "fig08", "fig09", "fig10", "fig11", "fig12", "fig13", "fig14")):
-            blocks += image(figures, key, key.replace("_", " "))
+            blocks += figure(figures, key)
     return blocks
 
 
@@ -1112,7 +1184,7 @@ def sweep(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     ]
     for key in sorted(figures):
         if key.startswith("sweep"):
-            blocks += image(figures, key, key.replace("_", " "))
+            blocks += figure(figures, key)
     return blocks
 
 
@@ -1245,18 +1317,7 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 + ").",
             )
         )
-    pics = image(
-        figures,
-        "robust_limit_cycles",
-        "States ending in a limit cycle, per law "
-        "(rows) and delay (columns), over a_true / a_design x w_max ratio",
-    )
-    pics += image(
-        figures,
-        "robust_settling_nt",
-        "Worst settling / (N* T) over the states, per law and delay (never: some state never settles)",
-    )
-    blocks += pics
+    blocks += figure(figures, "robust_limit_cycles") + figure(figures, "robust_settling_nt")
     wrows, cmds = [], []
     for law, by in rob["worst"].items():
         for prop, w in by.items():
@@ -1397,12 +1458,7 @@ def tuning(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             ],
             rows,
         ),
-        *image(
-            figures,
-            "tuning_pareto",
-            "Settling vs overshoot on the step: Pareto fronts of PD and PTO over every "
-            "candidate evaluated, best tunings (stars), paper gains (squares), the floor",
-        ),
+        *figure(figures, "tuning_pareto"),
         Block("p", text="The paper's PD-vs-PTO claims judged at the best tuning of both laws:"),
         table(
             ["claim", "verdict at best tuning", "measured"],

@@ -297,18 +297,24 @@ def adoption(res: Mapping) -> str:
         Adopt or not, and the conditions, from the rows of :func:`engineer_rows`.
     """
     rows = {r[0]: r[1] for r in engineer_rows(res)}
-    parts = []
     zone = rows["Which switching zone?"]
-    parts.append("use the corrected zone" if zone == "the corrected one" else "no valid zone")
+    parts = ["use the corrected zone" if zone == "the corrected one" else "no valid zone"]
     tuned = rows.get("At each law's best tuning (same overshoot bound)?")
+    paper = rows.get("Faster than PD at the paper's gains (step, 2 % band)?")
     if tuned:
-        parts.append(f"at this design point the corrected PTO {tuned.replace('PD', 'a tuned PD')}")
+        parts.append(f"at this design point the tuned PTO {tuned.replace('PD', 'a tuned PD')}")
+    elif paper:
+        parts.append(f"at the paper's gains the PTO {paper}")
     delay = rows.get("Tolerates a one-sample computation delay?")
     if delay and delay != "yes":
         parts.append("it needs delay compensation")
+    skipped = [s for s in ("tuning", "robust") if res[s] is None]
+    if skipped:
+        parts.append(f"not judged here: {' and '.join(skipped)} (skipped)")
+    care = any(w in p for p in parts for w in ("loses", "depends", "needs", "not judged"))
     verdict = (
-        "Adopt only with care" if any("loses" in p or "needs" in p for p in parts) else "Adopt"
+        "Do not adopt"
+        if zone != "the corrected one"
+        else ("Adopt only with care" if care else "Adopt")
     )
-    if zone != "the corrected one":
-        verdict = "Do not adopt"
     return f"{verdict}: " + "; ".join(parts) + "."
