@@ -105,3 +105,33 @@ def test_loop_poles_json():
 
     lp = loop_poles("x", PAPER.plant.a, 0.002, 323.0, 3.6)
     json.dumps(lp.to_json(), allow_nan=True)
+
+
+@pytest.mark.parametrize("delay", [0, 1, 2, 3])
+@pytest.mark.parametrize("gains", [(356.0, 1.15), (323.0, 3.6), (900.0, 0.3)])
+def test_delayed_loop_radius_matches_python_control_feedback(delay, gains):
+    """Independent reference: python-control's closed loop of L(z) = K (zI - Ad)^-1 Bd z^-delay."""
+    import control as ct
+
+    from ptoverify.model.poles import delayed_loop_radius
+
+    a, T = 2 * np.pi * 30, 0.002
+    k1, k2 = gains
+    A = np.array([[0.0, 1.0], [0.0, -a]])
+    B = np.array([[0.0], [a]])
+    plant = ct.sample_system(ct.ss(A, B, np.array([[k1, k2]]), [[0.0]]), T, method="zoh")
+    lag = ct.tf([1.0], [1.0] + [0.0] * delay, T)
+    cl = ct.feedback(ct.series(lag, plant), 1)
+    want = float(np.abs(ct.poles(cl)).max())
+    got = delayed_loop_radius(a, T, k1, k2, delay)
+    np.testing.assert_allclose(got, want, rtol=1e-9, err_msg="spectral radius with delay")
+
+
+def test_delay_margin_samples_is_the_last_stable_delay():
+    from ptoverify.model.poles import delay_margin_samples, delayed_loop_radius
+
+    a, T = 2 * np.pi * 30, 0.002
+    for k1, k2 in ((356.0, 1.15), (323.0, 3.6), (50.0, 0.2)):
+        n = delay_margin_samples(a, T, k1, k2)
+        assert all(delayed_loop_radius(a, T, k1, k2, d) < 1 for d in range(n + 1))
+        assert delayed_loop_radius(a, T, k1, k2, n + 1) >= 1 or n == 20

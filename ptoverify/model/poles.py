@@ -90,6 +90,12 @@ class LoopPoles:
         All poles in the open left half-plane / inside the unit circle.
     lyapunov_conditions : bool
         k_x1 > 0 and 1 + k_x2 > 0 (Section 5).
+    gain_margin_db : float
+        ``gain_margin`` in decibels, 20 log10 of it [dB].
+    delay_margin_samples : int
+        Most whole samples of computation delay (u_k applied at k + n) with which the
+        sampled loop stays stable, from 0 up to :data:`MAX_DELAY_SAMPLES`; -1 when it is
+        unstable without delay [samples].
     """
 
     name: str
@@ -114,10 +120,84 @@ class LoopPoles:
     stable_continuous: bool
     stable_sampled: bool
     lyapunov_conditions: bool
+    gain_margin_db: float = math.nan
+    delay_margin_samples: int = -1
 
     def to_json(self) -> dict:
         """Return the record as a JSON-able dict."""
         return asdict(self)
+
+
+#: Largest computation delay :func:`delay_margin_samples` tries [samples].
+MAX_DELAY_SAMPLES = 20
+
+
+def delayed_loop_radius(a: float, T: float, k_x1: float, k_x2: float, delay: int) -> float:  # noqa: N803
+    """Spectral radius of the sampled loop with ``delay`` samples of computation delay.
+
+    The state is augmented with the ``delay`` inputs still in flight:
+    x_{k+1} = Ad x_k + Bd u_{k-delay}, u_k = -K x_k.
+
+    Parameters
+    ----------
+    a : float
+        Bandwidth [rad/s].
+    T : float
+        Sampling period [s].
+    k_x1, k_x2 : float
+        Gains [1/s], [-] of u = -k_x1 x1 - k_x2 x2.
+    delay : int
+        Computation delay [samples], >= 0.
+
+    Returns
+    -------
+    float
+        Largest |z| [-]; < 1 means stable.
+
+    Examples
+    --------
+    >>> r0 = delayed_loop_radius(188.5, 0.002, 356.0, 1.15, 0)
+    >>> abs(r0 - sampled_spectral_radius(188.5, 0.002, 356.0, 1.15)) < 1e-12
+    True
+    """
+    Ad, Bd = zoh_matrices(a, T)
+    K = np.array([[k_x1, k_x2]])
+    if delay == 0:
+        return float(np.abs(np.linalg.eigvals(Ad - Bd @ K)).max())
+    n = 2 + delay
+    M = np.zeros((n, n))
+    M[:2, :2] = Ad
+    M[:2, n - 1 : n] = Bd  # the oldest input in flight acts now
+    M[2, :2] = -K[0]  # u_k enters the register
+    for i in range(3, n):
+        M[i, i - 1] = 1.0
+    return float(np.abs(np.linalg.eigvals(M)).max())
+
+
+def delay_margin_samples(a: float, T: float, k_x1: float, k_x2: float) -> int:  # noqa: N803
+    """Return the most whole samples of computation delay the sampled loop tolerates.
+
+    Parameters
+    ----------
+    a : float
+        Bandwidth [rad/s].
+    T : float
+        Sampling period [s].
+    k_x1, k_x2 : float
+        Gains [1/s], [-].
+
+    Returns
+    -------
+    int
+        Largest n <= :data:`MAX_DELAY_SAMPLES` with the loop stable for every delay
+        0..n [samples]; -1 when unstable without delay.
+    """
+    n = -1
+    for d in range(MAX_DELAY_SAMPLES + 1):
+        if delayed_loop_radius(a, T, k_x1, k_x2, d) >= 1.0:
+            break
+        n = d
+    return n
 
 
 def _plant(a: float) -> tuple[np.ndarray, np.ndarray]:
@@ -269,6 +349,10 @@ def _loop_poles(name: str, a: float, T: float, k_x1: float, k_x2: float) -> Loop
         stable_continuous=bool(np.all(np.real(p_c) < 0)),
         stable_sampled=bool(np.all(np.abs(p_d) < 1)),
         lyapunov_conditions=bool(k_x1 > 0 and 1 + k_x2 > 0),
+        gain_margin_db=float(20.0 * math.log10(min(gm, gm_nyq)))
+        if 0 < min(gm, gm_nyq) < math.inf
+        else math.nan,
+        delay_margin_samples=delay_margin_samples(a, T, k_x1, k_x2),
     )
 
 

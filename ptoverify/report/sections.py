@@ -795,6 +795,44 @@ def errata(res: dict[str, Any], records: list, rendered: dict | None = None) -> 
 
 
 # ------------------------------------------------------------------ derivations
+def inherited_errata(records: list) -> dict[str, str]:
+    """Map each equation downstream of an erratum to that erratum's id.
+
+    An equation whose own algebra is verified but whose input is an erratum's
+    result (the printed chain (20)-(27) after (16)) is not "verified" as a
+    result: it leads to a wrong value (the printed omega0).
+
+    Parameters
+    ----------
+    records : list of derivations.EquationRecord
+        The records (``id``, ``verdict``, ``inherits``).
+
+    Returns
+    -------
+    dict
+        Record id -> id of the first erratum it inherits from.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as R
+    >>> recs = [R(id="16", verdict="erratum", inherits=["17: unchanged", "20-22: changes"]),
+    ...         R(id="21", verdict="verified", inherits=[])]
+    >>> inherited_errata(recs)
+    {'20': '16', '21': '16', '22': '16'}
+    """
+    out: dict[str, str] = {}
+    for r in records:
+        if r.verdict != "erratum":
+            continue
+        for head in _downstream_ids(list(r.inherits)):
+            for part in head.split(","):
+                lo, _, hi = part.strip().partition("-")
+                if lo.isdigit() and (not hi or hi.isdigit()):
+                    for n in range(int(lo), int(hi or lo) + 1):
+                        out.setdefault(str(n), r.id)
+    return out
+
+
 def derivations(res: dict[str, Any], records: list, rendered: dict | None = None) -> list[Block]:
     """Show printed next to derived (MathML), verdicts; each row anchored as ``eq-<id>``.
 
@@ -807,8 +845,13 @@ def derivations(res: dict[str, Any], records: list, rendered: dict | None = None
 
     rendered = rendered or {}
     rows_html, rows_md = [], []
+    tainted = inherited_errata(records)
     for r in records:
         ml = rendered[r.id]["mathml"] if r.id in rendered else r.to_mathml()
+        verdict, css = r.verdict, r.verdict
+        if r.verdict == "verified" and r.id in tainted:
+            verdict = f"verified algebra; inherits the erratum of eq. ({tainted[r.id]})"
+            css = "inherits"
 
         def cell(key: str, text: str, ml=ml) -> str:
             m = ml.get(key, "")
@@ -818,8 +861,8 @@ def derivations(res: dict[str, Any], records: list, rendered: dict | None = None
         if r.verdict == "erratum":
             note += f' <a href="#erratum-{html.escape(r.id)}">(counterexample, consequences)</a>'
         rows_html.append(
-            f'<tr id="eq-{html.escape(r.id)}" class="{html.escape(r.verdict)}">'
-            f"<td>{html.escape(r.id)}</td><td>{html.escape(r.verdict)}</td>"
+            f'<tr id="eq-{html.escape(r.id)}" class="{html.escape(css)}">'
+            f"<td>{html.escape(r.id)}</td><td>{html.escape(verdict)}</td>"
             f"<td>{cell('printed', r.printed)}</td><td>{cell('derived', r.derived)}</td>"
             f"<td>{note}</td></tr>"
         )
@@ -827,7 +870,7 @@ def derivations(res: dict[str, Any], records: list, rendered: dict | None = None
             "| "
             + " | ".join(
                 c.replace("|", "\\|").replace("\n", " ")
-                for c in (r.id, r.verdict, f"`{r.printed}`", f"`{r.derived}`", r.note)
+                for c in (r.id, verdict, f"`{r.printed}`", f"`{r.derived}`", r.note)
             )
             + " |"
         )

@@ -246,6 +246,16 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
                 f"PTO linear loop stable for {_interval(nd)}; PD for {_interval(pd_nd)}",
             ]
         )
+    loops = res["poles"]["loops"]
+    if "linear" in loops and "pd" in loops:
+        lin, pd = loops["linear"], loops["pd"]
+        rows.append(
+            [
+                "Stability margins of the linear loops (sampled, nominal plant)?",
+                f"PTO linear zone: {_margins(lin)}",
+                f"PD: {_margins(pd)}",
+            ]
+        )
     p = res["properties"]["pto"] if "pto" in res["properties"] else None
     if p is not None:
         clean = p["stride_overs"] == 0 and p["limit_cycles"] == 0 and p["chattering"] == 0
@@ -267,6 +277,20 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
         ]
     )
     return rows
+
+
+def _margins(loop: Mapping) -> str:
+    """Gain margin [dB], phase margin [deg] and delay margin [samples] of one loop."""
+    n = loop["delay_margin_samples"]
+    delay = (
+        "unstable without delay"
+        if n < 0
+        else f"tolerates {n} sample{'s' if n != 1 else ''} of computation delay"
+    )
+    return (
+        f"gain margin {qty(loop['gain_margin_db'], 'dB')}, phase margin "
+        f"{qty(loop['phase_margin_deg'], 'deg')}, {delay}"
+    )
 
 
 def _interval(iv: Any) -> str:
