@@ -189,15 +189,25 @@ def test_report_renders_in_headless_chromium(two_reports, tmp_path):
         "const li=[...document.querySelectorAll('#findings ol.findings li')];"
         "const fv=li.filter(e=>e.getBoundingClientRect().height>0&&e.innerText.length>40).length;"
         "const raw=/\\{'|np\\.float64|array\\(|\\[np\\./.test(document.body.innerText)?1:0;"
+        "const W=document.documentElement.clientWidth;"
+        "const wide=[...document.querySelectorAll('td,th')].filter("
+        "c=>c.getBoundingClientRect().right>W+1).length;"
         "document.title=`IMAGES ${ok}/${imgs.length} MATH ${mh}/${m.length} ROWS ${rows} "
-        "FINDINGS ${fv}/${li.length} RAW ${raw}`;"
+        "FINDINGS ${fv}/${li.length} RAW ${raw} WIDE ${wide}`;"
         "}</script>"
     )
     probe_page = index.parent / "probe.html"
     probe_page.write_text(index.read_text().replace("</body>", probe + "</body>"))
     try:
         dom = subprocess.run(
-            [browser, *flags, "--virtual-time-budget=5000", "--dump-dom", probe_page.as_uri()],
+            [
+                browser,
+                *flags,
+                "--window-size=1280,1600",
+                "--virtual-time-budget=5000",
+                "--dump-dom",
+                probe_page.as_uri(),
+            ],
             capture_output=True,
             text=True,
             timeout=120,
@@ -223,6 +233,7 @@ def test_report_renders_in_headless_chromium(two_reports, tmp_path):
     shown, n_findings = map(int, parts[7].split("/"))
     assert 4 <= n_findings <= 6 and shown == n_findings, f"headline findings not rendered: {title}"
     assert parts[9] == "0", f"raw Python text on the page: {title}"
+    assert parts[11] == "0", f"table cells wider than a 1280 px page: {title}"
     png = shot.read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 50_000, "blank screenshot"
     # a non-blank page: many distinct pixel rows (decode via matplotlib, already a dependency)

@@ -326,7 +326,10 @@ math{font-size:1.05em}code{font-size:.85em}pre{background:#f6f6f6;padding:.5em;o
 .headline figure{flex:1 1 24em;margin:0}.row{display:flex;gap:1em;flex-wrap:wrap}
 .row figure{flex:1 1 22em}.erratum-block{border-left:4px solid #d88;padding:.2em 1em;margin:1em 0}
 table.derivations{table-layout:fixed;width:100%}table.derivations td{overflow-x:auto;
-overflow-wrap:anywhere}table.derivations td:nth-child(-n+2){width:6em}"""
+overflow-wrap:anywhere}table.derivations th:nth-child(1),table.derivations td:nth-child(1){width:3.5em}
+table.derivations th:nth-child(2),table.derivations td:nth-child(2){width:9em}
+table.derivations th:nth-child(5),table.derivations td:nth-child(5){width:22%}
+td{overflow-wrap:anywhere}table{max-width:100%}.erratum-block table td{overflow-x:auto;max-width:60em}"""
 
 #: Cell texts that get a CSS class (colour) of their own.
 STATUS_WORDS = frozenset(

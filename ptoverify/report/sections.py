@@ -690,6 +690,51 @@ def _counterexample_rows(ce: dict[str, Any], unit: str) -> tuple[list[str], list
     return ["quantity", *[t for t, _ in cols]], rows
 
 
+#: The paper's tilded symbols, named ``tx1``, ``tx20``, ... in the derivations.
+_TILDE_MI = re.compile(r"<mi>tx</mi>")
+_TILDE_TEXT = re.compile(r"\btx(\d+)")
+
+
+def tilde_mathml(text: str) -> str:
+    """Draw the derivations' ``tx`` symbols as x with a tilde (x~1 is the paper's tilde-x1).
+
+    Parameters
+    ----------
+    text : str
+        MathML from SymPy's presentation printer.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> tilde_mathml("<msub><mi>tx</mi><mi>1</mi></msub>")
+    '<msub><mover accent="true"><mi>x</mi><mo>~</mo></mover><mi>1</mi></msub>'
+    """
+    return _TILDE_MI.sub('<mover accent="true"><mi>x</mi><mo>~</mo></mover>', text)
+
+
+def tilde_text(text: str) -> str:
+    """Write the derivations' ``tx1`` as ``x~1`` in plain text.
+
+    Parameters
+    ----------
+    text : str
+        A plain-text form.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> tilde_text("a*tx1 + tx20")
+    'a*x~1 + x~20'
+    """
+    return _TILDE_TEXT.sub(r"x~\1", text)
+
+
 def render_records(records: list) -> dict[str, dict[str, Any]]:
     """Render what the derivation sections show of each record (SymPy work, done once).
 
@@ -708,7 +753,7 @@ def render_records(records: list) -> dict[str, dict[str, Any]]:
     """
     return {
         r.id: {
-            "mathml": r.to_mathml(),
+            "mathml": {k: tilde_mathml(v) for k, v in r.to_mathml().items()},
             "unit": (_expr_unit(r.derived) or _expr_unit(r.printed))
             if r.verdict == "erratum"
             else "",
@@ -761,11 +806,17 @@ def errata(res: dict[str, Any], records: list, rendered: dict | None = None) -> 
         ):
             if r[key]:
                 m = ml.get(key, "")
-                body = _MATH.format(m) if m else f"<code>{html.escape(r[key])}</code>"
+                zero = key == "corrected" and "=" not in r[key]  # a residual: the curve is = 0
+                if m:
+                    body = _MATH.format(m + ("<mo>=</mo><mn>0</mn>" if zero else ""))
+                else:
+                    body = (
+                        f"<code>{html.escape(tilde_text(r[key]) + (' = 0' if zero else ''))}</code>"
+                    )
                 forms.append(f"<tr><th>{label}</th><td>{body}</td></tr>")
         down = [i.split(":", 1) for i in r["inherits"]]
         lis = "".join(
-            f"<li>eq. {_eq_links(h.strip(), ids)}: {html.escape(t.strip())}</li>"
+            f"<li>eq. {_eq_links(h.strip(), ids)}: {html.escape(tilde_text(t.strip()))}</li>"
             if t
             else f"<li>{html.escape(h)}</li>"
             for h, *rest in down
@@ -775,19 +826,28 @@ def errata(res: dict[str, Any], records: list, rendered: dict | None = None) -> 
             f'<div class="erratum-block" id="erratum-{html.escape(r["id"])}">'
             f'<h3>Eq. ({html.escape(r["id"])}) <a href="#eq-{html.escape(r["id"])}">'
             "(in the derivations table)</a></h3>"
-            f"<p>{html.escape(r['note'])}</p><table>{''.join(forms)}</table>"
-            f"<p>Counterexample{' (values in ' + unit + ')' if unit else ''}:</p>"
+            f"<p>{html.escape(tilde_text(r['note']))}</p><table>{''.join(forms)}</table>"
+            "<p>Counterexample (each row in its own unit):</p>"
         )
         md = (
-            f"### Eq. ({r['id']})\n\n{r['note']}\n\nprinted: `{r['printed']}`\n\n"
-            f"derived: `{r['derived']}`\n\nCounterexample:"
+            f"### Eq. ({r['id']})\n\n{tilde_text(r['note'])}\n\n"
+            f"printed: `{tilde_text(r['printed'])}`\n\n"
+            f"derived: `{tilde_text(r['derived'])}`\n\n"
+            + (
+                f"corrected: `{tilde_text(r['corrected'])}"
+                f"{'' if '=' in r['corrected'] else ' = 0'}`\n\n"
+                if r["corrected"]
+                else ""
+            )
+            + "Counterexample (each row in its own unit):"
         )
         blocks.append(Block("raw", text=md, html=inner))
         blocks.append(tb)
         blocks.append(
             Block(
                 "raw",
-                text="Changes downstream:\n\n" + "\n".join(f"- eq. {i}" for i in r["inherits"]),
+                text="Changes downstream:\n\n"
+                + "\n".join(f"- eq. {tilde_text(i)}" for i in r["inherits"]),
                 html=f"<p>Changes downstream:</p><ul>{lis}</ul></div>",
             )
         )
@@ -870,7 +930,13 @@ def derivations(res: dict[str, Any], records: list, rendered: dict | None = None
             "| "
             + " | ".join(
                 c.replace("|", "\\|").replace("\n", " ")
-                for c in (r.id, verdict, f"`{r.printed}`", f"`{r.derived}`", r.note)
+                for c in (
+                    r.id,
+                    verdict,
+                    f"`{tilde_text(r.printed)}`",
+                    f"`{tilde_text(r.derived)}`",
+                    tilde_text(r.note),
+                )
             )
             + " |"
         )

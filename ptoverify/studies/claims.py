@@ -489,8 +489,8 @@ def _step_pd_31(c: _Ctx, cl: _Claim) -> Outcome:
         vals,
         ok,
         (
-            f"settling PD {_ms(ts_pd)} vs PTO {_ms(ts_pto)}: PD takes "
-            f"{more:+.1f} %; overshoot PD {os_pd:.3f} mm, PTO {os_pto:.3f} mm"
+            f"settling PD {_ms(ts_pd)} vs PTO {_ms(ts_pto)}: PD needs "
+            f"{_more_or_less(more)}; overshoot PD {os_pd:.3f} mm, PTO {os_pto:.3f} mm"
         ),
     )
 
@@ -980,10 +980,6 @@ def evaluate_claims(
 
 
 # ------------------------------------------------------------------ tuned sentences
-def _pct(x: float) -> str:
-    return "n/a" if not math.isfinite(x) else f"{x:+.2f} %"
-
-
 def _us(x: float) -> str:
     """Milliseconds to the microsecond: tuned laws differ by tens of microseconds."""
     return "never" if not math.isfinite(x) else f"{1e3 * x:.3f} ms"
@@ -998,11 +994,22 @@ def _setting(r: ReadingResult) -> str:
 def _say_31(c: ClaimResult, rs: list[ReadingResult]) -> str:
     parts = [
         f"{_setting(r)}: PD {_us(r.values['settling_pd_s'])} vs PTO "
-        f"{_us(r.values['settling_pto_s'])}, PD takes {_pct(r.values['pd_more_percent'])} "
+        f"{_us(r.values['settling_pto_s'])}, so PD needs {_more_or_less(r.values['pd_more_percent'])} "
         f"({r.verdict})"
         for r in rs
     ]
-    return f"31 % (paper {c.paper_value:g} %): " + "; ".join(parts) + "."
+    return (
+        f"The paper says PD needs {c.paper_value:g} % more settling time than the PTO; measured: "
+        + "; ".join(parts)
+        + "."
+    )
+
+
+def _more_or_less(percent: float) -> str:
+    """Say a signed percentage in words: '36.4 % less' or '0.2 % more' (never '-36.4 % more')."""
+    if not math.isfinite(percent):
+        return "an undefined amount of"
+    return f"{abs(percent):.1f} % {'more' if percent >= 0 else 'less'} time"
 
 
 def _say_settling(what: str) -> Callable[[ClaimResult, list[ReadingResult]], str]:
