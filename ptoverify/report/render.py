@@ -329,7 +329,7 @@ table.derivations{table-layout:fixed;width:100%}table.derivations td{overflow-x:
 overflow-wrap:anywhere}table.derivations th:nth-child(1),table.derivations td:nth-child(1){width:3.5em}
 table.derivations th:nth-child(2),table.derivations td:nth-child(2){width:9em}
 table.derivations th:nth-child(5),table.derivations td:nth-child(5){width:22%}
-td{overflow-wrap:anywhere}table{max-width:100%}.erratum-block table td{overflow-x:auto;max-width:60em}"""
+td{overflow-wrap:break-word}table{max-width:100%}.erratum-block table td{overflow-x:auto;max-width:60em}"""
 
 #: Cell texts that get a CSS class (colour) of their own.
 STATUS_WORDS = frozenset(

@@ -26,6 +26,7 @@ from ptoverify.report.render import (
     qty,
     table,
 )
+from ptoverify.report.standing import ratio_interval
 
 __all__ = [
     "headline_findings",
@@ -244,9 +245,9 @@ def _finding_settling(res: Any) -> tuple[str, str, str] | None:
 
     Both numbers stand in the same sentence, so the finding cannot overstate.
     """
-    from ptoverify.report.standing import _step_readings, _value_words
+    from ptoverify.report.standing import reading_words, step_readings
 
-    step = _step_readings(res)
+    step = step_readings(res)
     if not step:
         return None
     parts = []
@@ -257,7 +258,7 @@ def _finding_settling(res: Any) -> tuple[str, str, str] | None:
             continue
         fast = "PD" if pd < pto else "the corrected PTO"
         parts.append(
-            f"under {_value_words('a', a)} {fast} settles first (PD {_ms(pd)}, PTO {_ms(pto)})"
+            f"under {reading_words('a', a)} {fast} settles first (PD {_ms(pd)}, PTO {_ms(pto)})"
         )
     if not parts:
         return None
@@ -350,22 +351,22 @@ def _claim_value_sentence(c: dict[str, Any]) -> str:
 
 
 def _finding_robust(res: Any) -> tuple[str, str, str] | None:
-    from ptoverify.report.standing import _interval
-
     rob = res["robust"]
     if rob is None or "pto" not in rob["margins"]:
         return None
     m = rob["margins"]["pto"]
     d1, nd = m["linear_loop_a_ratio_stable_delay1"], m["linear_loop_a_ratio_stable"]
-    text = f"Without delay the PTO's linear zone is stable for a_true / a_design in {_interval(nd)}"
+    text = f"Without delay the PTO's linear zone is stable for a_true / a_design in {ratio_interval(nd)}"
     if "pd" in rob["margins"]:
         pd = rob["margins"]["pd"]
-        text += f" (PD: {_interval(pd['linear_loop_a_ratio_stable'])})"
+        text += f" (PD: {ratio_interval(pd['linear_loop_a_ratio_stable'])})"
     text += "; with a one-sample computation delay it is " + (
-        f"stable for {_interval(d1)}" if d1 else "unstable even at the design bandwidth"
+        f"stable for {ratio_interval(d1)}" if d1 else "unstable even at the design bandwidth"
     )
     if "pd" in rob["margins"]:
-        text += f" (PD: {_interval(rob['margins']['pd']['linear_loop_a_ratio_stable_delay1'])})"
+        text += (
+            f" (PD: {ratio_interval(rob['margins']['pd']['linear_loop_a_ratio_stable_delay1'])})"
+        )
     return (text + ".", "robustness", "robustness")
 
 
@@ -392,14 +393,6 @@ def _finding_gates(res: dict[str, Any]) -> tuple[str, str, str]:
         "summary",
         "gate table",
     )
-
-
-def _interval(iv: list | None) -> str:
-    if iv is None:
-        return "n/a"
-    lo = "below the searched 0.1" if iv[0] is None else fmt(iv[0])
-    hi = "beyond the searched 10" if iv[1] is None else fmt(iv[1])
-    return f"[{lo}, {hi}] [-]"
 
 
 def headline(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
@@ -1387,13 +1380,13 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
         rows.append(
             [
                 _law(law),
-                _interval(m["linear_loop_a_ratio_stable"])
+                ratio_interval(m["linear_loop_a_ratio_stable"])
                 if m["linear_loop_a_ratio_stable"]
                 else m["linear_loop_note"] or "n/a",
-                _interval(m["linear_loop_a_ratio_stable_delay1"])
+                ratio_interval(m["linear_loop_a_ratio_stable_delay1"])
                 if m["linear_loop_a_ratio_stable_delay1"]
                 else m["linear_loop_note_delay1"] or "n/a",
-                _interval(m["no_limit_cycle_a_ratio"])
+                ratio_interval(m["no_limit_cycle_a_ratio"])
                 if m["no_limit_cycle_a_ratio"]
                 else m["no_limit_cycle_note"] or "n/a",
             ]

@@ -46,7 +46,7 @@ def _ms(seconds: float | None) -> str:
     return "never" if seconds is None else qty(1e3 * seconds, "ms")
 
 
-def _value_words(dim: str, value: Any) -> str:
+def reading_words(dim: str, value: Any) -> str:
     words = READING_WORDS.get(dim, {})
     if value in words:
         return words[value]
@@ -97,7 +97,7 @@ def claim_standing(claim: Mapping) -> tuple[str, str]:
             )
         if len(values) > 1 and all(all(v) or not any(v) for v in values.values()):
             holding = [k for k, v in values.items() if all(v)]
-            words = " or ".join(_value_words(dim, _unkey(k)) for k in holding)
+            words = " or ".join(reading_words(dim, _unkey(k)) for k in holding)
             return "depends", f"holds only with {words}"
     return "depends", f"holds under {sum(ok)} of {len(readings)} readings"
 
@@ -139,7 +139,7 @@ def reviewer_rows(res: Mapping) -> list[list[str]]:
     return rows
 
 
-def _step_readings(res: Mapping) -> dict[str, Mapping]:
+def step_readings(res: Mapping) -> dict[str, Mapping]:
     """Return the 31 % claim's readings at the paper's gains, 2 % band, corrected PTO, by a."""
     out: dict[str, Mapping] = {}
     for c in res["claims"]:
@@ -185,21 +185,23 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             f"{qty(co['omega0'], 'mm/s')} ({'valid' if co['valid'] else 'invalid'})",
         ]
     ]
-    step = _step_readings(res)
+    step = step_readings(res)
     if step:
         parts, verdicts = [], []
         for a, r in step.items():
             v = r["values"]
             verdicts.append(_faster(v["settling_pto_s"], v["settling_pd_s"], T))
             parts.append(
-                f"{_value_words('a', a)}: PTO {_ms(v['settling_pto_s'])}, "
+                f"{reading_words('a', a)}: PTO {_ms(v['settling_pto_s'])}, "
                 f"PD {_ms(v['settling_pd_s'])}"
             )
         answer = (
             verdicts[0]
             if len(set(verdicts)) == 1
             else "depends on the reading of a: "
-            + "; ".join(f"{_value_words('a', a)}: {w}" for a, w in zip(step, verdicts, strict=True))
+            + "; ".join(
+                f"{reading_words('a', a)}: {w}" for a, w in zip(step, verdicts, strict=True)
+            )
         )
         rows.append(
             ["Faster than PD at the paper's gains (step, 2 % band)?", answer, "; ".join(parts)]
@@ -229,7 +231,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
                 "yes" if d1 is not None else "no: needs delay compensation or lower gains",
                 "PTO linear zone with one sample of delay: "
                 + (
-                    f"stable for a_true / a_design in {_interval(d1)}"
+                    f"stable for a_true / a_design in {ratio_interval(d1)}"
                     if d1
                     else m["linear_loop_note_delay1"]
                 ),
@@ -242,8 +244,8 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
         rows.append(
             [
                 "Tolerates a bandwidth other than the design value?",
-                f"a_true / a_design in {_interval(nd)}" if nd else m["linear_loop_note"],
-                f"PTO linear loop stable for {_interval(nd)}; PD for {_interval(pd_nd)}",
+                f"a_true / a_design in {ratio_interval(nd)}" if nd else m["linear_loop_note"],
+                f"PTO linear loop stable for {ratio_interval(nd)}; PD for {ratio_interval(pd_nd)}",
             ]
         )
     loops = res["poles"]["loops"]
@@ -293,7 +295,7 @@ def _margins(loop: Mapping) -> str:
     )
 
 
-def _interval(iv: Any) -> str:
+def ratio_interval(iv: Any) -> str:
     """Return an a_true / a_design interval in words (an open end: no limit found)."""
     if not iv:
         return "no interval (unstable at the design point)"
