@@ -165,7 +165,7 @@ def test_h_is_elementwise_for_any_shape_and_batch():
 
 def test_level_side_is_the_residual():
     """level_side(a x1, x2, omega) is a x1 + level_term(x2, omega) for every state, the
-    infinite velocities (NaN: inf - inf) and any batch size included."""
+    infinite velocities (+-inf: the side of x2) and any batch size included."""
     from ptoverify.model.curves import level_side, level_term
 
     rng = np.random.default_rng(7)
@@ -178,7 +178,7 @@ def test_level_side_is_the_residual():
         full = ax1 + level_term(x2, omega)
         for band in (0.0, 1e-2):
             assert np.array_equal(level_side(ax1, x2, omega, band), full, equal_nan=True)
-        assert np.isnan(full[::7]).all() and np.isnan(full[1::7]).all()
+        assert (full[::7] == np.inf).all() and (full[1::7] == -np.inf).all()  # x2's side
         for size in (1, 63, 64, 65):
             got = [
                 level_side(ax1[i : i + size], x2[i : i + size], omega[i : i + size])
@@ -216,3 +216,20 @@ def test_root_22_against_mpmath_and_batch_independent():
         np.concatenate([root_22(b0[i : i + 64]) for i in range(0, b0.size, 64)]), y
     )
     assert np.isnan(root_22([-1.0, np.nan, np.inf])).all() and root_22(0.0) == 0.0
+
+
+def test_omega_c_is_elementwise_for_any_batch():
+    rng = np.random.default_rng(2024)
+    a = 188.5
+    x2 = -rng.uniform(1, 600, 4000)
+    x1 = rng.uniform(0.001, 0.999, 4000) * (-x2) / a
+    x1[:8], x2[:8] = (
+        [0.0, 1.0, -1.0, 0.0, 1.0, 5.0, -5.0, 0.0],
+        [0.0, 0.0, 1.0, 1.0, 1.0, -1.0, -1.0, -0.0],
+    )
+    with np.errstate(all="ignore"):
+        big = omega_c(x1, x2, a)
+        for size in (1, 3, 64, 65):
+            parts = [omega_c(x1[i : i + size], x2[i : i + size], a) for i in range(0, 4000, size)]
+            assert np.array_equal(np.concatenate(parts), big, equal_nan=True), size
+    assert np.isnan(big[0]) and big[1] == big[2] == 0.0 and big[4] == np.inf  # eq. (32) limits

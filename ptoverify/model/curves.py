@@ -92,14 +92,20 @@ def h(r: ArrayLike) -> Array:
     Returns
     -------
     ndarray
-        h(r) >= 0 [-], of the shape of ``r``.
+        h(r) >= 0 [-], of the shape of ``r``; +inf at r = +inf, so a level
+        curve's residual at x2 = +-inf is +-inf (the side is that of x2).
 
     Examples
     --------
     >>> float(h(1e-10))      # r^2/2 - r^3/3: exact where r - log1p(r) would give 0
     4.999999999666667e-21
     """
-    return _direct_or_series(r, lambda x: x - np.log1p(x), 0.2, _H_SERIES)
+    return _direct_or_series(r, _h_direct, 0.2, _H_SERIES)
+
+
+def _h_direct(r: Array) -> Array:
+    """Return r - log1p(r), and its limit +inf at r = +inf (where it reads inf - inf)."""
+    return np.where(r == np.inf, np.inf, r - np.log1p(r))
 
 
 def _e2(u: ArrayLike) -> Array:
