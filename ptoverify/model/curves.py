@@ -59,10 +59,11 @@ _E2_SERIES = np.array([1.0 / np.prod(np.arange(1, n + 1, dtype=float)) for n in 
 
 
 def _series(x: Array, coef: Array) -> Array:
-    """Return sum_j coef[j] x^(2 + j) by Horner's rule from zero (x finite)."""
-    acc = np.zeros_like(x)
-    for c in coef[::-1]:
-        acc = acc * x + c
+    """Return sum_j coef[j] x^(2 + j) by Horner's rule (x finite)."""
+    acc = np.full_like(x, coef[-1])
+    for c in coef[-2::-1]:
+        acc *= x
+        acc += c
     return acc * (x * x)
 
 
@@ -70,7 +71,7 @@ def _direct_or_series(x: ArrayLike, direct, radius: float, coef: Array) -> Array
     """Return ``direct(x)``, and the series ``coef`` where |x| < ``radius``; x's shape."""
     x = np.asarray(x, dtype=float)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        out = np.array(direct(x), dtype=float)
+        out = direct(np.atleast_1d(x)).reshape(x.shape)  # a fresh array
     near = np.abs(x) < radius
     if near.any():  # (no series values: nothing to overwrite)
         out[near] = _series(x[near], coef)
@@ -105,7 +106,9 @@ def h(r: ArrayLike) -> Array:
 
 def _h_direct(r: Array) -> Array:
     """Return r - log1p(r), and its limit +inf at r = +inf (where it reads inf - inf)."""
-    return np.where(r == np.inf, np.inf, r - np.log1p(r))
+    out = r - np.log1p(r)
+    out[r == np.inf] = np.inf
+    return out
 
 
 def _e2(u: ArrayLike) -> Array:

@@ -192,7 +192,7 @@ def saturate_linear(v: NDArray[np.float64], w: float):
     """
     with np.errstate(invalid="ignore"):
         region = np.where(np.abs(v) > w, Region.SATURATED, Region.LINEAR).astype(np.int8)
-    return np.clip(v, -w, w), region
+    return np.minimum(np.maximum(v, -w), w), region  # np.clip(v, -w, w)
 
 
 def _pd_input(x1, x2, kp, kd, w: float):
@@ -246,38 +246,43 @@ def _pto_block(a: float, w: float) -> Callable:
     """
 
     def block(x1, x2, g1, g2, dd, lv):
-        g1, g2, dd, lv = (
-            np.broadcast_to(np.asarray(p, dtype=float), x1.shape) for p in (g1, g2, dd, lv)
-        )
         u = np.empty(x1.shape)
         region = np.empty(x1.shape, dtype=np.int8)
         lin = np.abs(x1) < dd
         if lin.any():  # S_L, eq. (34)
-            u[lin], region[lin] = _pd_input(x1[lin], x2[lin], g1[lin], g2[lin], w)
+            g1l, g2l = _at(g1, lin), _at(g2, lin)
+            u[lin], region[lin] = _pd_input(x1[lin], x2[lin], g1l, g2l, w)
         out = ~lin
         if out.any():
-            u[out], region[out] = _outside_linear(x1[out], x2[out], lv[out], a, w)
+            u[out], region[out] = _outside_linear(x1[out], x2[out], _at(lv, out), a, w)
         return _origin(x1, x2, u, region)
 
     return block
 
 
+def _at(p, mask):
+    """Return a parameter at the states of ``mask`` (a float as it is, else its entries)."""
+    return p[mask] if isinstance(p, np.ndarray) and p.ndim else p
+
+
 def _outside_linear(y1, y2, lv, a: float, w: float):
     """PTO input outside the linear zone: eq. (12), or omega_c in the switching zone.
 
-    ``lv``: the zone's level per state [mm/s] (NaN: no zone); eqs. (13), (14), (28)-(33).
+    ``lv``: the zone's level [mm/s] (NaN: no zone), a float or one per state;
+    eqs. (13), (14), (28)-(33).
     """
     sig = level_residual(y1, y2, a, w)  # switching function, eqs. (9), (11)
     u, region = _bang(sig, y2, w)  # eq. (12)
     # zone candidates: between l1 and l2 (x2 and sigma of opposite signs), with a zone
     cand = np.flatnonzero((np.sign(y2) * np.sign(sig) < 0) & ~np.isnan(lv))
     if cand.size:
-        c1, c2, lc = y1[cand], y2[cand], lv[cand]
+        c1, c2, lc = y1[cand], y2[cand], _at(lv, cand)
         r0 = level_residual(c1, c2, a, lc)  # on or inside l1* (l2*), eqs. (13), (14)
         zp = (c2 < 0) & (r0 <= 0)
         inz = zp | ((c2 > 0) & (r0 >= 0))
         if inz.any():
-            wc = np.clip(omega_c(c1[inz], c2[inz], a), lc[inz], w)  # eqs. (28)-(33)
+            # omega_c clipped to [level, w_max], eqs. (28)-(33)
+            wc = np.minimum(np.maximum(omega_c(c1[inz], c2[inz], a), _at(lc, inz)), w)
             idx, zpi = cand[inz], zp[inz]
             u[idx] = np.where(zpi, wc, -wc)
             region[idx] = np.where(zpi, Region.ZONE_P, Region.ZONE_N)
