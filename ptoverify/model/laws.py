@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from enum import IntEnum
 from functools import partial
 
@@ -120,8 +120,8 @@ class Law:
 
     name: str
     vector: ArrayFn
-    scalar: ScalarFn | None = field(default=None)
-    w_max: float = math.inf
+    scalar: ScalarFn | None
+    w_max: float
     note: str = ""
     family: LawFamily | None = None
     odd: bool = False

@@ -71,13 +71,14 @@ def check_key(value: object) -> None:
     )
 
 
-def memo(maxsize: int = 64) -> Callable[[F], F]:
+def memo(maxsize: int | None = 64) -> Callable[[F], F]:
     """Return a decorator that memoizes a function on checked keys.
 
     Parameters
     ----------
-    maxsize : int
-        Entries kept per function (least recently used dropped first) [-].
+    maxsize : int or None
+        Entries kept per function (least recently used dropped first) [-];
+        None: no limit (for a few objects built once per option set).
 
     Returns
     -------
