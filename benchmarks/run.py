@@ -51,7 +51,7 @@ if sys.path[0] != str(ROOT):
     sys.path.insert(0, str(ROOT))
 
 from ptoverify.config import paper_config  # noqa: E402
-from ptoverify.model.curves import blockwise, omega_c  # noqa: E402
+from ptoverify.model.curves import omega_c  # noqa: E402
 from ptoverify.model.laws import make_law  # noqa: E402
 from ptoverify.model.mintime import (  # noqa: E402
     ZOHReach,
@@ -223,17 +223,11 @@ def bench_omega(cfg, size: dict) -> dict:
     t_closed, t_bisect = median_times(
         [lambda: omega_c(x1, x2, a), lambda: omega_c_bisection(x1, x2, a)], size["repeat"]
     )
-    # the same bisection given the closed form's blockwise evaluation (not the key: a
-    # check that the ratio measures the method, not the memory traffic)
-    t_blocked = median_time(
-        lambda: blockwise(lambda b1, b2: omega_c_bisection(b1, b2, a), x1, x2), size["repeat"]
-    )
     rel = np.abs(omega_c_bisection(x1, x2, a) / omega_c(x1, x2, a) - 1.0)
     return {
         "ratio": t_bisect / t_closed,
         "closed_ms": 1e3 * t_closed,
         "bisection_ms": 1e3 * t_bisect,
-        "blocked_bisection_ms": 1e3 * t_blocked,
         "max_rel_diff": float(np.max(rel)),
     }
 
@@ -593,9 +587,7 @@ def table(out: dict, extra: dict) -> str:
     rows += [
         "",
         f"omega_c: bisection {om['bisection_ms']:.1f} ms vs closed form "
-        f"{om['closed_ms']:.2f} ms, max rel diff {om['max_rel_diff']:.2g}; blockwise "
-        f"bisection {om['blocked_bisection_ms']:.1f} ms "
-        f"(ratio {om['blocked_bisection_ms'] / om['closed_ms']:.3g})",
+        f"{om['closed_ms']:.2f} ms, max rel diff {om['max_rel_diff']:.2g}",
         f"t_f rel error median: collocation {oc['collocation_err']:.3g}, two-phase "
         f"{oc['two_phase_err']:.3g}; solver failures {oc['failures']}",
         f"vector law vs scalar law (per-state speed-up): {extra['vector_vs_scalar']:.3g}",

@@ -271,3 +271,32 @@ def test_cli_zone_json(capsys):
 def test_cli_zone_bad_config(tmp_path, capsys):
     assert main(["zone", "--config", str(tmp_path / "missing.toml")]) == 2
     assert capsys.readouterr().err.startswith("ptoverify: error:")
+
+
+def test_principle_margin_broadcasts_elementwise():
+    """Rows of an (omega0 x velocity) call are the one-omega0 calls; paired arrays are the
+    one-state calls (one evaluation, elementwise, for any shapes)."""
+    rng = np.random.default_rng(2024)
+    w = PAPER.plant.w_max
+    x2 = np.concatenate([rng.uniform(-w, w, 700), [0.0, -0.0, -w, w]])
+    om = np.array([0.0, 1e-6 * w, 0.2 * w, 0.7 * w, w, 2.0 * w])
+    for reading in ("strict", "lenient"):
+        rows = principle_margin(PAPER, om[:, None], x2, reading=reading)
+        for k, o in enumerate(om):
+            assert np.array_equal(rows[k], principle_margin(PAPER, float(o), x2, reading=reading))
+        pair = principle_margin(PAPER, np.resize(om, x2.size), x2, reading=reading)
+        want = [
+            principle_margin(PAPER, float(o), x2[i : i + 1], reading=reading)[0]
+            for i, o in enumerate(np.resize(om, x2.size))
+        ]
+        assert np.array_equal(pair, want)
+
+
+def test_smallest_d_depends_on_the_plant_only():
+    from ptoverify.config import PTOSettings
+    from ptoverify.model.zones import clear_caches
+
+    base = smallest_d(PAPER)
+    clear_caches()
+    other = dataclasses.replace(PAPER, pto=PTOSettings(d=3.7, k1=10.0, k2=0.1))
+    assert smallest_d(other) == base

@@ -6,9 +6,11 @@ plant     flow (eq. 7), step (one-sample map, eq. 15), zoh_matrices
 curves    switching_function, level_residual (eqs. 9, 11, 13, 14, 28, 33), Lambert-W roots
           root_22 (eq. 22), root_k (eqs. 26, 31), omega_c (eq. 32)
 zones     PTOZone; printed_zone (eqs. 19-27 as printed), corrected_zone, zone_summary
-laws      Law, Region; to_law (eq. 12), pd_law, pto_law (eq. 35: pto, pto-printed); make_law
+laws      Law (one vector path; one state is an array of one), Region; to_law (eq. 12),
+          pd_law, pto_law (eq. 35: pto, pto-printed); make_law, with_state_gains
 mintime   min_time (closed form), discrete_min_steps (N* by LPs), discrete_min_steps_batch
 reach     ZonotopeTable, zonotope_steps: N-step null-controllable sets as 2-D zonotopes
 ocp       TwoPhaseOCP, CollocationOCP (CasADi + IPOPT), convergence_study
 poles     PD and linear-zone (eq. 37) loops: poles, damping, margins (python-control)
+memo      memo, clear_memos: the one memo mechanism, keyed on configuration objects
 """

@@ -1,8 +1,10 @@
-"""Control laws: time-optimal (eq. 12), PD, and the region bookkeeping.
+"""Control laws: time-optimal (eq. 12), PD, PTO (eq. 35), and the region bookkeeping.
 
-A law is a :class:`Law`: calling it with arrays of states returns the input
-and the region code of each state; ``law.scalar(x1, x2)`` is the cheap path
-for one state given as Python floats.  Every law returns |u| <= w_max.
+A law is a :class:`Law`: calling it with states returns the input and the
+region code of each state.  Each law has one evaluation, its vector path;
+one state (``law.scalar(x1, x2)`` or ``law(x1, x2)`` on floats) is that path
+on an array of one state, so a state's input does not depend on the batch it
+is evaluated in.  Every law returns |u| <= w_max.
 
 Region codes (:class:`Region`) name the branch of the law that acted, so a
 simulation can say which region every sample used.
@@ -14,13 +16,14 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from enum import IntEnum
+from functools import partial
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import LAW_NAMES, Config
 from ptoverify.errors import InputError
-from ptoverify.model.curves import blockwise, level_side, omega_c
+from ptoverify.model.curves import level_residual, omega_c
 
 __all__ = [
     "Region",
@@ -31,11 +34,10 @@ __all__ = [
     "pto_law",
     "pto_corrected_law",
     "pto_printed_law",
-    "omega_c_scalar",
+    "saturate_linear",
     "make_law",
     "with_state_gains",
     "LAW_NAMES",
-    "h_scalar",
 ]
 
 
@@ -51,8 +53,6 @@ class Region(IntEnum):
     SATURATED = 6  #: linear input clipped at +-w_max
 
 
-_I8 = {r: np.int8(r) for r in Region}  # region codes as int8 scalars (np.where keeps int8)
-
 ArrayFn = Callable[
     [NDArray[np.float64], NDArray[np.float64]], tuple[NDArray[np.float64], NDArray[np.int8]]
 ]
@@ -65,9 +65,9 @@ class LawFamily:
 
     A batch that drives states with several laws of one family evaluates them
     in one call, each state with its law's parameters
-    (:func:`ptoverify.sim.simulate.simulate_segments`): per sample, one call's
-    fixed overhead in place of one per law.  Each state's input and region are
-    bit for bit those of its own law's vector path.
+    (:func:`ptoverify.sim.simulate.simulate_segments`).  A member's own
+    ``vector`` is this function with its ``params``, so each state's input and
+    region are those of its own law by construction.
 
     Attributes
     ----------
@@ -85,18 +85,26 @@ class LawFamily:
     params: tuple[float, ...]
 
 
+def _on_one_state(vector: ArrayFn, x1: float, x2: float) -> tuple[float, int]:
+    """Evaluate ``vector`` on an array of the one state (x1 [mm], x2 [mm/s])."""
+    u, region = vector(np.array([x1], dtype=float), np.array([x2], dtype=float))
+    return float(u[0]), int(region[0])
+
+
 @dataclass(frozen=True)
 class Law:
-    """A feedback law u = f(x1, x2), vectorized and scalar.
+    """A feedback law u = f(x1, x2): one vector path, and one state through it.
 
     Attributes
     ----------
     name : str
         Name (``to``, ``pd``, ``pto``, ``pto-printed``).
     vector : callable
-        ``vector(x1, x2) -> (u, region)`` on float arrays.
-    scalar : callable
-        ``scalar(x1, x2) -> (u, region)`` on Python floats.
+        ``vector(x1, x2) -> (u [mm/s], region)`` on 1-D float arrays of one shape.
+    scalar : callable or None
+        ``scalar(x1, x2) -> (u [mm/s], region)`` on Python floats.  None (the
+        suite's laws): ``vector`` on an array of the one state.  A law built
+        around third-party code may give that code's own one-state mode.
     w_max : float
         Saturation [mm/s] the law respects.
     note : str
@@ -112,166 +120,51 @@ class Law:
 
     name: str
     vector: ArrayFn
-    scalar: ScalarFn
+    scalar: ScalarFn | None
     w_max: float
     note: str = ""
     family: LawFamily | None = None
     odd: bool = False
 
+    def __post_init__(self) -> None:
+        """Make ``scalar`` the vector path on one state where none is given."""
+        if self.scalar is None:
+            object.__setattr__(self, "scalar", partial(_on_one_state, self.vector))
+
     def __call__(
         self, x1: ArrayLike, x2: ArrayLike
     ) -> tuple[NDArray[np.float64], NDArray[np.int8]]:
-        """Evaluate the law on arrays; returns (u [mm/s], region codes)."""
-        x1, x2 = np.asarray(x1, dtype=float), np.asarray(x2, dtype=float)
-        if x1.shape != x2.shape:
-            x1, x2 = np.broadcast_arrays(x1, x2)
-        return self.vector(x1, x2)
+        """Evaluate the law on states of any shape (floats: an array of one state).
 
+        Parameters
+        ----------
+        x1, x2 : array_like
+            Position [mm] and velocity [mm/s], broadcast together.
 
-_H_COEF = tuple((-1.0) ** n / n for n in range(25, 1, -1))  # Horner order, highest first
-
-
-def h_scalar(r: float) -> float:
-    """Return r - ln(1 + r) for a Python float, exact near 0 (see ``curves.h``).
-
-    Parameters
-    ----------
-    r : float
-        Argument [-], r > -1.
-
-    Returns
-    -------
-    float
-        h(r) >= 0 [-].
-
-    Examples
-    --------
-    >>> h_scalar(1e-10)
-    4.999999999666667e-21
-    """
-    if -0.2 < r < 0.2:
-        acc = 0.0
-        for c in _H_COEF:
-            acc = acc * r + c
-        return acc * r * r
-    return r - math.log1p(r)
-
-
-def sigma_scalar(x1: float, x2: float, a: float, omega: float) -> float:
-    """Scalar :func:`ptoverify.model.curves.level_residual` (eqs. 9, 11, 13, 14).
-
-    Parameters
-    ----------
-    x1, x2 : float
-        State [mm], [mm/s].
-    a : float
-        Bandwidth [rad/s].
-    omega : float
-        Input level of the curve [mm/s], omega > 0.
-
-    Returns
-    -------
-    float
-        a x1 + sgn(x2) omega h(|x2|/omega) [mm/s]: > 0 right of the curve.
-
-    Examples
-    --------
-    >>> sigma_scalar(1.0, 0.0, 100.0, 300.0)
-    100.0
-    """
-    if x2 > 0:
-        return a * x1 + omega * h_scalar(x2 / omega)
-    if x2 < 0:
-        return a * x1 - omega * h_scalar(-x2 / omega)
-    return a * x1
+        Returns
+        -------
+        u : ndarray
+            Input [mm/s], of the broadcast shape (0-d for two floats).
+        region : ndarray of int8
+            :class:`Region` code per state.
+        """
+        x1, x2 = np.broadcast_arrays(np.asarray(x1, dtype=float), np.asarray(x2, dtype=float))
+        u, region = self.vector(x1.ravel(), x2.ravel())
+        return u.reshape(x1.shape), region.reshape(x1.shape)
 
 
 def _bang(sigma: NDArray[np.float64], x2: NDArray[np.float64], w: float):
     """Time-optimal input from the switching function: S_P u l1 -> +w, S_N u l2 -> -w."""
-    pos = sigma < 0
-    on = sigma == 0
-    if on.any():  # on the curve: the sign of x2 decides
-        pos |= on & (x2 < 0)
-    return _pick_sign(pos, w), _pick_region(pos, Region.BANG_P, Region.BANG_N)
-
-
-def _pick_sign(pos, w: float):
-    """``np.where(pos, w, -w)`` without branches: 2 w pos - w, exact for 0 < w < inf.
-
-    (np.where on an irregular mask costs several times the arithmetic.)
-    """
-    u = np.empty(pos.shape)
-    if 0.0 < w < math.inf:  # 2 w is exact, 2 w - w = w and 0 - w = -w exactly
-        np.multiply(pos, 2.0 * w, out=u)
-        np.subtract(u, w, out=u)
-    else:
-        u[...] = np.where(pos, w, -w)
-    return u
-
-
-def _pick_region(pos, yes: Region, no: Region):
-    """``np.where(pos, yes, no)`` as int8 codes, without branches (yes = no - 1 or no + 1)."""
-    region = np.empty(pos.shape, dtype=np.int8)
-    if yes == no - 1:
-        np.subtract(_I8[no], pos, out=region)
-    else:
-        np.add(_I8[no], pos, out=region)
-    return region
+    pos = (sigma < 0) | ((sigma == 0) & (x2 < 0))  # on the curve: the sign of x2 decides
+    region = np.where(pos, Region.BANG_P, Region.BANG_N).astype(np.int8)
+    return np.where(pos, w, -w), region
 
 
 def _origin(x1, x2, u, region):
     """Set u = 0, region ORIGIN at the origin (in place); return (u, region)."""
-    origin = x1 == 0
-    if origin.any():  # x2 only where x1 is 0 (rare away from the origin)
-        origin &= x2 == 0
-        if origin.any():
-            u[origin], region[origin] = 0.0, Region.ORIGIN
+    origin = (x1 == 0) & (x2 == 0)
+    u[origin], region[origin] = 0.0, Region.ORIGIN
     return u, region
-
-
-def to_law(cfg: Config) -> Law:
-    """Time-optimal feedback law, eq. (12).
-
-    u = +w_max in S_P and on l1, -w_max in S_N and on l2, 0 at the origin, where
-    S_P / S_N are the sides of the switching curve l1 - o - l2 (eqs. 9, 11).
-
-    Parameters
-    ----------
-    cfg : Config
-        Configuration (plant a, w_max).
-
-    Returns
-    -------
-    Law
-        The TO law.
-
-    Examples
-    --------
-    >>> from ptoverify.config import paper_config
-    >>> law = to_law(paper_config())
-    >>> law.scalar(5.0, 0.0)
-    (-300.0, 2)
-    """
-    a, w = cfg.plant.a, cfg.plant.w_max
-
-    def vector(x1, x2):
-        # the sign of switching_function(x1, x2, a, w) = a x1 + level_term(x2, w)
-        u, region = _bang(level_side(a * x1, x2, w), x2, w)
-        return _origin(x1, x2, u, region)
-
-    # the PTO block with no linear zone (|x1| < 0 never holds) and no switching zone
-    # runs exactly this arithmetic: TO is a member of the PTO family
-    family = _pto_family(a, w, (0.0, 0.0, 0.0, math.nan))
-
-    def scalar(x1: float, x2: float) -> tuple[float, int]:
-        if x1 == 0.0 and x2 == 0.0:
-            return 0.0, int(Region.ORIGIN)
-        s = sigma_scalar(x1, x2, a, w)
-        if s < 0 or (s == 0 and x2 < 0):
-            return w, int(Region.BANG_P)
-        return -w, int(Region.BANG_N)
-
-    return Law("to", vector, scalar, w, "time-optimal bang-bang, eq. (12)", family, odd=True)
 
 
 def saturate_linear(v: NDArray[np.float64], w: float):
@@ -297,8 +190,14 @@ def saturate_linear(v: NDArray[np.float64], w: float):
     >>> u.tolist(), [Region(k).name for k in r]
     ([1.0, -300.0], ['LINEAR', 'SATURATED'])
     """
-    u = np.minimum(np.maximum(v, -w), w)  # np.clip(v, -w, w), without its wrapper
-    return u, _pick_region(np.abs(v) > w, Region.SATURATED, Region.LINEAR)
+    with np.errstate(invalid="ignore"):
+        region = np.where(np.abs(v) > w, Region.SATURATED, Region.LINEAR).astype(np.int8)
+    return np.minimum(np.maximum(v, -w), w), region  # np.clip(v, -w, w)
+
+
+def _pd_input(x1, x2, kp, kd, w: float):
+    """PD input sat(-kp x1 - kd x2) and its region; gains floats or one per state."""
+    return saturate_linear(-kp * x1 - kd * x2, w)
 
 
 def pd_law(cfg: Config, *, gains: tuple[NDArray, NDArray] | None = None) -> Law:
@@ -329,69 +228,12 @@ def pd_law(cfg: Config, *, gains: tuple[NDArray, NDArray] | None = None) -> Law:
     """
     w, kp, kd = cfg.plant.w_max, cfg.pd.kp, cfg.pd.kd
     if gains is not None:
-        return _state_gains_law(
-            "pd", lambda x1, x2: saturate_linear(-gains[0] * x1 - gains[1] * x2, w), w
-        )
+        return _state_gains_law("pd", partial(_pd_input, w=w), gains, w)
 
     def vector(x1, x2):
-        return saturate_linear(-kp * x1 - kd * x2, w)
+        return _pd_input(x1, x2, kp, kd, w)
 
-    def scalar(x1: float, x2: float) -> tuple[float, int]:
-        v = -kp * x1 - kd * x2
-        if v > w:
-            return w, int(Region.SATURATED)
-        if v < -w:
-            return -w, int(Region.SATURATED)
-        return v, int(Region.LINEAR)
-
-    return Law("pd", vector, scalar, w, f"PD u = sat(-{kp:g} x1 - {kd:g} x2)", odd=True)
-
-
-def omega_c_scalar(x1: float, x2: float, a: float) -> float:
-    """Level omega_c of the curve through (x1, x2), eqs. (28)-(32), for Python floats.
-
-    Solves eq. (31) in u = ln(1 + w), where it reads m = 1 - u / (e^u - 1) with
-    m = -a x1 / x2 (eq. 30, m = 1 - k).  m(u) is increasing and concave for
-    u > 0 and m(u) < u / 2, so Newton from u = 2 m climbs monotonically to the
-    root; then omega_c = |x2| / (e^u - 1) (eq. 32).
-
-    Parameters
-    ----------
-    x1, x2 : float
-        State [mm], [mm/s] with x1 x2 < 0.
-    a : float
-        Bandwidth [rad/s].
-
-    Returns
-    -------
-    float
-        omega_c [mm/s]; 0.0 when m >= 1, inf when m <= 0.
-
-    Examples
-    --------
-    >>> wc = omega_c_scalar(0.1, -100.0, 188.5)
-    >>> abs(188.5 * 0.1 - 100.0 + wc * math.log1p(100.0 / wc)) < 1e-10
-    True
-    """
-    m = -a * x1 / x2
-    if m <= 0.0:
-        return math.inf
-    if m >= 1.0:
-        return 0.0
-    u = 2.0 * m
-    for _ in range(60):
-        if u < 1e-3:
-            g = u * (0.5 - u * (1.0 / 12.0 - u * u / 720.0)) - m
-            dg = 0.5 - u / 6.0
-        else:
-            e = math.expm1(u)
-            g = 1.0 - u / e - m
-            dg = ((u - 1.0) * e + u) / (e * e)
-        du = g / dg
-        u -= du
-        if abs(du) <= 4e-16 * u:
-            break
-    return abs(x2) / math.expm1(u)
+    return Law("pd", vector, None, w, f"PD u = sat(-{kp:g} x1 - {kd:g} x2)", odd=True)
 
 
 def _pto_block(a: float, w: float) -> Callable:
@@ -399,74 +241,96 @@ def _pto_block(a: float, w: float) -> Callable:
 
     ``block(x1, x2, g1, g2, dd, lv)``: linear gains k1 [1/s], k2 [-], linear-zone
     half-width d [mm], switching-zone level [mm/s] (NaN: no zone), each a float or
-    one per state; on 1-D float arrays of one block (:func:`ptoverify.model.curves.blockwise`).
+    one per state.  Each branch is evaluated on the states it acts on (masks);
+    the linear zone first, as it takes precedence.
     """
 
     def block(x1, x2, g1, g2, dd, lv):
-        # each branch on the states it acts on (the linear zone first, as it takes
-        # precedence); the same elementwise arithmetic as evaluating every branch
-        # everywhere and selecting, so the result is unchanged.  g1, g2: the linear
-        # gains, dd: d, lv: the zone's level (NaN: no zone); floats or one per state
+        u = np.empty(x1.shape)
+        region = np.empty(x1.shape, dtype=np.int8)
         lin = np.abs(x1) < dd
-        n_lin = np.count_nonzero(lin)
-        if n_lin == lin.size:  # all in the linear zone: no masks
-            u, region = saturate_linear(-g1 * x1 - g2 * x2, w)
-            return _origin(x1, x2, u, region)
-        if 2 * n_lin >= lin.size:  # mostly linear: the linear input everywhere, the
-            # other states overwritten below (no gather and scatter of the linear ones)
-            with np.errstate(invalid="ignore", over="ignore"):  # only where overwritten
-                u, region = saturate_linear(-g1 * x1 - g2 * x2, w)
-        else:
-            u = np.empty(x1.shape)
-            region = np.empty(x1.shape, dtype=np.int8)
-            if n_lin:
-                il = lin.nonzero()[0]  # indices: one search of the mask, then gathers
-                if np.ndim(g1):
-                    g1, g2 = g1.take(il), g2.take(il)
-                u[il], region[il] = saturate_linear(-g1 * x1.take(il) - g2 * x2.take(il), w)
-        if n_lin < lin.size:
-            out = (~lin).nonzero()[0]
-            y1, y2 = x1.take(out), x2.take(out)
-            sig = level_side(a * y1, y2, w)  # the sign of switching_function
-            uo, ro = _bang(sig, y2, w)
-            per = np.ndim(lv) > 0
-            if per or not math.isnan(lv):
-                # ((y2 < 0) & (sig > 0)) | ((y2 > 0) & (sig < 0)), in fewer passes
-                between = np.sign(y2)
-                between *= np.sign(sig)
-                between = between < 0
-                if per:
-                    lv = lv.take(out)
-                    between &= ~np.isnan(lv)
-                cand = between.nonzero()[0]
-                if cand.size:
-                    c1, c2 = y1.take(cand), y2.take(cand)
-                    lc = lv.take(cand) if per else lv
-                    r0 = level_side(a * c1, c2, lc)  # the sign of level_residual
-                    zp = (c2 < 0) & (r0 <= 0)
-                    inz = zp | ((c2 > 0) & (r0 >= 0))
-                    if inz.any():  # closed form only where it is used
-                        # np.clip(omega_c, lc, w), without its wrapper
-                        wc = np.maximum(omega_c(c1[inz], c2[inz], a), lc[inz] if per else lc)
-                        np.minimum(wc, w, out=wc)
-                        zpi = zp[inz]
-                        idx = cand[inz]
-                        uo[idx] = np.where(zpi, wc, -wc)
-                        ro[idx] = np.where(zpi, Region.ZONE_P, Region.ZONE_N)
-            u[out], region[out] = uo, ro
+        if lin.any():  # S_L, eq. (34)
+            g1l, g2l = _at(g1, lin), _at(g2, lin)
+            u[lin], region[lin] = _pd_input(x1[lin], x2[lin], g1l, g2l, w)
+        out = ~lin
+        if out.any():
+            u[out], region[out] = _outside_linear(x1[out], x2[out], _at(lv, out), a, w)
         return _origin(x1, x2, u, region)
 
     return block
 
 
+def _at(p, mask):
+    """Return a parameter at the states of ``mask`` (a float as it is, else its entries)."""
+    return p[mask] if isinstance(p, np.ndarray) and p.ndim else p
+
+
+def _outside_linear(y1, y2, lv, a: float, w: float):
+    """PTO input outside the linear zone: eq. (12), or omega_c in the switching zone.
+
+    ``lv``: the zone's level [mm/s] (NaN: no zone), a float or one per state;
+    eqs. (13), (14), (28)-(33).
+    """
+    sig = level_residual(y1, y2, a, w)  # switching function, eqs. (9), (11)
+    u, region = _bang(sig, y2, w)  # eq. (12)
+    # zone candidates: between l1 and l2 (x2 and sigma of opposite signs), with a zone
+    cand = np.flatnonzero((np.sign(y2) * np.sign(sig) < 0) & ~np.isnan(lv))
+    if cand.size:
+        c1, c2, lc = y1[cand], y2[cand], _at(lv, cand)
+        r0 = level_residual(c1, c2, a, lc)  # on or inside l1* (l2*), eqs. (13), (14)
+        zp = (c2 < 0) & (r0 <= 0)
+        inz = zp | ((c2 > 0) & (r0 >= 0))
+        if inz.any():
+            # omega_c clipped to [level, w_max], eqs. (28)-(33)
+            wc = np.minimum(np.maximum(omega_c(c1[inz], c2[inz], a), _at(lc, inz)), w)
+            idx, zpi = cand[inz], zp[inz]
+            u[idx] = np.where(zpi, wc, -wc)
+            region[idx] = np.where(zpi, Region.ZONE_P, Region.ZONE_N)
+    return u, region
+
+
 def _pto_family(a: float, w: float, params: tuple[float, ...]) -> LawFamily:
     """Return the PTO family of a plant (:class:`LawFamily`), this member's ``params``."""
-    block = _pto_block(a, w)
+    return LawFamily(("pto-block", float(a), float(w)), _pto_block(a, w), tuple(map(float, params)))
 
-    def vector(x1, x2, *p):
-        return blockwise(block, x1, x2, *p)
 
-    return LawFamily(("pto-block", float(a), float(w)), vector, tuple(float(v) for v in params))
+def _bind(family: LawFamily) -> ArrayFn:
+    """``vector(x1, x2)`` = ``family.vector(x1, x2, *family.params)``."""
+
+    def vector(x1, x2):
+        return family.vector(x1, x2, *family.params)
+
+    return vector
+
+
+def to_law(cfg: Config) -> Law:
+    """Time-optimal feedback law, eq. (12).
+
+    u = +w_max in S_P and on l1, -w_max in S_N and on l2, 0 at the origin, where
+    S_P / S_N are the sides of the switching curve l1 - o - l2 (eqs. 9, 11).
+    It is the PTO law's function with no linear zone (d = 0) and no switching
+    zone, which is eq. (12) exactly (a member of the PTO family).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (plant a, w_max).
+
+    Returns
+    -------
+    Law
+        The TO law.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> law = to_law(paper_config())
+    >>> law.scalar(5.0, 0.0)
+    (-300.0, 2)
+    """
+    a, w = cfg.plant.a, cfg.plant.w_max
+    family = _pto_family(a, w, (0.0, 0.0, 0.0, math.nan))
+    return Law("to", _bind(family), None, w, "time-optimal bang-bang, eq. (12)", family, odd=True)
 
 
 def pto_law(
@@ -520,42 +384,12 @@ def pto_law(
     d, k1, k2 = cfg.pto.d, cfg.pto.k1, cfg.pto.k2
     zone = omega0 is not None and 0.0 < omega0 < w
     om = float(omega0) if zone else w
-
-    params = (k1, k2, d, om if zone else math.nan)
-    family = _pto_family(a, w, params)
-    pto_block = _pto_block(a, w)
-
-    def block(x1, x2, g1=k1, g2=k2, dd=d, lv=params[3]):
-        return pto_block(x1, x2, g1, g2, dd, lv)
-
+    family = _pto_family(a, w, (k1, k2, d, om if zone else math.nan))
     if gains is not None:
-        return _state_gains_law(name, lambda x1, x2: blockwise(block, x1, x2, *gains), w)
-
-    def vector(x1, x2):
-        return blockwise(block, x1, x2)
-
-    def scalar(x1: float, x2: float) -> tuple[float, int]:
-        if x1 == 0.0 and x2 == 0.0:
-            return 0.0, int(Region.ORIGIN)
-        if -d < x1 < d:
-            v = -k1 * x1 - k2 * x2
-            if v > w:
-                return w, int(Region.SATURATED)
-            if v < -w:
-                return -w, int(Region.SATURATED)
-            return v, int(Region.LINEAR)
-        s = sigma_scalar(x1, x2, a, w)
-        if zone:
-            if x2 < 0 and s > 0 and sigma_scalar(x1, x2, a, om) <= 0:
-                return min(max(omega_c_scalar(x1, x2, a), om), w), int(Region.ZONE_P)
-            if x2 > 0 and s < 0 and sigma_scalar(x1, x2, a, om) >= 0:
-                return -min(max(omega_c_scalar(x1, x2, a), om), w), int(Region.ZONE_N)
-        if s < 0 or (s == 0 and x2 < 0):
-            return w, int(Region.BANG_P)
-        return -w, int(Region.BANG_N)
-
+        per_state = gains if len(gains) == 4 else (*gains, *family.params[2:])
+        return _state_gains_law(name, family.vector, per_state, w)
     note = note or f"PTO eq. (35), omega0 = {om:g} mm/s"
-    return Law(name, vector, scalar, w, note, family, odd=True)
+    return Law(name, _bind(family), None, w, note, family, odd=True)
 
 
 def pto_corrected_law(cfg: Config, *, gains: tuple[NDArray, NDArray] | None = None) -> Law:
@@ -642,13 +476,23 @@ def pto_printed_law(cfg: Config) -> Law:
     )
 
 
-def _state_gains_law(name: str, vector: ArrayFn, w: float) -> Law:
-    """Return a law whose gains are one per state: only its vector path exists."""
+def _state_gains_law(name: str, fn: Callable, gains: tuple, w: float) -> Law:
+    """Return a law whose parameters are one per state: ``fn(x1, x2, *gains)``.
 
-    def scalar(x1: float, x2: float) -> tuple[float, int]:
-        raise TypeError("a law with per-state gains has no scalar path; call it on arrays")
+    Its states must have the gains' shape (state i is driven by gains i), so its
+    one-state path exists only for one gain set.
+    """
+    arrays = np.broadcast_arrays(*(np.asarray(g, dtype=float) for g in gains))
+    flat = tuple(g.ravel() for g in arrays)  # Law.__call__ hands the states flattened
 
-    return Law(name, vector, scalar, w, f"{name} with per-state linear gains")
+    def vector(x1, x2):
+        if x1.shape != flat[0].shape:
+            raise ValueError(
+                f"a law with {flat[0].size} per-state gain sets was given {x1.size} states"
+            )
+        return fn(x1, x2, *flat)
+
+    return Law(name, vector, None, w, f"{name} with per-state linear gains")
 
 
 def with_state_gains(name: str, cfg: Config, gains: dict[str, ArrayLike]) -> Law:
@@ -674,7 +518,7 @@ def with_state_gains(name: str, cfg: Config, gains: dict[str, ArrayLike]) -> Law
     Returns
     -------
     Law
-        Vector path only (its scalar path raises TypeError).
+        For states of the gains' shape (others raise ValueError).
 
     Examples
     --------

@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Plant
 from ptoverify.errors import InputError
-from ptoverify.model.curves import blockwise, h
+from ptoverify.model.curves import h
 from ptoverify.model.reach import DiscreteLimit
 
 __all__ = [
@@ -93,16 +93,16 @@ def min_time(x1: ArrayLike, x2: ArrayLike, plant: Plant) -> MinTime:
     >>> 0.02 < float(mt.t_f) < 0.03, float(mt.t_switch) < float(mt.t_f)
     (True, True)
     """
-    t_f, t_switch, side, q = blockwise(
-        lambda b1, b2: _min_time(b1, b2, plant.a, plant.w_max), x1, x2
+    x1, x2 = np.broadcast_arrays(np.asarray(x1, dtype=float), np.asarray(x2, dtype=float))
+    t_f, t_switch, side, q = (
+        v.reshape(x1.shape) for v in _min_time(x1.ravel(), x2.ravel(), plant.a, plant.w_max)
     )
     return MinTime(t_f=t_f, t_switch=t_switch, side=side, q=q)
 
 
 def _min_time(x1: NDArray, x2: NDArray, a: float, w: float) -> tuple[NDArray, ...]:
-    """:func:`min_time` on broadcast float arrays (one block): (t_f, t_switch, side, q)."""
-    hr = h(np.abs(x2) / w)
-    sigma = a * x1 + np.sign(x2) * w * hr  # switching_function, eqs. (9), (11)
+    """:func:`min_time` on 1-D float arrays of one shape: (t_f, t_switch, side, q)."""
+    sigma = a * x1 + np.sign(x2) * w * h(np.abs(x2) / w)  # switching_function, eqs. (9), (11)
     pos = sigma > 0
     pos |= ~(pos | (sigma < 0)) & (x2 < 0)  # on the curve: the side of x2
     side = np.where(pos, 1.0, -1.0)
@@ -110,11 +110,7 @@ def _min_time(x1: NDArray, x2: NDArray, a: float, w: float) -> tuple[NDArray, ..
     rho = y2 / w
     fast = rho <= -1.0
     with np.errstate(all="ignore"):
-        # h(rho) is h(|x2| / w), computed above, where y2 > 0 (rho = |x2| / w bit for bit)
-        redo = np.flatnonzero(~(y2 > 0) | fast)
-        if redo.size:
-            hr[redo] = h(np.where(fast[redo], 0.0, rho[redo]))
-        g = a * y1 / w + hr
+        g = a * y1 / w + h(np.where(fast, 0.0, rho))
         q2 = -(w * w) * np.expm1(-g)
         fi = np.flatnonzero(fast)  # y2 <= -w: the form without cancellation
         if fi.size:

@@ -21,7 +21,7 @@ Both problems are written in the dimensionless variables of eq. (1)::
 so that one NLP (one ``nlpsol`` and one set of CasADi functions) serves every
 plant and every state: the state enters as a parameter, the plant only through
 the scaling.  The solvers are built once per process and per option set
-(cached with :func:`functools.lru_cache`).  The two-phase solver starts from
+(memoized with :func:`ptoverify.model.memo.memo`).  The two-phase solver starts from
 its previous solution (warm; the 2x2 system has one solution, so the result
 does not depend on the start); collocation starts cold by default (see
 :class:`CollocationOCP`) so that a result does not depend on call order.
@@ -36,7 +36,6 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from functools import lru_cache
 
 import casadi as ca
 import numpy as np
@@ -45,6 +44,7 @@ from numpy.typing import NDArray
 from ptoverify.config import Plant
 from ptoverify.errors import InputError
 from ptoverify.model.curves import switching_function
+from ptoverify.model.memo import memo
 
 __all__ = [
     "OCPResult",
@@ -145,7 +145,7 @@ def _tau_lower_bound(z1: float, z2: float) -> float:
 
 
 # ---------------------------------------------------------------- two-phase
-@lru_cache(maxsize=None)
+@memo(maxsize=None)
 def _two_phase_solver(max_iter: int, tol: float) -> ca.Function:
     """Build the two-phase NLP once: variables (tau1, tau2), parameters (z1, z2, s, scale).
 
@@ -283,7 +283,7 @@ class TwoPhaseOCP:
 
 
 # ---------------------------------------------------------------- collocation
-@lru_cache(maxsize=None)
+@memo(maxsize=None)
 def _collocation_solver(
     intervals: int, degree: int, max_iter: int, tol: float, control: str
 ) -> ca.Function:

@@ -23,7 +23,6 @@ these conditions do not make the sampled loop stable.
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import asdict, dataclass
 
@@ -31,6 +30,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Config
+from ptoverify.model.memo import memo
 from ptoverify.model.plant import zoh_matrices
 
 __all__ = [
@@ -301,7 +301,7 @@ def loop_poles(name: str, a: float, T: float, k_x1: float, k_x2: float) -> LoopP
     return _loop_poles(str(name), float(a), float(T), float(k_x1), float(k_x2))
 
 
-@functools.lru_cache(maxsize=64)
+@memo(maxsize=64)
 def _loop_poles(name: str, a: float, T: float, k_x1: float, k_x2: float) -> LoopPoles:  # noqa: N803
     """Analyse one loop (:func:`loop_poles`), memoized on the scalar arguments.
 

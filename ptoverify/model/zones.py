@@ -52,15 +52,15 @@ right); the scan over (0, w_max] does not rely on it.
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Config, PTOSettings
 from ptoverify.model.curves import level_curve_x1, level_residual, level_term, root_22, root_k
+from ptoverify.model.memo import memo
 from ptoverify.model.plant import flow
 from ptoverify.verdict import tie_band
 
@@ -172,25 +172,27 @@ def _tol(cfg: Config) -> float:
     return tie_band(cfg.plant.w_max, cfg.plant.a, cfg.plant.position_range)
 
 
-def _l1star_x1(x2: NDArray[np.float64], a: float, omega0: float) -> NDArray[np.float64]:
-    """x1 on l1* at velocity x2 < 0 (eq. 13); omega0 = 0 gives the limit x1 = -x2 / a."""
-    if omega0 <= 0.0:
-        return -x2 / a
-    return level_curve_x1(x2, a, omega0)
+def _l1star_x1(x2: NDArray[np.float64], a: float, omega0: ArrayLike) -> NDArray[np.float64]:
+    """x1 on l1* at velocity x2 < 0 (eq. 13); omega0 <= 0 gives the limit x1 = -x2 / a."""
+    omega0 = np.asarray(omega0, dtype=float)
+    with np.errstate(all="ignore"):
+        return np.where(
+            omega0 <= 0.0, -x2 / a, level_curve_x1(x2, a, np.where(omega0 <= 0.0, 1.0, omega0))
+        )
 
 
-def _source_intervals(cfg: Config, omega0: float, x2: NDArray[np.float64], d: float):
+def _source_intervals(cfg: Config, omega0: ArrayLike, x2: NDArray[np.float64], d: float):
     """Left/right ends of the source x1-intervals at each velocity (u = -w_max, |x1| >= d).
 
-    Returns two intervals (lo, hi) per velocity; an empty one has lo > hi.
+    Returns two intervals (lo, hi) per velocity, of the broadcast shape of
+    ``omega0`` [mm/s] and ``x2`` [mm/s] for the first (right of l1*, x1 >= d) and
+    of ``x2`` for the second (l2 <= x1 <= -d); an empty one has lo > hi.
     """
     a, w = cfg.plant.a, cfg.plant.w_max
     neg = x2 < 0
-    with np.errstate(all="ignore"):
-        l1s = np.where(neg, _l1star_x1(np.where(neg, x2, -1.0), a, min(omega0, w)), 0.0)
+    l1s = np.where(neg, _l1star_x1(np.where(neg, x2, -1.0), a, np.minimum(omega0, w)), 0.0)
     lo_a = np.where(neg, np.maximum(l1s, d), d)  # right piece: x1 >= d
-    hi_a = np.full_like(x2, np.inf)
-    return (lo_a, hi_a), _l2_sources(cfg, x2, d)
+    return (lo_a, np.inf), _l2_sources(cfg, x2, d)
 
 
 def _l2_sources(cfg: Config, x2: NDArray[np.float64], d: float):
@@ -236,8 +238,10 @@ def principle_margin(
     ndarray
         min over the sources at that velocity of sigma(F_{-w_max}(x)) [mm/s];
         +inf where the rule exempts every source.  The principle holds where >= 0.
-        Of the broadcast shape of ``omega0`` and ``x2``; every entry is what a
-        scalar ``omega0`` gives, bit for bit (the evaluation is elementwise).
+        Of the broadcast shape of ``omega0`` and ``x2``.  The evaluation is
+        elementwise (one path for any shapes): what depends on the velocity
+        alone (the landing after one sample, the l2 side) is computed on ``x2``
+        and broadcast, the l1* side on the broadcast shape.
     """
     if reading not in READINGS:
         raise ValueError(f"reading must be one of {READINGS}")
@@ -246,124 +250,14 @@ def principle_margin(
     if x2 is None:
         x2 = np.linspace(-w, w, points)
     x2 = np.asarray(x2, dtype=float)
-    om = np.asarray(omega0, dtype=float)
-    if om.ndim == 0:
-        c1, f2 = flow(0.0, x2, -w, cfg.plant.sample_time, a)  # F1 = x1 + c1, F2 = f2
-        with np.errstate(all="ignore"):
-            term = level_term(f2, w)  # sigma(F) = a F1 + term: the part that is x1-free
-        (lo_a, hi_a), (lo_b, hi_b) = _source_intervals(cfg, float(om), x2, d)
-        return np.minimum(
-            _side_margin(lo_a, hi_a, c1, term, a, d, reading),
-            _side_margin(lo_b, hi_b, c1, term, a, d, reading),
-        )
-    # an array of omega0: the l2 side, and the l1* side at x2 >= 0 (sources x1 >= d),
-    # do not depend on omega0; evaluate them on x2 once and l1* only where x2 < 0
-    outer = x2.ndim == 1 and om.shape == (om.shape[0], 1)  # one row per omega0
-    if outer:  # the even grid of _worst_margins: the same velocities call after call
-        c1, term, m_b, m_fixed = _omega_free_memo(cfg.plant, d, reading, x2.tobytes())
-    else:
-        c1, term, m_b, m_fixed = _omega_free(cfg.plant, d, reading, x2)
-    shape = np.broadcast_shapes(om.shape, x2.shape)
-    out = np.array(np.broadcast_to(m_fixed, shape))
-    om = np.minimum(om, w)
-
-    def l1_side(sel, xn, on, c1n, tn, mbn):  # out[sel]: the l1* side's margin, and m_b's
-        with np.errstate(all="ignore"):
-            l1s = np.where(on <= 0.0, -xn / a, level_curve_x1(xn, a, np.where(on <= 0.0, 1.0, on)))
-        lo = np.maximum(l1s, d)  # right piece: x1 >= max(l1*, d)
-        out[sel] = np.minimum(_side_margin(lo, np.inf, c1n, tn, a, d, reading), mbn)
-
-    if outer:  # columns x2 < 0; of each row, those where l1* may lie at x1 >= d
-        cols = np.flatnonzero(x2 < 0)
-        for rows, n in _row_groups(_beyond_d(x2[cols], om[:, 0], a, d)):
-            c = cols[:n]
-            l1_side((rows[:, None], c), x2[c], om[rows], c1[c], term[c], m_b[c])
-    else:
-        x2b = np.broadcast_to(x2, shape)
-        sel = x2b < 0
-        xn, on = x2b[sel], np.broadcast_to(om, shape)[sel]
-        c1n, tn = np.broadcast_to(c1, shape)[sel], np.broadcast_to(term, shape)[sel]
-        l1_side(sel, xn, on, c1n, tn, np.broadcast_to(m_b, shape)[sel])
-    return out
-
-
-#: Relative headroom of the bound of :func:`_beyond_d` on l1*'s x1 (the round-off of
-#: the computed x1 and of the bound is below 1e-13 relative)
-_L1S_HEADROOM = 1.0 + 1e-6
-
-
-def _beyond_d(
-    xn: NDArray[np.float64], omegas: NDArray[np.float64], a: float, d: float
-) -> NDArray[np.intp]:
-    """Per omega0, how many leading velocities of ``xn`` may have l1* at x1 >= d.
-
-    At x2 < 0, l1* lies at x1 = omega0 h(|x2| / omega0) / a (:func:`level_curve_x1`)
-    and h(r) <= min(r, r^2 / 2) for r >= 0, so x1 <= min(|x2|, x2^2 / (2 omega0)) / a;
-    as computed, within 1e-13 relative of that bound (where r >= 0.2, r - log1p(r)
-    <= r exactly).  Where the bound times :data:`_L1S_HEADROOM` is below d, the
-    computed l1* is < d, the sources start at max(l1*, d) = d, and the margin there
-    is the omega0-free one that :func:`principle_margin` starts from: the side
-    margin cannot fall as its sources' left end moves right (the residual rises
-    with x1, and rounding is monotone), and the l1* side at x1 >= d is in that
-    margin already.  With ``xn`` ascending (x2 < 0, |x2| falling) such velocities
-    form a trailing run; the length of the rest is returned.  Where ``xn`` is not
-    ascending, or omega0 is not positive and finite, every velocity counts.
-    """
-    full = np.full(omegas.shape, xn.size, dtype=np.intp)
-    if xn.size < 2 or not (np.diff(xn) > 0).all():
-        return full
-    ax = -xn[::-1]  # |x2|, ascending
-    ad = a * d
-    n_lin = xn.size - np.searchsorted(ax * _L1S_HEADROOM, ad)  # |x2| (1 + 1e-6) >= a d
-    with np.errstate(all="ignore"):  # x2^2 (1 + 1e-6) >= 2 omega0 a d
-        n_quad = xn.size - np.searchsorted(ax * ax * _L1S_HEADROOM, 2.0 * omegas * ad)
-    ok = (omegas > 0) & np.isfinite(omegas)
-    return np.where(ok, np.minimum(n_lin, n_quad), full)
-
-
-def _row_groups(counts: NDArray[np.intp]) -> list[tuple[NDArray[np.intp], int]]:
-    """Group rows that need a leading run of ``counts`` columns (rows needing none left out).
-
-    Each group is computed over its longest run, less than twice its shortest (the
-    extra entries come out as they would anyway: the computation is elementwise).
-    """
-    order = np.argsort(-counts, kind="stable")
-    ranked = counts[order].tolist()
-    groups, i = [], 0
-    while i < len(ranked) and ranked[i] > 0:
-        j = i + 1
-        while j < len(ranked) and 2 * ranked[j] > ranked[i]:
-            j += 1
-        groups.append((order[i:j], ranked[i]))
-        i = j
-    return groups
-
-
-def _omega_free(plant, d: float, reading: str, x2: NDArray[np.float64]):
-    """Return what the margin at velocities x2 has that does not depend on omega0.
-
-    Returns c1 and term (sigma(F) = a (x1 + c1) + term after one sample of -w_max),
-    the l2 side's margin, and the minimum of it and the l1* side's margin where that
-    side's sources are x1 >= d whatever omega0 (x2 >= 0).
-    """
-    cfg = Config(name="zone", plant=plant)
-    a, w = plant.a, plant.w_max
-    c1, f2 = flow(0.0, x2, -w, plant.sample_time, a)
+    c1, f2 = flow(0.0, x2, -w, cfg.plant.sample_time, a)  # F1 = x1 + c1, F2 = f2
     with np.errstate(all="ignore"):
-        term = level_term(f2, w)
-    lo_b, hi_b = _l2_sources(cfg, x2, d)
-    m_b = _side_margin(lo_b, hi_b, c1, term, a, d, reading)
-    m_fixed = np.minimum(_side_margin(np.full_like(x2, d), np.inf, c1, term, a, d, reading), m_b)
-    return c1, term, m_b, m_fixed
-
-
-@functools.lru_cache(maxsize=32)
-def _omega_free_memo(plant, d: float, reading: str, x2_bytes: bytes):
-    """:func:`_omega_free` of a 1-D velocity array, memoized on its bytes (read-only)."""
-    out = _omega_free(plant, d, reading, np.frombuffer(x2_bytes, dtype=float))
-    for arr in out:
-        arr.flags.writeable = False
-    return out
+        term = level_term(f2, w)  # sigma(F) = a F1 + term: the part that is x1-free
+    (lo_a, hi_a), (lo_b, hi_b) = _source_intervals(cfg, omega0, x2, d)
+    return np.minimum(
+        _side_margin(lo_a, hi_a, c1, term, a, d, reading),
+        _side_margin(lo_b, hi_b, c1, term, a, d, reading),
+    )
 
 
 def _side_margin(lo, hi, c1, term, a: float, d: float, reading: str):
@@ -411,31 +305,20 @@ def _kinks_many(cfg: Config, omegas: NDArray[np.float64], d: float) -> list[list
 
 
 def _worst_margin(cfg: Config, omega0: float, reading: str, d: float | None = None) -> float:
-    """Dense worst margin over |x2| <= w_max [mm/s].
-
-    4001 even velocities, the kinks of :func:`_kinks` (the minimum often sits on
-    one, where a coarse grid would miss it by slope x spacing), and 201 points
-    around each of the 8 lowest local minima of the even grid.
-    """
+    """Dense worst margin over |x2| <= w_max [mm/s] (:func:`_worst_margins` of one omega0)."""
     return _worst_margins(cfg, np.array([float(omega0)]), reading, d)[0]
 
 
 def _worst_margins(
-    cfg: Config,
-    omegas: NDArray[np.float64],
-    reading: str,
-    d: float | None = None,
-    *,
-    below: float = -math.inf,
+    cfg: Config, omegas: NDArray[np.float64], reading: str, d: float | None = None
 ) -> list[float]:
-    """:func:`_worst_margin` for each omega0 of an array, bit for bit, in two evaluations.
+    """Dense worst margin over |x2| <= w_max for each omega0 of an array [mm/s].
 
-    The even grids of all omega0 are one broadcast :func:`principle_margin` call and
-    their refinement points (kinks and minima, different per omega0) one elementwise
-    call; the evaluation is elementwise, so each value is that of its own call.  An
-    omega0 whose even grid already has a margin < ``below`` is not refined: its value
-    is then that grid minimum, still < ``below`` (the refined value can only be
-    lower), which is all a feasibility test against ``below`` needs.
+    4001 even velocities, the kinks of :func:`_kinks` (the minimum often sits on
+    one, where a coarse grid would miss it by slope x spacing), and 201 points
+    around each of the 8 lowest local minima of the even grid.  The even grids of
+    all omega0 are one broadcast :func:`principle_margin` call and the refinement
+    points (different per omega0) one elementwise call.
     """
     w = cfg.plant.w_max
     d = cfg.pto.d if d is None else d
@@ -443,39 +326,22 @@ def _worst_margins(
     x2 = np.linspace(-w, w, 4001)
     M = principle_margin(cfg, omegas[:, None], x2, reading=reading, d=d)
     step = x2[1] - x2[0]
-    dense = M.min(axis=1)
-    refine = ~(dense < below)
     is_min = (M[:, 1:-1] <= M[:, :-2]) & (M[:, 1:-1] <= M[:, 2:])
     kinks = _kinks_many(cfg, omegas, d)
-    locs = []
+    fines = []
     for k in range(omegas.size):
-        if not refine[k]:
-            kinks[k] = []
-            locs.append(np.zeros(0, dtype=np.intp))
-            continue
         loc = np.flatnonzero(is_min[k]) + 1
-        locs.append(loc[np.argsort(M[k][loc])[:8]])
-    centre = x2[np.concatenate(locs)]
-    # one linspace per minimum, all at once (linspace is elementwise in its ends)
-    bands = np.linspace(centre - step, centre + step, 201, axis=1)
-    fines, sizes, j = [], [], 0
-    for k in range(omegas.size):
-        n = locs[k].size
-        fine = np.clip(np.concatenate([np.array(kinks[k]), bands[j : j + n].ravel()]), -w, w)
-        j += n
-        fines.append(fine)
-        sizes.append(fine.size)
-    sizes_a = np.array(sizes)
-    out = [float(v) for v in dense]
-    if sizes_a.sum():
-        pts = np.concatenate(fines)
-        fm = principle_margin(cfg, np.repeat(omegas, sizes_a), pts, reading=reading, d=d)
-        has = np.flatnonzero(sizes_a)
-        starts = np.concatenate([[0], np.cumsum(sizes_a)[:-1]])[has]
-        mins = np.minimum.reduceat(fm, starts)
-        for k, fmin in zip(has.tolist(), mins, strict=True):
-            out[k] = float(min(dense[k], fmin))
-    return out
+        loc = loc[np.argsort(M[k][loc])[:8]]
+        bands = np.linspace(x2[loc] - step, x2[loc] + step, 201, axis=1).ravel()
+        fines.append(np.clip(np.concatenate([np.array(kinks[k]), bands]), -w, w))
+    sizes = np.array([f.size for f in fines])
+    pts = np.concatenate(fines)
+    fm = principle_margin(cfg, np.repeat(omegas, sizes), pts, reading=reading, d=d)
+    ends = np.cumsum(sizes)
+    return [
+        float(min(M[k].min(), fm[end - n : end].min(initial=np.inf)))
+        for k, (n, end) in enumerate(zip(sizes.tolist(), ends.tolist(), strict=True))
+    ]
 
 
 def principle_violations(
@@ -658,34 +524,15 @@ def _degenerate(cfg: Config, omega0: float) -> bool:
     return float(level_curve_x1(-w, a, omega0)) < d
 
 
-#: Every this-many-th velocity of the even grid of :func:`_worst_margins` is the coarse
-#: grid on which :func:`_feasible_many` first looks for a violation.
-_COARSE = 32
-#: Halvings of a bisection in :func:`_feasible_intervals` judged in one batch.
-_LOOKAHEAD = 3
-
-
 def _feasible_many(
     cfg: Config, omegas: NDArray[np.float64], reading: str, tol: float
 ) -> NDArray[np.bool_]:
-    """Return ``_worst_margins(cfg, omegas, reading) >= -tol`` per omega0, with less work.
-
-    A margin < -tol on every ``_COARSE``-th velocity of the even grid (evaluated
-    elementwise, so the same values as in the full grid) already makes the worst
-    margin < -tol; only the other omega0 are evaluated in full.  The answers are
-    those of the full evaluation.
-    """
-    w = cfg.plant.w_max
-    coarse = np.linspace(-w, w, 4001)[::_COARSE]
-    m = principle_margin(cfg, omegas[:, None], coarse, reading=reading, d=cfg.pto.d)
-    ok = ~(m.min(axis=1) < -tol)
-    if ok.any():
-        ok[ok] = np.array(_worst_margins(cfg, omegas[ok], reading, below=-tol)) >= -tol
-    return ok
+    """Return whether the principle holds (worst margin >= -tol [mm/s]) per omega0."""
+    return np.array(_worst_margins(cfg, omegas, reading)) >= -tol
 
 
-@functools.lru_cache(maxsize=16)
-def _feasible_intervals(cfg: Config, reading: str, scan: int) -> list[tuple[float, float]]:
+@memo(maxsize=16)
+def _feasible_intervals(cfg: Config, reading: str, scan: int) -> tuple[tuple[float, float], ...]:
     """Scan omega0 over (0, w_max], then bisect every edge of the feasible set."""
     w, tol = cfg.plant.w_max, _tol(cfg)
     grid = np.unique(
@@ -694,25 +541,15 @@ def _feasible_intervals(cfg: Config, reading: str, scan: int) -> list[tuple[floa
     ok = _feasible_many(cfg, grid, reading, tol)
 
     def edge(good: float, bad: float) -> float:
-        # bisection, up to 60 halvings until |good - bad| <= 1e-10 w_max; the midpoints
-        # of the next _LOOKAHEAD halvings (every outcome) are judged in one batch, and
-        # the walk through them takes the very steps one midpoint at a time would
-        done = 0
-        while True:
-            tree = [(good, bad)]  # breadth first: node k's children are 2k + 1 (ok), 2k + 2
-            for k in range(2**_LOOKAHEAD - 1):
-                g, b = tree[k]
-                mid = 0.5 * (g + b)
-                tree += [(mid, b), (g, mid)]
-            mids = np.array([0.5 * (g + b) for g, b in tree[: 2**_LOOKAHEAD - 1]])
-            feasible = _feasible_many(cfg, mids, reading, tol)
-            k = 0
-            for _ in range(_LOOKAHEAD):
-                good, bad = tree[2 * k + 1] if feasible[k] else tree[2 * k + 2]
-                k = 2 * k + 1 if feasible[k] else 2 * k + 2
-                done += 1
-                if abs(good - bad) <= 1e-10 * w or done == 60:
-                    return good
+        # bisection, up to 60 halvings until |good - bad| <= 1e-10 w_max
+        for _ in range(60):
+            mid = 0.5 * (good + bad)
+            good, bad = (
+                (mid, bad) if _feasible_many(cfg, np.array([mid]), reading, tol)[0] else (good, mid)
+            )
+            if abs(good - bad) <= 1e-10 * w:
+                break
+        return good
 
     intervals, i = [], 0
     while i < len(grid):
@@ -726,7 +563,7 @@ def _feasible_intervals(cfg: Config, reading: str, scan: int) -> list[tuple[floa
         hi = w if j == len(grid) - 1 else edge(float(grid[j]), float(grid[j + 1]))
         intervals.append((lo, hi))
         i = j + 1
-    return intervals
+    return tuple(intervals)
 
 
 def smallest_d(cfg: Config, reading: str = "strict") -> float:
@@ -753,12 +590,12 @@ def smallest_d(cfg: Config, reading: str = "strict") -> float:
     return _smallest_d(Config(name="zone", plant=cfg.plant), reading)
 
 
-@functools.lru_cache(maxsize=16)
+@memo(maxsize=16)
 def _smallest_d(cfg: Config, reading: str) -> float:
     tol, R = _tol(cfg), cfg.plant.position_range
 
     def feasible(d: float) -> bool:
-        return _worst_margins(cfg, np.zeros(1), reading, d, below=-tol)[0] >= -tol
+        return _worst_margin(cfg, 0.0, reading, d) >= -tol
 
     if feasible(0.0):
         return 0.0
@@ -821,7 +658,7 @@ def _zone_key(cfg: Config) -> Config:
     return Config(name="zone", plant=cfg.plant, pto=PTOSettings(d=cfg.pto.d))
 
 
-@functools.lru_cache(maxsize=16)
+@memo(maxsize=16)
 def _corrected_zone(cfg: Config, reading: str, scan: int, verify: bool) -> PTOZone:
     """:func:`corrected_zone`, memoized on its normalised arguments (Config is frozen).
 
@@ -933,14 +770,14 @@ def zone_for_law(cfg: Config, variant: str) -> PTOZone:
     return _zone_for_law(_zone_key(cfg), variant)
 
 
-@functools.lru_cache(maxsize=256)
+@memo(maxsize=256)
 def _zone_for_law(cfg: Config, variant: str) -> PTOZone:
     return corrected_zone(cfg, verify=False) if variant == "corrected" else printed_zone(cfg)
 
 
 def clear_caches() -> None:
     """Empty the memos of this module (zones, feasible intervals, d_min per configuration)."""
-    for fn in (_corrected_zone, _feasible_intervals, _smallest_d, _zone_for_law, _omega_free_memo):
+    for fn in (_corrected_zone, _feasible_intervals, _smallest_d, _zone_for_law):
         fn.cache_clear()
 
 
