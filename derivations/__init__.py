@@ -17,8 +17,6 @@ common           -- the flow of eq. (1) by dsolve, PlantNumbers, shared helpers
 section3         -- eqs. (3)-(12); minimum time and switch time (``mintime``)
 section4         -- eqs. (13)-(35); 15inv, 19c, 22c, 22W, 26W, 31W
 section5         -- eqs. (36)-(39); the stability claim (``39L``)
-evaluate         -- the judge's joined evaluation of both sides (repeats computed once)
-lambertw         -- mpmath's Lambert W, branch-point series coefficients kept
 
 Examples
 --------
