@@ -438,14 +438,39 @@ def test_corrected_curve_reaches_l1_in_one_step():
 
 
 def test_printed_chain_numbers_match_curves():
+    """The chain (21)-(27) at the paper's plant, named as the paper: b0, y*, x~20, k, z*."""
     c = paper_config()
     a_, w_, T_, d_ = c.plant.a, c.plant.w_max, c.plant.sample_time, c.pto.d
     res = section4.intersection(a_, w_, T_, d_, corrected=False)
     b0 = a_ * d_ / w_ + 2 * a_ * T_
-    x20 = -float(root_22(b0)) * w_
-    om0 = -x20 / float(root_k(-a_ * d_ / x20))
-    assert_allclose(res["x20"], x20, rtol=1e-10, err_msg="printed chain x~20 (eq. 23)")
-    assert_allclose(res["omega0"], om0, rtol=1e-10, err_msg="printed chain omega0 (eq. 27)")
+    y_star = float(root_22(b0))
+    x20 = -y_star * w_
+    k = 1 + a_ * d_ / x20
+    z_star = float(root_k(1 - k))
+    assert_allclose(res.b0, b0, rtol=1e-14, err_msg="printed chain b0 (eq. 21)")
+    assert_allclose(res.y_star, y_star, rtol=1e-10, err_msg="printed chain y* (eq. 22)")
+    assert_allclose(res.x20_tilde, x20, rtol=1e-10, err_msg="printed chain x~20 (eq. 23)")
+    assert_allclose(res.k, k, rtol=1e-10, err_msg="printed chain k (eq. 25)")
+    assert_allclose(res.z_star, z_star, rtol=1e-10, err_msg="printed chain z* (eq. 26)")
+    assert_allclose(res.omega0, -x20 / z_star, rtol=1e-10, err_msg="printed chain omega0 (27)")
+
+
+@pytest.mark.parametrize("cfg", ALL_CONFIGS, ids=lambda c: c.name)
+def test_corrected_chain_meets_the_corrected_curve(cfg):
+    """Corrected chain: (d, x~20) lies on the corrected curve (19c) and on l1* of level
+    omega0, each residual evaluated in double precision (tolerance: round-off of terms
+    up to a d + |x~20| [mm/s])."""
+    a_, w_, T_, d_ = cfg.plant.a, cfg.plant.w_max, cfg.plant.sample_time, cfg.pto.d
+    res = section4.intersection(a_, w_, T_, d_, corrected=True)
+    x20, om0 = res.x20_tilde, res.omega0
+    assert_allclose(res.y_star, -x20 / w_, rtol=1e-14, err_msg="y* = -x~20/omega_m (21)")
+    scale = 1e-12 * (a_ * d_ + abs(x20) + a_ * w_ * T_)
+    on_19c = a_ * d_ + x20 - a_ * w_ * T_ + w_ * np.log(2 - (1 + x20 / w_) * np.exp(-a_ * T_))
+    assert_allclose(on_19c, 0.0, atol=scale, err_msg="(d, x~20) on the corrected curve 19c")
+    if np.isfinite(om0):
+        on_l1star = a_ * d_ + x20 + om0 * np.log1p(-x20 / om0)
+        assert_allclose(on_l1star, 0.0, atol=scale, err_msg="(d, x~20) on l1* (eq. 13)")
+        assert_allclose(res.z_star, -x20 / om0, rtol=1e-12, err_msg="z* = -x~20/omega0 (25)")
 
 
 def test_closed_loop_and_lyapunov():
@@ -491,7 +516,7 @@ def test_numeric_examples_use_the_callers_plant(cfg, records):
         err_msg="(16) evaluated at the caller's plant",
     )
     pr = section4.intersection(num.a, num.w_max, num.T, num.d, corrected=False)
-    assert f"omega0 = {pr['omega0']:.6g} mm/s" in recs["27"].note
+    assert f"omega0 = {pr.omega0:.6g} mm/s" in recs["27"].note
     assert f"a = {num.a:.6g} rad/s" in recs["36Z"].note
     Ad, Bd = zoh_reference(num.a, num.T)
     rho = max(abs(np.linalg.eigvals(Ad - Bd @ np.array([[num.k1, num.k2]]))))
