@@ -15,10 +15,12 @@ record           -- EquationRecord, judge (the verdict machinery)
 printed          -- the printed transcriptions, as data, in one file
 common           -- the flow of eq. (1) by dsolve, PlantNumbers, shared helpers
 section3         -- eqs. (3)-(12); minimum time and switch time (``mintime``)
-section4         -- eqs. (13)-(35); 15inv, 19c, 22c, 22W, 26W, 31W
+section4         -- eqs. (13)-(35): assembles the four parts below; ``intersection``
+section4_image   -- eqs. (13)-(19): l1*, l2*, the one-sample image of l1; 15inv, 19c
+section4_boundary -- eqs. (20)-(27): the intersection, y*, z*, omega0; 22c
+section4_input   -- eqs. (28)-(35): the suboptimal input omega_c, the compound law
+section4_lambert -- Lambert-W closed forms of (22), (26), (31): 22W, 26W, 31W
 section5         -- eqs. (36)-(39); the stability claim (``39L``)
-evaluate         -- the judge's joined evaluation of both sides (repeats computed once)
-lambertw         -- mpmath's Lambert W, branch-point series coefficients kept
 
 Examples
 --------

@@ -33,9 +33,6 @@ import numpy as np
 import sympy as sp
 from sympy.printing.mathml import mathml
 
-from derivations.evaluate import SharedEvaluator, shared_evaluator
-from derivations.lambertw import lambertw
-
 __all__ = [
     "EquationRecord",
     "Judgement",
@@ -301,25 +298,6 @@ def _simplify_zero(diff: sp.Expr) -> bool | None:
         return None
 
 
-@lru_cache(maxsize=4096)
-def _lambertw_at(x: Any, k: int, prec: int) -> Any:
-    with mpmath.workprec(prec):
-        return lambertw(x, k)  # mpmath's values, its branch-point series coefficients kept
-
-
-def _lambertw(x: Any, k: int = 0) -> Any:
-    """Lambert W of mpmath at the working precision, each distinct value computed once.
-
-    Records 22W, 26W and 31W evaluate the same root at the same points in several
-    comparisons (substitution, branch signs); the value is the one mpmath computes.
-    """
-    return _lambertw_at(x, k, mpmath.mp.prec)
-
-
-# lambdify's mpmath namespace with the memoized Lambert W (the printed code is unchanged)
-_MODULES = [{"LambertW": _lambertw}, "mpmath"]
-
-
 def _to_real(v: Any) -> float | None:
     """Real part of an mpmath value if it is real and finite, else None."""
     if isinstance(v, bool):
@@ -336,13 +314,15 @@ def _to_real(v: Any) -> float | None:
 
 
 @lru_cache(maxsize=256)
-def _compiled(
-    syms: tuple[sp.Symbol, ...], p_t: tuple[sp.Expr, ...], d_t: tuple[sp.Expr, ...]
-) -> tuple[Callable, Callable, SharedEvaluator]:
-    """Lambdify (mpmath) and join the two sides; a comparison judged again reuses them."""
-    f_p = sp.lambdify(syms, list(p_t), modules=_MODULES, docstring_limit=0)
-    f_d = sp.lambdify(syms, list(d_t), modules=_MODULES, docstring_limit=0)
-    return f_p, f_d, shared_evaluator(f_p, f_d)  # the same values, repeated work done once
+def _compiled(syms: tuple[sp.Symbol, ...], exprs: tuple[sp.Expr, ...]) -> Callable:
+    """Both sides as one mpmath function, ``lambdify(..., cse=True)``; reused when judged again.
+
+    The printed and the derived form share large subexpressions (the flow's
+    ``exp((a*x1 + x2)/omega_m)``, a Lambert-W root): lambdified together, SymPy's
+    common-subexpression elimination computes each once.  ``LambertW`` is printed as
+    ``mpmath.lambertw``.
+    """
+    return sp.lambdify(syms, list(exprs), modules="mpmath", cse=True, docstring_limit=0)
 
 
 def judge(
@@ -359,7 +339,10 @@ def judge(
     free symbols that ``sampler`` draws.  Step 1 tries to prove ``printed - derived
     == 0`` by cheap rewrites (:func:`_rewrite_zero`).  Step 2 evaluates both at
     admissible random points (fixed ``seed``) in ``DPS``-digit arithmetic:
-    ``N_CROSS`` points cross-check a proof, ``n`` points decide otherwise.  Step 3,
+    ``N_CROSS`` points cross-check a proof, ``n`` points decide otherwise; both
+    sides are one ``lambdify(..., cse=True)`` function, and a point where it raises
+    (a side, or a subexpression they share, undefined there) or a side is not real
+    and finite is skipped.  Step 3,
     only when step 1 neither proved nor disproved and the numbers do not disagree,
     tries ``simplify`` (:func:`_simplify_zero`) to upgrade the comparison to a
     proof.  A symbolic "cannot prove" is never a pass on its own.
@@ -411,19 +394,19 @@ def judge(
     missing = free - set(syms)
     if missing:
         raise ValueError(f"sampler does not draw {sorted(map(str, missing))}")
-    f_p, f_d, evaluate = _compiled(tuple(syms), p_t, d_t)
+    both = _compiled(tuple(syms), p_t + d_t)
+    m = len(p_t)
     worst, worst_err, n_ok = None, -1.0, 0
     n_drawn = min((len(v) for v in pts.values()), default=0)  # a sampler may filter points
     cols = [np.asarray(pts[s], dtype=float).tolist() for s in syms]  # Python floats
     with mpmath.workdps(DPS):
         for i in range(n_drawn):
             args = [mpmath.mpf(c[i]) for c in cols]
-            both = evaluate(*args)  # None: the joined code raised; the originals decide
             try:
-                vp = [_to_real(v) for v in (f_p(*args) if both is None else both[0])]
-                vd = [_to_real(v) for v in (f_d(*args) if both is None else both[1])]
+                values = [_to_real(v) for v in both(*args)]
             except (ValueError, ZeroDivisionError, TypeError):
-                continue
+                continue  # not admissible: a side (or a shared subexpression) is undefined
+            vp, vd = values[:m], values[m:]
             if any(v is None for v in vp + vd):
                 continue
             n_ok += 1

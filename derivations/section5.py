@@ -159,17 +159,17 @@ def _rec_36_claim(num: PlantNumbers) -> EquationRecord:
 
     pr = intersection(av, wv, Tv, dv, corrected=False)
     co = intersection(av, wv, Tv, dv, corrected=True)
-    j_pr = judge(sp.sign(resid), sp.Integer(1), sampler(pr["omega0"]), symbolic=False)
-    j_co = judge(sp.sign(resid), sp.Integer(1), sampler(co["omega0"]), symbolic=False)
+    j_pr = judge(sp.sign(resid), sp.Integer(1), sampler(pr.omega0), symbolic=False)
+    j_co = judge(sp.sign(resid), sp.Integer(1), sampler(co.omega0), symbolic=False)
     return record_from(
         "36Z",
         f"sign of the l1 residual one -omega_m sample after l1*: {sp.sstr(resid)}",
         [
             "state on l1* (level omega0) with x1 > d, |x2| < omega_m; one exact "
             "sample of u = -omega_m; l1 residual of the image must be > 0",
-            f"printed chain (omega0 = {pr['omega0']:.6g} mm/s): {j_pr.verdict}"
+            f"printed chain (omega0 = {pr.omega0:.6g} mm/s): {j_pr.verdict}"
             f" ({j_pr.n_points} states of l1* with x1 > d in the band)",
-            f"corrected chain (omega0 = {co['omega0']:.6g} mm/s): "
+            f"corrected chain (omega0 = {co.omega0:.6g} mm/s): "
             f"{j_co.verdict} ({j_co.n_points} states)",
         ],
         j_pr,
@@ -179,7 +179,7 @@ def _rec_36_claim(num: PlantNumbers) -> EquationRecord:
         f"d = {dv:.6g} mm) for the omega0 of the printed chain. "
         + (
             f"With it, no state of l1* with x1 > d has |x2| < omega_m (l1* "
-            f"reaches x1 = d at x2 = {pr['x20']:.6g} mm/s), so the claim has no "
+            f"reaches x1 = d at x2 = {pr.x20_tilde:.6g} mm/s), so the claim has no "
             "admissible instance (and by 36 the zone is empty for omega0 > "
             "omega_m). "
             if j_pr.n_points == 0

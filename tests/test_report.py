@@ -381,36 +381,90 @@ def test_jobs_below_one_is_an_input_error(tmp_path, capsys):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_pool_worker_error_keeps_its_type_and_trace():
-    """A stage that raises in a worker process raises here, same type, with its trace."""
+def test_pool_stage_error_keeps_its_type_and_names_the_stage():
+    """A stage that raises in a worker process raises here, same type, with its stage."""
     from ptoverify.report.collect import _run_in_pool
 
     with pytest.raises(KeyError) as info:
         _run_in_pool(["no such stage"], paper_config(), None, 1, lambda *a: None)
     assert "no such stage" in str(info.value)
-    assert any("worker process" in n for n in getattr(info.value, "__notes__", []))
+    notes = getattr(info.value, "__notes__", [])
+    assert any("no such stage" in n and "worker process" in n for n in notes), notes
 
 
-def test_pool_from_an_unguarded_script(tmp_path):
-    """The pool starts fresh interpreters: a script without an ``if __name__`` guard is
-    not re-run in the workers (multiprocessing's spawn would re-import it)."""
+def _descendants(pid: int) -> set[int]:
+    """The live descendants of a process (Linux /proc)."""
+    out: set[int] = set()
+    todo = [pid]
+    while todo:
+        p = todo.pop()
+        for task in Path(f"/proc/{p}/task").glob("*"):
+            try:
+                kids = [int(c) for c in (task / "children").read_text().split()]
+            except OSError:
+                continue
+            out.update(kids)
+            todo += kids
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig, code", [("SIGTERM", 143), ("SIGINT", 130)])
+def test_report_pool_interrupted_cleans_up(tmp_path, sig, code):
+    """SIGTERM to the command, or Ctrl-C to its process group, while the pool's workers
+    draw figures: one line, exit 143 / 130 within seconds, no folder left, no worker left
+    running."""
+    import signal
     import sys
+    import time
 
-    script = tmp_path / "plain.py"
-    script.write_text(
-        "from ptoverify.config import paper_config\n"
-        "from ptoverify.report.collect import _run_in_pool\n"
-        "print('script ran')\n"
-        "try:\n"
-        "    _run_in_pool(['no such stage'], paper_config(), None, 1, lambda *a: None)\n"
-        "except KeyError:\n"
-        "    print('stage error arrived')\n"
+    out = tmp_path / "out"
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "ptoverify.cli", "report", "--out", str(out), "--jobs", "2"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=env,
+        text=True,
+        cwd=tmp_path,
+        start_new_session=True,
     )
-    res = subprocess.run(
-        [sys.executable, str(script)], capture_output=True, text=True, timeout=120, cwd=tmp_path
-    )
-    assert res.returncode == 0, res.stderr[-2000:]
-    assert res.stdout.split() == ["script", "ran", "stage", "error", "arrived"], res.stdout
+    workers: set[int] = set()
+    try:
+        deadline = time.monotonic() + 300
+        while not any(tmp_path.glob(".out.tmp-*/figures/*.png")):
+            assert proc.poll() is None, proc.communicate()
+            assert time.monotonic() < deadline, "the workers never drew a figure"
+            time.sleep(0.05)
+        workers = _descendants(proc.pid)
+        assert len(workers) >= 2, workers  # the two workers (and the resource tracker)
+        if sig == "SIGTERM":
+            proc.send_signal(signal.SIGTERM)
+        else:
+            os.killpg(proc.pid, signal.SIGINT)  # what a terminal's Ctrl-C does
+        t_sig = time.monotonic()
+        _, err = proc.communicate(timeout=60)
+        waited = time.monotonic() - t_sig
+    finally:
+        proc.kill()
+    assert proc.returncode == code, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("ptoverify: error:"), err
+    # the workers are stopped, not waited for: their stages run for tens of seconds more
+    assert waited < 10.0, f"the command took {waited:.1f} s to stop"
+    deadline = time.monotonic() + 10
+    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(_alive(p) for p in workers), "a worker outlived the command"
+    assert list(tmp_path.iterdir()) == [], "the run left files behind"
 
 
 # ------------------------------------------------------------------ typed, traced results

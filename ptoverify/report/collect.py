@@ -37,15 +37,13 @@ timings are not part of the results.
 from __future__ import annotations
 
 import datetime as _dt
-import gc
 import json
 import math
 import platform
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -325,37 +323,21 @@ def figure_inputs(cfg: Config) -> Any:
 
 def _stage_derivations(cfg: Config, figdir: Path | None) -> dict[str, Any]:
     """SymPy: the equation records and the derivation gate (the only SymPy users)."""
-    # SymPy makes ~10^5 long-lived objects (its import and caches); the cyclic
-    # collector's ~370 passes over them cost ~0.13 s of CPU here. It is paused for the
-    # stage: the few cycles made (~25k objects, a few MB) are collected after it
-    with _collector_paused():
-        import derivations
-        from ptoverify.report.sections import render_records
-        from ptoverify.studies.checks import run_checks
+    import derivations
+    from ptoverify.report.sections import render_records
+    from ptoverify.studies.checks import run_checks
 
-        p = cfg.plant
-        plant = derivations.PlantNumbers(
-            a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
-        )
-        records = derivations.all_records(plant)
-        return {
-            "derivations": [r.to_json() for r in records],
-            "_records": records,
-            "_rendered": render_records(records),  # MathML and units: SymPy work, done here
-            "_checks": run_checks(cfg, [SYMBOLIC_GATE]),
-        }
-
-
-@contextmanager
-def _collector_paused() -> Iterator[None]:
-    """Pause the cyclic garbage collector for a stage (as it was before, after it)."""
-    collecting = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if collecting:
-            gc.enable()
+    p = cfg.plant
+    plant = derivations.PlantNumbers(
+        a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
+    )
+    records = derivations.all_records(plant)
+    return {
+        "derivations": [r.to_json() for r in records],
+        "_records": records,
+        "_rendered": render_records(records),  # MathML and units: SymPy work, done here
+        "_checks": run_checks(cfg, [SYMBOLIC_GATE]),
+    }
 
 
 def _stage_ground_truth(cfg: Config, figdir: Path | None) -> dict[str, Any]:
@@ -413,16 +395,11 @@ def _stage_robust(cfg: Config, figdir: Path | None) -> dict[str, Any]:
 
 def _stage_tuning(cfg: Config, figdir: Path | None) -> dict[str, Any]:
     """Run the fair tuning comparison and draw its Pareto fronts."""
-    # the tunings allocate small objects by the ten thousand (candidates, gain dicts,
-    # keys), which trigger ~120 collector passes, one of them over everything the
-    # process holds (SciPy's and Matplotlib's objects): ~0.05 s of CPU for next to no
-    # garbage cycles. It is paused for the stage, as for the derivations
-    with _collector_paused():
-        res = tuning_results(cfg)
-        return {
-            "tuning": res,
-            "_files": [] if figdir is None else _plots().save_tuning(res, figdir),
-        }
+    res = tuning_results(cfg)
+    return {
+        "tuning": res,
+        "_files": [] if figdir is None else _plots().save_tuning(res, figdir),
+    }
 
 
 def _stage_figures(cfg: Config, figdir: Path | None) -> dict[str, Any]:
@@ -617,33 +594,20 @@ def collect(
     return out
 
 
-#: A pool worker: runs the stages it is sent (pickled on stdin) and answers on its
-#: own copy of stdout; anything a stage prints (C libraries included) goes to stderr.
-_WORKER = r"""
-import gc, os, pickle, sys, traceback
-answer = os.fdopen(os.dup(1), "wb")
-os.dup2(2, 1)
-from ptoverify.report.collect import _run_stage
-while True:
-    try:
-        task = pickle.load(sys.stdin.buffer)
-    except EOFError:
-        break
-    # what earlier stages left (modules, memos) lives as long as the worker: out of
-    # the collector's full passes (about 0.1 s of CPU per worker)
-    gc.freeze()
-    try:
-        result = ("ok", _run_stage(*task))
-    except BaseException as exc:
-        trace = traceback.format_exc()
-        try:
-            pickle.dumps(exc)
-        except Exception:
-            exc = RuntimeError(f"{type(exc).__name__}: {exc}")
-        result = ("error", exc, trace)
-    pickle.dump(result, answer)
-    answer.flush()
-"""
+def _worker_setup() -> None:
+    """Prepare a pool worker: its stdout goes to stderr, and it leaves Ctrl-C to the parent.
+
+    A stage's results return through the pool, so what it prints (C libraries
+    included) goes to stderr and never mixes with the command's stdout (``--json``
+    keeps it for one JSON object).  A terminal's Ctrl-C reaches the whole process
+    group: the workers ignore it, and the parent, interrupted, stops them.
+    """
+    import os
+    import signal
+
+    sys.stdout.flush()
+    os.dup2(2, 1)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _run_in_pool(
@@ -655,82 +619,47 @@ def _run_in_pool(
 ) -> None:
     """Run the stages in ``jobs`` worker processes; ``finished(name, result)`` as each ends.
 
-    Each worker is a fresh interpreter (``sys.executable -c``, this process's
-    ``sys.path``): no fork of solver or BLAS state, and no re-import of the
-    caller's ``__main__``, so a script calling :func:`write_report` needs no
-    ``if __name__ == "__main__"`` guard.  Workers take the stages in the order
-    given (longest first).  A stage's exception is raised here with its type
-    (an ``InputError`` stays one) and the worker's traceback as a note; the
-    workers are then killed.  Where no process can be started, the stages run
-    in this process.
+    The pool is a :class:`concurrent.futures.ProcessPoolExecutor` of spawned
+    processes (fresh interpreters: no fork of solver or BLAS state).  Like every
+    spawned pool, it imports the caller's main module in each worker: a script that
+    calls :func:`collect` or :func:`write_report` with ``jobs`` > 1 needs the
+    ``if __name__ == "__main__":`` guard.  The stages are submitted longest first.
+    A stage's exception is raised here with its type (an ``InputError`` stays one)
+    and a note naming the stage (the worker's traceback is its ``__cause__``).
+    When the run ends early (a stage's error, Ctrl-C, SIGTERM), the stages not
+    started are cancelled and the workers are terminated, so none goes on writing
+    into ``figdir``.  Where no pool can be made, the stages run in this process.
     """
-    import os
-    import pickle
-    import queue
-    import threading
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    todo: queue.SimpleQueue = queue.SimpleQueue()
-    for name in names:
-        todo.put(name)
-    answers: queue.SimpleQueue = queue.SimpleQueue()
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
-    procs: list[subprocess.Popen] = []
+    ctx = multiprocessing.get_context("spawn")
+    others = set(multiprocessing.active_children())
     try:
-        for _ in range(jobs):
-            procs.append(
-                subprocess.Popen(
-                    [sys.executable, "-c", _WORKER],
-                    stdin=subprocess.PIPE,
-                    stdout=subprocess.PIPE,
-                    env=env,
-                )
-            )
-    except OSError:  # no process can be started here: run the stages in this one
-        for proc in procs:
-            proc.kill()
+        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_setup)
+    except OSError:  # no semaphores or pipes here: the stages run in this process
         for name in names:
             finished(name, _run_stage(name, cfg, figdir))
         return
-
-    def serve(proc: subprocess.Popen) -> None:
-        while True:
-            try:
-                name = todo.get_nowait()
-            except queue.Empty:
-                return
-            try:
-                pickle.dump((name, cfg, figdir), proc.stdin)
-                proc.stdin.flush()
-                answers.put((name, pickle.load(proc.stdout)))  # noqa: S301 - our own worker
-            except (EOFError, OSError, pickle.UnpicklingError):
-                code = proc.wait()
-                why = RuntimeError(f"report stage '{name}': its worker process died (exit {code})")
-                answers.put((name, ("error", why, "")))
-                return
-
-    threads = [threading.Thread(target=serve, args=(p,), daemon=True) for p in procs]
-    for t in threads:
-        t.start()
-    try:
-        for _ in names:
-            name, answer = answers.get()
-            if answer[0] == "error":
-                exc, trace = answer[1], answer[2]
-                if trace:
-                    exc.add_note(f"in report stage '{name}' (worker process):\n{trace}")
-                raise exc
-            finished(name, answer[1])
-    finally:
-        # every answer is in (or the run failed): a worker holds nothing more, and its
-        # interpreter's shutdown with the numeric libraries loaded costs ~0.3 s
-        for proc in procs:
-            proc.kill()
-            try:
-                proc.stdin.close()
-            except OSError:
-                pass
-        for proc in procs:
-            proc.wait()
+    with pool:
+        try:
+            futures = {pool.submit(_run_stage, name, cfg, figdir): name for name in names}
+            for future in as_completed(futures):
+                name = futures[future]
+                try:
+                    result = future.result()
+                except Exception as exc:
+                    exc.add_note(f"in report stage '{name}' (worker process)")
+                    raise
+                finished(name, result)
+        except BaseException:
+            pool.shutdown(wait=False, cancel_futures=True)
+            workers = [p for p in multiprocessing.active_children() if p not in others]
+            for process in workers:
+                process.terminate()
+            for process in workers:
+                process.join()
+            raise
 
 
 def _robust(cfg: Config) -> dict[str, Any]:
