@@ -18,7 +18,7 @@ from enum import IntEnum
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ptoverify.config import LAW_NAMES, Config
+from ptoverify.config import ALL_LAW_NAMES, BASELINE_NAMES, LAW_NAMES, Config
 from ptoverify.errors import InputError
 from ptoverify.model.curves import blockwise, level_side, omega_c
 
@@ -711,7 +711,7 @@ _FACTORIES: dict[str, Callable[[Config], Law]] = {
 
 
 def make_law(name: str, cfg: Config) -> Law:
-    """Build a law by name: ``to``, ``pd``, ``pto`` or ``pto-printed``.
+    """Build a law by name: ``to``, ``pd``, ``pto``, ``pto-printed``, ``ptos``, ``cascade-p``.
 
     Parameters
     ----------
@@ -725,6 +725,10 @@ def make_law(name: str, cfg: Config) -> Law:
     Law
         The law.
     """
+    if name in BASELINE_NAMES:  # the baselines import this module: built lazily
+        from ptoverify.model.baselines import cascade_law, ptos_law
+
+        return ptos_law(cfg) if name == "ptos" else cascade_law(cfg)
     if name not in _FACTORIES:
-        raise InputError(f"unknown law '{name}' (choose from {', '.join(LAW_NAMES)})")
+        raise InputError(f"unknown law '{name}' (choose from {', '.join(ALL_LAW_NAMES)})")
     return _FACTORIES[name](cfg)
