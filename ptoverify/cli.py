@@ -209,7 +209,7 @@ def _cmd_mintime(args: argparse.Namespace) -> int:
 
 # ---------------------------------------------------------------- simulate
 def _add_simulate(sub) -> None:
-    from ptoverify.config import LAW_NAMES
+    from ptoverify.config import ALL_LAW_NAMES
 
     p = sub.add_parser(
         "simulate",
@@ -218,7 +218,7 @@ def _add_simulate(sub) -> None:
         "Section 6 reference: step 5 mm, ramp 0-30 mm at 200 mm/s, sine 5 mm 5 Hz.",
         epilog="example:\n  ptoverify simulate --law to --signal step --csv to_step.csv",
     )
-    p.add_argument("--law", choices=LAW_NAMES, default="pto", help="control law (default pto)")
+    p.add_argument("--law", choices=ALL_LAW_NAMES, default="pto", help="control law (default pto)")
     p.add_argument(
         "--signal",
         choices=("step", "ramp", "sine"),
@@ -617,6 +617,8 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
 # ---------------------------------------------------------------- sweep
 def _add_sweep(sub) -> None:
+    from ptoverify.config import ALL_LAW_NAMES
+
     p = sub.add_parser(
         "sweep",
         help="suboptimality of each law over a grid of initial states",
@@ -637,6 +639,13 @@ def _add_sweep(sub) -> None:
         default=200,
         help="grid points per axis (default 200: 40,000 states; at most 1000)",
     )
+    p.add_argument(
+        "--law",
+        action="append",
+        choices=ALL_LAW_NAMES,
+        default=None,
+        help="sweep only this law (repeatable; default to, pd, pto, pto-printed)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     p.set_defaults(handler=_cmd_sweep)
 
@@ -654,7 +663,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         from ptoverify.progress import stderr_bar
 
         bar = stderr_bar(args.quiet)
-        res = run_sweep(cfg, SweepSettings(n1=args.grid, n2=args.grid), progress=bar)
+        laws = tuple(dict.fromkeys(args.law)) if args.law else SweepSettings.laws
+        res = run_sweep(cfg, SweepSettings(args.grid, args.grid, laws=laws), progress=bar)
         result = res.to_json()
         if args.out is not None:
             tmp = make_temp(target)

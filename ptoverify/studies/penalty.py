@@ -185,8 +185,8 @@ def move_sizes(cfg: Config, count: int = 40, smallest: float = TIGHT_BAND) -> ND
     Examples
     --------
     >>> from ptoverify.config import paper_config
-    >>> move_sizes(paper_config(), 3).tolist()
-    [0.01, 0.7071067811865476, 50.0]
+    >>> [round(s, 6) for s in move_sizes(paper_config(), 3).tolist()]
+    [0.01, 0.707107, 50.0]
     """
     r = cfg.plant.position_range
     if count < 2 or not 0.0 < smallest < r:
