@@ -707,6 +707,120 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+# ---------------------------------------------------------------- design
+def _add_design(sub) -> None:
+    from ptoverify.config import ALL_LAW_NAMES
+    from ptoverify.studies.design import BANDWIDTHS_HZ, DESIGN_LAWS, GRID, SAMPLE_TIMES
+
+    p = sub.add_parser(
+        "design",
+        help="design charts over sample time x bandwidth",
+        description="Every law at the configuration's gains over a grid of sample time T x "
+        "bandwidth: median and worst settling / N*T over an envelope grid, the linear loop's "
+        "margin in a_true / a_design without and with a one-sample delay, the PTO zone.",
+        epilog="example:\n  ptoverify design --sample-times 0.001 0.002 --bandwidths 10 30 --json"
+        "\n  ptoverify design --dask local --out design-paper",
+    )
+    p.add_argument(
+        "--sample-times",
+        nargs="+",
+        type=finite_float,
+        metavar="S",
+        default=list(SAMPLE_TIMES),
+        help="sample times T [s] (default 0.25-8 ms)",
+    )
+    p.add_argument(
+        "--bandwidths",
+        nargs="+",
+        type=finite_float,
+        metavar="HZ",
+        default=list(BANDWIDTHS_HZ),
+        help="bandwidths [Hz] (default 5-100)",
+    )
+    p.add_argument(
+        "--laws",
+        nargs="+",
+        choices=ALL_LAW_NAMES,
+        default=list(DESIGN_LAWS),
+        help="laws (default pd pto ptos cascade-p)",
+    )
+    p.add_argument(
+        "--reading",
+        choices=("2pi", "hz"),
+        default="2pi",
+        help="a = 2 pi f (2pi, default) or a = f rad/s (hz)",
+    )
+    p.add_argument(
+        "--grid",
+        type=positive_int,
+        default=GRID,
+        metavar="N",
+        help=f"N x N envelope states per point ({GRID}; 2 to 100)",
+    )
+    p.add_argument(
+        "--dask",
+        metavar="ADDRESS",
+        default=None,
+        help="run the points on a dask.distributed scheduler, or 'local'",
+    )
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        default=None,
+        help="write design.json and design.csv into DIR (atomically)",
+    )
+    p.set_defaults(handler=_cmd_design)
+
+
+def _cmd_design(args: argparse.Namespace) -> int:
+    from ptoverify.studies.design import dask_design_runner, design_chart
+
+    cfg = _config(args)
+    runner = dask_design_runner(args.dask) if args.dask else None
+    target = tmp = None
+    if args.out is not None:
+        target = check_target(args.out, config_hash=cfg.digest())
+    try:
+        chart = design_chart(
+            cfg,
+            args.sample_times,
+            args.bandwidths,
+            laws=args.laws,
+            reading=args.reading,
+            grid=args.grid,
+            runner=runner,
+            backend=args.dask or "in-process",
+        )
+        result = chart.to_json()
+        if args.out is not None:
+            tmp = make_temp(target)
+            (tmp / "design.json").write_text(json.dumps(result, indent=2) + "\n")
+            (tmp / "design.csv").write_text(chart.to_csv())
+            result["files"] = [str(target / "design.json"), str(target / "design.csv")]
+            publish(tmp, target, config_hash=cfg.digest(), name=cfg.name)
+            tmp = None
+    finally:
+        discard(tmp)
+    if args.json:
+        print_json(result)
+        return 0
+    print(
+        f"design chart ({chart.reading} reading), {len(chart.points)} points, "
+        f"{chart.seconds:.1f} s; median / worst settling over N*T"
+    )
+    for pt in chart.points:
+        cells = "  ".join(
+            f"{r.law} {r.median_ratio_nt:.2f}/{r.worst_ratio_nt:.2f}" for r in pt.laws
+        )
+        print(
+            f"T {pt.sample_time * 1e3:g} ms, {pt.bandwidth_hz:g} Hz: fastest {pt.fastest or '-'}"
+            f" (x{pt.fastest_by:.2f}); {cells}"
+        )
+    for f in result.get("files", []):
+        print(f"wrote {f}")
+    return 0
+
+
 # ---------------------------------------------------------------- zone
 def _add_zone(sub) -> None:
     p = sub.add_parser(
@@ -995,6 +1109,7 @@ COMMANDS: list[tuple[str, Callable[[Any], None]]] = [
     ("conform", _add_conform),
     ("robust", _add_robust),
     ("tune", _add_tune),
+    ("design", _add_design),
 ]
 
 

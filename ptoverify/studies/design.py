@@ -1,0 +1,477 @@
+"""Design charts: every law over a grid of sample time T x bandwidth.
+
+At each design point (T, f) the configuration's plant is re-sampled: a = 2 pi f
+(reading ``2pi``) or a = f rad/s (reading ``hz``), the configuration's w_max
+and position range, each law at the configuration's gains.  The point is
+validated as a configuration file would be (:func:`ptoverify.config.config_from_mapping`,
+so a bad T or bandwidth is an InputError naming the key).  Per law:
+
+* settling / N*T over an n x n grid of the envelope (:func:`ptoverify.studies.sweep.grid_states`;
+  the sweep's settling, exact between samples, :func:`ptoverify.studies.sweep.settling_times`;
+  N* by :func:`ptoverify.model.mintime.discrete_min_steps_batch`): median and worst,
+  and the fraction of states that settle;
+* the robustness margin of its linear loop in a_true / a_design, without and
+  with a one-sample delay (:func:`ptoverify.studies.robust.linear_loop_margin`,
+  the linear loop as a PD of the law's gains,
+  :func:`ptoverify.studies.ptos_claim.baseline_linear_gains`), and the
+  spectral radius of the delayed loop at the design a;
+
+and for the PTO its corrected zone (:func:`ptoverify.model.zones.zone_for_law`):
+usable, degenerate (inside the linear zone), why.  Every point is independent:
+:func:`design_chart` runs them in this process or on a ``dask.distributed``
+cluster (``runner``), and the results are equal.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from ptoverify.config import ALL_LAW_NAMES, Config, PDGains, config_from_mapping
+from ptoverify.errors import InputError
+from ptoverify.model.laws import make_law
+from ptoverify.model.mintime import discrete_min_steps_batch, min_time
+from ptoverify.model.zones import zone_for_law
+from ptoverify.studies.ptos_claim import READINGS, baseline_linear_gains
+from ptoverify.studies.robust import linear_loop_margin, linear_loop_radii
+from ptoverify.studies.sweep import SweepSettings, grid_states, settling_times
+
+__all__ = [
+    "DESIGN_LAWS",
+    "SAMPLE_TIMES",
+    "BANDWIDTHS_HZ",
+    "LawAtPoint",
+    "DesignPoint",
+    "DesignChart",
+    "design_point",
+    "design_chart",
+    "dask_design_runner",
+]
+
+DESIGN_LAWS = ("pd", "pto", "ptos", "cascade-p")  #: default laws (TO never settles)
+SAMPLE_TIMES = (0.00025, 0.0005, 0.001, 0.002, 0.004, 0.008)  #: default T [s]
+BANDWIDTHS_HZ = (5.0, 10.0, 30.0, 60.0, 100.0)  #: default bandwidths [Hz]
+GRID = 10  #: default envelope grid per axis (even: the origin is off the grid)
+
+
+@dataclass(frozen=True)
+class LawAtPoint:
+    """One law at one design point.
+
+    Attributes
+    ----------
+    law, note : str
+        Law name and its one-line description at this point.
+    k_x1, k_x2 : float
+        Linear-loop gains [1/s], [-] (NaN: no linear loop, TO).
+    median_ratio_nt, worst_ratio_nt : float
+        Median and worst settling / N*T over the grid's states [-] (inf: some
+        state never settles; NaN: no state settles for the median).
+    fraction_settled : float
+        Share of the grid's states that settle [-].
+    margin_lo, margin_hi : float
+        Stable interval of a_true / a_design of the linear loop [-] (0 / inf:
+        stable past the searched range [0.1, 10]; NaN: unstable at 1 or none).
+    margin_delay_lo, margin_delay_hi : float
+        The same with a one-sample delay [-].
+    radius_delay1 : float
+        Spectral radius of the delayed linear loop at a_true = a_design [-].
+    """
+
+    law: str
+    note: str
+    k_x1: float
+    k_x2: float
+    median_ratio_nt: float
+    worst_ratio_nt: float
+    fraction_settled: float
+    margin_lo: float
+    margin_hi: float
+    margin_delay_lo: float
+    margin_delay_hi: float
+    radius_delay1: float
+
+
+@dataclass(frozen=True)
+class DesignPoint:
+    """Every law at one (T, bandwidth).
+
+    Attributes
+    ----------
+    sample_time : float
+        T [s].
+    bandwidth_hz : float
+        Bandwidth as given [Hz].
+    a : float
+        Bandwidth under the reading [rad/s].
+    laws : tuple of LawAtPoint
+        One per law asked, in order.
+    pto_zone_usable, pto_zone_degenerate : bool
+        The corrected PTO zone exists (0 < omega0 < w_max) / lies inside the linear zone.
+    pto_zone_reason : str
+        Why, in words.
+    fastest : str
+        Law with the least median settling / N*T ("" if none settles).
+    fastest_by : float
+        Runner-up's median ratio over the fastest's [-] (>= 1; inf: no runner-up settles).
+    seconds : float
+        Wall time of the point [s] (not compared between runs).
+    """
+
+    sample_time: float
+    bandwidth_hz: float
+    a: float
+    laws: tuple[LawAtPoint, ...]
+    pto_zone_usable: bool
+    pto_zone_degenerate: bool
+    pto_zone_reason: str
+    fastest: str
+    fastest_by: float
+    seconds: float
+
+    def law(self, name: str) -> LawAtPoint:
+        """Return the :class:`LawAtPoint` of ``name``."""
+        for r in self.laws:
+            if r.law == name:
+                return r
+        raise KeyError(name)
+
+
+@dataclass(frozen=True)
+class DesignChart:
+    """A design chart: points over sample_times x bandwidths (row-major: T outer).
+
+    Attributes
+    ----------
+    config_name : str
+        The base configuration.
+    reading : str
+        ``2pi`` or ``hz``.
+    sample_times : tuple of float
+        T [s].
+    bandwidths_hz : tuple of float
+        Bandwidths [Hz].
+    laws : tuple of str
+        Laws.
+    grid : int
+        Envelope grid per axis.
+    points : tuple of DesignPoint
+        len(sample_times) x len(bandwidths_hz) points.
+    backend : str
+        ``in-process`` or the dask address.
+    seconds : float
+        Wall time [s].
+    """
+
+    config_name: str
+    reading: str
+    sample_times: tuple[float, ...]
+    bandwidths_hz: tuple[float, ...]
+    laws: tuple[str, ...]
+    grid: int
+    points: tuple[DesignPoint, ...]
+    backend: str
+    seconds: float
+
+    def to_json(self, *, timings: bool = True) -> dict[str, Any]:
+        """Return a JSON-able dict (inf and NaN as strings; ``timings`` False drops wall times)."""
+
+        def clean(v):
+            if isinstance(v, float) and not math.isfinite(v):
+                return str(v)
+            if isinstance(v, dict):
+                return {k: clean(x) for k, x in v.items() if timings or k != "seconds"}
+            if isinstance(v, (list, tuple)):
+                return [clean(x) for x in v]
+            return v
+
+        out = {
+            "config": self.config_name,
+            "reading": self.reading,
+            "sample_times_s": list(self.sample_times),
+            "bandwidths_hz": list(self.bandwidths_hz),
+            "laws": list(self.laws),
+            "grid": self.grid,
+            "points": [clean(asdict(p)) for p in self.points],
+            "backend": self.backend,
+        }
+        if timings:
+            out["seconds"] = self.seconds
+        return out
+
+    def to_csv(self) -> str:
+        """Return one CSV row per (point, law)."""
+        cols = [f for f in LawAtPoint.__dataclass_fields__ if f != "note"]
+        lines = [",".join(["sample_time_s", "bandwidth_hz", "a", "pto_zone_usable", *cols])]
+        for p in self.points:
+            for r in p.laws:
+                row = [p.sample_time, p.bandwidth_hz, p.a, p.pto_zone_usable]
+                row += [getattr(r, c) for c in cols]
+                lines.append(",".join(str(v) for v in row))
+        return "\n".join(lines) + "\n"
+
+
+def point_config(cfg: Config, sample_time: float, bandwidth_hz: float, reading: str) -> Config:
+    """Return the validated configuration of one design point.
+
+    Parameters
+    ----------
+    cfg : Config
+        Base configuration (w_max, range, gains).
+    sample_time : float
+        T [s].
+    bandwidth_hz : float
+        Bandwidth [Hz].
+    reading : str
+        ``2pi`` (a = 2 pi f) or ``hz`` (a = f rad/s).
+
+    Returns
+    -------
+    Config
+        The configuration (validated as a file would be).
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> point_config(paper_config(), 0.001, 30.0, "hz").plant.a
+    30.0
+    """
+    if reading not in READINGS:
+        raise InputError(f"--reading must be one of {', '.join(READINGS)}, got {reading!r}")
+    m = cfg.to_mapping()
+    plant = {k: v for k, v in m["plant"].items() if k not in ("a", "bandwidth_hz")}
+    plant["sample_time"] = float(sample_time)
+    plant["bandwidth_hz" if reading == "2pi" else "a"] = float(bandwidth_hz)
+    return config_from_mapping({**m, "plant": plant})
+
+
+def _margin(law: str, cfg: Config, gains: tuple[float, float], delay: int) -> tuple[float, float]:
+    """(lo, hi) of the linear loop's stable a_true / a_design interval."""
+    pd = replace(cfg, pd=PDGains(kp=gains[0], kd=gains[1]))
+    key = "linear_loop_a_ratio_stable" + ("_delay1" if delay else "")
+    got = linear_loop_margin("pd", pd, delay_samples=delay)[key]
+    if got is None:
+        return math.nan, math.nan
+    lo, hi = got
+    return (0.0 if lo is None else lo), (math.inf if hi is None else hi)
+
+
+def _law_at(name: str, cfg: Config, grid: int, states: tuple) -> LawAtPoint:
+    """Measure one law at one point (module docstring)."""
+    x1, x2, nt, steps = states
+    s = SweepSettings()
+    p = cfg.plant
+    law = make_law(name, cfg)
+    st = settling_times(
+        law, p, x1, x2, steps, s.band, p.a * s.band, s.hold, mirror=True
+    ).time  # the sweep's settling, exact between samples
+    ok = np.isfinite(nt)
+    ratio = st[ok] / nt[ok]
+    settled = np.isfinite(ratio)
+    worst = float(ratio.max()) if settled.all() else math.inf
+    median = float(np.median(ratio[settled])) if settled.all() else math.nan
+    if name == "to":
+        gains, m0, m1, rad = (math.nan, math.nan), (math.nan,) * 2, (math.nan,) * 2, math.nan
+    else:
+        gains = baseline_linear_gains(cfg, name)
+        m0, m1 = _margin(name, cfg, gains, 0), _margin(name, cfg, gains, 1)
+        pd = replace(cfg, pd=PDGains(kp=gains[0], kd=gains[1]))
+        rad = float(linear_loop_radii("pd", pd, [1.0], delay_samples=1)[0])
+    frac = float(np.count_nonzero(settled)) / max(1, ratio.size)
+    return LawAtPoint(name, law.note, *gains, median, worst, frac, *m0, *m1, rad)
+
+
+def design_point(
+    cfg: Config,
+    sample_time: float,
+    bandwidth_hz: float,
+    reading: str = "2pi",
+    laws: Sequence[str] = DESIGN_LAWS,
+    grid: int = GRID,
+) -> DesignPoint:
+    """Measure every law at one design point (module docstring).
+
+    Parameters
+    ----------
+    cfg : Config
+        Base configuration.
+    sample_time : float
+        T [s].
+    bandwidth_hz : float
+        Bandwidth [Hz].
+    reading : str
+        ``2pi`` or ``hz``.
+    laws : sequence of str
+        Law names.
+    grid : int
+        Envelope grid per axis, >= 2.
+
+    Returns
+    -------
+    DesignPoint
+        The point.
+    """
+    t0 = time.perf_counter()
+    c = point_config(cfg, sample_time, bandwidth_hz, reading)
+    p = c.plant
+    X1, X2 = grid_states(p, grid, grid)
+    x1, x2 = X1.ravel(), X2.ravel()
+    s = SweepSettings()
+    t_f = min_time(x1, x2, p).t_f
+    steps = math.ceil(s.horizon_factor * float(t_f.max()) / p.T) + math.ceil(s.hold / p.T - 1e-9)
+    n_star = discrete_min_steps_batch(x1, x2, p).steps
+    nt = np.where(n_star > 0, n_star * p.T, np.nan)
+    rows = tuple(_law_at(name, c, grid, (x1, x2, nt, steps)) for name in laws)
+    z = zone_for_law(c, "corrected")
+    ranked = sorted((r.median_ratio_nt, r.law) for r in rows if math.isfinite(r.median_ratio_nt))
+    fastest = ranked[0][1] if ranked else ""
+    by = ranked[1][0] / ranked[0][0] if len(ranked) > 1 else math.inf
+    return DesignPoint(
+        float(sample_time),
+        float(bandwidth_hz),
+        p.a,
+        rows,
+        bool(z.usable),
+        bool(z.degenerate),
+        z.reason,
+        fastest,
+        float(by),
+        time.perf_counter() - t0,
+    )
+
+
+Runner = Callable[[list[tuple]], list[DesignPoint]]
+
+
+def _check_axes(values: Sequence[float], what: str) -> tuple[float, ...]:
+    vals = tuple(float(v) for v in values)
+    if not vals or any(not math.isfinite(v) or v <= 0 for v in vals):
+        raise InputError(f"{what} must be positive numbers, got {list(values)}")
+    if len(vals) > 50:
+        raise InputError(f"{what}: at most 50 values, got {len(vals)}")
+    return vals
+
+
+def design_chart(
+    cfg: Config,
+    sample_times: Sequence[float] = SAMPLE_TIMES,
+    bandwidths_hz: Sequence[float] = BANDWIDTHS_HZ,
+    *,
+    laws: Sequence[str] = DESIGN_LAWS,
+    reading: str = "2pi",
+    grid: int = GRID,
+    runner: Runner | None = None,
+    backend: str = "in-process",
+) -> DesignChart:
+    """Measure every design point (module docstring).
+
+    Parameters
+    ----------
+    cfg : Config
+        Base configuration.
+    sample_times : sequence of float
+        T [s].
+    bandwidths_hz : sequence of float
+        Bandwidths [Hz].
+    laws : sequence of str
+        Law names.
+    reading : str
+        ``2pi`` or ``hz``.
+    grid : int
+        Envelope grid per axis (2 to 100).
+    runner : callable, optional
+        ``runner(tasks) -> points`` in task order, each task the arguments of
+        :func:`design_point`; default: in this process, one after the other.
+    backend : str
+        Name of the runner, recorded.
+
+    Returns
+    -------
+    DesignChart
+        The chart.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> ch = design_chart(paper_config(), [0.002], [30.0], laws=("pd",), grid=4)
+    >>> ch.points[0].fastest
+    'pd'
+    """
+    t0 = time.perf_counter()
+    ts, bw = _check_axes(sample_times, "sample times"), _check_axes(bandwidths_hz, "bandwidths")
+    laws = tuple(dict.fromkeys(laws))
+    for name in laws:
+        if name not in ALL_LAW_NAMES:
+            raise InputError(f"unknown law '{name}' (choose from {', '.join(ALL_LAW_NAMES)})")
+    if not 2 <= grid <= 100:
+        raise InputError(f"--grid must be in [2, 100], got {grid}")
+    for T in ts:  # validate every point before any runs  # noqa: N806
+        for f in bw:
+            point_config(cfg, T, f, reading)
+    tasks = [(cfg, T, f, reading, laws, grid) for T in ts for f in bw]
+    points = (runner or _in_process)(tasks)
+    return DesignChart(
+        cfg.name, reading, ts, bw, laws, grid, tuple(points), backend, time.perf_counter() - t0
+    )
+
+
+def _in_process(tasks: list[tuple]) -> list[DesignPoint]:
+    return [design_point(*t) for t in tasks]
+
+
+def _task(args: tuple) -> DesignPoint:
+    """One design point from its argument tuple (a dask task)."""
+    return design_point(*args)
+
+
+def dask_design_runner(address: str) -> Runner:
+    """Return a runner for :func:`design_chart` on a ``dask.distributed`` cluster.
+
+    Parameters
+    ----------
+    address : str
+        Scheduler address (``tcp://host:port``), or ``local`` to start a
+        LocalCluster of 2 single-threaded worker processes for the run.
+
+    Returns
+    -------
+    callable
+        ``runner(tasks) -> points`` in task order.
+
+    Raises
+    ------
+    InputError
+        A malformed address.
+    """
+    from ptoverify.errors import ClusterError
+    from ptoverify.studies.robust import DASK_CONNECT_TIMEOUT_S, check_dask_address
+
+    check_dask_address(address)
+
+    def run(tasks: list[tuple]) -> list[DesignPoint]:
+        from dask.distributed import Client, LocalCluster
+
+        if address == "local":
+            with (
+                LocalCluster(
+                    n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+                ) as cluster,
+                Client(cluster) as client,
+            ):
+                return client.gather(client.map(_task, tasks, pure=False))
+        try:
+            client = Client(address, timeout=DASK_CONNECT_TIMEOUT_S)
+        except OSError as exc:
+            raise ClusterError(
+                f"cannot reach the Dask scheduler at {address} within "
+                f"{DASK_CONNECT_TIMEOUT_S:g} s ({type(exc).__name__}); start it, or use --dask local"
+            ) from None
+        with client:
+            return client.gather(client.map(_task, tasks, pure=False))
+
+    return run
