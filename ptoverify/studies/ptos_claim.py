@@ -331,10 +331,12 @@ def reading_config(cfg: Config, reading: str) -> Config:
     return cfg.with_plant(a=cfg.bandwidth_hz)
 
 
-def _measure(cfg: Config, reading: str, setting: str, bound: float, pto_ts: float) -> PTOSMeasure:
+def _measure(
+    cfg: Config, reading: str, setting: str, bound: float, pto_ts: float, grid: tuple
+) -> PTOSMeasure:
     p = ptos_design(cfg)
     lin = replace(cfg, pto=replace(cfg.pto, d=min(p.y_l, cfg.plant.position_range)))
-    props = law_properties(make_law("ptos", cfg), lin)
+    props = law_properties(make_law("ptos", cfg), lin, n1=grid[0], n2=grid[1], rest=grid[2])
     m = response_metrics(cfg, "ptos", "step")
     usable = (
         props.limit_cycles == 0
@@ -365,7 +367,13 @@ def _measure(cfg: Config, reading: str, setting: str, bound: float, pto_ts: floa
     )
 
 
-def ptos_claim(cfg: Config, *, maxiter: int = 20, popsize: int = 8) -> PTOSClaim:
+def ptos_claim(
+    cfg: Config,
+    *,
+    maxiter: int = 20,
+    popsize: int = 8,
+    grid: tuple[int, int, int] = (101, 101, 200),
+) -> PTOSClaim:
     """Test the claim under both readings (module docstring).
 
     Parameters
@@ -374,6 +382,8 @@ def ptos_claim(cfg: Config, *, maxiter: int = 20, popsize: int = 8) -> PTOSClaim
         Configuration (its bandwidth in Hz gives the two readings).
     maxiter, popsize : int
         Effort of each tuning (:func:`tune_baseline`).
+    grid : tuple of int
+        (n1, n2, rest) of the properties' grid (default: the gates' grid).
 
     Returns
     -------
@@ -390,12 +400,14 @@ def ptos_claim(cfg: Config, *, maxiter: int = 20, popsize: int = 8) -> PTOSClaim
             "pd-paper": paper["pd"]["overshoot_mm"],
         }
         pto_ts = paper["pto"]["settling_2pct_s"]
-        rows = [_measure(c, reading, "configured", bounds["pto-paper"], pto_ts)]
+        rows = [_measure(c, reading, "configured", bounds["pto-paper"], pto_ts, grid)]
         for name, b in bounds.items():
             for search in ("ptos-ideal", "ptos"):
                 t = tune_baseline(c, search, b, maxiter=maxiter, popsize=popsize)
                 if t.feasible:
-                    rows.append(_measure(t.config, reading, f"tuned {search} {name}", b, pto_ts))
+                    rows.append(
+                        _measure(t.config, reading, f"tuned {search} {name}", b, pto_ts, grid)
+                    )
         measures += rows
         verdicts.append(
             (reading, "not reproduced" if any(r.usable for r in rows) else "reproduced")
