@@ -709,8 +709,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 # ---------------------------------------------------------------- design
 def _add_design(sub) -> None:
-    from ptoverify.config import ALL_LAW_NAMES
-    from ptoverify.studies.design import BANDWIDTHS_HZ, DESIGN_LAWS, GRID, SAMPLE_TIMES
+    from ptoverify.config import ALL_LAW_NAMES, DESIGN_BANDWIDTHS_HZ, DESIGN_LAWS
+    from ptoverify.config import DESIGN_SAMPLE_TIMES as SAMPLE_TIMES
 
     p = sub.add_parser(
         "design",
@@ -734,7 +734,7 @@ def _add_design(sub) -> None:
         nargs="+",
         type=finite_float,
         metavar="HZ",
-        default=list(BANDWIDTHS_HZ),
+        default=list(DESIGN_BANDWIDTHS_HZ),
         help="bandwidths [Hz] (default 5-100)",
     )
     p.add_argument(
@@ -753,9 +753,9 @@ def _add_design(sub) -> None:
     p.add_argument(
         "--grid",
         type=positive_int,
-        default=GRID,
+        default=10,
         metavar="N",
-        help=f"N x N envelope states per point ({GRID}; 2 to 100)",
+        help="N x N envelope states per point (10; 2 to 100)",
     )
     p.add_argument(
         "--dask",

@@ -59,6 +59,10 @@ LAW_NAMES: tuple[str, ...] = ("to", "pd", "pto", "pto-printed")
 BASELINE_NAMES: tuple[str, ...] = ("ptos", "cascade-p")
 #: Every law :func:`ptoverify.model.laws.make_law` builds.
 ALL_LAW_NAMES: tuple[str, ...] = LAW_NAMES + BASELINE_NAMES
+#: Defaults of ``ptoverify design`` (:mod:`ptoverify.studies.design`): laws, T [s], bandwidth [Hz].
+DESIGN_LAWS: tuple[str, ...] = ("pd", "pto", "ptos", "cascade-p")
+DESIGN_SAMPLE_TIMES: tuple[float, ...] = (0.00025, 0.0005, 0.001, 0.002, 0.004, 0.008)
+DESIGN_BANDWIDTHS_HZ: tuple[float, ...] = (5.0, 10.0, 30.0, 60.0, 100.0)
 
 
 @dataclass(frozen=True)

@@ -62,7 +62,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ptoverify.config import Config, PDGains
-from ptoverify.model.laws import Law, Region, pd_law, saturate_linear
+from ptoverify.model.laws import Law, Region, pd_law, register_law, saturate_linear
 
 __all__ = ["PTOSDesign", "ptos_design", "ptos_law", "cascade_gain", "cascade_law"]
 
@@ -251,3 +251,7 @@ def cascade_law(cfg: Config, *, kp: float | None = None) -> Law:
     kp = cascade_gain(cfg) if kp is None else float(kp)
     law = pd_law(replace(cfg, pd=PDGains(kp=kp, kd=0.0)))
     return replace(law, name="cascade-p", note=f"cascade P u = sat(-{kp:.6g} x1)")
+
+
+register_law("ptos", ptos_law)
+register_law("cascade-p", cascade_law)

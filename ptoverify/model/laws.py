@@ -33,6 +33,7 @@ __all__ = [
     "pto_printed_law",
     "omega_c_scalar",
     "make_law",
+    "register_law",
     "with_state_gains",
     "LAW_NAMES",
     "h_scalar",
@@ -710,6 +711,24 @@ _FACTORIES: dict[str, Callable[[Config], Law]] = {
 }
 
 
+def register_law(name: str, factory: Callable[[Config], Law]) -> None:
+    """Let :func:`make_law` build a law defined in another module of this layer.
+
+    The baselines (:mod:`ptoverify.model.baselines`, which import this module)
+    register themselves when the ``ptoverify.model`` package is imported.
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`ptoverify.config.BASELINE_NAMES`.
+    factory : callable
+        ``factory(cfg) -> Law``.
+    """
+    if name not in BASELINE_NAMES:
+        raise ValueError(f"register_law: {name!r} is not a baseline name")
+    _FACTORIES[name] = factory
+
+
 def make_law(name: str, cfg: Config) -> Law:
     """Build a law by name: ``to``, ``pd``, ``pto``, ``pto-printed``, ``ptos``, ``cascade-p``.
 
@@ -725,10 +744,6 @@ def make_law(name: str, cfg: Config) -> Law:
     Law
         The law.
     """
-    if name in BASELINE_NAMES:  # the baselines import this module: built lazily
-        from ptoverify.model.baselines import cascade_law, ptos_law
-
-        return ptos_law(cfg) if name == "ptos" else cascade_law(cfg)
     if name not in _FACTORIES:
         raise InputError(f"unknown law '{name}' (choose from {', '.join(ALL_LAW_NAMES)})")
     return _FACTORIES[name](cfg)

@@ -32,7 +32,15 @@ from typing import Any
 
 import numpy as np
 
-from ptoverify.config import ALL_LAW_NAMES, Config, PDGains, config_from_mapping
+from ptoverify.config import (
+    ALL_LAW_NAMES,
+    DESIGN_BANDWIDTHS_HZ,
+    DESIGN_LAWS,
+    DESIGN_SAMPLE_TIMES,
+    Config,
+    PDGains,
+    config_from_mapping,
+)
 from ptoverify.errors import InputError
 from ptoverify.model.laws import make_law
 from ptoverify.model.mintime import discrete_min_steps_batch, min_time
@@ -53,9 +61,9 @@ __all__ = [
     "dask_design_runner",
 ]
 
-DESIGN_LAWS = ("pd", "pto", "ptos", "cascade-p")  #: default laws (TO never settles)
-SAMPLE_TIMES = (0.00025, 0.0005, 0.001, 0.002, 0.004, 0.008)  #: default T [s]
-BANDWIDTHS_HZ = (5.0, 10.0, 30.0, 60.0, 100.0)  #: default bandwidths [Hz]
+
+SAMPLE_TIMES = DESIGN_SAMPLE_TIMES  #: default T [s]
+BANDWIDTHS_HZ = DESIGN_BANDWIDTHS_HZ  #: default bandwidths [Hz]
 GRID = 10  #: default envelope grid per axis (even: the origin is off the grid)
 
 
