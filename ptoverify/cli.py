@@ -709,7 +709,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 # ---------------------------------------------------------------- design
 def _add_design(sub) -> None:
-    from ptoverify.config import ALL_LAW_NAMES, DESIGN_BANDWIDTHS_HZ, DESIGN_LAWS
+    from ptoverify.config import ALL_LAW_NAMES, DESIGN_BANDWIDTHS_HZ, DESIGN_GRID, DESIGN_LAWS
     from ptoverify.config import DESIGN_SAMPLE_TIMES as SAMPLE_TIMES
 
     p = sub.add_parser(
@@ -753,9 +753,9 @@ def _add_design(sub) -> None:
     p.add_argument(
         "--grid",
         type=positive_int,
-        default=10,
+        default=DESIGN_GRID,
         metavar="N",
-        help="N x N envelope states per point (10; 2 to 100)",
+        help=f"N x N envelope states per point ({DESIGN_GRID}; 2 to 100)",
     )
     p.add_argument(
         "--dask",
@@ -816,6 +816,71 @@ def _cmd_design(args: argparse.Namespace) -> int:
             f"T {pt.sample_time * 1e3:g} ms, {pt.bandwidth_hz:g} Hz: fastest {pt.fastest or '-'}"
             f" (x{pt.fastest_by:.2f}); {cells}"
         )
+    for f in result.get("files", []):
+        print(f"wrote {f}")
+    return 0
+
+
+# ---------------------------------------------------------------- penalty
+def _add_penalty(sub) -> None:
+    from ptoverify.config import ALL_LAW_NAMES
+
+    p = sub.add_parser(
+        "penalty",
+        help="settling against move size, beside t_f* and N*T",
+        description="Point-to-point moves from rest, 0.01 mm to the position range "
+        "(log-spaced): each law's settling (0.01 mm, exact between samples, held 0.05 s) and "
+        "arrival, beside the minimum time t_f* and the discrete limit N*T.",
+        epilog="example:\n  ptoverify penalty --json\n  ptoverify penalty --tuned --out penalty",
+    )
+    p.add_argument("--laws", nargs="+", choices=ALL_LAW_NAMES, default=list(ALL_LAW_NAMES))
+    p.add_argument("--count", type=positive_int, default=40, metavar="N", help="sizes (40)")
+    p.add_argument(
+        "--tuned",
+        action="store_true",
+        help="each law at its best tuning under the PTO's paper-gain overshoot",
+    )
+    p.add_argument("--out", metavar="DIR", default=None, help="write penalty.json and .csv")
+    p.set_defaults(handler=_cmd_penalty)
+
+
+def _cmd_penalty(args: argparse.Namespace) -> int:
+    from ptoverify.studies.penalty import penalty_curves
+    from ptoverify.studies.ptos_claim import fair_configs
+
+    cfg = _config(args)
+    if not 2 <= args.count <= 1000:
+        raise InputError(f"--count must be in [2, 1000], got {args.count}")
+    laws = tuple(dict.fromkeys(args.laws))
+    target = check_target(args.out, config_hash=cfg.digest()) if args.out else None
+    configs = fair_configs(cfg, laws) if args.tuned else None
+    res = penalty_curves(
+        cfg, laws, count=args.count, configs=configs,
+        setting="tuned pto-paper" if args.tuned else "configured",
+    )  # fmt: skip
+    result = res.to_json()
+    if target is not None:
+        tmp = make_temp(target)
+        try:
+            (tmp / "penalty.json").write_text(json.dumps(result, indent=2) + "\n")
+            res.write_csv(tmp / "penalty.csv")
+            publish(tmp, target, config_hash=cfg.digest(), name=cfg.name)
+        except BaseException:
+            discard(tmp)
+            raise
+        result["files"] = [str(target / "penalty.json"), str(target / "penalty.csv")]
+    if args.json:
+        print_json(result)
+        return 0
+    print(f"penalty ({res.setting}); settling: {res.settling}")
+    print(
+        f"{'law':<12} "
+        + " ".join(f"{s:>9.3g}" for s in res.sizes_mm[:: max(1, len(res.sizes_mm) // 8)])
+    )
+    for c in res.curves:
+        cells = c.ratio_nt[:: max(1, len(res.sizes_mm) // 8)]
+        print(f"{c.law:<12} " + " ".join(f"{v:>9.2f}" for v in cells))
+    print("(settling / N*T at the sizes in mm above; nan: never settles)")
     for f in result.get("files", []):
         print(f"wrote {f}")
     return 0
@@ -1110,6 +1175,7 @@ COMMANDS: list[tuple[str, Callable[[Any], None]]] = [
     ("robust", _add_robust),
     ("tune", _add_tune),
     ("design", _add_design),
+    ("penalty", _add_penalty),
 ]
 
 

@@ -6,6 +6,7 @@ the exact N* (no law beats it), and the CSV / JSON of one result against each ot
 
 import csv
 import io
+import json
 import math
 
 import numpy as np
@@ -94,3 +95,15 @@ def test_tuned_configs_change_the_law():
     assert "150" in res.curves[0].note and not math.isclose(
         res.curves[0].settling_s[-1], base.curves[0].settling_s[-1]
     )
+
+
+def test_cli_penalty(tmp_path, capsys):
+    from ptoverify.cli import main
+
+    out = tmp_path / "pen"
+    assert main(["penalty", "--laws", "pd", "to", "--count", "5", "--json", "--out", str(out)]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert list(res["laws"]) == ["pd", "to"] and len(res["sizes_mm"]) == 5
+    assert json.loads((out / "penalty.json").read_text())["laws"] == res["laws"]
+    assert main(["penalty", "--count", "1"]) == 2
+    assert capsys.readouterr().err.startswith("ptoverify: error: --count")

@@ -35,6 +35,7 @@ import numpy as np
 from ptoverify.config import (
     ALL_LAW_NAMES,
     DESIGN_BANDWIDTHS_HZ,
+    DESIGN_GRID,
     DESIGN_LAWS,
     DESIGN_SAMPLE_TIMES,
     Config,
@@ -64,7 +65,7 @@ __all__ = [
 
 SAMPLE_TIMES = DESIGN_SAMPLE_TIMES  #: default T [s]
 BANDWIDTHS_HZ = DESIGN_BANDWIDTHS_HZ  #: default bandwidths [Hz]
-GRID = 10  #: default envelope grid per axis (even: the origin is off the grid)
+GRID = DESIGN_GRID  #: default envelope grid per axis (even: the origin is off the grid)
 
 
 @dataclass(frozen=True)

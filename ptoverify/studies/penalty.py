@@ -97,6 +97,8 @@ class PenaltyResult:
         Simulated time [s].
     seconds : float
         Wall time of the computation [s].
+    setting : str
+        Whose gains: ``configured``, or the tuning's name.
     """
 
     config_name: str
@@ -108,6 +110,7 @@ class PenaltyResult:
     settling: str
     horizon_s: float
     seconds: float
+    setting: str = "configured"
 
     def to_json(self) -> dict[str, Any]:
         """Return the curves as a JSON-able dict (NaN as None)."""
@@ -117,6 +120,7 @@ class PenaltyResult:
 
         return {
             "config": self.config_name,
+            "setting": self.setting,
             "settling_definition": self.settling,
             "horizon_s": self.horizon_s,
             "sizes_mm": col(self.sizes_mm),
@@ -202,6 +206,7 @@ def penalty_curves(
     *,
     count: int = 40,
     configs: dict[str, Config] | None = None,
+    setting: str = "configured",
 ) -> PenaltyResult:
     """Settling and arrival of each law against move size (module docstring).
 
@@ -216,6 +221,8 @@ def penalty_curves(
     configs : dict, optional
         Law name -> the configuration its law is built from (e.g. its best
         tuning); the plant simulated is always ``cfg``'s.
+    setting : str
+        Name of whose gains these are (recorded).
 
     Returns
     -------
@@ -257,4 +264,5 @@ def penalty_curves(
         SETTLING_DEFINITION,
         steps * T,
         time.perf_counter() - t0,
+        setting,
     )

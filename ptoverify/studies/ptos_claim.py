@@ -48,6 +48,7 @@ __all__ = [
     "ptos_claim",
     "READINGS",
     "reading_config",
+    "fair_configs",
 ]
 
 #: Search ranges: PTOS alpha [-] and log10(k / a); cascade log10(kp / a).
@@ -413,3 +414,47 @@ def ptos_claim(
             (reading, "not reproduced" if any(r.usable for r in rows) else "reproduced")
         )
     return PTOSClaim(tuple(measures), tuple(verdicts), time.perf_counter() - t0)
+
+
+def fair_configs(
+    cfg: Config, laws: tuple[str, ...], bound: str = "pto-paper", *, maxiter: int = 20
+) -> dict[str, Config]:
+    """Each law's best tuning on the step under one shared overshoot bound.
+
+    PD and PTO from :func:`ptoverify.studies.tune.fair_tunings`, PTOS and the
+    cascade P loop from :func:`tune_baseline`, under the bound named ``bound``
+    (:data:`ptoverify.studies.tune.FAIR_BOUNDS`: the PTO's or the PD's overshoot at
+    the paper's gains).  TO and the printed PTO have no gains: their
+    configuration is ``cfg``.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (plant, the paper's gains).
+    laws : tuple of str
+        Law names.
+    bound : str
+        ``pto-paper`` or ``pd-paper``.
+    maxiter : int
+        Generations of the baselines' searches.
+
+    Returns
+    -------
+    dict
+        Law name -> the configuration holding its tuned gains.
+    """
+    from ptoverify.studies.tune import FAIR_BOUNDS, fair_tunings
+
+    if bound not in FAIR_BOUNDS:
+        raise InputError(f"bound must be one of {', '.join(FAIR_BOUNDS)}, got {bound!r}")
+    fair = fair_tunings(cfg)
+    out = {}
+    for law in laws:
+        if law in ("pd", "pto"):
+            out[law] = fair.config(law, bound)
+        elif law in ("ptos", "cascade-p"):
+            t = tune_baseline(cfg, law, fair.bounds[bound], maxiter=maxiter)
+            out[law] = t.config if t.feasible else cfg
+        else:
+            out[law] = cfg
+    return out
