@@ -758,6 +758,13 @@ def _add_design(sub) -> None:
         help=f"N x N envelope states per point ({DESIGN_GRID}; 2 to 100)",
     )
     p.add_argument(
+        "--tuned",
+        type=finite_float,
+        metavar="MM",
+        default=None,
+        help="tune every law at every point (step, overshoot <= MM, stable, no limit cycle)",
+    )
+    p.add_argument(
         "--dask",
         metavar="ADDRESS",
         default=None,
@@ -790,6 +797,7 @@ def _cmd_design(args: argparse.Namespace) -> int:
             grid=args.grid,
             runner=runner,
             backend=args.dask or "in-process",
+            tuned_overshoot=args.tuned,
         )
         result = chart.to_json()
         if args.out is not None:

@@ -112,3 +112,19 @@ def test_cli_json_and_out(tmp_path, capsys):
     assert saved["points"] == res["points"]
     rows = (out / "design.csv").read_text().splitlines()
     assert len(rows) == 1 + 2
+
+
+def test_tuned_point_uses_the_tuning():
+    """--tuned: the law's gains are the tuning's (recomputed here), measured as configured ones."""
+    from ptoverify.studies.design import TUNE_EFFORT
+    from ptoverify.studies.ptos_claim import tune_baseline
+
+    pt = design_point(CFG, 0.002, 30.0, laws=("cascade-p", "to"), grid=4, tuned_overshoot=0.0)
+    r = pt.law("cascade-p")
+    c = point_config(CFG, 0.002, 30.0, "2pi")
+    t = tune_baseline(c, "cascade-p", 0.0, maxiter=TUNE_EFFORT["maxiter"],
+                      popsize=TUNE_EFFORT["popsize"])  # fmt: skip
+    assert r.gains_from == "tuned" and r.k_x1 == t.gains()[0]
+    assert pt.law("to").gains_from == "configured"
+    with pytest.raises(InputError, match="--tuned"):
+        design_chart(CFG, [0.002], [30.0], tuned_overshoot=-1.0)

@@ -90,6 +90,10 @@ class LawAtPoint:
         The same with a one-sample delay [-].
     radius_delay1 : float
         Spectral radius of the delayed linear loop at a_true = a_design [-].
+    gains_from : str
+        ``configured``, ``tuned`` (the step's 2 % settling minimized under the
+        chart's overshoot bound, :func:`tuned_law_config`) or ``tuning infeasible``
+        (no gains met the constraints: the configured ones are measured).
     """
 
     law: str
@@ -104,6 +108,7 @@ class LawAtPoint:
     margin_delay_lo: float
     margin_delay_hi: float
     radius_delay1: float
+    gains_from: str = "configured"
 
 
 @dataclass(frozen=True)
@@ -169,6 +174,8 @@ class DesignChart:
         Laws.
     grid : int
         Envelope grid per axis.
+    tuned_overshoot : float or None
+        Overshoot bound [mm] of the per-point tunings; None: configured gains.
     points : tuple of DesignPoint
         len(sample_times) x len(bandwidths_hz) points.
     backend : str
@@ -183,6 +190,7 @@ class DesignChart:
     bandwidths_hz: tuple[float, ...]
     laws: tuple[str, ...]
     grid: int
+    tuned_overshoot: float | None
     points: tuple[DesignPoint, ...]
     backend: str
     seconds: float
@@ -206,6 +214,7 @@ class DesignChart:
             "bandwidths_hz": list(self.bandwidths_hz),
             "laws": list(self.laws),
             "grid": self.grid,
+            "tuned_overshoot_mm": self.tuned_overshoot,
             "points": [clean(asdict(p)) for p in self.points],
             "backend": self.backend,
         }
@@ -270,8 +279,60 @@ def _margin(law: str, cfg: Config, gains: tuple[float, float], delay: int) -> tu
     return (0.0 if lo is None else lo), (math.inf if hi is None else hi)
 
 
-def _law_at(name: str, cfg: Config, grid: int, states: tuple) -> LawAtPoint:
-    """Measure one law at one point (module docstring)."""
+#: Search effort of the tunings at a design point (smaller than ``tune``'s default: a
+#: chart tunes every law at every point).
+TUNE_EFFORT = {"maxiter": 10, "popsize": 8, "d_grid": 5, "d_refine": 2, "polish": 8}
+
+
+def tuned_law_config(cfg: Config, name: str, max_overshoot: float) -> Config | None:
+    """Return the configuration of ``name`` tuned on the step (None: infeasible).
+
+    PD and PTO by :func:`ptoverify.studies.tune.tune`, PTOS and cascade P by
+    :func:`ptoverify.studies.ptos_claim.tune_baseline`, each minimizing the 2 %
+    settling of the Section 6 step under the same overshoot bound, a stable sampled
+    linear loop and no limit cycle; effort :data:`TUNE_EFFORT`.  TO and the printed
+    PTO have nothing to tune: ``cfg``.
+
+    Parameters
+    ----------
+    cfg : Config
+        The design point's configuration.
+    name : str
+        Law name.
+    max_overshoot : float
+        Overshoot bound [mm].
+
+    Returns
+    -------
+    Config or None
+        The tuned configuration.
+    """
+    from ptoverify.studies.ptos_claim import tune_baseline
+    from ptoverify.studies.tune import tune
+
+    e = TUNE_EFFORT
+    if name in ("pd", "pto"):
+        try:
+            return tune(
+                cfg, name, "step", max_overshoot=max_overshoot, find_runner_up=False, **e
+            ).config
+        except InputError:  # tune's answer when no gains meet the constraints
+            return None
+    if name in ("ptos", "cascade-p"):
+        t = tune_baseline(cfg, name, max_overshoot, maxiter=e["maxiter"], popsize=e["popsize"])
+        return t.config if t.feasible else None
+    return cfg
+
+
+def _law_at(
+    name: str, cfg: Config, grid: int, states: tuple, overshoot: float | None = None
+) -> LawAtPoint:
+    """Measure one law at one point (module docstring); tuned first if ``overshoot`` is set."""
+    gains_from = "configured"
+    if overshoot is not None and name not in ("to", "pto-printed"):
+        tuned = tuned_law_config(cfg, name, overshoot)
+        gains_from = "tuning infeasible" if tuned is None else "tuned"
+        cfg = tuned or cfg
     x1, x2, nt, steps = states
     s = SweepSettings()
     p = cfg.plant
@@ -292,7 +353,7 @@ def _law_at(name: str, cfg: Config, grid: int, states: tuple) -> LawAtPoint:
         pd = replace(cfg, pd=PDGains(kp=gains[0], kd=gains[1]))
         rad = float(linear_loop_radii("pd", pd, [1.0], delay_samples=1)[0])
     frac = float(np.count_nonzero(settled)) / max(1, ratio.size)
-    return LawAtPoint(name, law.note, *gains, median, worst, frac, *m0, *m1, rad)
+    return LawAtPoint(name, law.note, *gains, median, worst, frac, *m0, *m1, rad, gains_from)
 
 
 def design_point(
@@ -302,6 +363,7 @@ def design_point(
     reading: str = "2pi",
     laws: Sequence[str] = DESIGN_LAWS,
     grid: int = GRID,
+    tuned_overshoot: float | None = None,
 ) -> DesignPoint:
     """Measure every law at one design point (module docstring).
 
@@ -319,6 +381,9 @@ def design_point(
         Law names.
     grid : int
         Envelope grid per axis, >= 2.
+    tuned_overshoot : float, optional
+        Tune every law at the point under this step overshoot bound [mm]
+        (:func:`tuned_law_config`); None: the configuration's gains.
 
     Returns
     -------
@@ -335,7 +400,7 @@ def design_point(
     steps = math.ceil(s.horizon_factor * float(t_f.max()) / p.T) + math.ceil(s.hold / p.T - 1e-9)
     n_star = discrete_min_steps_batch(x1, x2, p).steps
     nt = np.where(n_star > 0, n_star * p.T, np.nan)
-    rows = tuple(_law_at(name, c, grid, (x1, x2, nt, steps)) for name in laws)
+    rows = tuple(_law_at(n, c, grid, (x1, x2, nt, steps), tuned_overshoot) for n in laws)
     z = zone_for_law(c, "corrected")
     ranked = sorted((r.median_ratio_nt, r.law) for r in rows if math.isfinite(r.median_ratio_nt))
     fastest = ranked[0][1] if ranked else ""
@@ -376,6 +441,7 @@ def design_chart(
     grid: int = GRID,
     runner: Runner | None = None,
     backend: str = "in-process",
+    tuned_overshoot: float | None = None,
 ) -> DesignChart:
     """Measure every design point (module docstring).
 
@@ -398,6 +464,8 @@ def design_chart(
         :func:`design_point`; default: in this process, one after the other.
     backend : str
         Name of the runner, recorded.
+    tuned_overshoot : float, optional
+        Tune every law at every point under this overshoot bound [mm].
 
     Returns
     -------
@@ -422,10 +490,23 @@ def design_chart(
     for T in ts:  # validate every point before any runs  # noqa: N806
         for f in bw:
             point_config(cfg, T, f, reading)
-    tasks = [(cfg, T, f, reading, laws, grid) for T in ts for f in bw]
+    if tuned_overshoot is not None and not (
+        math.isfinite(tuned_overshoot) and tuned_overshoot >= 0
+    ):
+        raise InputError(f"--tuned must be a finite overshoot >= 0 mm, got {tuned_overshoot}")
+    tasks = [(cfg, T, f, reading, laws, grid, tuned_overshoot) for T in ts for f in bw]
     points = (runner or _in_process)(tasks)
     return DesignChart(
-        cfg.name, reading, ts, bw, laws, grid, tuple(points), backend, time.perf_counter() - t0
+        cfg.name,
+        reading,
+        ts,
+        bw,
+        laws,
+        grid,
+        tuned_overshoot,
+        tuple(points),
+        backend,
+        time.perf_counter() - t0,
     )
 
 
