@@ -56,6 +56,14 @@ def test_margins_against_scipy_zoh(point):
     assert checked >= 2
 
 
+def test_pto_comparison(point):
+    pto = point.law("pto").median_ratio_nt
+    for r in point.laws:
+        if r.law != "pto" and math.isfinite(r.median_ratio_nt) and math.isfinite(pto):
+            assert (r.law in point.pto_beats) == (pto < r.median_ratio_nt), r.law
+            assert (r.law in point.pto_loses_to) == (pto > r.median_ratio_nt), r.law
+
+
 def test_point_structure(point):
     assert [r.law for r in point.laws] == ["pd", "pto", "ptos", "cascade-p"]
     medians = {r.law: r.median_ratio_nt for r in point.laws if math.isfinite(r.median_ratio_nt)}
@@ -114,6 +122,7 @@ def test_cli_json_and_out(tmp_path, capsys):
     assert len(rows) == 1 + 2
 
 
+@pytest.mark.slow
 def test_tuned_point_uses_the_tuning():
     """--tuned: the law's gains are the tuning's (recomputed here), measured as configured ones."""
     from ptoverify.studies.design import TUNE_EFFORT
@@ -126,5 +135,6 @@ def test_tuned_point_uses_the_tuning():
                       popsize=TUNE_EFFORT["popsize"])  # fmt: skip
     assert r.gains_from == "tuned" and r.k_x1 == t.gains()[0]
     assert pt.law("to").gains_from == "configured"
+    assert pt.pto_beats == () and pt.pto_loses_to == ()  # no PTO asked
     with pytest.raises(InputError, match="--tuned"):
         design_chart(CFG, [0.002], [30.0], tuned_overshoot=-1.0)

@@ -133,6 +133,10 @@ class DesignPoint:
         Law with the least median settling / N*T ("" if none settles).
     fastest_by : float
         Runner-up's median ratio over the fastest's [-] (>= 1; inf: no runner-up settles).
+    pto_beats, pto_loses_to : tuple of str
+        Laws whose median settling / N*T is above / below the PTO's (a law that
+        never settles from some state is beaten by a PTO that always does, and
+        beats one that does not); empty without ``pto``.
     seconds : float
         Wall time of the point [s] (not compared between runs).
     """
@@ -146,6 +150,8 @@ class DesignPoint:
     pto_zone_reason: str
     fastest: str
     fastest_by: float
+    pto_beats: tuple[str, ...]
+    pto_loses_to: tuple[str, ...]
     seconds: float
 
     def law(self, name: str) -> LawAtPoint:
@@ -405,6 +411,7 @@ def design_point(
     ranked = sorted((r.median_ratio_nt, r.law) for r in rows if math.isfinite(r.median_ratio_nt))
     fastest = ranked[0][1] if ranked else ""
     by = ranked[1][0] / ranked[0][0] if len(ranked) > 1 else math.inf
+    beats, loses = _against_pto(rows)
     return DesignPoint(
         float(sample_time),
         float(bandwidth_hz),
@@ -415,8 +422,25 @@ def design_point(
         z.reason,
         fastest,
         float(by),
+        beats,
+        loses,
         time.perf_counter() - t0,
     )
+
+
+def _against_pto(rows: tuple[LawAtPoint, ...]) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(laws the PTO beats, laws that beat it) by median settling / N*T (NaN: never settles)."""
+    pto = next((r for r in rows if r.law == "pto"), None)
+    if pto is None:
+        return (), ()
+
+    def key(r: LawAtPoint) -> float:
+        return r.median_ratio_nt if math.isfinite(r.median_ratio_nt) else math.inf
+
+    others = [r for r in rows if r.law != "pto"]
+    beats = tuple(r.law for r in others if key(pto) < key(r))
+    loses = tuple(r.law for r in others if key(r) < key(pto))
+    return beats, loses
 
 
 Runner = Callable[[list[tuple]], list[DesignPoint]]
