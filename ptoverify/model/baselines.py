@@ -37,11 +37,13 @@ deceleration the plant guarantees along every approach to rest; the parabola
 x2^2 = 2 a w_max |x1| is also the second-order osculation of the time-optimal
 switching curve l1 (eq. 9) at the origin (also re-derived).
 
-What this shows: at the default k = a the profile's edge value f(y_l) = A / k
-= w_max, so the square-root branch lies entirely beyond the saturation and
+What this shows: the command at the edge, at rest, is (k / a) f(y_l) =
+(k / a) (A / k) = A / a = w_max for every k.  At the default k = a (no velocity
+term) the square-root branch therefore lies entirely beyond the saturation and
 PTOS reduces to the cascade P loop u = sat(-(alpha a / 2) x1).  With k > a the
-branch acts, but the drive cannot follow the profile at high speed (its limit is
-on the velocity command, not on the acceleration that PTOS assumes).
+branch acts unclipped only while the velocity term -(k / a - 1) x2 pulls the
+command back inside +-w_max, i.e. while approaching the target: the limit is on
+the velocity command, not on the acceleration PTOS assumes.
 
 DSPTOS (Choi et al.'s damping scheduling) is not built: it schedules the
 damping of an acceleration-limited double integrator's linear loop between the
