@@ -758,6 +758,9 @@ def _add_design(sub) -> None:
         help=f"N x N envelope states per point ({DESIGN_GRID}; 2 to 100)",
     )
     p.add_argument(
+        "--jobs", type=positive_int, default=1, metavar="N", help="local worker processes (1)"
+    )
+    p.add_argument(
         "--tuned",
         type=finite_float,
         metavar="MM",
@@ -780,10 +783,14 @@ def _add_design(sub) -> None:
 
 
 def _cmd_design(args: argparse.Namespace) -> int:
-    from ptoverify.studies.design import dask_design_runner, design_chart
+    from ptoverify.studies.design import dask_design_runner, design_chart, process_runner
 
     cfg = _config(args)
+    if args.dask and args.jobs > 1:
+        raise InputError("--dask and --jobs are exclusive")
     runner = dask_design_runner(args.dask) if args.dask else None
+    if args.jobs > 1:
+        runner = process_runner(args.jobs)
     target = tmp = None
     if args.out is not None:
         target = check_target(args.out, config_hash=cfg.digest())
@@ -796,7 +803,7 @@ def _cmd_design(args: argparse.Namespace) -> int:
             reading=args.reading,
             grid=args.grid,
             runner=runner,
-            backend=args.dask or "in-process",
+            backend=args.dask or (f"{args.jobs} processes" if args.jobs > 1 else "in-process"),
             tuned_overshoot=args.tuned,
         )
         result = chart.to_json()

@@ -15,7 +15,13 @@ from conftest import zoh_reference
 from ptoverify.cli import main
 from ptoverify.config import paper_config
 from ptoverify.errors import InputError
-from ptoverify.studies.design import dask_design_runner, design_chart, design_point, point_config
+from ptoverify.studies.design import (
+    dask_design_runner,
+    design_chart,
+    design_point,
+    point_config,
+    process_runner,
+)
 
 CFG = paper_config()
 
@@ -138,3 +144,11 @@ def test_tuned_point_uses_the_tuning():
     assert pt.pto_beats == () and pt.pto_loses_to == ()  # no PTO asked
     with pytest.raises(InputError, match="--tuned"):
         design_chart(CFG, [0.002], [30.0], tuned_overshoot=-1.0)
+
+
+@pytest.mark.slow
+def test_process_pool_equals_in_process():
+    args = dict(laws=("pd", "ptos"), grid=4)
+    here = design_chart(CFG, [0.002], [30.0, 60.0], **args)
+    there = design_chart(CFG, [0.002], [30.0, 60.0], runner=process_runner(2), **args)
+    assert here.to_json(timings=False)["points"] == there.to_json(timings=False)["points"]

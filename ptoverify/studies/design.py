@@ -60,6 +60,7 @@ __all__ = [
     "design_point",
     "design_chart",
     "dask_design_runner",
+    "process_runner",
 ]
 
 
@@ -541,6 +542,36 @@ def _in_process(tasks: list[tuple]) -> list[DesignPoint]:
 def _task(args: tuple) -> DesignPoint:
     """One design point from its argument tuple (a dask task)."""
     return design_point(*args)
+
+
+def process_runner(jobs: int) -> Runner:
+    """Return a runner for :func:`design_chart` on ``jobs`` local processes.
+
+    ``concurrent.futures.ProcessPoolExecutor`` with spawned workers; the points
+    are the in-process ones (each computed alone, in the same way).
+
+    Parameters
+    ----------
+    jobs : int
+        Worker processes, >= 1.
+
+    Returns
+    -------
+    callable
+        ``runner(tasks) -> points`` in task order.
+    """
+    if jobs < 1:
+        raise InputError(f"--jobs must be >= 1, got {jobs}")
+
+    def run(tasks: list[tuple]) -> list[DesignPoint]:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        ctx = multiprocessing.get_context("spawn")  # no fork of a threaded parent
+        with ProcessPoolExecutor(min(jobs, max(1, len(tasks))), mp_context=ctx) as pool:
+            return list(pool.map(_task, tasks))
+
+    return run
 
 
 def dask_design_runner(address: str) -> Runner:
