@@ -209,7 +209,7 @@ def _cmd_mintime(args: argparse.Namespace) -> int:
 
 # ---------------------------------------------------------------- simulate
 def _add_simulate(sub) -> None:
-    from ptoverify.config import LAW_NAMES
+    from ptoverify.config import ALL_LAW_NAMES
 
     p = sub.add_parser(
         "simulate",
@@ -218,7 +218,7 @@ def _add_simulate(sub) -> None:
         "Section 6 reference: step 5 mm, ramp 0-30 mm at 200 mm/s, sine 5 mm 5 Hz.",
         epilog="example:\n  ptoverify simulate --law to --signal step --csv to_step.csv",
     )
-    p.add_argument("--law", choices=LAW_NAMES, default="pto", help="control law (default pto)")
+    p.add_argument("--law", choices=ALL_LAW_NAMES, default="pto", help="control law (default pto)")
     p.add_argument(
         "--signal",
         choices=("step", "ramp", "sine"),
@@ -617,6 +617,8 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
 # ---------------------------------------------------------------- sweep
 def _add_sweep(sub) -> None:
+    from ptoverify.config import ALL_LAW_NAMES
+
     p = sub.add_parser(
         "sweep",
         help="suboptimality of each law over a grid of initial states",
@@ -637,6 +639,13 @@ def _add_sweep(sub) -> None:
         default=200,
         help="grid points per axis (default 200: 40,000 states; at most 1000)",
     )
+    p.add_argument(
+        "--law",
+        action="append",
+        choices=ALL_LAW_NAMES,
+        default=None,
+        help="sweep only this law (repeatable; default to, pd, pto, pto-printed)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     p.set_defaults(handler=_cmd_sweep)
 
@@ -654,7 +663,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         from ptoverify.progress import stderr_bar
 
         bar = stderr_bar(args.quiet)
-        res = run_sweep(cfg, SweepSettings(n1=args.grid, n2=args.grid), progress=bar)
+        laws = tuple(dict.fromkeys(args.law)) if args.law else SweepSettings.laws
+        res = run_sweep(cfg, SweepSettings(args.grid, args.grid, laws=laws), progress=bar)
         result = res.to_json()
         if args.out is not None:
             tmp = make_temp(target)
@@ -694,6 +704,200 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
             print(f"{name:<12} skipped: {why}")
         for f in result.get("files", []):
             print(f"wrote {f}")
+    return 0
+
+
+# ---------------------------------------------------------------- design
+def _add_design(sub) -> None:
+    from ptoverify.config import ALL_LAW_NAMES, DESIGN_BANDWIDTHS_HZ, DESIGN_GRID, DESIGN_LAWS
+    from ptoverify.config import DESIGN_SAMPLE_TIMES as SAMPLE_TIMES
+
+    p = sub.add_parser(
+        "design",
+        help="design charts over sample time x bandwidth",
+        description="Every law at the configuration's gains over a grid of sample time T x "
+        "bandwidth: median and worst settling / N*T over an envelope grid, the linear loop's "
+        "margin in a_true / a_design without and with a one-sample delay, the PTO zone.",
+        epilog="example:\n  ptoverify design --sample-times 0.001 0.002 --bandwidths 10 30 --json"
+        "\n  ptoverify design --dask local --out design-paper",
+    )
+    p.add_argument(
+        "--sample-times",
+        nargs="+",
+        type=finite_float,
+        metavar="S",
+        default=list(SAMPLE_TIMES),
+        help="sample times T [s] (default 0.25-8 ms)",
+    )
+    p.add_argument(
+        "--bandwidths",
+        nargs="+",
+        type=finite_float,
+        metavar="HZ",
+        default=list(DESIGN_BANDWIDTHS_HZ),
+        help="bandwidths [Hz] (default 5-100)",
+    )
+    p.add_argument(
+        "--laws",
+        nargs="+",
+        choices=ALL_LAW_NAMES,
+        default=list(DESIGN_LAWS),
+        help="laws (default pd pto ptos cascade-p)",
+    )
+    p.add_argument(
+        "--reading",
+        choices=("2pi", "hz"),
+        default="2pi",
+        help="a = 2 pi f (2pi, default) or a = f rad/s (hz)",
+    )
+    p.add_argument(
+        "--grid",
+        type=positive_int,
+        default=DESIGN_GRID,
+        metavar="N",
+        help=f"N x N envelope states per point ({DESIGN_GRID}; 2 to 100)",
+    )
+    p.add_argument(
+        "--jobs", type=positive_int, default=1, metavar="N", help="local worker processes (1)"
+    )
+    p.add_argument(
+        "--tuned",
+        type=finite_float,
+        metavar="MM",
+        default=None,
+        help="tune every law at every point (step, overshoot <= MM, stable, no limit cycle)",
+    )
+    p.add_argument(
+        "--dask",
+        metavar="ADDRESS",
+        default=None,
+        help="run the points on a dask.distributed scheduler, or 'local'",
+    )
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        default=None,
+        help="write design.json and design.csv into DIR (atomically)",
+    )
+    p.set_defaults(handler=_cmd_design)
+
+
+def _cmd_design(args: argparse.Namespace) -> int:
+    from ptoverify.studies.design import dask_design_runner, design_chart, process_runner
+
+    cfg = _config(args)
+    if args.dask and args.jobs > 1:
+        raise InputError("--dask and --jobs are exclusive")
+    runner = dask_design_runner(args.dask) if args.dask else None
+    if args.jobs > 1:
+        runner = process_runner(args.jobs)
+    target = tmp = None
+    if args.out is not None:
+        target = check_target(args.out, config_hash=cfg.digest())
+    try:
+        chart = design_chart(
+            cfg,
+            args.sample_times,
+            args.bandwidths,
+            laws=args.laws,
+            reading=args.reading,
+            grid=args.grid,
+            runner=runner,
+            backend=args.dask or (f"{args.jobs} processes" if args.jobs > 1 else "in-process"),
+            tuned_overshoot=args.tuned,
+        )
+        result = chart.to_json()
+        if args.out is not None:
+            tmp = make_temp(target)
+            (tmp / "design.json").write_text(json.dumps(result, indent=2) + "\n")
+            (tmp / "design.csv").write_text(chart.to_csv())
+            result["files"] = [str(target / "design.json"), str(target / "design.csv")]
+            publish(tmp, target, config_hash=cfg.digest(), name=cfg.name)
+            tmp = None
+    finally:
+        discard(tmp)
+    if args.json:
+        print_json(result)
+        return 0
+    print(
+        f"design chart ({chart.reading} reading), {len(chart.points)} points, "
+        f"{chart.seconds:.1f} s; median / worst settling over N*T"
+    )
+    for pt in chart.points:
+        cells = "  ".join(
+            f"{r.law} {r.median_ratio_nt:.2f}/{r.worst_ratio_nt:.2f}" for r in pt.laws
+        )
+        print(
+            f"T {pt.sample_time * 1e3:g} ms, {pt.bandwidth_hz:g} Hz: fastest {pt.fastest or '-'}"
+            f" (x{pt.fastest_by:.2f}); {cells}"
+        )
+    for f in result.get("files", []):
+        print(f"wrote {f}")
+    return 0
+
+
+# ---------------------------------------------------------------- penalty
+def _add_penalty(sub) -> None:
+    from ptoverify.config import ALL_LAW_NAMES
+
+    p = sub.add_parser(
+        "penalty",
+        help="settling against move size, beside t_f* and N*T",
+        description="Point-to-point moves from rest, 0.01 mm to the position range "
+        "(log-spaced): each law's settling (0.01 mm, exact between samples, held 0.05 s) and "
+        "arrival, beside the minimum time t_f* and the discrete limit N*T.",
+        epilog="example:\n  ptoverify penalty --json\n  ptoverify penalty --tuned --out penalty",
+    )
+    p.add_argument("--laws", nargs="+", choices=ALL_LAW_NAMES, default=list(ALL_LAW_NAMES))
+    p.add_argument("--count", type=positive_int, default=40, metavar="N", help="sizes (40)")
+    p.add_argument(
+        "--tuned",
+        action="store_true",
+        help="each law at its best tuning under the PTO's paper-gain overshoot",
+    )
+    p.add_argument("--out", metavar="DIR", default=None, help="write penalty.json and .csv")
+    p.set_defaults(handler=_cmd_penalty)
+
+
+def _cmd_penalty(args: argparse.Namespace) -> int:
+    from ptoverify.studies.penalty import penalty_curves
+    from ptoverify.studies.ptos_claim import fair_configs
+
+    cfg = _config(args)
+    if not 2 <= args.count <= 1000:
+        raise InputError(f"--count must be in [2, 1000], got {args.count}")
+    laws = tuple(dict.fromkeys(args.laws))
+    target = check_target(args.out, config_hash=cfg.digest()) if args.out else None
+    configs = fair_configs(cfg, laws) if args.tuned else None
+    res = penalty_curves(
+        cfg, laws, count=args.count, configs=configs,
+        setting="tuned pto-paper" if args.tuned else "configured",
+    )  # fmt: skip
+    result = res.to_json()
+    if target is not None:
+        tmp = make_temp(target)
+        try:
+            (tmp / "penalty.json").write_text(json.dumps(result, indent=2) + "\n")
+            res.write_csv(tmp / "penalty.csv")
+            publish(tmp, target, config_hash=cfg.digest(), name=cfg.name)
+        except BaseException:
+            discard(tmp)
+            raise
+        result["files"] = [str(target / "penalty.json"), str(target / "penalty.csv")]
+    if args.json:
+        print_json(result)
+        return 0
+    print(f"penalty ({res.setting}); settling: {res.settling}")
+    print(
+        f"{'law':<12} "
+        + " ".join(f"{s:>9.3g}" for s in res.sizes_mm[:: max(1, len(res.sizes_mm) // 8)])
+    )
+    for c in res.curves:
+        cells = c.ratio_nt[:: max(1, len(res.sizes_mm) // 8)]
+        print(f"{c.law:<12} " + " ".join(f"{v:>9.2f}" for v in cells))
+    print("(settling / N*T at the sizes in mm above; nan: never settles)")
+    for f in result.get("files", []):
+        print(f"wrote {f}")
     return 0
 
 
@@ -985,6 +1189,8 @@ COMMANDS: list[tuple[str, Callable[[Any], None]]] = [
     ("conform", _add_conform),
     ("robust", _add_robust),
     ("tune", _add_tune),
+    ("design", _add_design),
+    ("penalty", _add_penalty),
 ]
 
 

@@ -29,7 +29,7 @@ import hashlib
 import json
 import math
 import tomllib
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -46,11 +46,24 @@ __all__ = [
     "Robustness",
     "robustness_from_mapping",
     "LAW_NAMES",
+    "BASELINE_NAMES",
+    "ALL_LAW_NAMES",
+    "PTOSGains",
+    "CascadeGains",
 ]
 
 #: The laws the suite implements (:func:`ptoverify.model.laws.make_law`), here so that naming
 #: them (the command line's choices) loads no numerics.
 LAW_NAMES: tuple[str, ...] = ("to", "pd", "pto", "pto-printed")
+#: The baselines a servo engineer compares against (:mod:`ptoverify.model.baselines`).
+BASELINE_NAMES: tuple[str, ...] = ("ptos", "cascade-p")
+#: Every law :func:`ptoverify.model.laws.make_law` builds.
+ALL_LAW_NAMES: tuple[str, ...] = LAW_NAMES + BASELINE_NAMES
+#: Defaults of ``ptoverify design`` (:mod:`ptoverify.studies.design`): laws, T [s], bandwidth [Hz].
+DESIGN_LAWS: tuple[str, ...] = ("pd", "pto", "ptos", "cascade-p")
+DESIGN_SAMPLE_TIMES: tuple[float, ...] = (0.00025, 0.0005, 0.001, 0.002, 0.004, 0.008)
+DESIGN_BANDWIDTHS_HZ: tuple[float, ...] = (5.0, 10.0, 30.0, 60.0, 100.0)
+DESIGN_GRID = 10  #: envelope states per axis of a design point (even: the origin is off the grid)
 
 
 @dataclass(frozen=True)
@@ -113,6 +126,37 @@ class PTOSettings:
     d: float = 0.5
     k1: float = 323.0
     k2: float = 3.6
+
+
+@dataclass(frozen=True)
+class PTOSGains:
+    """Settings of the PTOS baseline (table ``[ptos]``, optional).
+
+    Attributes
+    ----------
+    alpha : float
+        Deceleration discount of the square-root profile, 0 < alpha <= 1 [-].
+    k : float or None
+        Velocity-loop gain k [1/s] the profile is designed for (Workman's k2);
+        None: the plant's own a (then u is the profile itself).
+    """
+
+    alpha: float = 0.9
+    k: float | None = None
+
+
+@dataclass(frozen=True)
+class CascadeGains:
+    """Gain of the cascade P baseline (table ``[cascade]``, optional).
+
+    Attributes
+    ----------
+    kp : float or None
+        Position gain [1/s] of u = sat(-kp x1); None: a / 4 (the continuous
+        loop x1'' + a x1' + a kp x1 = 0 critically damped).
+    """
+
+    kp: float | None = None
 
 
 @dataclass(frozen=True)
@@ -179,6 +223,10 @@ class Config:
         PTO settings.
     robustness : Robustness
         The uncertainty box of ``ptoverify robust``.
+    ptos : PTOSGains
+        PTOS baseline settings.
+    cascade : CascadeGains
+        Cascade P baseline gain.
     bandwidth_hz : float or None
         The bandwidth as given in Hz, when the file gave it in Hz.
     """
@@ -189,6 +237,8 @@ class Config:
     pto: PTOSettings = field(default_factory=PTOSettings)
     bandwidth_hz: float | None = None
     robustness: Robustness = field(default_factory=Robustness)
+    ptos: PTOSGains = field(default_factory=PTOSGains)
+    cascade: CascadeGains = field(default_factory=CascadeGains)
 
     def with_plant(self, **changes: float) -> Config:
         """Return a copy with plant fields replaced (``a``, ``w_max``...)."""
@@ -221,13 +271,19 @@ class Config:
         else:
             plant["a"] = p.a
         plant.update(w_max=p.w_max, sample_time=p.sample_time, position_range=p.position_range)
-        return {
+        out = {
             "name": self.name,
             "plant": plant,
             "pd": {"kp": self.pd.kp, "kd": self.pd.kd},
             "pto": {"d": self.pto.d, "k1": self.pto.k1, "k2": self.pto.k2},
             "robustness": self.robustness.to_mapping(),
         }
+        # the baselines' tables only when set (so a configuration without them keeps its digest)
+        for key, obj in (("ptos", self.ptos), ("cascade", self.cascade)):
+            given = {k: v for k, v in asdict(obj).items() if v is not None}
+            if obj != type(obj)():
+                out[key] = given
+        return out
 
 
 PAPER_MAPPING: dict[str, Any] = {
@@ -380,7 +436,7 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
         infinities and out-of-range values; the message names the key.
     """
     for key in data:
-        if key not in {"name", "robustness", *_SECTIONS}:
+        if key not in {"name", "robustness", "ptos", "cascade", *_SECTIONS}:
             raise ConfigError(f"unknown config key '{key}'")
     name = data.get("name", "custom")
     if (
@@ -432,7 +488,35 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
         pto=PTOSettings(d=pto["d"], k1=pto["k1"], k2=pto["k2"]),
         bandwidth_hz=bandwidth_hz,
         robustness=robustness_from_mapping(data.get("robustness", {}), plant),
+        ptos=PTOSGains(**_baseline_table(data, "ptos", plant["sample_time"])),
+        cascade=CascadeGains(**_baseline_table(data, "cascade", plant["sample_time"])),
     )
+
+
+#: The optional baseline tables: key -> (lowest, highest, whether scaled by 1/T, strict low).
+_BASELINE_KEYS = {
+    "ptos": {"alpha": (0.0, 1.0, False, True), "k": (0.0, None, True, True)},
+    "cascade": {"kp": (0.0, None, True, False)},
+}
+
+
+def _baseline_table(data: dict[str, Any], name: str, T: float) -> dict[str, float]:  # noqa: N803
+    """Validate an optional ``[ptos]`` / ``[cascade]`` table (the key is named)."""
+    raw = data.get(name, {})
+    if not isinstance(raw, dict):
+        raise ConfigError(f"config key '{name}' must be a table [{name}], got {raw!r}")
+    out = {}
+    for key, value in raw.items():
+        if key not in _BASELINE_KEYS[name]:
+            raise ConfigError(f"unknown config key '{name}.{key}'")
+        lo, hi, scaled, strict = _BASELINE_KEYS[name][key]
+        v = _number(name, key, value)
+        hi = LIMITS["gain_T"] / T if scaled else hi
+        if v < lo or (strict and v == lo) or v > hi:
+            low = f"> {lo:g}" if strict else f">= {lo:g}"
+            raise ConfigError(f"config key '{name}.{key}' must be {low} and <= {hi:g}, got {v!r}")
+        out[key] = v
+    return out
 
 
 def _pair(key: str, value: Any, lo: float, hi: float, *, integer: bool = False) -> tuple:

@@ -21,7 +21,7 @@ from functools import partial
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ptoverify.config import LAW_NAMES, Config
+from ptoverify.config import ALL_LAW_NAMES, BASELINE_NAMES, LAW_NAMES, Config
 from ptoverify.errors import InputError
 from ptoverify.model.curves import level_residual, omega_c
 
@@ -36,6 +36,7 @@ __all__ = [
     "pto_printed_law",
     "saturate_linear",
     "make_law",
+    "register_law",
     "with_state_gains",
     "LAW_NAMES",
 ]
@@ -554,8 +555,26 @@ _FACTORIES: dict[str, Callable[[Config], Law]] = {
 }
 
 
+def register_law(name: str, factory: Callable[[Config], Law]) -> None:
+    """Let :func:`make_law` build a law defined in another module of this layer.
+
+    The baselines (:mod:`ptoverify.model.baselines`, which import this module)
+    register themselves when the ``ptoverify.model`` package is imported.
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`ptoverify.config.BASELINE_NAMES`.
+    factory : callable
+        ``factory(cfg) -> Law``.
+    """
+    if name not in BASELINE_NAMES:
+        raise ValueError(f"register_law: {name!r} is not a baseline name")
+    _FACTORIES[name] = factory
+
+
 def make_law(name: str, cfg: Config) -> Law:
-    """Build a law by name: ``to``, ``pd``, ``pto`` or ``pto-printed``.
+    """Build a law by name: ``to``, ``pd``, ``pto``, ``pto-printed``, ``ptos``, ``cascade-p``.
 
     Parameters
     ----------
@@ -570,5 +589,5 @@ def make_law(name: str, cfg: Config) -> Law:
         The law.
     """
     if name not in _FACTORIES:
-        raise InputError(f"unknown law '{name}' (choose from {', '.join(LAW_NAMES)})")
+        raise InputError(f"unknown law '{name}' (choose from {', '.join(ALL_LAW_NAMES)})")
     return _FACTORIES[name](cfg)
