@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ptoverify.config import Config
-from ptoverify.model.intervals import add, div, h_iv, mul, sub
+from ptoverify.model.intervals import add, div, down, h_iv, mul, sub, up
 from ptoverify.model.laws import make_law
 
 __all__ = ["LawSpec", "law_spec", "sigma_point", "omega_c_iv", "enclose", "LawBox"]
@@ -123,7 +123,9 @@ def sigma_point(spec: LawSpec, x1, x2, level: float):
     Returns
     -------
     tuple of ndarray
-        (lo, hi) [mm/s]: > 0 right of the curve.
+        (lo, hi) [mm/s]: > 0 right of the curve.  Tight (a few ulps) where the
+        value is within 1 mm/s of 0; elsewhere a looser enclosure (from
+        0 <= h(r) <= r) that still excludes [-1, 1] mm/s.
 
     Examples
     --------
@@ -133,13 +135,25 @@ def sigma_point(spec: LawSpec, x1, x2, level: float):
     >>> bool(lo[0] <= 188.49555921538757 <= hi[0])
     True
     """
+    x1, x2 = np.asarray(x1, dtype=float), np.asarray(x2, dtype=float)
     ax = mul((spec.a, spec.a), _iv(x1))
-    r = div(_iv(np.abs(x2)), (level, level))
-    hh = mul((level, level), h_iv(r))
-    plus = add(ax, hh)
-    minus = sub(ax, hh)
+    # 0 <= level h(|x2| / level) <= |x2|: a loose enclosure first; h is evaluated only
+    # where that one meets [-1, 1] mm/s (the callers compare with 0 or a tie band)
     pos = x2 >= 0
-    return np.where(pos, plus[0], minus[0]), np.where(pos, plus[1], minus[1])
+    v = np.abs(x2)
+    lo = np.where(pos, ax[0], down(ax[0] - v))
+    hi = np.where(pos, up(ax[1] + v), ax[1])
+    near = (lo <= 1.0) & (hi >= -1.0)
+    if near.any():
+        idx = np.flatnonzero(near)
+        r = div(_iv(v[idx]), (level, level))
+        hh = mul((level, level), h_iv(r))
+        axi = (ax[0][idx], ax[1][idx])
+        plus, minus = add(axi, hh), sub(axi, hh)
+        pi = pos[idx]
+        lo[idx] = np.where(pi, plus[0], minus[0])
+        hi[idx] = np.where(pi, plus[1], minus[1])
+    return lo, hi
 
 
 def omega_c_iv(spec: LawSpec, x1, x2):
