@@ -233,13 +233,16 @@ def _outside_point(spec: LawSpec, x1, x2):
     lo, hi = inf.copy(), -inf
     bang_p = s_lo <= 0
     bang_n = s_hi >= 0
+    if spec.has_zone:  # a state certainly in a zone takes no bang-bang input
+        o_lo, o_hi = sigma_point(spec, x1, x2, spec.omega0)
+        bang_n &= ~((x2 < 0) & (s_lo > 0) & (o_hi <= 0))
+        bang_p &= ~((x2 > 0) & (s_hi < 0) & (o_lo >= 0))
     lo = np.where(bang_n, -w, np.where(bang_p, w, lo))
     hi = np.where(bang_p, w, np.where(bang_n, -w, hi))
     origin = (x1 == 0) & (x2 == 0)
     lo = np.where(origin, np.minimum(lo, 0.0), lo)
     hi = np.where(origin, np.maximum(hi, 0.0), hi)
     if spec.has_zone:
-        o_lo, o_hi = sigma_point(spec, x1, x2, spec.omega0)
         zp = (x2 < 0) & (s_hi > 0) & (o_lo <= 0)
         zn = (x2 > 0) & (s_lo < 0) & (o_hi >= 0)
         z = zp | zn
