@@ -4,12 +4,15 @@ An interval is a pair ``(lo, hi)`` of float arrays (or floats) with lo <= hi.
 Every operation returns an interval that contains the exact real result for
 every choice of operands in the operand intervals.
 
-Why ``np.nextafter`` outward on every result is sound: NumPy's ``+ - * /`` on
-float64 are IEEE 754 operations in round-to-nearest, so the computed result r
-differs from the exact real result by at most half an ulp of r (overflow gives
-inf, which is still a bound).  The exact result therefore lies in
-``[nextafter(r, -inf), nextafter(r, +inf)]``: one ulp outward on each side
-covers the half ulp of error.  No transcendental libm call is trusted: log1p
+Why widening every result outward is sound: NumPy's ``+ - * /`` on float64
+are IEEE 754 operations in round-to-nearest, so the computed result r differs
+from the exact real result by at most half an ulp of r.  Any float at least
+half an ulp below (above) r is then a lower (upper) bound.  :func:`down` and
+:func:`up` move r by two ulps relative (|r| 2^-51, plus 2^-1000 for tiny r),
+which stays outward even after the widening's own rounding (proof in
+:func:`down`); ``np.nextafter`` (exactly one ulp) would be as sound and is ten
+times slower on large arrays.  Every result stays finite here (the grid and
+the constants are finite), and non-finite images are treated as exits.  No transcendental libm call is trusted: log1p
 and h(r) = r - ln(1 + r) are enclosed by bounded series evaluated with these
 operations (:func:`log1p_point`, :func:`h_point`), and the exponentials of the
 ZOH map are computed in python-flint ``arb`` ball arithmetic and converted to
@@ -48,17 +51,29 @@ __all__ = [
 ]
 
 ARB_PREC = 200  #: working precision of the arb certificates [bits]
-_SERIES_TERMS = 14  #: odd terms of the atanh series of ln (|s| <= 0.172: error < 1e-22)
+_SERIES_TERMS = 11  #: odd terms of the atanh series of ln (|s| <= 0.175: error < 1e-19 |s|)
 _H_TERMS = 28  #: terms of the alternating series of h on [0, 1/4]
 
 
+_REL = 2.0**-51  #: two ulps of a normal float, relative
+_ABS = 2.0**-1000  #: covers results below 2^-970 (subnormal scaling) [any unit]
+
+
 def down(x):
-    """Return the next float below x (one ulp outward).
+    """Return a float below x by at least two ulps: x - (|x| 2^-51 + 2^-1000).
+
+    Sound lower bound of the exact result e of the IEEE operation that gave x
+    (|e - x| <= ulp(x) / 2): for normal x, delta = |x| 2^-51 >= 2 ulp(x) (the
+    product by a power of two is exact and adding 2^-1000 only rounds up), and
+    fl(x - delta) <= x - delta + ulp(x - delta) / 2 <= x - 2 ulp(x) + ulp(x)
+    since ulp(x - delta) <= 2 ulp(x); so the result is <= x - ulp(x) <= e.
+    For |x| < 2^-970 the 2^-1000 term dominates every rounding error.
+    (np.nextafter is exact one-ulp widening too, but ten times slower.)
 
     Parameters
     ----------
     x : array_like
-        Rounded-to-nearest result of one IEEE operation.
+        Rounded-to-nearest result of one IEEE operation (finite).
 
     Returns
     -------
@@ -70,16 +85,21 @@ def down(x):
     >>> float(down(1.0)) < 1.0
     True
     """
-    return np.nextafter(x, -np.inf)
+    t = np.abs(x)
+    if not isinstance(t, np.ndarray):
+        return x - (t * _REL + _ABS)
+    t *= _REL
+    t += _ABS
+    return np.subtract(x, t, out=t)
 
 
 def up(x):
-    """Return the next float above x (one ulp outward).
+    """Return a float above x by at least two ulps (see :func:`down`).
 
     Parameters
     ----------
     x : array_like
-        Rounded-to-nearest result of one IEEE operation.
+        Rounded-to-nearest result of one IEEE operation (finite).
 
     Returns
     -------
@@ -91,7 +111,12 @@ def up(x):
     >>> float(up(1.0)) > 1.0
     True
     """
-    return np.nextafter(x, np.inf)
+    t = np.abs(x)
+    if not isinstance(t, np.ndarray):
+        return x + (t * _REL + _ABS)
+    t *= _REL
+    t += _ABS
+    return np.add(x, t, out=t)
 
 
 def add(p, q):
@@ -212,16 +237,34 @@ def _ln2() -> tuple[float, float]:
     return _LN2
 
 
+def _mul_pos(p, q):
+    """Enclose p * q for nonnegative intervals p, q (two products)."""
+    return down(np.multiply(p[0], q[0])), up(np.multiply(p[1], q[1]))
+
+
+_ATANH_COEF = None  # enclosures of 1 / (2k + 1), k = 0..K, set by _atanh_coef()
+
+
+def _atanh_coef():
+    """Enclosures of the atanh series' coefficients 1 / (2k + 1)."""
+    global _ATANH_COEF
+    if _ATANH_COEF is None:
+        _ATANH_COEF = [_recip(2 * k + 1) for k in range(_SERIES_TERMS + 1)]
+    return _ATANH_COEF
+
+
 def _atanh_series(s):
-    """Enclose 2 atanh(s) = ln((1 + s) / (1 - s)) for an interval s with |s| <= 0.18."""
+    """Enclose 2 atanh(s) = ln((1 + s) / (1 - s)) for an interval s with |s| <= 0.175."""
+    coef = _atanh_coef()
     s2 = mul(s, s)
-    acc = _recip(2 * _SERIES_TERMS + 1)
-    for k in range(_SERIES_TERMS - 1, -1, -1):  # Horner in s^2
-        acc = add(mul(acc, s2), _recip(2 * k + 1))
+    s2 = (np.maximum(s2[0], 0.0), s2[1])  # a square is nonnegative
+    acc = coef[_SERIES_TERMS]
+    for k in range(_SERIES_TERMS - 1, -1, -1):  # Horner in s^2: all terms nonnegative
+        acc = add(_mul_pos(acc, s2), coef[k])
     # omitted terms k > K: 2 sum s^(2k+1)/(2k+1) <= 2 |s|^(2K+3) / ((2K+3)(1 - s^2))
-    # <= |s| * 2e-24 for |s| <= 0.175 and K = 14 (0.175^30 < 1e-22); larger |s|: no bound
+    # <= |s| * 1e-19 for |s| <= 0.175 and K = 11 (2 0.175^24 / (25 0.969) < 5.7e-20)
     m = np.maximum(np.abs(s[0]), np.abs(s[1]))
-    tail = np.where(m <= 0.175, up(m * 2e-24), np.inf)
+    tail = np.where(m <= 0.175, up(m * 1e-19), 1e300)  # 1e300: no bound
     val = mul(s, acc)
     val = (down(2.0 * val[0]), up(2.0 * val[1]))
     return down(val[0] - tail), up(val[1] + tail)
@@ -260,9 +303,11 @@ def log1p_point(r):
     big = ~small
     if big.any():
         rb = r[big]
-        x = add((1.0, 1.0), (rb, rb))  # 1 + r enclosed; ln is increasing
-        ends = [_log_point(np.maximum(xe, np.finfo(float).tiny)) for xe in x]
-        lo[big], hi[big] = ends[0][0], ends[1][1]
+        # s = fl(1 + r) is within ulp(s)/2 of 1 + r, and ln has slope <= 1/(s (1 - 2^-53))
+        # there, so |ln(1 + r) - ln s| < 2^-52: one series at s, widened by 2^-52
+        xs = np.maximum(1.0 + rb, np.finfo(float).tiny)
+        ln = _log_point(xs)
+        lo[big], hi[big] = down(ln[0] - 2.0**-52), up(ln[1] + 2.0**-52)
     return lo, hi
 
 
@@ -298,6 +343,18 @@ def log1p_iv(p):
     return log1p_point(p[0])[0], log1p_point(p[1])[1]
 
 
+_H_COEF = None  # enclosures of (-1)^n / n, set by _h_coef()
+
+
+def _h_coef():
+    """Enclosures of the h series' coefficients (-1)^n / n, index n."""
+    global _H_COEF
+    if _H_COEF is None:
+        c = [_recip(n) if n else (0.0, 0.0) for n in range(_H_TERMS + 1)]
+        _H_COEF = [(-v[1], -v[0]) if n % 2 else v for n, v in enumerate(c)]
+    return _H_COEF
+
+
 def h_point(r):
     """Enclose h(r) = r - ln(1 + r) at float points r >= 0 (eq. 9's h).
 
@@ -326,12 +383,10 @@ def h_point(r):
     if small.any():
         rs = r[small]
         rr = (rs, rs)
-        acc = _recip(_H_TERMS)
-        acc = (-acc[1], -acc[0]) if _H_TERMS % 2 else acc
+        coef = _h_coef()
+        acc = coef[_H_TERMS]
         for n in range(_H_TERMS - 1, 1, -1):  # Horner: sum_{n=2}^{N} (-1)^n r^(n-2) / n
-            c = _recip(n)
-            c = (-c[1], -c[0]) if n % 2 else c
-            acc = add(mul(acc, rr), c)
+            acc = add(mul(acc, rr), coef[n])
         val = mul(mul(acc, rr), rr)
         # alternating, decreasing terms (r <= 1/4): the error is below the first omitted
         # term r^(N+1) / (N+1) <= r^2 0.25^(N-1) / (N+1) <= r^2 1e-17 for N = 28
@@ -392,10 +447,10 @@ def arb_interval(x: arb) -> tuple[float, float]:
         return -np.inf, np.inf
     lo = float(x.lower())
     while not arb(lo) <= x:
-        lo = float(down(lo))
+        lo = float(np.nextafter(lo, -np.inf))
     hi = float(x.upper())
     while not arb(hi) >= x:
-        hi = float(up(hi))
+        hi = float(np.nextafter(hi, np.inf))
     return lo, hi
 
 

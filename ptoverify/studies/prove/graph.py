@@ -290,6 +290,7 @@ def successors(e1: np.ndarray, e2: np.ndarray, img: Images):
     n1, n2 = e1.size - 1, e2.size - 1
     y1lo, y1hi, y2lo, y2hi = img.box
     exits = (y1lo < e1[0]) | (y1hi > e1[-1]) | (y2lo < e2[0]) | (y2hi > e2[-1])
+    exits |= ~(np.isfinite(y1lo) & np.isfinite(y1hi) & np.isfinite(y2lo) & np.isfinite(y2hi))
     i0 = np.clip(np.searchsorted(e1, y1lo, "left") - 1, 0, n1 - 1)
     i1 = np.clip(np.searchsorted(e1, y1hi, "right") - 1, 0, n1 - 1)
     j0 = np.clip(np.searchsorted(e2, y2lo, "left") - 1, 0, n2 - 1)

@@ -23,7 +23,12 @@ from ptoverify.model.lawbox import LawSpec, enclose, law_spec
 from ptoverify.model.laws import make_law
 from ptoverify.model.plant import step
 from ptoverify.studies.prove.graph import Grid, images, longest_path, make_grid, successors
-from ptoverify.studies.prove.stride import Counterexample, find_counterexample, stride_check
+from ptoverify.studies.prove.stride import (
+    Counterexample,
+    StrideResult,
+    find_counterexample,
+    stride_check,
+)
 from ptoverify.studies.prove.target import Target, box_in_target, certify_decrease, make_target
 
 __all__ = ["Resolution", "BallResult", "PropertyResult", "LawProof", "prove_ball", "prove_law"]
@@ -90,8 +95,8 @@ class BallResult:
         The ellipse (decrease certified for this interval when ``certified``).
     bound : ndarray
         Certified samples to the target per cell; inf: unproven.
-    strict, relaxed : ndarray of bool
-        No stride-over proved per cell, in each reading.
+    stride : StrideResult
+        No stride-over per cell, in each reading.
     k : ndarray of int
         Samples of each cell's macro-step.
     image : tuple of ndarray
@@ -106,8 +111,7 @@ class BallResult:
     a_hi: float
     target: Target
     bound: np.ndarray
-    strict: np.ndarray
-    relaxed: np.ndarray
+    stride: StrideResult
     k: np.ndarray
     image: tuple
     u_lo: np.ndarray
@@ -180,7 +184,7 @@ def prove_ball(
     boxes = grid.boxes()
     gains = (spec.g1, spec.g2) if target.certified else None
     maps = step_maps(ball, p.sample_time, res.steps, gains=gains)
-    strict, relaxed = stride_check(spec, cfg, maps, boxes)
+    stride = stride_check(spec, cfg, maps, boxes)
     img = images(spec, maps, target, boxes, p.position_range + excursion, res.steps)
     starts, succ, exits = successors(grid.e1, grid.e2, img)
     if target.certified:
@@ -188,9 +192,7 @@ def prove_ball(
         bound = longest_path(starts, succ, img.k, in_target, img.to_target, exits)
     else:
         bound = np.full(grid.size, np.inf)
-    return BallResult(
-        a_lo, a_hi, target, bound, strict, relaxed, img.k, img.box, img.u_lo, img.u_hi, exits
-    )
+    return BallResult(a_lo, a_hi, target, bound, stride, img.k, img.box, img.u_lo, img.u_hi, exits)
 
 
 @dataclass(frozen=True)
@@ -337,10 +339,12 @@ def _region(b, bad, area) -> dict | None:
     }
 
 
-def _status(name: str, ok, b, area, cex=None, detail="") -> PropertyResult:
-    """Build a property from per-cell verdicts."""
+def _status(name: str, ok, b, area, cex=None, detail="", gap=None) -> PropertyResult:
+    """Build a property from per-cell verdicts (``gap``: unproven area per cell)."""
     inside = area > 0
-    cov = float(area[ok & inside].sum() / area[inside].sum())
+    if gap is None:
+        gap = np.where(ok, 0.0, area)
+    cov = float(1.0 - gap[inside].sum() / area[inside].sum())
     if cex is not None:
         status = "refuted"
     elif bool(ok[inside].all()):
@@ -418,7 +422,8 @@ def _suboptimality(cfg, grid, bound, radius):
     b = grid.boxes()
     near = np.where((b[0] < 0) & (b[1] > 0), 0.0, np.minimum(np.abs(b[0]), np.abs(b[1])))
     use = (near >= radius) & (np.abs(b[0]) <= p.position_range) & (np.abs(b[1]) <= p.position_range)
-    if not use.any() or not np.all(np.isfinite(bound[use])):
+    use &= np.isfinite(bound)  # over the proved cells
+    if not use.any():
         return None
     wt = float(np.nextafter(p.w_max * p.sample_time, np.inf))  # divided by an upper bound
     n_star = np.ceil(down(near[use] / wt))  # N* >= t_f*/T >= |x1| / (w T), rounded down
@@ -482,17 +487,32 @@ def prove_law(
     t1 = time.perf_counter()
     grid = law_grid(cfg, spec, res, excursion)
     bound = np.max(np.stack([bl.bound for bl in balls]), axis=0)
-    strict = np.logical_and.reduce([bl.strict for bl in balls])
-    relaxed = np.logical_and.reduce([bl.relaxed for bl in balls])
     b, area = _envelope_weights(cfg, grid)
     enc = enclose(spec, b)
     input_ok = (enc.lo >= -p.w_max) & (enc.hi <= p.w_max)
     props = [_status("input-bound", input_ok, b, area, detail="|u| <= w_max over every cell")]
-    for reading, ok in (("strict", strict), ("relaxed", relaxed)):
+    full = (b[1] - b[0]) * (b[3] - b[2])
+    for reading in ("strict", "relaxed"):
+        ok = np.logical_and.reduce([getattr(bl.stride, reading) for bl in balls])
+        gap = np.minimum(sum(getattr(bl.stride, reading + "_gap") for bl in balls), full)
         cex = None
         if not ok[area > 0].all() and math.isfinite(spec.d):
-            cex = find_counterexample(spec, cfg, b, ~ok & (area > 0), relaxed=reading == "relaxed")
-        props.append(_status(f"no-stride-over-{reading}", ok, b, area, cex))
+            leaves = balls[0].stride.leaves
+            cex = find_counterexample(
+                spec, cfg, leaves, np.ones(leaves[0].size, dtype=bool), relaxed=reading == "relaxed"
+            )
+        depth = max(bl.stride.depth for bl in balls)
+        props.append(
+            _status(
+                f"no-stride-over-{reading}",
+                ok,
+                b,
+                area,
+                cex,
+                detail=f"cells refined up to {depth} times where the first check failed",
+                gap=gap * np.where(full > 0, area / full, 0.0),
+            )
+        )
     tgt = balls[0].target if all(bl.target.certified for bl in balls) else next(
         bl.target for bl in balls if not bl.target.certified
     )

@@ -31,7 +31,9 @@ from ptoverify.model.laws import make_law
 from ptoverify.sim.simulate import simulate_batch
 from ptoverify.verdict import tie_band
 
-__all__ = ["stride_check", "Counterexample", "find_counterexample"]
+__all__ = ["stride_check", "StrideResult", "Counterexample", "find_counterexample"]
+
+_SPLIT = 8  #: a failing box is cut into _SPLIT x _SPLIT children (three halvings)
 
 
 def _sides(spec: LawSpec, piece, u_lo, u_hi, maps: StepMaps, d: float, tol: float):
@@ -67,8 +69,8 @@ def _sides(spec: LawSpec, piece, u_lo, u_hi, maps: StepMaps, d: float, tol: floa
     return strict, relaxed
 
 
-def stride_check(spec: LawSpec, cfg: Config, maps: StepMaps, boxes):
-    """Prove no stride-over per cell, strict and relaxed readings.
+def _check(spec: LawSpec, cfg: Config, maps: StepMaps, boxes):
+    """Prove no stride-over per box, strict and relaxed readings (no refinement).
 
     Parameters
     ----------
@@ -105,6 +107,96 @@ def stride_check(spec: LawSpec, cfg: Config, maps: StepMaps, boxes):
         strict[idx] &= s
         relaxed[idx] &= r
     return strict, relaxed
+
+
+@dataclass(frozen=True)
+class StrideResult:
+    """No stride-over per cell, after refinement.
+
+    Attributes
+    ----------
+    strict, relaxed : ndarray of bool
+        Proved on the whole cell, in each reading.
+    strict_gap, relaxed_gap : ndarray
+        Area of the cell where the proof fails [mm mm/s].
+    leaves : tuple of ndarray
+        The smallest boxes where a reading still fails (x1lo, x1hi, x2lo, x2hi).
+    depth : int
+        Refinement levels used (each halves the boxes' sides).
+    """
+
+    strict: np.ndarray
+    relaxed: np.ndarray
+    strict_gap: np.ndarray
+    relaxed_gap: np.ndarray
+    leaves: tuple
+    depth: int
+
+
+def stride_check(
+    spec: LawSpec, cfg: Config, maps: StepMaps, boxes, *, depth: int = 24, cap: int = 20_000
+) -> StrideResult:
+    """Prove no stride-over per cell, refining failing cells into quarters.
+
+    A failing box is cut into 8 x 8 children (three halvings of each side, so
+    children tile the box exactly: the last child ends at the box's edge); each
+    child is checked again, down to ``depth`` halvings or while fewer than
+    ``cap`` boxes fail.  The verdict of a
+    cell holds where all its leaves pass; the failing leaves' area is its gap.
+
+    Parameters
+    ----------
+    spec : LawSpec
+        The law.
+    cfg : Config
+        Configuration (the yardstick d [mm], the tie band).
+    maps : StepMaps
+        One-step map enclosures.
+    boxes : tuple of ndarray
+        Cells (x1lo, x1hi, x2lo, x2hi) [mm], [mm/s].
+    depth : int
+        Most refinement levels.
+    cap : int
+        Most failing boxes carried to the next level.
+
+    Returns
+    -------
+    StrideResult
+        Per-cell verdicts and gaps.
+    """
+    n = boxes[0].size
+    s, r = _check(spec, cfg, maps, boxes)
+    owner = np.arange(n)
+    cur = boxes
+    fail_s, fail_r = ~s, ~r
+    level = 0
+    while level < depth and (fail_s | fail_r).any() and np.count_nonzero(fail_s | fail_r) <= cap:
+        keep = np.flatnonzero(fail_s | fail_r)
+        b = tuple(v[keep] for v in cur)
+        f = np.arange(_SPLIT) / _SPLIT  # each side cut in _SPLIT: 3 levels at once
+        t1 = np.repeat(f, _SPLIT)[:, None]
+        t2 = np.tile(f, _SPLIT)[:, None]
+        # a child's upper edge is computed exactly as its neighbour's lower edge
+        # (t + 1/8 is exact), and the last one is the box's own edge: no gaps
+        lo1 = b[0] + t1 * (b[1] - b[0])
+        lo2 = b[2] + t2 * (b[3] - b[2])
+        u1, u2 = t1 + 1.0 / _SPLIT, t2 + 1.0 / _SPLIT
+        hi1 = np.where(u1 >= 1.0, b[1], b[0] + u1 * (b[1] - b[0]))
+        hi2 = np.where(u2 >= 1.0, b[3], b[2] + u2 * (b[3] - b[2]))
+        kids = tuple(v.ravel() for v in (lo1, hi1, lo2, hi2))
+        owner = np.tile(owner[keep], _SPLIT * _SPLIT)
+        cur = kids
+        s, r = _check(spec, cfg, maps, cur)
+        fail_s, fail_r = ~s, ~r
+        level += 3
+    area = (cur[1] - cur[0]) * (cur[3] - cur[2])
+    gap_s = np.bincount(owner[fail_s], weights=area[fail_s], minlength=n)
+    gap_r = np.bincount(owner[fail_r], weights=area[fail_r], minlength=n)
+    bad = fail_s | fail_r
+    leaves = tuple(v[bad] for v in cur)
+    strict = np.bincount(owner[fail_s], minlength=n) == 0
+    relaxed = np.bincount(owner[fail_r], minlength=n) == 0
+    return StrideResult(strict, relaxed, gap_s, gap_r, leaves, level)
 
 
 @dataclass(frozen=True)
