@@ -86,7 +86,9 @@ def test_linear_flag_means_unsaturated_linear():
     assert enc.linear.any()
     p1, p2 = rng.uniform(box[0], box[1]), rng.uniform(box[2], box[3])
     u, region = make_law("pto", cfg)(p1[enc.linear], p2[enc.linear])
-    np.testing.assert_array_equal(region, 5, err_msg="a linear-flagged box holds a non-linear state")
+    np.testing.assert_array_equal(
+        region, 5, err_msg="a linear-flagged box holds a non-linear state"
+    )
 
 
 def test_outside_law_is_monotone():

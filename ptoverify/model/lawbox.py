@@ -102,7 +102,7 @@ def law_spec(name: str, cfg: Config) -> LawSpec:
 
 
 def _iv(x):
-    """A point array as a degenerate interval."""
+    """Return a point array as a degenerate interval."""
     return (x, x)
 
 
@@ -362,5 +362,3 @@ def outside_extent(spec: LawSpec, box):
     right = (x1hi >= d, (np.maximum(x1lo, d), x1hi, x2lo, x2hi))
     left = (x1lo <= -d, (x1lo, np.minimum(x1hi, -d), x2lo, x2hi))
     return [right, left]
-
-

@@ -120,7 +120,7 @@ class BallResult:
 
 
 def law_grid(cfg: Config, spec: LawSpec, res: Resolution, excursion: float) -> Grid:
-    """The grid of a proof: the envelope widened by ``excursion`` [mm] along x1.
+    """Return the grid of a proof: the envelope widened by ``excursion`` [mm] along x1.
 
     Parameters
     ----------
@@ -151,7 +151,13 @@ def law_grid(cfg: Config, spec: LawSpec, res: Resolution, excursion: float) -> G
 
 
 def prove_ball(
-    cfg: Config, name: str, a_lo: float, a_hi: float, res: Resolution, excursion: float, target: Target
+    cfg: Config,
+    name: str,
+    a_lo: float,
+    a_hi: float,
+    res: Resolution,
+    excursion: float,
+    target: Target,
 ) -> BallResult:
     """Prove reach and no stride-over on every cell for every a in [a_lo, a_hi].
 
@@ -289,11 +295,11 @@ class LawProof:
     timings_s: dict = field(default_factory=dict)
 
     def property(self, name: str) -> PropertyResult:
-        """The property called ``name``."""
+        """Return the property called ``name``."""
         return next(p for p in self.properties if p.name == name)
 
     def to_json(self) -> dict:
-        """The ``prove --json`` object of this law."""
+        """Return the ``prove --json`` object of this law."""
         return {
             "law": self.law,
             "a_interval": list(self.a_interval),
@@ -334,7 +340,12 @@ def _region(b, bad, area) -> dict | None:
     return {
         "cells": int(i.size),
         "area_fraction": float(area[bad].sum() / area.sum()),
-        "bounding_box": [float(b[0][i].min()), float(b[1][i].max()), float(b[2][i].min()), float(b[3][i].max())],
+        "bounding_box": [
+            float(b[0][i].min()),
+            float(b[1][i].max()),
+            float(b[2][i].min()),
+            float(b[3][i].max()),
+        ],
         "first_cells": cells,
     }
 
@@ -355,7 +366,7 @@ def _status(name: str, ok, b, area, cex=None, detail="", gap=None) -> PropertyRe
 
 
 def simulate_to_target(cfg: Config, name: str, target: Target, x1, x2, a: float, steps: int):
-    """Samples each state needs to enter the ellipse, by exact ZOH stepping (floats).
+    """Count the samples each state needs to enter the ellipse, by exact ZOH stepping (floats).
 
     Parameters
     ----------
@@ -392,7 +403,7 @@ def simulate_to_target(cfg: Config, name: str, target: Target, x1, x2, a: float,
 
 
 def _simulate(cfg, name, target, grid, bound, a_values, n_random, seed=0):
-    """Simulated worst to the ellipse from cell centres and seeded random states."""
+    """Simulate the worst case to the ellipse from cell centres and seeded random states."""
     p = cfg.plant
     r = p.position_range
     b = grid.boxes()
@@ -482,7 +493,10 @@ def prove_law(
         pass
     else:  # no linear zone (TO): no target
         target = Target(target.P, 0.0, False, "the law has no linear zone: no target ellipse")
-    jobs = [(cfg, name, float(edges[q]), float(edges[q + 1]), res, excursion, target) for q in range(len(edges) - 1)]
+    jobs = [
+        (cfg, name, float(edges[q]), float(edges[q + 1]), res, excursion, target)
+        for q in range(len(edges) - 1)
+    ]
     balls = tuple(mapper(_run_ball, jobs))
     t1 = time.perf_counter()
     grid = law_grid(cfg, spec, res, excursion)
@@ -513,8 +527,10 @@ def prove_law(
                 gap=gap * np.where(full > 0, area / full, 0.0),
             )
         )
-    tgt = balls[0].target if all(bl.target.certified for bl in balls) else next(
-        bl.target for bl in balls if not bl.target.certified
+    tgt = (
+        balls[0].target
+        if all(bl.target.certified for bl in balls)
+        else next(bl.target for bl in balls if not bl.target.certified)
     )
     detail = "" if tgt.certified else f"no certified target: {tgt.reason}"
     props.append(_status("reach", np.isfinite(bound), b, area, detail=detail))
@@ -541,7 +557,11 @@ def prove_law(
         grid=grid,
         bound=bound,
         balls=balls,
-        timings_s={"proof": round(t2 - t0, 3), "cells_and_graph": round(t1 - t0, 3), "simulation": round(t3 - t2, 3)},
+        timings_s={
+            "proof": round(t2 - t0, 3),
+            "cells_and_graph": round(t1 - t0, 3),
+            "simulation": round(t3 - t2, 3),
+        },
     )
 
 

@@ -277,7 +277,9 @@ def _certify(spec: LawSpec, cfg: Config, x1: float, x2: float):
         return (float(y1.mid()), float(y2.mid())), u, float(s0.mid()), float(s1.mid()), bool(inside)
 
 
-def find_counterexample(spec: LawSpec, cfg: Config, boxes, failing, *, relaxed: bool, limit: int = 400):
+def find_counterexample(
+    spec: LawSpec, cfg: Config, boxes, failing, *, relaxed: bool, limit: int = 400
+):
     """Search failing cells for a certified stride-over.
 
     Parameters

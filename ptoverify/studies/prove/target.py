@@ -208,7 +208,10 @@ def box_in_target(target: Target, box) -> np.ndarray:
     for x1 in (box[0], box[1]):
         for x2 in (box[2], box[3]):
             q = add(
-                add(mul((p11, p11), mul((x1, x1), (x1, x1))), mul((2 * p12, 2 * p12), mul((x1, x1), (x2, x2)))),
+                add(
+                    mul((p11, p11), mul((x1, x1), (x1, x1))),
+                    mul((2 * p12, 2 * p12), mul((x1, x1), (x2, x2))),
+                ),
                 mul((p22, p22), mul((x2, x2), (x2, x2))),
             )
             ok &= q[1] <= target.c
