@@ -12,6 +12,7 @@
 from __future__ import annotations
 
 import functools
+import math
 import time
 from dataclasses import dataclass
 
@@ -142,7 +143,7 @@ def run_prove(
     a_interval : tuple of float, optional
         The plant's a [rad/s]; default the nominal a.
     pieces : int, optional
-        Sub-intervals of the a-interval (default 8 for an interval, else 1).
+        Sub-intervals of the a-interval, geometric (default: each at most 2 % wide).
     excursion : float
         Margin beyond the envelope [mm], 0 <= excursion <= position_range.
     dask : str, optional
@@ -162,7 +163,12 @@ def run_prove(
     t0 = time.perf_counter()
     mapper = _dask_mapper(dask) if dask else map
     interval = a_interval is not None and a_interval[1] > a_interval[0]
-    n = pieces or (8 if interval else 1)
+    # sub-intervals of at most 2 % of a: wider ones widen the images into spurious cycles
+    n = pieces or (
+        max(1, math.ceil(math.log(a_interval[1] / a_interval[0]) / math.log(1.02)))
+        if interval
+        else 1
+    )
     proofs = tuple(
         prove_law(
             cfg,

@@ -487,7 +487,11 @@ def prove_law(
     res = res or Resolution()
     spec = law_spec(name, cfg)
     lo, hi = a_interval or (p.a, p.a)
-    edges = np.linspace(lo, hi, pieces + 1) if hi > lo else np.array([lo, lo])
+    if hi > lo:
+        edges = np.geomspace(lo, hi, pieces + 1)
+        edges[0], edges[-1] = lo, hi  # exact ends
+    else:
+        edges = np.array([lo, lo])
     target = make_target(arb(p.a), p.a, p.sample_time, spec.g1, spec.g2, spec.d, p.w_max)
     if not math.isfinite(spec.d) or spec.d > 0:
         pass
