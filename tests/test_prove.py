@@ -215,3 +215,10 @@ def test_suboptimality_is_a_certified_upper_bound(pd_proof):
     bound = _cell_bound(pd_proof, x1, x2)
     ok = np.isfinite(bound) & (n_star > 0)
     assert np.all(bound[ok] / n_star[ok] <= ratio + 1e-12)
+
+
+def test_proof_gates_pass_at_the_paper_values():
+    from ptoverify.studies.checks import run_checks
+
+    verdicts = run_checks(paper_config(), ["proof-no-stride-over", "proof-reach"])
+    assert [v.status for v in verdicts] == ["pass", "pass"], verdicts
