@@ -167,21 +167,25 @@ def _bounds_ok(data, problems: list) -> int:
         img = data["image"][q]
         k = data["k"][q]
         to_t = _inside_target(data, *img) & bool(data["certified"])
-        for c in np.flatnonzero(np.isfinite(b)).tolist():
-            if b[c] == 0 and in_t[c]:
-                continue
-            if to_t[c] and b[c] >= k[c]:
-                continue
-            y1lo, y1hi, y2lo, y2hi = img[:, c]
-            if not (e1[0] <= y1lo and y1hi <= e1[-1] and e2[0] <= y2lo and y2hi <= e2[-1]):
-                bad += 1
-                continue
-            i0, i1 = np.searchsorted(e1, y1lo, "left") - 1, np.searchsorted(e1, y1hi, "right") - 1
-            j0, j1 = np.searchsorted(e2, y2lo, "left") - 1, np.searchsorted(e2, y2hi, "right") - 1
-            i0, j0 = max(i0, 0), max(j0, 0)
-            i1, j1 = min(i1, n1 - 1), min(j1, n2 - 1)
-            if not b[c] >= k[c] + grid[j0 : j1 + 1, i0 : i1 + 1].max():
-                bad += 1
+        cells = np.flatnonzero(np.isfinite(b) & ~((b == 0) & in_t) & ~(to_t & (b >= k)))
+        y1lo, y1hi, y2lo, y2hi = img[:, cells]
+        inside = (e1[0] <= y1lo) & (y1hi <= e1[-1]) & (e2[0] <= y2lo) & (y2hi <= e2[-1])
+        bad += int(np.count_nonzero(~inside))
+        cells = cells[inside]
+        y1lo, y1hi, y2lo, y2hi = img[:, cells]
+        i0 = np.maximum(np.searchsorted(e1, y1lo, "left") - 1, 0)
+        i1 = np.minimum(np.searchsorted(e1, y1hi, "right") - 1, n1 - 1)
+        j0 = np.maximum(np.searchsorted(e2, y2lo, "left") - 1, 0)
+        j1 = np.minimum(np.searchsorted(e2, y2hi, "right") - 1, n2 - 1)
+        # the largest bound over each rectangle of cells: one sliding-window maximum
+        # per rectangle shape (a handful of shapes), read at the rectangle's corner
+        worst = np.empty(cells.size)
+        shapes = np.stack([j1 - j0 + 1, i1 - i0 + 1], axis=1)
+        for hh, ww in np.unique(shapes, axis=0).tolist():
+            sel = (shapes[:, 0] == hh) & (shapes[:, 1] == ww)
+            win = np.lib.stride_tricks.sliding_window_view(grid, (hh, ww)).max(axis=(2, 3))
+            worst[sel] = win[j0[sel], i0[sel]]
+        bad += int(np.count_nonzero(~(b[cells] >= k[cells] + worst)))
         if not np.all(data["bound"] >= b):
             problems.append("bound: the overall bound is below a sub-interval's")
     if bad:
