@@ -242,3 +242,18 @@ def test_proof_gates_pass_at_the_paper_values():
 
     verdicts = run_checks(paper_config(), ["proof-no-stride-over", "proof-reach"])
     assert [v.status for v in verdicts] == ["pass", "pass"], verdicts
+
+
+@pytest.mark.slow
+def test_dask_local_equals_in_process():
+    """The sub-intervals on a LocalCluster give the in-process result exactly."""
+    from ptoverify.studies.prove import run_prove
+
+    cfg = paper_config()
+    a = cfg.plant.a
+    kw = dict(laws=("pd",), a_interval=(0.99 * a, 1.01 * a), pieces=2, n_random=100)
+    here = run_prove(cfg, **kw)
+    there = run_prove(cfg, dask="local", **kw)
+    np.testing.assert_array_equal(here.proofs[0].bound, there.proofs[0].bound)
+    assert here.proofs[0].to_json()["properties"] == there.proofs[0].to_json()["properties"]
+    assert there.backend == "dask:local"
