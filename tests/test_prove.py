@@ -257,3 +257,18 @@ def test_dask_local_equals_in_process():
     np.testing.assert_array_equal(here.proofs[0].bound, there.proofs[0].bound)
     assert here.proofs[0].to_json()["properties"] == there.proofs[0].to_json()["properties"]
     assert there.backend == "dask:local"
+
+
+def test_omega0_one_percent_larger_does_not_prove(monkeypatch):
+    """The conformance mutant omega0 x 1.01 fails on a sliver at the zone's corner: no proof."""
+    import ptoverify.studies.prove.run as prove_run
+
+    real = prove_run.law_spec
+
+    def spec(name, c):
+        s = real(name, c)
+        return replace(s, omega0=1.01 * s.omega0) if s.has_zone else s
+
+    monkeypatch.setattr(prove_run, "law_spec", spec)
+    proof = prove_law(paper_config(), "pto", n_random=0)
+    assert proof.property("no-stride-over-strict").status != "proved"
