@@ -519,6 +519,10 @@ def prove_law(
             cex = find_counterexample(
                 spec, cfg, leaves, np.ones(leaves[0].size, dtype=bool), relaxed=reading == "relaxed"
             )
+        note = ""
+        if cex is not None and not cex.confirmed_by_simulation:  # refuted needs both
+            note = f"; a state certified in arb but not confirmed by simulate: {cex.x0}"
+            cex = None
         depth = max(bl.stride.depth for bl in balls)
         props.append(
             _status(
@@ -527,7 +531,7 @@ def prove_law(
                 b,
                 area,
                 cex,
-                detail=f"cells refined up to {depth} times where the first check failed",
+                detail=f"cells refined up to {depth} times where the first check failed{note}",
                 gap=gap * np.where(full > 0, area / full, 0.0),
             )
         )
