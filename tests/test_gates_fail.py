@@ -115,6 +115,28 @@ def _(monkeypatch, cfg):
     return cfg
 
 
+@perturbation("proof-reach", baseline=False)
+def _(monkeypatch, cfg):
+    # a linear zone that is unstable when sampled: no certified target, nothing proved
+    return dataclasses.replace(cfg, pto=dataclasses.replace(cfg.pto, k2=6.0))
+
+
+@perturbation("proof-no-stride-over", baseline=False)
+def _(monkeypatch, cfg):
+    # the PTO without its switching zone (TO outside the linear zone) strides over
+    import math
+
+    import ptoverify.studies.prove.run as prove_run
+
+    real = prove_run.law_spec
+
+    def spec(name, c):
+        return dataclasses.replace(real(name, c), omega0=math.nan)
+
+    monkeypatch.setattr(prove_run, "law_spec", spec)
+    return dataclasses.replace(cfg, name="no-zone")
+
+
 @perturbation("input-bound")
 def _(monkeypatch, cfg):
     _wrap_laws(monkeypatch, lambda u, x1, x2, c: 1.001 * u)

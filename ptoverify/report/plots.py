@@ -1820,3 +1820,41 @@ def save_conform_figures(
             plt.close(fig)
         out[f"response_{name}"] = outdir / f"response_{name}.png"
     return out
+
+
+def save_proof_map(proof, path: str | Path) -> Path:
+    """Draw the certified bound of a proof per cell (``prove --out``).
+
+    Parameters
+    ----------
+    proof : LawProof
+        Output of :func:`ptoverify.studies.prove.run.prove_law`.
+    path : str or Path
+        PNG file to write.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    fig = Figure(figsize=(7.5, 4.8))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    e1, e2 = proof.grid.e1, proof.grid.e2
+    n1, n2 = proof.grid.shape
+    z = np.ma.masked_invalid(np.where(np.isfinite(proof.bound), proof.bound, np.nan)).reshape(
+        n2, n1
+    )
+    mesh = ax.pcolormesh(e1, e2, z, cmap="viridis", shading="flat")
+    bad = ~np.isfinite(proof.bound.reshape(n2, n1))
+    if bad.any():
+        ax.pcolormesh(
+            e1, e2, np.ma.masked_where(~bad, np.ones_like(z.data)), cmap="Reds", vmin=0, vmax=1
+        )
+    fig.colorbar(mesh, ax=ax, label="certified samples to the target ellipse")
+    ax.set_xlabel("x1 [mm]")
+    ax.set_ylabel("x2 [mm/s]")
+    ax.set_title(f"{proof.law}: certified bound per cell (red: unproven)")
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    return path

@@ -516,6 +516,45 @@ def _no_stride(ctx: GateContext) -> Verdict:
     )
 
 
+@gate("proof-no-stride-over", "1")
+def _proof_no_stride(ctx: GateContext) -> Verdict:
+    """Corrected PTO: no stride-over proved for every state of the envelope (interval proof)."""
+    from ptoverify.studies.prove import nominal_proof
+
+    proof = nominal_proof(ctx.cfg)
+    p, relaxed = proof.property("no-stride-over-strict"), proof.property("no-stride-over-relaxed")
+    measured = 1.0 if p.status == "refuted" else 1.0 - p.coverage
+    return at_most(
+        "proof-no-stride-over",
+        measured,
+        0.0,
+        f"fraction of the envelope where no stride-over is not proved in the strict reading "
+        f"(no crossing of l1/l2 from the bang-bang region, the corrected zone's design): "
+        f"{p.status}; relaxed reading (landing in the linear zone allowed): {relaxed.status}, "
+        f"coverage {relaxed.coverage:.6f} ({proof.cells} cells, ptoverify prove)",
+    )
+
+
+@gate("proof-reach", "1")
+def _proof_reach(ctx: GateContext) -> Verdict:
+    """Corrected PTO: certified reach of the target ellipse on at least 99.7 % of the envelope."""
+    from ptoverify.studies.prove import nominal_proof
+
+    proof = nominal_proof(ctx.cfg)
+    p = proof.property("reach")
+    sound = proof.target.certified and proof.simulation_over_bound == 0
+    return at_most(
+        "proof-reach",
+        1.0 - p.coverage if sound else 1.0,
+        0.003,
+        f"fraction of the envelope without a certified bound to the target ellipse ({p.status}; "
+        f"the rest leaves |x1| <= position_range); bound {proof.bound_samples} samples vs "
+        f"simulated worst {proof.simulated_worst_samples}; "
+        f"{proof.simulation_over_bound} simulated states over their bound"
+        + ("" if proof.target.certified else f"; {proof.target.reason}"),
+    )
+
+
 @gate("no-limit-cycle", "1")
 def _no_limit_cycle(ctx: GateContext) -> Verdict:
     """Corrected PTO: no sustained oscillation at the end of the horizon."""

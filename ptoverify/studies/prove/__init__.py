@@ -1,0 +1,204 @@
+"""Proofs over the continuum of initial states (``ptoverify prove``).
+
+- :mod:`.target`: the certified target ellipse x' P x <= c (arb).
+- :mod:`.graph`: the graded cell grid, macro-step images, longest-path bounds.
+- :mod:`.stride`: no stride-over per cell (strict, relaxed), certified counterexamples.
+- :mod:`.run`: :func:`prove_law`, one law's properties.
+- :mod:`.certificate`: the certificate's arrays and its independent check.
+- :func:`run_prove`: every law, in-process or on a dask cluster; :class:`ProveRun`.
+- :func:`nominal_proof`: the corrected PTO's nominal proof, memoized for the gates.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import time
+from dataclasses import dataclass
+
+from ptoverify.config import Config
+from ptoverify.errors import InputError
+from ptoverify.studies.prove.run import LawProof, Resolution, prove_law
+
+__all__ = ["ProveRun", "run_prove", "nominal_proof", "parse_a_interval", "PROVE_LAWS"]
+
+#: Laws ``prove`` covers, the reference PTO first.
+PROVE_LAWS = ("pto", "pto-printed", "pd", "to")
+
+
+@dataclass(frozen=True)
+class ProveRun:
+    """The result of ``ptoverify prove``.
+
+    Attributes
+    ----------
+    proofs : tuple of LawProof
+        One per law, the reference PTO first.
+    a_interval : tuple of float
+        The plant's a covered [rad/s].
+    excursion : float
+        Margin allowed beyond the envelope [mm].
+    backend : str
+        ``in-process`` or the dask scheduler used.
+    elapsed_s : float
+        Wall time of the run [s].
+    """
+
+    proofs: tuple
+    a_interval: tuple
+    excursion: float
+    backend: str
+    elapsed_s: float
+
+    def to_json(self) -> dict:
+        """Return the ``prove --json`` object: the reference law's keys, then every law's."""
+        ref = self.proofs[0].to_json()
+        ref["timings_s"] = dict(ref["timings_s"], total=round(self.elapsed_s, 3))
+        return {
+            **ref,
+            "excursion_mm": self.excursion,
+            "backend": self.backend,
+            "laws": {p.law: p.to_json() for p in self.proofs},
+        }
+
+
+def parse_a_interval(text: str, a: float) -> tuple[float, float]:
+    """Parse ``--a-interval LO,HI`` (ratios to the nominal a) into rad/s.
+
+    Parameters
+    ----------
+    text : str
+        ``LO,HI`` with 0 < LO <= 1 <= HI <= 10 (ratios a_true / a_design).
+    a : float
+        Nominal bandwidth [rad/s].
+
+    Returns
+    -------
+    tuple of float
+        (a_lo, a_hi) [rad/s].
+
+    Examples
+    --------
+    >>> parse_a_interval("0.8,1.25", 100.0)
+    (80.0, 125.0)
+    """
+    try:
+        lo, hi = (float(v) for v in text.split(","))
+    except ValueError:
+        raise InputError(f"--a-interval must be LO,HI (two numbers), got {text!r}") from None
+    if not (0.0 < lo <= 1.0 <= hi <= 10.0):
+        raise InputError(f"--a-interval needs 0 < LO <= 1 <= HI <= 10, got {text!r}")
+    return lo * a, hi * a
+
+
+def _dask_mapper(address: str):
+    """Return a ``map``-like callable running jobs on a dask.distributed cluster."""
+    from ptoverify.studies.robust import check_dask_address
+
+    check_dask_address(address)
+
+    def run(fn, jobs):
+        from dask.distributed import Client, LocalCluster
+
+        from ptoverify.errors import ClusterError
+
+        jobs = list(jobs)
+        if address == "local":
+            with (
+                LocalCluster(
+                    n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+                ) as cluster,
+                Client(cluster) as client,
+            ):
+                return client.gather(client.map(fn, jobs, pure=False))
+        try:
+            client = Client(address, timeout=30)
+        except OSError as exc:
+            raise ClusterError(f"cannot reach the Dask scheduler at {address} ({exc})") from None
+        with client:
+            return client.gather(client.map(fn, jobs, pure=False))
+
+    return run
+
+
+def run_prove(
+    cfg: Config,
+    *,
+    laws: tuple[str, ...] = PROVE_LAWS,
+    a_interval: tuple[float, float] | None = None,
+    pieces: int | None = None,
+    excursion: float = 0.0,
+    dask: str | None = None,
+    res: Resolution | None = None,
+    n_random: int = 20_000,
+) -> ProveRun:
+    """Prove every law's properties over the envelope.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+    laws : tuple of str
+        Laws, the reference first.
+    a_interval : tuple of float, optional
+        The plant's a [rad/s]; default the nominal a.
+    pieces : int, optional
+        Sub-intervals of the a-interval, geometric (default: each at most 2 % wide).
+    excursion : float
+        Margin beyond the envelope [mm], 0 <= excursion <= position_range.
+    dask : str, optional
+        Scheduler address or ``local``: the sub-intervals run there.
+    res : Resolution, optional
+        Grid settings.
+    n_random : int
+        Seeded random states simulated per law besides the cell centres.
+
+    Returns
+    -------
+    ProveRun
+        The proofs.
+    """
+    if not 0.0 <= excursion <= cfg.plant.position_range:
+        raise InputError(f"--excursion must be in [0, position_range], got {excursion:g}")
+    t0 = time.perf_counter()
+    mapper = _dask_mapper(dask) if dask else map
+    interval = a_interval is not None and a_interval[1] > a_interval[0]
+    # sub-intervals of at most 2 % of a: wider ones widen the images into spurious cycles
+    n = pieces or (
+        max(1, math.ceil(math.log(a_interval[1] / a_interval[0]) / math.log(1.02)))
+        if interval
+        else 1
+    )
+    proofs = tuple(
+        prove_law(
+            cfg,
+            name,
+            a_interval=a_interval,
+            pieces=n,
+            excursion=excursion,
+            res=res,
+            n_random=n_random,
+            mapper=mapper,
+        )
+        for name in laws
+    )
+    a_lo, a_hi = a_interval or (cfg.plant.a, cfg.plant.a)
+    backend = f"dask:{dask}" if dask else "in-process"
+    return ProveRun(proofs, (a_lo, a_hi), excursion, backend, time.perf_counter() - t0)
+
+
+@functools.lru_cache(maxsize=4)
+def nominal_proof(cfg: Config) -> LawProof:
+    """Return the corrected PTO's nominal proof (memoized: the gates share it).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    LawProof
+        The proof of ``pto`` for the nominal a.
+    """
+    return prove_law(cfg, "pto", n_random=5_000)

@@ -1,0 +1,578 @@
+"""``ptoverify prove``: proofs over the continuum of initial states, per law.
+
+For each sub-interval of the plant's a (one point, the nominal a, by default)
+:func:`prove_ball` builds the grid, the certified target, the macro-step
+images and the longest-path bounds, and proves no stride-over per cell.  A
+cell's verdict over an a-interval is the conjunction (and its bound the
+maximum) over the sub-intervals, so it holds for every constant a in it.
+:func:`prove_law` gathers the per-cell results into the properties.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from flint import arb
+
+from ptoverify.config import Config
+from ptoverify.model.intervals import a_ball, down, step_maps
+from ptoverify.model.lawbox import LawSpec, enclose, law_spec
+from ptoverify.model.laws import make_law
+from ptoverify.model.plant import step
+from ptoverify.studies.prove.graph import Grid, images, longest_path, make_grid, successors
+from ptoverify.studies.prove.stride import (
+    Counterexample,
+    StrideResult,
+    find_counterexample,
+    stride_check,
+)
+from ptoverify.studies.prove.target import Target, box_in_target, certify_decrease, make_target
+
+__all__ = ["Resolution", "BallResult", "PropertyResult", "LawProof", "prove_ball", "prove_law"]
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """Grid and macro-step settings.
+
+    Attributes
+    ----------
+    h1 : float
+        Cell width near the origin and the zones [mm].
+    h2 : float
+        Cell height [mm/s].
+    h1_max : float
+        Largest cell width [mm].
+    h_edge : float
+        Cell width at the envelope's edge [mm].
+    steps : int
+        Longest macro-step [samples].
+    """
+
+    h1: float = 0.02
+    h2: float = 5.0
+    h1_max: float = 2.0
+    h_edge: float = 0.05
+    steps: int = 40
+
+
+def fine_extent(spec: LawSpec) -> float:
+    """Half-width of the finely gridded strip [mm]: the zones, the curves, the linear zone.
+
+    Parameters
+    ----------
+    spec : LawSpec
+        The law.
+
+    Returns
+    -------
+    float
+        |x1| below which cells have the fine width, one millimetre beyond the
+        widest of the linear zone, the switching curves within |x2| <= w_max
+        (eqs. 9, 13) and w_max / g1 [mm].
+    """
+    w = spec.w_max
+    level = spec.omega0 if spec.has_zone else w
+    curve = level * (w / level - math.log1p(w / level)) / spec.a
+    extent = max(curve, w / spec.g1 if spec.g1 > 0 else 0.0)
+    if math.isfinite(spec.d):
+        extent = max(extent, spec.d)
+    return extent + 1.0
+
+
+@dataclass(frozen=True)
+class BallResult:
+    """Per-cell results for one sub-interval of a.
+
+    Attributes
+    ----------
+    a_lo, a_hi : float
+        The plant's bandwidth interval [rad/s].
+    target : Target
+        The ellipse (decrease certified for this interval when ``certified``).
+    bound : ndarray
+        Certified samples to the target per cell; inf: unproven.
+    stride : StrideResult
+        No stride-over per cell, in each reading.
+    k : ndarray of int
+        Samples of each cell's macro-step.
+    image : tuple of ndarray
+        Each cell's macro-step image box [mm], [mm/s].
+    u_lo, u_hi : ndarray
+        Input enclosure per cell [mm/s].
+    exits : ndarray of bool
+        The image leaves the grid.
+    """
+
+    a_lo: float
+    a_hi: float
+    target: Target
+    bound: np.ndarray
+    stride: StrideResult
+    k: np.ndarray
+    image: tuple
+    u_lo: np.ndarray
+    u_hi: np.ndarray
+    exits: np.ndarray
+
+
+def law_grid(cfg: Config, spec: LawSpec, res: Resolution, excursion: float) -> Grid:
+    """Return the grid of a proof: the envelope widened by ``excursion`` [mm] along x1.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (position_range [mm], w_max [mm/s]).
+    spec : LawSpec
+        The law.
+    res : Resolution
+        Grid settings.
+    excursion : float
+        Margin allowed beyond the envelope [mm].
+
+    Returns
+    -------
+    Grid
+        The grid.
+    """
+    p = cfg.plant
+    return make_grid(
+        p.position_range + excursion,
+        p.w_max,
+        fine_extent(spec),
+        res.h1,
+        res.h2,
+        res.h1_max,
+        res.h_edge,
+    )
+
+
+def prove_ball(
+    cfg: Config,
+    name: str,
+    a_lo: float,
+    a_hi: float,
+    res: Resolution,
+    excursion: float,
+    target: Target,
+) -> BallResult:
+    """Prove reach and no stride-over on every cell for every a in [a_lo, a_hi].
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (the law is designed with its a).
+    name : str
+        Law name.
+    a_lo, a_hi : float
+        The plant's bandwidth interval [rad/s].
+    res : Resolution
+        Grid settings.
+    excursion : float
+        Margin allowed beyond the envelope [mm].
+    target : Target
+        Ellipse (built for the nominal a); its decrease is certified here for the interval.
+
+    Returns
+    -------
+    BallResult
+        Per-cell results.
+    """
+    p = cfg.plant
+    spec = law_spec(name, cfg)
+    ball = arb(a_lo) if a_lo == a_hi else a_ball(a_lo, a_hi)
+    if target.certified and not certify_decrease(target.P, ball, p.sample_time, spec.g1, spec.g2):
+        target = Target(target.P, target.c, False, "decrease not certified for this a-interval")
+    grid = law_grid(cfg, spec, res, excursion)
+    boxes = grid.boxes()
+    gains = (spec.g1, spec.g2) if target.certified else None
+    maps = step_maps(ball, p.sample_time, res.steps, gains=gains)
+    stride = stride_check(spec, cfg, maps, boxes)
+    img = images(spec, maps, target, boxes, p.position_range + excursion, res.steps)
+    starts, succ, exits = successors(grid.e1, grid.e2, img)
+    if target.certified:
+        in_target = box_in_target(target, boxes)
+        bound = longest_path(starts, succ, img.k, in_target, img.to_target, exits)
+    else:
+        bound = np.full(grid.size, np.inf)
+    return BallResult(a_lo, a_hi, target, bound, stride, img.k, img.box, img.u_lo, img.u_hi, exits)
+
+
+@dataclass(frozen=True)
+class PropertyResult:
+    """One proved (or not) property.
+
+    Attributes
+    ----------
+    name : str
+        Property name.
+    status : str
+        ``proved``, ``refuted`` or ``unproven``.
+    coverage : float
+        Fraction of the envelope's area where it is proved [-].
+    counterexample : Counterexample or None
+        A certified counterexample (``refuted``).
+    unproven_region : dict or None
+        Where the proof fails: cell count, bounding box [mm, mm/s], a few cells.
+    detail : str
+        One line.
+    """
+
+    name: str
+    status: str
+    coverage: float
+    counterexample: Counterexample | None = None
+    unproven_region: dict | None = None
+    detail: str = ""
+
+    def to_json(self) -> dict:
+        """Plain JSON object."""
+        return {
+            "name": self.name,
+            "status": self.status,
+            "coverage": self.coverage,
+            "counterexample": self.counterexample.to_json() if self.counterexample else None,
+            "unproven_region": self.unproven_region,
+            "detail": self.detail,
+        }
+
+
+@dataclass(frozen=True)
+class LawProof:
+    """Everything ``prove`` establishes for one law.
+
+    Attributes
+    ----------
+    law : str
+        Law name.
+    a_interval : tuple of float
+        The plant's a [rad/s] the proof covers (lo, hi).
+    properties : tuple of PropertyResult
+        Input bound, no stride-over (strict, relaxed), reach.
+    target : Target
+        The certified ellipse.
+    bound_samples : int or None
+        Largest certified bound over the proved cells [samples].
+    simulated_worst_samples : int or None
+        Largest simulated number of samples to the same ellipse [samples].
+    simulated_states : int
+        States simulated [-].
+    simulation_over_bound : int
+        Simulated states that needed more samples than their cell's bound (must be 0).
+    certified_max_ratio_nt : float or None
+        Certified upper bound on (samples to the target) / N* outside ``excluded_radius`` [-].
+    excluded_radius : float
+        |x1| below which the ratio is not bounded [mm].
+    cells : int
+        Number of cells [-].
+    grid : Grid
+        The cells.
+    bound : ndarray
+        Per-cell certified bound (max over sub-intervals) [samples]; inf: unproven.
+    balls : tuple of BallResult
+        Per sub-interval results.
+    timings_s : dict
+        Wall time per stage [s].
+    """
+
+    law: str
+    a_interval: tuple
+    properties: tuple
+    target: Target
+    bound_samples: int | None
+    simulated_worst_samples: int | None
+    simulated_states: int
+    simulation_over_bound: int
+    certified_max_ratio_nt: float | None
+    excluded_radius: float
+    cells: int
+    grid: Grid
+    bound: np.ndarray
+    balls: tuple
+    timings_s: dict = field(default_factory=dict)
+
+    def property(self, name: str) -> PropertyResult:
+        """Return the property called ``name``."""
+        return next(p for p in self.properties if p.name == name)
+
+    def to_json(self) -> dict:
+        """Return the ``prove --json`` object of this law."""
+        return {
+            "law": self.law,
+            "a_interval": list(self.a_interval),
+            "properties": {p.name: p.to_json() for p in self.properties},
+            "target": {
+                "P": [list(r) for r in self.target.P],
+                "c": self.target.c,
+                "certified": self.target.certified,
+                "reason": self.target.reason,
+            },
+            "bound_samples": self.bound_samples,
+            "simulated_worst_samples": self.simulated_worst_samples,
+            "simulated_states": self.simulated_states,
+            "simulation_over_bound": self.simulation_over_bound,
+            "suboptimality": {
+                "certified_max_ratio_nt": self.certified_max_ratio_nt,
+                "excluded_radius": self.excluded_radius,
+            },
+            "cells": self.cells,
+            "timings_s": self.timings_s,
+        }
+
+
+def _envelope_weights(cfg: Config, grid: Grid):
+    """Area of each cell inside the envelope |x1| <= position_range [mm mm/s]."""
+    b = grid.boxes()
+    r = cfg.plant.position_range
+    width = np.clip(np.minimum(b[1], r) - np.maximum(b[0], -r), 0.0, None)
+    return b, width * (b[3] - b[2])
+
+
+def _region(b, bad, area) -> dict | None:
+    """Summary of the cells where a proof fails."""
+    if not bad.any():
+        return None
+    i = np.flatnonzero(bad)
+    cells = [[float(b[q][c]) for q in range(4)] for c in i[:5].tolist()]
+    return {
+        "cells": int(i.size),
+        "area_fraction": float(area[bad].sum() / area.sum()),
+        "bounding_box": [
+            float(b[0][i].min()),
+            float(b[1][i].max()),
+            float(b[2][i].min()),
+            float(b[3][i].max()),
+        ],
+        "first_cells": cells,
+    }
+
+
+def _status(name: str, ok, b, area, cex=None, detail="", gap=None) -> PropertyResult:
+    """Build a property from per-cell verdicts (``gap``: unproven area per cell)."""
+    inside = area > 0
+    if gap is None:
+        gap = np.where(ok, 0.0, area)
+    cov = float(1.0 - gap[inside].sum() / area[inside].sum())
+    if cex is not None:
+        status = "refuted"
+    elif bool(ok[inside].all()):
+        status = "proved"
+    else:
+        status = "unproven"
+    return PropertyResult(name, status, cov, cex, _region(b, ~ok & inside, area), detail)
+
+
+def simulate_to_target(cfg: Config, name: str, target: Target, x1, x2, a: float, steps: int):
+    """Count the samples each state needs to enter the ellipse, by exact ZOH stepping (floats).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+    name : str
+        Law name.
+    target : Target
+        The ellipse (a state counts as inside at x' P x <= c (1 + 1e-9)).
+    x1, x2 : ndarray
+        Initial states [mm], [mm/s].
+    a : float
+        The plant's bandwidth [rad/s].
+    steps : int
+        Horizon [samples].
+
+    Returns
+    -------
+    ndarray of float
+        First sample inside the ellipse; inf if not within ``steps``.
+    """
+    law = make_law(name, cfg)
+    plant = cfg.with_plant(a=a).plant
+    (p11, p12), (_, p22) = target.P
+    level = target.c * (1 + 1e-9)
+    first = np.full(x1.size, np.inf)
+    y1, y2 = x1.copy(), x2.copy()
+    for k in range(steps + 1):
+        inside = p11 * y1 * y1 + 2 * p12 * y1 * y2 + p22 * y2 * y2 <= level
+        first = np.where(np.isinf(first) & inside, k, first)
+        u, _r = law(y1, y2)
+        y1, y2 = step(y1, y2, u, plant)
+    return first
+
+
+def _simulate(cfg, name, target, grid, bound, a_values, n_random, seed=0):
+    """Simulate the worst case to the ellipse from cell centres and seeded random states."""
+    p = cfg.plant
+    r = p.position_range
+    b = grid.boxes()
+    c1, c2 = 0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3])
+    keep = np.abs(c1) <= r
+    rng = np.random.default_rng(seed)
+    x1 = np.concatenate([c1[keep], rng.uniform(-r, r, n_random)])
+    x2 = np.concatenate([c2[keep], rng.uniform(-p.w_max, p.w_max, n_random)])
+    i = np.clip(np.searchsorted(grid.e1, x1, "right") - 1, 0, grid.shape[0] - 1)
+    j = np.clip(np.searchsorted(grid.e2, x2, "right") - 1, 0, grid.shape[1] - 1)
+    cb = bound[j * grid.shape[0] + i]
+    finite = np.isfinite(bound)
+    horizon = int(bound[finite].max()) + 5 if finite.any() else 400
+    worst, over = 0, 0
+    for a in a_values:
+        first = simulate_to_target(cfg, name, target, x1, x2, a, horizon)
+        proved = np.isfinite(cb)
+        over += int(np.count_nonzero(proved & (first > cb)))
+        reached = first[proved & np.isfinite(first)]
+        worst = max(worst, int(reached.max()) if reached.size else 0)
+    return worst, over, x1.size
+
+
+def _suboptimality(cfg, grid, bound, radius):
+    """Certified max of bound / N* over proved cells with |x1| >= radius (N* >= |x1| / (w T))."""
+    p = cfg.plant
+    b = grid.boxes()
+    near = np.where((b[0] < 0) & (b[1] > 0), 0.0, np.minimum(np.abs(b[0]), np.abs(b[1])))
+    use = (near >= radius) & (np.abs(b[0]) <= p.position_range) & (np.abs(b[1]) <= p.position_range)
+    use &= np.isfinite(bound)  # over the proved cells
+    if not use.any():
+        return None
+    wt = float(np.nextafter(p.w_max * p.sample_time, np.inf))  # divided by an upper bound
+    n_star = np.ceil(down(near[use] / wt))  # N* >= t_f*/T >= |x1| / (w T), rounded down
+    return float(np.max(bound[use] / n_star))
+
+
+def prove_law(
+    cfg: Config,
+    name: str,
+    *,
+    a_interval: tuple[float, float] | None = None,
+    pieces: int = 1,
+    excursion: float = 0.0,
+    res: Resolution | None = None,
+    n_random: int = 20_000,
+    mapper=map,
+    excluded_radius: float | None = None,
+) -> LawProof:
+    """Prove the properties of one law over the envelope.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+    name : str
+        ``pto``, ``pto-printed``, ``pd`` or ``to``.
+    a_interval : tuple of float, optional
+        The plant's a [rad/s] (lo, hi); default the nominal a.
+    pieces : int
+        Sub-intervals the a-interval is split into.
+    excursion : float
+        Margin beyond the envelope the images may use [mm].
+    res : Resolution, optional
+        Grid settings.
+    n_random : int
+        Seeded random states simulated besides the cell centres.
+    mapper : callable
+        ``map``-like callable running the sub-intervals (in-process or a cluster's).
+    excluded_radius : float, optional
+        Neighbourhood |x1| < radius [mm] left out of the suboptimality bound
+        (default a tenth of position_range).
+
+    Returns
+    -------
+    LawProof
+        The proof.
+    """
+    t0 = time.perf_counter()
+    p = cfg.plant
+    res = res or Resolution()
+    spec = law_spec(name, cfg)
+    lo, hi = a_interval or (p.a, p.a)
+    if hi > lo:
+        edges = np.geomspace(lo, hi, pieces + 1)
+        edges[0], edges[-1] = lo, hi  # exact ends
+    else:
+        edges = np.array([lo, lo])
+    target = make_target(arb(p.a), p.a, p.sample_time, spec.g1, spec.g2, spec.d, p.w_max)
+    if not math.isfinite(spec.d) or spec.d > 0:
+        pass
+    else:  # no linear zone (TO): no target
+        target = Target(target.P, 0.0, False, "the law has no linear zone: no target ellipse")
+    jobs = [
+        (cfg, name, float(edges[q]), float(edges[q + 1]), res, excursion, target)
+        for q in range(len(edges) - 1)
+    ]
+    balls = tuple(mapper(_run_ball, jobs))
+    t1 = time.perf_counter()
+    grid = law_grid(cfg, spec, res, excursion)
+    bound = np.max(np.stack([bl.bound for bl in balls]), axis=0)
+    b, area = _envelope_weights(cfg, grid)
+    enc = enclose(spec, b)
+    input_ok = (enc.lo >= -p.w_max) & (enc.hi <= p.w_max)
+    props = [_status("input-bound", input_ok, b, area, detail="|u| <= w_max over every cell")]
+    full = (b[1] - b[0]) * (b[3] - b[2])
+    for reading in ("strict", "relaxed"):
+        ok = np.logical_and.reduce([getattr(bl.stride, reading) for bl in balls])
+        gap = np.minimum(sum(getattr(bl.stride, reading + "_gap") for bl in balls), full)
+        cex = None
+        if not ok[area > 0].all() and math.isfinite(spec.d):
+            leaves = balls[0].stride.leaves
+            cex = find_counterexample(
+                spec, cfg, leaves, np.ones(leaves[0].size, dtype=bool), relaxed=reading == "relaxed"
+            )
+        note = ""
+        if cex is not None and not cex.confirmed_by_simulation:  # refuted needs both
+            note = f"; a state certified in arb but not confirmed by simulate: {cex.x0}"
+            cex = None
+        depth = max(bl.stride.depth for bl in balls)
+        props.append(
+            _status(
+                f"no-stride-over-{reading}",
+                ok,
+                b,
+                area,
+                cex,
+                detail=f"cells refined up to {depth} times where the first check failed{note}",
+                gap=gap * np.where(full > 0, area / full, 0.0),
+            )
+        )
+    tgt = (
+        balls[0].target
+        if all(bl.target.certified for bl in balls)
+        else next(bl.target for bl in balls if not bl.target.certified)
+    )
+    detail = "" if tgt.certified else f"no certified target: {tgt.reason}"
+    props.append(_status("reach", np.isfinite(bound), b, area, detail=detail))
+    t2 = time.perf_counter()
+    finite = np.isfinite(bound) & (area > 0)
+    worst = over = n_sim = None
+    if tgt.certified and finite.any():
+        a_values = np.linspace(lo, hi, 9) if hi > lo else [p.a]
+        worst, over, n_sim = _simulate(cfg, name, target, grid, bound, a_values, n_random)
+    t3 = time.perf_counter()
+    radius = 0.1 * p.position_range if excluded_radius is None else excluded_radius
+    return LawProof(
+        law=name,
+        a_interval=(float(lo), float(hi)),
+        properties=tuple(props),
+        target=tgt,
+        bound_samples=int(bound[finite].max()) if finite.any() else None,
+        simulated_worst_samples=worst,
+        simulated_states=n_sim or 0,
+        simulation_over_bound=over or 0,
+        certified_max_ratio_nt=_suboptimality(cfg, grid, bound, radius) if tgt.certified else None,
+        excluded_radius=radius,
+        cells=grid.size,
+        grid=grid,
+        bound=bound,
+        balls=balls,
+        timings_s={
+            "proof": round(t2 - t0, 3),
+            "cells_and_graph": round(t1 - t0, 3),
+            "simulation": round(t3 - t2, 3),
+        },
+    )
+
+
+def _run_ball(job) -> BallResult:
+    """Run :func:`prove_ball` on a job tuple (picklable for a cluster)."""
+    return prove_ball(*job)

@@ -1,0 +1,319 @@
+"""No stride-over, proved per cell, and certified counterexamples.
+
+The definitions are :mod:`ptoverify.studies.properties`': a sample with
+|x1| >= d (the PTO's d, the yardstick of every law), not in a switching zone,
+on the S_N side of l1 - o - l2 (sigma >= 0) strides over when the next sample
+has sigma < -tol (tol = :func:`ptoverify.verdict.tie_band`); the mirror for
+S_P.  Strict reading: any such crossing fails.  Relaxed reading: a crossing
+that lands in the linear strip |x1| < d is allowed.
+
+Per cell, each piece outside the strip is mapped one sample with the input of
+its bang-bang points (-w_max on the S_N side, +w_max on S_P; PD: the input's
+enclosure over the piece), and the image's sigma is bounded by monotonicity
+(sigma increases in x1 and x2).  A lemma closes the case the boxes cannot:
+under u = -w_max, while x2 >= 0, sigma(x) = a x1 + w_max h(x2 / w_max) is
+constant along the flow (d sigma / dt = a x2 + x2 / (w_max + x2) (-a x2 - a
+w_max) = 0), so a state with sigma >= 0 and x2 >= 0 whose next x2 is >= 0
+keeps sigma >= 0 (x2 is monotone over the sample); the mirror for u = +w_max.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from flint import arb, ctx
+
+from ptoverify.config import Config
+from ptoverify.model.intervals import ARB_PREC, StepMaps, affine_image
+from ptoverify.model.lawbox import LawSpec, enclose, sigma_point
+from ptoverify.model.laws import make_law
+from ptoverify.sim.simulate import simulate_batch
+from ptoverify.verdict import tie_band
+
+__all__ = ["stride_check", "StrideResult", "Counterexample", "find_counterexample"]
+
+_SPLIT = 8  #: a failing box is cut into _SPLIT x _SPLIT children (three halvings)
+
+
+def _sides(spec: LawSpec, piece, u_lo, u_hi, maps: StepMaps, d: float, tol: float):
+    """Strict and relaxed verdicts of one outside piece per cell (bool arrays)."""
+    w = spec.w_max
+    one = np.ones(piece[0].size, dtype=np.intp)
+    strict = np.ones(piece[0].size, dtype=bool)
+    relaxed = strict.copy()
+    bang = np.isfinite(spec.d)  # PTO and TO: S_N's non-zone points take -w_max
+    # S_N candidates: sigma_w >= 0 possible (largest at the upper-right corner)
+    s_hi = sigma_point(spec, piece[1], piece[3], w)[1]
+    s_lo = sigma_point(spec, piece[0], piece[2], w)[0]
+    for side in (-1.0, 1.0):  # the input of the side: -w on S_N, +w on S_P
+        cand = (s_hi >= 0) if side < 0 else (s_lo <= 0)
+        if bang:
+            cand &= (u_lo <= -w) if side < 0 else (u_hi >= w)  # has bang-bang points
+            u = (np.full(one.size, side * w),) * 2
+        else:
+            u = (u_lo, u_hi)
+        img = affine_image(maps, one, piece, u)
+        y2lo, y2hi = np.clip(img[2], -w, w), np.clip(img[3], -w, w)
+        if side < 0:
+            ok = sigma_point(spec, img[0], y2lo, w)[0] >= -tol
+            if bang:
+                ok |= (piece[2] >= 0) & (y2lo >= 0)  # the invariance lemma
+        else:
+            ok = sigma_point(spec, img[1], y2hi, w)[1] <= tol
+            if bang:
+                ok |= (piece[3] <= 0) & (y2hi <= 0)
+        lands_in = (img[0] > -d) & (img[1] < d)
+        strict &= ~cand | ok
+        relaxed &= ~cand | ok | lands_in
+    return strict, relaxed
+
+
+def _check(spec: LawSpec, cfg: Config, maps: StepMaps, boxes):
+    """Prove no stride-over per box, strict and relaxed readings (no refinement).
+
+    Parameters
+    ----------
+    spec : LawSpec
+        The law.
+    cfg : Config
+        Configuration (the yardstick d [mm], the tie band).
+    maps : StepMaps
+        One-step map enclosures (the plant's a, or a ball of a).
+    boxes : tuple of ndarray
+        Cells (x1lo, x1hi, x2lo, x2hi) [mm], [mm/s].
+
+    Returns
+    -------
+    strict, relaxed : ndarray of bool
+        Proved per cell.
+    """
+    p = cfg.plant
+    d = cfg.pto.d
+    tol = tie_band(p.w_max, p.a, p.position_range)
+    x1lo, x1hi, x2lo, x2hi = boxes
+    strict = np.ones(x1lo.size, dtype=bool)
+    relaxed = strict.copy()
+    for right in (True, False):
+        has = (x1hi >= d) if right else (x1lo <= -d)
+        idx = np.flatnonzero(has)
+        if idx.size == 0:
+            continue
+        lo = np.maximum(x1lo[idx], d) if right else x1lo[idx]
+        hi = x1hi[idx] if right else np.minimum(x1hi[idx], -d)
+        piece = (lo, hi, x2lo[idx], x2hi[idx])
+        enc = enclose(spec, piece)
+        s, r = _sides(spec, piece, enc.lo, enc.hi, maps, d, tol)
+        strict[idx] &= s
+        relaxed[idx] &= r
+    return strict, relaxed
+
+
+@dataclass(frozen=True)
+class StrideResult:
+    """No stride-over per cell, after refinement.
+
+    Attributes
+    ----------
+    strict, relaxed : ndarray of bool
+        Proved on the whole cell, in each reading.
+    strict_gap, relaxed_gap : ndarray
+        Area of the cell where the proof fails [mm mm/s].
+    leaves : tuple of ndarray
+        The smallest boxes where a reading still fails (x1lo, x1hi, x2lo, x2hi).
+    depth : int
+        Refinement levels used (each halves the boxes' sides).
+    """
+
+    strict: np.ndarray
+    relaxed: np.ndarray
+    strict_gap: np.ndarray
+    relaxed_gap: np.ndarray
+    leaves: tuple
+    depth: int
+
+
+def stride_check(
+    spec: LawSpec, cfg: Config, maps: StepMaps, boxes, *, depth: int = 24, cap: int = 20_000
+) -> StrideResult:
+    """Prove no stride-over per cell, refining failing cells into quarters.
+
+    A failing box is cut into 8 x 8 children (three halvings of each side, so
+    children tile the box exactly: the last child ends at the box's edge); each
+    child is checked again, down to ``depth`` halvings or while fewer than
+    ``cap`` boxes fail.  The verdict of a
+    cell holds where all its leaves pass; the failing leaves' area is its gap.
+
+    Parameters
+    ----------
+    spec : LawSpec
+        The law.
+    cfg : Config
+        Configuration (the yardstick d [mm], the tie band).
+    maps : StepMaps
+        One-step map enclosures.
+    boxes : tuple of ndarray
+        Cells (x1lo, x1hi, x2lo, x2hi) [mm], [mm/s].
+    depth : int
+        Most refinement levels.
+    cap : int
+        Most failing boxes carried to the next level.
+
+    Returns
+    -------
+    StrideResult
+        Per-cell verdicts and gaps.
+    """
+    n = boxes[0].size
+    s, r = _check(spec, cfg, maps, boxes)
+    owner = np.arange(n)
+    cur = boxes
+    fail_s, fail_r = ~s, ~r
+    level = 0
+    while level < depth and (fail_s | fail_r).any() and np.count_nonzero(fail_s | fail_r) <= cap:
+        keep = np.flatnonzero(fail_s | fail_r)
+        b = tuple(v[keep] for v in cur)
+        f = np.arange(_SPLIT) / _SPLIT  # each side cut in _SPLIT: 3 levels at once
+        t1 = np.repeat(f, _SPLIT)[:, None]
+        t2 = np.tile(f, _SPLIT)[:, None]
+        # a child's upper edge is computed exactly as its neighbour's lower edge
+        # (t + 1/8 is exact), and the last one is the box's own edge: no gaps
+        lo1 = b[0] + t1 * (b[1] - b[0])
+        lo2 = b[2] + t2 * (b[3] - b[2])
+        u1, u2 = t1 + 1.0 / _SPLIT, t2 + 1.0 / _SPLIT
+        hi1 = np.where(u1 >= 1.0, b[1], b[0] + u1 * (b[1] - b[0]))
+        hi2 = np.where(u2 >= 1.0, b[3], b[2] + u2 * (b[3] - b[2]))
+        kids = tuple(v.ravel() for v in (lo1, hi1, lo2, hi2))
+        owner = np.tile(owner[keep], _SPLIT * _SPLIT)
+        cur = kids
+        s, r = _check(spec, cfg, maps, cur)
+        fail_s, fail_r = ~s, ~r
+        level += 3
+    area = (cur[1] - cur[0]) * (cur[3] - cur[2])
+    gap_s = np.bincount(owner[fail_s], weights=area[fail_s], minlength=n)
+    gap_r = np.bincount(owner[fail_r], weights=area[fail_r], minlength=n)
+    bad = fail_s | fail_r
+    leaves = tuple(v[bad] for v in cur)
+    strict = np.bincount(owner[fail_s], minlength=n) == 0
+    relaxed = np.bincount(owner[fail_r], minlength=n) == 0
+    return StrideResult(strict, relaxed, gap_s, gap_r, leaves, level)
+
+
+@dataclass(frozen=True)
+class Counterexample:
+    """A certified stride-over.
+
+    Attributes
+    ----------
+    x0 : tuple of float
+        The state [mm], [mm/s] (exact floats).
+    x1 : tuple of float
+        Its next sample, rounded from the arb ball [mm], [mm/s].
+    u : float
+        The law's input there [mm/s] (certified branch).
+    sigma0, sigma1 : float
+        Switching function before and after [mm/s] (midpoints of certified balls).
+    lands_in_strip : bool
+        The next sample lies in |x1| < d (a stride-over only in the strict reading).
+    confirmed_by_simulation : bool
+        ``simulate``'s one step (floats) shows the same crossing.
+    """
+
+    x0: tuple
+    x1: tuple
+    u: float
+    sigma0: float
+    sigma1: float
+    lands_in_strip: bool
+    confirmed_by_simulation: bool
+
+    def to_json(self) -> dict:
+        """Plain JSON object."""
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.__dict__.items()}
+
+
+def _sigma_arb(a: arb, x1: arb, x2: arb, level: float) -> arb:
+    """Switching function in arb (eqs. 9, 11, 13, 14); x2's sign must be certain."""
+    lv = arb(level)
+    r = abs(x2) / lv
+    h = r - r.log1p()
+    return a * x1 + (lv * h if x2 > 0 else -lv * h if x2 < 0 else 0)
+
+
+def _certify(spec: LawSpec, cfg: Config, x1: float, x2: float):
+    """Certify a stride-over from (x1, x2) in arb; None if it cannot be certified."""
+    p = cfg.plant
+    d, w = cfg.pto.d, p.w_max
+    tol = tie_band(w, p.a, p.position_range)
+    if abs(x1) < d or x2 == 0.0 or not np.isfinite(spec.d) or abs(x1) < spec.d:
+        return None
+    with ctx.workprec(ARB_PREC):
+        a = arb(spec.a)
+        s0 = _sigma_arb(a, arb(x1), arb(x2), w)
+        if s0 > 0:
+            side = -1.0
+        elif s0 < 0:
+            side = 1.0
+        else:
+            return None
+        if spec.has_zone:  # certify that the state is not in the zone: sigma_omega0 on S's side
+            so = _sigma_arb(a, arb(x1), arb(x2), spec.omega0)
+            if not ((so > 0) if side < 0 else (so < 0)):
+                return None
+        u = side * w
+        e = (-arb(p.a) * arb(p.sample_time)).exp()
+        y2 = arb(u) + (arb(x2) - arb(u)) * e
+        y1 = arb(x1) + arb(u) * arb(p.sample_time) + (arb(x2) - arb(u)) * (1 - e) / arb(p.a)
+        if not (y2 > 0 or y2 < 0):
+            return None
+        s1 = _sigma_arb(a, y1, y2, w)
+        crossed = (s1 < -tol) if side < 0 else (s1 > tol)
+        if not crossed:
+            return None
+        inside = abs(y1) < d
+        outside = abs(y1) >= d
+        if not (inside or outside):
+            return None
+        return (float(y1.mid()), float(y2.mid())), u, float(s0.mid()), float(s1.mid()), bool(inside)
+
+
+def find_counterexample(
+    spec: LawSpec, cfg: Config, boxes, failing, *, relaxed: bool, limit: int = 400
+):
+    """Search failing cells for a certified stride-over.
+
+    Parameters
+    ----------
+    spec : LawSpec
+        The law (PTO or TO).
+    cfg : Config
+        Configuration.
+    boxes : tuple of ndarray
+        Cells [mm], [mm/s].
+    failing : ndarray of bool
+        Cells whose proof failed.
+    relaxed : bool
+        Search for a crossing that lands outside the strip (relaxed reading).
+    limit : int
+        Cells tried at most.
+
+    Returns
+    -------
+    Counterexample or None
+        A state certified in arb and confirmed by one simulated step.
+    """
+    idx = np.flatnonzero(failing)[:limit]
+    law = make_law(spec.name, cfg)
+    for c in idx.tolist():
+        for f1, f2 in ((0.5, 0.5), (0.0, 0.0), (1.0, 1.0), (0.0, 1.0), (1.0, 0.0)):
+            x1 = float(boxes[0][c] + f1 * (boxes[1][c] - boxes[0][c]))
+            x2 = float(boxes[2][c] + f2 * (boxes[3][c] - boxes[2][c]))
+            got = _certify(spec, cfg, x1, x2)
+            if got is None or (relaxed and got[4]):
+                continue
+            y, u, s0, s1, inside = got
+            b = simulate_batch(law, cfg.plant, [x1], [x2], 1)
+            z1, z2 = float(b.x1[1, 0]), float(b.x2[1, 0])
+            sim = bool(b.u[0, 0] == u and abs(z1 - y[0]) < 1e-9 and abs(z2 - y[1]) < 1e-6)
+            return Counterexample((x1, x2), y, u, s0, s1, inside, sim)
+    return None
