@@ -6,7 +6,7 @@ import re
 from typing import Any
 
 from ptoverify.errors import ClusterError, InputError
-from ptoverify.studies.robust.maps import Runner, _map_task
+from ptoverify.studies.robust.maps import Runner, map_task
 
 __all__ = ["DASK_CONNECT_TIMEOUT_S", "check_dask_address", "dask_runner"]
 
@@ -79,7 +79,7 @@ def dask_runner(address: str) -> Runner:
                 ) as cluster,
                 Client(cluster) as client,
             ):
-                return client.gather(client.map(_map_task, *zip(*tasks, strict=True), pure=False))
+                return client.gather(client.map(map_task, *zip(*tasks, strict=True), pure=False))
         try:
             client = Client(address, timeout=DASK_CONNECT_TIMEOUT_S)
         except OSError as exc:  # TimeoutError and refused connections
@@ -88,6 +88,6 @@ def dask_runner(address: str) -> Runner:
                 f"{DASK_CONNECT_TIMEOUT_S:g} s ({type(exc).__name__}); start it, or use --dask local"
             ) from None
         with client:
-            return client.gather(client.map(_map_task, *zip(*tasks, strict=True), pure=False))
+            return client.gather(client.map(map_task, *zip(*tasks, strict=True), pure=False))
 
     return run

@@ -160,8 +160,21 @@ def _n_star(x1: NDArray, x2: NDArray, a_ratio: NDArray, w_ratio: NDArray, plant:
 LawSpec = str | Callable[[Config], Law]
 
 
-def _law(spec: LawSpec, cfg: Config) -> Law:
-    """Build the nominal law: a name for :func:`make_law`, or a factory ``f(cfg) -> Law``."""
+def nominal_law(spec: LawSpec, cfg: Config) -> Law:
+    """Build the nominal law: a name for :func:`make_law`, or a factory ``f(cfg) -> Law``.
+
+    Parameters
+    ----------
+    spec : str or callable
+        Law name (``to``, ``pd``, ``pto``, ``pto-printed``) or a factory.
+    cfg : Config
+        Nominal configuration (the law's design).
+
+    Returns
+    -------
+    Law
+        The law.
+    """
     return make_law(spec, cfg) if isinstance(spec, str) else spec(cfg)
 
 
@@ -216,7 +229,9 @@ def trajectory_properties(
     x2 = np.atleast_1d(np.asarray(x2, dtype=float))
     steps = horizon_steps(cfg) if steps is None else steps
     if batch is None:
-        batch = simulate_batch(_law(law_name, cfg), cfg.plant, x1, x2, steps, mismatch=mismatch)
+        batch = simulate_batch(
+            nominal_law(law_name, cfg), cfg.plant, x1, x2, steps, mismatch=mismatch
+        )
     return _measure(batch, cfg, x1, x2, mismatch, with_settling, with_tf=True)
 
 
@@ -479,7 +494,7 @@ def map_cells(
         Per law, its cells in the order delay, w_max_ratio, a_ratio (see
         :func:`robust_maps`).
     """
-    made = [_map_probes(_law(law, cfg), cfg, s) for law in laws]
+    made = [_map_probes(nominal_law(law, cfg), cfg, s) for law in laws]
     props = evaluate_probes(cfg, [p for probes, _ in made for p in probes], seconds=seconds)
     out, at = [], 0
     for probes, cells in made:
@@ -488,8 +503,23 @@ def map_cells(
     return out
 
 
-def _map_task(law: LawSpec, cfg: Config, s: RobustSettings) -> list[dict[str, Any]]:
-    """Every cell of one law: the picklable unit a Dask runner distributes."""
+def map_task(law: LawSpec, cfg: Config, s: RobustSettings) -> list[dict[str, Any]]:
+    """Return every map cell of one law: the picklable unit a Dask runner distributes.
+
+    Parameters
+    ----------
+    law : str or callable
+        Law name or factory ``f(cfg) -> Law``.
+    cfg : Config
+        Nominal configuration with its box.
+    s : RobustSettings
+        Grid sizes.
+
+    Returns
+    -------
+    list of dict
+        The law's cells (:func:`map_cells`).
+    """
     return map_cells([law], cfg, s)[0]
 
 

@@ -27,9 +27,9 @@ from ptoverify.studies.robust.maps import (
     LawSpec,
     Probe,
     RobustSettings,
-    _law,
     evaluate_probes,
     map_states,
+    nominal_law,
 )
 
 __all__ = [
@@ -215,7 +215,7 @@ def no_limit_cycle_margin(
         or ``None`` with a note when the nominal loop already has a limit cycle.
     """
     s = settings or RobustSettings()
-    job = margin_job(_law(law, cfg), cfg, s, rtol=rtol)
+    job = margin_job(nominal_law(law, cfg), cfg, s, rtol=rtol)
     return job(lambda probes: evaluate_probes(cfg, probes))
 
 

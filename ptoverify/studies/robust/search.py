@@ -41,8 +41,8 @@ from ptoverify.studies.robust.maps import (
     LawSpec,
     Probe,
     RobustSettings,
-    _law,
     evaluate_probes,
+    nominal_law,
 )
 
 __all__ = ["worst_case", "worst_cases", "search_jobs", "grid_worst", "merge_found"]
@@ -336,6 +336,6 @@ def worst_cases(
         ``evaluations`` (trajectories simulated by this law's searches, all properties).
     """
     s = settings or RobustSettings()
-    jobs = search_jobs(_law(law, cfg), cfg, starts, s)
+    jobs = search_jobs(nominal_law(law, cfg), cfg, starts, s)
     found = run_together(lambda probes: evaluate_probes(cfg, probes), jobs)
     return merge_found(cfg, starts, found)

@@ -23,10 +23,10 @@ from ptoverify.sim.lockstep import run_together
 from ptoverify.studies.robust.cluster import dask_runner
 from ptoverify.studies.robust.maps import (
     RobustSettings,
-    _law,
     evaluate_probes,
     map_cells,
     maps_dict,
+    nominal_law,
     robust_maps,
 )
 from ptoverify.studies.robust.margins import linear_loop_margin, margin_job, most_robust
@@ -143,7 +143,7 @@ def run_robust(
         cells = map_cells(s.laws, cfg, s, seconds=booked)
     timings["maps"] = time.perf_counter() - t1
     # every law's searches and margin scans side by side: one batch per round
-    fns = [_law(law, cfg) for law in s.laws]
+    fns = [nominal_law(law, cfg) for law in s.laws]
     starts = [{prop: grid_worst(c, prop) for prop in s.properties} for c in cells]
     per_law = [search_jobs(fn, cfg, st, s) for fn, st in zip(fns, starts, strict=True)]
     jobs = [j for js in per_law for j in js]
