@@ -117,12 +117,12 @@ def test_zero_box_maps_equal_nominal_simulation():
     )
     cfg = dataclasses.replace(CFG, robustness=box)
     maps = robust_maps(cfg, dataclasses.replace(TINY, laws=("to",)))
-    (cell,) = maps["laws"]["to"]
+    (cell,) = maps.laws["to"]
     x1, x2 = map_states(cfg, TINY)
     nominal = simulate_batch(make_law("to", CFG), CFG.plant, x1, x2, horizon_steps(cfg))
     window = nominal.x1[-max(20, horizon_steps(cfg) // 4) :]
-    assert cell["limit_cycle_states"] == int(oscillating(window, 1e-3).sum())
-    assert cell["limit_cycle_states"] > 0, "sampled TO limit-cycles nominally (a known finding)"
+    assert cell.limit_cycle_states == int(oscillating(window, 1e-3).sum())
+    assert cell.limit_cycle_states > 0, "sampled TO limit-cycles nominally (a known finding)"
 
 
 @pytest.mark.parametrize("law_name, gains", [("pd", ("kp", "kd")), ("pto", ("k1", "k2"))])
@@ -139,7 +139,7 @@ def test_linear_margin_endpoints_against_independent_eigenvalues(law_name, gains
         Ad, Bd, *_ = cont2discrete((A, B, np.eye(2), np.zeros((2, 1))), p.sample_time, method="zoh")
         return np.abs(np.linalg.eigvals(Ad - Bd @ k)).max()
 
-    lo, hi = linear_loop_margin(law_name, CFG)["linear_loop_a_ratio_stable"]
+    lo, hi = linear_loop_margin(law_name, CFG).interval
     for end in (lo, hi):
         if end is not None:
             assert abs(radius(end) - 1.0) < 1e-9, f"spectral radius at the endpoint {end}"
@@ -179,12 +179,12 @@ def test_linear_loop_radii_against_scipy_and_one_by_one(law_name):
 
 
 def test_linear_margin_of_to_is_none_and_unstable_design_is_reported():
-    assert linear_loop_margin("to", CFG)["linear_loop_a_ratio_stable"] is None
+    assert linear_loop_margin("to", CFG).interval is None
 
     bad = dataclasses.replace(CFG, pd=dataclasses.replace(CFG.pd, kp=1e5))
     assert sampled_spectral_radius(bad.plant.a, bad.plant.T, 1e5, bad.pd.kd) > 1
     m = linear_loop_margin("pd", bad)
-    assert m["linear_loop_a_ratio_stable"] is None and "unstable" in m["linear_loop_note"]
+    assert m.interval is None and "unstable" in m.note
 
 
 def _trap_law(cfg):
@@ -209,18 +209,18 @@ def test_search_finds_planted_worst_case_the_grid_misses(seed):
     s = RobustSettings(n1=7, n2=6, rest=6, n_a=3, n_w=2, search_iterations=20, search_population=40)
     box = dataclasses.replace(CFG.robustness, delay_samples=(0, 0), seed=seed)
     cfg = dataclasses.replace(CFG, robustness=box)
-    (cells,) = robust_maps(cfg, dataclasses.replace(s, laws=(_trap_law,)))["laws"].values()
-    assert all(c["not_settled"] == 0 for c in cells), "the grid must miss the trap"
+    (cells,) = robust_maps(cfg, dataclasses.replace(s, laws=(_trap_law,))).laws.values()
+    assert all(c.not_settled == 0 for c in cells), "the grid must miss the trap"
     w = worst_case(_trap_law, "settling_ratio_nt", cfg, grid_worst(cells, "settling_ratio_nt"), s)
-    assert w["grid"] is not None
-    assert w["unbounded"] and w["searched"] == math.inf, "the search did not find the trap"
-    x1, x2 = w["state"]
+    assert w.grid is not None
+    assert w.unbounded and w.searched == math.inf, "the search did not find the trap"
+    x1, x2 = w.state
     # reproducible: the reported state and parameters never settle either
     m = Mismatch(
-        a_ratio=w["params"]["a_ratio"],
-        w_max_ratio=w["params"]["w_max_ratio"],
-        delay_samples=w["params"]["delay_samples"],
-        position_quantum=w["params"]["position_quantum"],
+        a_ratio=w.params.a_ratio,
+        w_max_ratio=w.params.w_max_ratio,
+        delay_samples=w.params.delay_samples,
+        position_quantum=w.params.position_quantum,
     )
     again = trajectory_properties(_trap_law, cfg, np.array([x1]), np.array([x2]), m)
     assert again["settling_ratio_nt"][0] == math.inf
@@ -261,7 +261,7 @@ def test_no_limit_cycle_margin_against_a_brute_force_scan():
         )
         return not (props["limit_cycle_mm"] > 0).any()
 
-    lo, hi = no_limit_cycle_margin("pto", CFG, TINY, rtol=1e-3)["no_limit_cycle_a_ratio"]
+    lo, hi = no_limit_cycle_margin("pto", CFG, TINY, rtol=1e-3).interval
     assert hi is not None and 1.0 < hi < 10.0
     assert clean(hi), f"limit cycle at the reported edge {hi}"
     scan = np.geomspace(1.0, 10.0, 40)
@@ -278,20 +278,20 @@ def test_maps_do_not_depend_on_batching(monkeypatch):
     s = dataclasses.replace(TINY, laws=("pto",))
     together = robust_maps(CFG, s)
     monkeypatch.setattr(maps_mod, "BATCH_STATES", 1)
-    assert robust_maps(CFG, s) == together
+    assert robust_maps(CFG, s).to_json() == together.to_json()
 
 
 def test_search_is_deterministic_for_a_seed():
     """Two runs of the seeded search give the same worst cases; another seed differs."""
     s = dataclasses.replace(TINY, laws=("pto",))
-    (cells,) = robust_maps(CFG, s)["laws"].values()
+    (cells,) = robust_maps(CFG, s).laws.values()
     starts = {p: grid_worst(cells, p) for p in ("overshoot_mm", "settling_ratio_nt")}
     one = worst_cases("pto", CFG, starts, s)
     assert worst_cases("pto", CFG, starts, s) == one
     other = dataclasses.replace(CFG, robustness=dataclasses.replace(CFG.robustness, seed=5))
     assert worst_cases("pto", other, starts, s) != one, "the seed does not reach the search"
     for prop, w in one.items():
-        assert w["searched"] >= w["grid"], f"{prop}: searched below the grid's worst"
+        assert w.searched >= w.grid, f"{prop}: searched below the grid's worst"
 
 
 def test_search_population_below_five_is_an_input_error():

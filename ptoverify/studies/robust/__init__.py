@@ -8,6 +8,8 @@ margins   linear-loop stability margins (eigenvalues) and the no-limit-cycle mar
 search    worst cases by SciPy's differential evolution, seeded (worst_cases)
 cluster   the maps on a dask.distributed cluster (dask_runner, check_dask_address)
 study     the whole study (run_robust -> RobustResult) and its gates (robust_gates)
+results   the typed results, each with to_json: RobustMaps (MapCell, PropertyMax),
+          WorstCase (CaseParams, Start), LawMargins (Margin), MostRobust
 """
 
 from ptoverify.studies.robust.cluster import (
@@ -35,6 +37,17 @@ from ptoverify.studies.robust.margins import (
     most_robust,
     no_limit_cycle_margin,
 )
+from ptoverify.studies.robust.results import (
+    CaseParams,
+    LawMargins,
+    MapCell,
+    Margin,
+    MostRobust,
+    PropertyMax,
+    RobustMaps,
+    Start,
+    WorstCase,
+)
 from ptoverify.studies.robust.search import grid_worst, worst_case, worst_cases
 from ptoverify.studies.robust.study import (
     GATE_LAW,
@@ -45,6 +58,15 @@ from ptoverify.studies.robust.study import (
 )
 
 __all__ = [
+    "CaseParams",
+    "LawMargins",
+    "MapCell",
+    "Margin",
+    "MostRobust",
+    "PropertyMax",
+    "RobustMaps",
+    "Start",
+    "WorstCase",
     "BATCH_STATES",
     "DASK_CONNECT_TIMEOUT_S",
     "GATE_LAW",

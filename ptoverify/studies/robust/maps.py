@@ -53,6 +53,7 @@ from ptoverify.model.reach import zonotope_steps_each
 from ptoverify.sim.lockstep import Ask, simulate_asks
 from ptoverify.sim.simulate import BatchResult, Mismatch, simulate_batch
 from ptoverify.studies.properties import oscillating, stride_over_counts
+from ptoverify.studies.robust.results import MapCell, PropertyMax, RobustMaps
 from ptoverify.studies.sweep import even_points, settle_steps
 
 __all__ = [
@@ -335,24 +336,34 @@ def map_states(cfg: Config, s: RobustSettings | None = None) -> tuple[NDArray, N
     return x1, x2
 
 
-def _summarize(props: dict[str, NDArray], x1: NDArray, x2: NDArray) -> dict[str, Any]:
-    """One map cell's summary of the per-state properties."""
-    summary: dict[str, Any] = {}
+def _summarize(
+    props: dict[str, NDArray], x1: NDArray, x2: NDArray, cell: tuple[int, float, float]
+) -> MapCell:
+    """Summarize one map cell's per-state properties; ``cell`` is (delay, w_ratio, a_ratio)."""
+    worst = {}
     for key in PROPERTIES:
         v = props[key]
         fin = v[~np.isnan(v)]
         k = int(np.nanargmax(np.where(np.isnan(v), -np.inf, v)))
-        summary[key] = {
-            "max": float(fin.max()) if fin.size else math.nan,
-            "state": [float(x1[k]), float(x2[k])],
-        }
-    summary["states_with_stride_over"] = int((props["stride_overs"] > 0).sum())
-    summary["limit_cycle_states"] = int((props["limit_cycle_mm"] > 0).sum())
-    summary["not_settled"] = int(np.isinf(props["settling_s"]).sum())
+        worst[key] = (float(fin.max()) if fin.size else math.nan, (float(x1[k]), float(x2[k])))
     r = props["settling_ratio_nt"]
-    summary["settling_ratio_nt"]["median"] = float(np.median(r))
-    summary["settling_ratio_nt"]["p95"] = float(np.percentile(r, 95, method="higher"))
-    return summary
+    dl, wr, ar = cell
+    return MapCell(
+        a_ratio=ar,
+        w_max_ratio=wr,
+        delay_samples=dl,
+        stride_overs=PropertyMax(*worst["stride_overs"]),
+        limit_cycle_mm=PropertyMax(*worst["limit_cycle_mm"]),
+        overshoot_mm=PropertyMax(*worst["overshoot_mm"]),
+        settling_ratio_nt=PropertyMax(
+            *worst["settling_ratio_nt"],
+            median=float(np.median(r)),
+            p95=float(np.percentile(r, 95, method="higher")),
+        ),
+        states_with_stride_over=int((props["stride_overs"] > 0).sum()),
+        limit_cycle_states=int((props["limit_cycle_mm"] > 0).sum()),
+        not_settled=int(np.isinf(props["settling_s"]).sum()),
+    )
 
 
 BATCH_STATES = 16384  #: most states simulated at once (memory: ~25 bytes x states x horizon)
@@ -456,16 +467,15 @@ def _map_probes(fn: Law, cfg: Config, s: RobustSettings) -> tuple[list[Probe], l
 
 def _map_cells(
     cfg: Config, s: RobustSettings, cells: list[tuple], props: list[dict[str, NDArray]]
-) -> list[dict[str, Any]]:
+) -> tuple[MapCell, ...]:
     """Summarize the measured probes of :func:`_map_probes` cell by cell."""
     x1, x2 = map_states(cfg, s)
     n = x1.size
     flat = {k: np.concatenate([p[k] for p in props]) for k in props[0]}
-    return [
-        {"a_ratio": ar, "w_max_ratio": wr, "delay_samples": dl}
-        | _summarize({k: v[i * n : (i + 1) * n] for k, v in flat.items()}, x1, x2)
-        for i, (dl, wr, ar) in enumerate(cells)
-    ]
+    return tuple(
+        _summarize({k: v[i * n : (i + 1) * n] for k, v in flat.items()}, x1, x2, cell)
+        for i, cell in enumerate(cells)
+    )
 
 
 def map_cells(
@@ -474,8 +484,8 @@ def map_cells(
     s: RobustSettings,
     *,
     seconds: dict[str, float] | None = None,
-) -> list[list[dict[str, Any]]]:
-    """Every map cell of each law, all laws' probes simulated together.
+) -> list[tuple[MapCell, ...]]:
+    """Return every map cell of each law, all laws' probes simulated together.
 
     Parameters
     ----------
@@ -490,9 +500,8 @@ def map_cells(
 
     Returns
     -------
-    list of list of dict
-        Per law, its cells in the order delay, w_max_ratio, a_ratio (see
-        :func:`robust_maps`).
+    list of tuple of MapCell
+        Per law, its cells in the order delay, w_max_ratio, a_ratio.
     """
     made = [_map_probes(nominal_law(law, cfg), cfg, s) for law in laws]
     props = evaluate_probes(cfg, [p for probes, _ in made for p in probes], seconds=seconds)
@@ -503,7 +512,7 @@ def map_cells(
     return out
 
 
-def map_task(law: LawSpec, cfg: Config, s: RobustSettings) -> list[dict[str, Any]]:
+def map_task(law: LawSpec, cfg: Config, s: RobustSettings) -> tuple[MapCell, ...]:
     """Return every map cell of one law: the picklable unit a Dask runner distributes.
 
     Parameters
@@ -517,7 +526,7 @@ def map_task(law: LawSpec, cfg: Config, s: RobustSettings) -> list[dict[str, Any
 
     Returns
     -------
-    list of dict
+    tuple of MapCell
         The law's cells (:func:`map_cells`).
     """
     return map_cells([law], cfg, s)[0]
@@ -531,7 +540,7 @@ def robust_maps(
     settings: RobustSettings | None = None,
     *,
     runner: Runner | None = None,
-) -> dict[str, Any]:
+) -> RobustMaps:
     """Evaluate every law on a grid of perturbations times a grid of initial states.
 
     Parameters
@@ -549,17 +558,16 @@ def robust_maps(
 
     Returns
     -------
-    dict
-        ``a_ratio``, ``w_max_ratio``, ``delay_samples`` (the grid axes), ``states``
-        (initial states per cell) and per law a list of cell summaries (``laws``),
-        in the order delay, w_max_ratio, a_ratio.
+    RobustMaps
+        The grid axes, the states per cell and each law's cells, in the order
+        delay, w_max_ratio, a_ratio.
 
     Examples
     --------
     >>> from ptoverify.config import paper_config
     >>> s = RobustSettings(n1=3, n2=3, rest=2, n_a=2, n_w=1, laws=("pd",))
     >>> maps = robust_maps(paper_config(), s)
-    >>> maps["states"], len(maps["laws"]["pd"])
+    >>> maps.states, len(maps.laws["pd"])
     (11, 4)
     """
     s = settings or RobustSettings()
@@ -570,8 +578,8 @@ def robust_maps(
     return maps_dict(cfg, s, dict(zip(s.laws, cells, strict=True)))
 
 
-def maps_dict(cfg: Config, s: RobustSettings, laws: dict) -> dict[str, Any]:
-    """Build the ``maps`` object: the grid axes, the states per cell, each law's cells.
+def maps_dict(cfg: Config, s: RobustSettings, laws: dict) -> RobustMaps:
+    """Build the maps: the grid axes, the states per cell, each law's cells.
 
     Parameters
     ----------
@@ -584,14 +592,14 @@ def maps_dict(cfg: Config, s: RobustSettings, laws: dict) -> dict[str, Any]:
 
     Returns
     -------
-    dict
+    RobustMaps
         See :func:`robust_maps`.
     """
     ars, wrs, delays = _map_axes(cfg, s)
-    return {
-        "a_ratio": ars,
-        "w_max_ratio": wrs,
-        "delay_samples": delays,
-        "states": int(map_states(cfg, s)[0].size),
-        "laws": laws,
-    }
+    return RobustMaps(
+        a_ratio=tuple(ars),
+        w_max_ratio=tuple(wrs),
+        delay_samples=tuple(delays),
+        states=int(map_states(cfg, s)[0].size),
+        laws={law: tuple(cells) for law, cells in laws.items()},
+    )

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -31,6 +30,7 @@ from ptoverify.studies.robust.maps import (
     map_states,
     nominal_law,
 )
+from ptoverify.studies.robust.results import LawMargins, Margin, MostRobust
 
 __all__ = [
     "MARGIN_RANGE",
@@ -136,7 +136,7 @@ def linear_loop_radii(
     return np.abs(np.linalg.eigvals(mats)).max(axis=-1)
 
 
-def linear_loop_margin(law: str, cfg: Config, *, delay_samples: int = 0) -> dict[str, Any]:
+def linear_loop_margin(law: str, cfg: Config, *, delay_samples: int = 0) -> Margin:
     """Largest interval of a_true / a_design around 1 where the sampled linear loop is stable.
 
     The linear loop is PD's u = -kp x1 - kd x2 or the PTO's linear zone
@@ -156,39 +156,35 @@ def linear_loop_margin(law: str, cfg: Config, *, delay_samples: int = 0) -> dict
 
     Returns
     -------
-    dict
-        ``linear_loop_a_ratio_stable`` (``..._delay1`` with a delay): [lo, hi] with
-        each endpoint the last stable ratio to 1e-12 relative (``None`` where
-        stability reaches past the searched range [0.1, 10]), or ``None`` with a
-        note when there is no linear loop or it is unstable at the design point.
+    Margin
+        ``interval`` (lo, hi) [-] with each endpoint the last stable ratio to 1e-12
+        relative (None where stability reaches past the searched range [0.1, 10]),
+        or None with a ``note`` when there is no linear loop or it is unstable at
+        the design point.
 
     Examples
     --------
     >>> from ptoverify.config import paper_config
-    >>> lo, hi = linear_loop_margin("pd", paper_config())["linear_loop_a_ratio_stable"]
+    >>> lo, hi = linear_loop_margin("pd", paper_config()).interval
     >>> lo is None and hi > 1.0
     True
     """
     if delay_samples not in (0, 1):
         raise InputError(f"linear_loop_margin: delay_samples must be 0 or 1, got {delay_samples}")
-    key = "linear_loop_a_ratio_stable" + ("_delay1" if delay_samples else "")
-    note = key.replace("_a_ratio_stable", "_note")
     if _linear_gains(law, cfg) is None:
-        return {key: None, note: "no linear loop"}
+        return Margin(None, "no linear loop")
 
     def stable(ratios: NDArray) -> NDArray[np.bool_]:
         return linear_loop_radii(law, cfg, ratios, delay_samples=delay_samples) < 1.0
 
     if not stable(np.array([1.0]))[0]:
-        return {key: None, note: "unstable at the design point"}
-    lo = _edge(stable, MARGIN_RANGE[0])
-    hi = _edge(stable, MARGIN_RANGE[1])
-    return {key: [lo, hi], note: ""}
+        return Margin(None, "unstable at the design point")
+    return Margin((_edge(stable, MARGIN_RANGE[0]), _edge(stable, MARGIN_RANGE[1])))
 
 
 def no_limit_cycle_margin(
     law: LawSpec, cfg: Config, settings: RobustSettings | None = None, *, rtol: float = 1e-3
-) -> dict[str, Any]:
+) -> Margin:
     """Interval of a_true / a_design around 1 with no limit cycle from any grid state.
 
     Saturation, delay and measurement stay nominal (ratio 1, no delay, exact
@@ -210,9 +206,9 @@ def no_limit_cycle_margin(
 
     Returns
     -------
-    dict
-        ``no_limit_cycle_a_ratio``: [lo, hi] (``None`` endpoints beyond [0.1, 10]),
-        or ``None`` with a note when the nominal loop already has a limit cycle.
+    Margin
+        ``interval`` (lo, hi) [-] (None endpoints beyond [0.1, 10]), or None with a
+        ``note`` when the nominal loop already has a limit cycle.
     """
     s = settings or RobustSettings()
     job = margin_job(nominal_law(law, cfg), cfg, s, rtol=rtol)
@@ -225,7 +221,7 @@ MARGIN_PROBE_RATIOS = 16  #: ratios per probe of a margin scan
 
 def margin_job(
     fn: Law, cfg: Config, s: RobustSettings, *, rtol: float = 1e-3
-) -> Callable[[Callable[[list[Probe]], list[dict[str, NDArray]]]], dict[str, Any]]:
+) -> Callable[[Callable[[list[Probe]], list[dict[str, NDArray]]]], Margin]:
     """:func:`no_limit_cycle_margin` as a job of :func:`ptoverify.sim.lockstep.run_together`.
 
     Parameters
@@ -248,7 +244,7 @@ def margin_job(
     x1, x2 = map_states(cfg, s)
     n = x1.size
 
-    def job(ev: Callable[[list[Probe]], list[dict[str, NDArray]]]) -> dict[str, Any]:
+    def job(ev: Callable[[list[Probe]], list[dict[str, NDArray]]]) -> Margin:
         def clean(ratios: NDArray) -> NDArray[np.bool_]:
             """No limit cycle from any grid state, for each ratio."""
             step = MARGIN_PROBE_RATIOS
@@ -270,9 +266,8 @@ def margin_job(
             return ~(np.concatenate(lc) > 0).any(axis=1)
 
         if not clean(np.array([1.0]))[0]:
-            return {"no_limit_cycle_a_ratio": None, "no_limit_cycle_note": "limit cycles nominally"}
-        lo, hi = _edges(clean, grid=40, rtol=rtol)
-        return {"no_limit_cycle_a_ratio": [lo, hi], "no_limit_cycle_note": ""}
+            return Margin(None, "limit cycles nominally")
+        return Margin(_edges(clean, grid=40, rtol=rtol))
 
     return job
 
@@ -333,34 +328,35 @@ def _edges(
     return lo, hi
 
 
-def most_robust(margins: dict[str, Any]) -> dict[str, Any]:
+def most_robust(margins: dict[str, LawMargins]) -> MostRobust:
     """Which law's linear loop tolerates the widest bandwidth error (log-width of the interval).
 
     Parameters
     ----------
     margins : dict
-        Per law, the output of :func:`linear_loop_margin`.
+        Law -> its margins (only ``linear`` is read).
 
     Returns
     -------
-    dict
-        ``law`` and ``log_width`` per law (ln(hi/lo), endpoints beyond the searched
-        range taken at the range's ends), or ``law`` None when no law has a margin.
+    MostRobust
+        ``law`` and ``log_width`` per law (ln(hi/lo) [-], endpoints beyond the
+        searched range taken at the range's ends); ``law`` None when no law has
+        a margin.
 
     Examples
     --------
-    >>> most_robust({"pd": {"linear_loop_a_ratio_stable": [0.5, 2.0]},
-    ...              "to": {"linear_loop_a_ratio_stable": None}})["law"]
+    >>> m = lambda iv: LawMargins(Margin(iv), Margin(None))
+    >>> most_robust({"pd": m((0.5, 2.0)), "to": m(None)}).law
     'pd'
     """
     widths: dict[str, float] = {}
     for law, m in margins.items():
-        iv = m.get("linear_loop_a_ratio_stable")
+        iv = m.linear.interval
         if iv is None:
             continue
         lo = iv[0] if iv[0] is not None else MARGIN_RANGE[0]
         hi = iv[1] if iv[1] is not None else MARGIN_RANGE[1]
         widths[law] = math.log(hi / lo)
     if not widths:
-        return {"law": None, "log_width": {}}
-    return {"law": max(widths, key=widths.get), "log_width": widths}
+        return MostRobust(None, {})
+    return MostRobust(max(widths, key=widths.get), widths)

@@ -44,6 +44,7 @@ from ptoverify.studies.robust.maps import (
     evaluate_probes,
     nominal_law,
 )
+from ptoverify.studies.robust.results import CaseParams, MapCell, Start, WorstCase
 
 __all__ = ["worst_case", "worst_cases", "search_jobs", "grid_worst", "merge_found"]
 
@@ -56,9 +57,9 @@ def worst_case(
     law: LawSpec,
     prop: str,
     cfg: Config,
-    grid_worst: list[dict[str, Any]],
+    grid_worst: list[Start],
     settings: RobustSettings | None = None,
-) -> dict[str, Any]:
+) -> WorstCase:
     """Search the box for the worst value of ``prop`` under ``law``.
 
     One property of :func:`worst_cases` (see there).
@@ -69,17 +70,15 @@ def worst_case(
         Law name and one of :data:`PROPERTIES`.
     cfg : Config
         Nominal configuration with its box.
-    grid_worst : list of dict
-        Starting points: each ``state`` [x1 mm, x2 mm/s], ``params``
-        (``a_ratio``, ``w_max_ratio``, ``delay_samples``) and ``value``.
+    grid_worst : list of Start
+        Starting points (:func:`grid_worst`), worst first.
     settings : RobustSettings, optional
         Population and generations.
 
     Returns
     -------
-    dict
-        ``grid`` (the best starting value), ``searched``, ``state`` and ``params``
-        (with the full mismatch: quantum, noise, seed), ``evaluations``.
+    WorstCase
+        The grid's and the searched worst, where, and the evaluations.
     """
     return worst_cases(law, cfg, {prop: grid_worst}, settings)[prop]
 
@@ -97,13 +96,13 @@ def _box_bounds(cfg: Config, prop: str) -> tuple[NDArray, NDArray]:
     return np.array(lo, dtype=float), np.array(hi, dtype=float)
 
 
-def grid_worst(cells: list[dict[str, Any]], prop: str, k: int = 4) -> list[dict[str, Any]]:
+def grid_worst(cells: Sequence[MapCell], prop: str, k: int = 4) -> list[Start]:
     """Return the ``k`` worst cells of a map for ``prop`` as search starting points.
 
     Parameters
     ----------
-    cells : list of dict
-        Cell summaries of one law (``robust_maps(...)["laws"][law]``).
+    cells : sequence of MapCell
+        The cells of one law (``robust_maps(...).laws[law]``).
     prop : str
         One of :data:`PROPERTIES`.
     k : int
@@ -111,21 +110,20 @@ def grid_worst(cells: list[dict[str, Any]], prop: str, k: int = 4) -> list[dict[
 
     Returns
     -------
-    list of dict
-        ``state`` [x1 mm, x2 mm/s], ``value``, ``params`` of each cell, worst first.
+    list of Start
+        Each cell's worst state of ``prop`` and its perturbation, worst first
+        (cells with a non-finite worst left out).
     """
-    scored = [c for c in cells if math.isfinite(c[prop]["max"])]
-    scored.sort(key=lambda c: -c[prop]["max"])
+    scored = [c for c in cells if math.isfinite(c.prop(prop).max)]
+    scored.sort(key=lambda c: -c.prop(prop).max)
     return [
-        {
-            "state": c[prop]["state"],
-            "value": c[prop]["max"],
-            "params": {
-                "a_ratio": c["a_ratio"],
-                "w_max_ratio": c["w_max_ratio"],
-                "delay_samples": c["delay_samples"],
-            },
-        }
+        Start(
+            state=c.prop(prop).state,
+            value=c.prop(prop).max,
+            a_ratio=c.a_ratio,
+            w_max_ratio=c.w_max_ratio,
+            delay_samples=c.delay_samples,
+        )
         for c in scored[:k]
     ]
 
@@ -138,14 +136,14 @@ def _problems(cfg: Config, props: Sequence[str]) -> list[tuple[str, int]]:
 
 
 def _initial(
-    cfg: Config, prop: str, delay: int, starts: list[dict[str, Any]], size: int, rng
+    cfg: Config, prop: str, delay: int, starts: list[Start], size: int, rng
 ) -> NDArray[np.float64]:
     """Return the first population (size, 4): grid worst cells of ``delay``, then an LHS."""
     lo, hi = _box_bounds(cfg, prop)
     pop = lo + (hi - lo) * qmc.LatinHypercube(d=4, rng=rng).random(size)
-    mine = [g for g in starts if int(g["params"]["delay_samples"]) == delay]
+    mine = [g for g in starts if g.delay_samples == delay]
     for i, g in enumerate(mine[:size]):
-        z = np.array([*g["state"], g["params"]["a_ratio"], g["params"]["w_max_ratio"]])
+        z = np.array([*g.state, g.a_ratio, g.w_max_ratio])
         if prop == "overshoot_mm":  # from rest, x1_0 > 0 (the box's overshoot variables)
             z[0], z[1] = abs(z[0]), 0.0
         pop[i] = np.clip(z, lo, hi)
@@ -153,7 +151,7 @@ def _initial(
 
 
 def _search_job(
-    fn: Law, cfg: Config, prop: str, delay: int, starts: list[dict[str, Any]], s: RobustSettings
+    fn: Law, cfg: Config, prop: str, delay: int, starts: list[Start], s: RobustSettings
 ) -> Callable[[Callable[[list[Probe]], list[dict[str, NDArray]]]], dict[str, Any]]:
     """One differential evolution (law, property, delay) as a :func:`run_together` job.
 
@@ -217,7 +215,7 @@ def _search_job(
 
 
 def search_jobs(
-    fn: Law, cfg: Config, starts: dict[str, list[dict[str, Any]]], s: RobustSettings
+    fn: Law, cfg: Config, starts: dict[str, list[Start]], s: RobustSettings
 ) -> list[Callable]:
     """Return the jobs of one law's searches: one per property and delay of the box.
 
@@ -250,8 +248,8 @@ def search_jobs(
 
 
 def merge_found(
-    cfg: Config, starts: dict[str, list[dict[str, Any]]], found: list[dict[str, Any]]
-) -> dict[str, dict[str, Any]]:
+    cfg: Config, starts: dict[str, list[Start]], found: list[dict[str, Any]]
+) -> dict[str, WorstCase]:
     """Combine one law's search results (:func:`search_jobs`, in order) into its worst cases.
 
     Parameters
@@ -266,7 +264,7 @@ def merge_found(
     Returns
     -------
     dict
-        See :func:`worst_cases`.
+        Property -> :class:`WorstCase` (see :func:`worst_cases`).
     """
     box = cfg.robustness
     count = sum(f["count"] for f in found)
@@ -274,40 +272,39 @@ def merge_found(
     for prop in starts:
         best = {"value": -math.inf, "z": None, "delay": box.delay_samples[0]}
         for g in starts[prop][:1]:  # the grid's worst cell: a trajectory the maps simulated
-            pr = g["params"]
-            z0 = np.array([*g["state"], pr["a_ratio"], pr["w_max_ratio"]], dtype=float)
-            best = {"value": float(g["value"]), "z": z0, "delay": int(pr["delay_samples"])}
+            z0 = np.array([*g.state, g.a_ratio, g.w_max_ratio], dtype=float)
+            best = {"value": float(g.value), "z": z0, "delay": g.delay_samples}
         for f in found:  # in search order; ties keep the first
             if f[prop]["value"] > best["value"]:
                 best = f[prop]
-        vals = [float(g["value"]) for g in starts[prop]]
+        vals = [float(g.value) for g in starts[prop]]
         g = max(vals) if vals else -math.inf
         z, searched = best["z"], best["value"]
-        out[prop] = {
-            "grid": g if g > -math.inf else None,
-            "grid_unbounded": g == math.inf,
-            "searched": searched if searched > -math.inf else None,
-            "unbounded": searched == math.inf,  # e.g. never settles: JSON shows searched null
-            "state": [float(z[0]), float(z[1])] if z is not None else None,
-            "params": {
-                "a_ratio": float(z[2]) if z is not None else None,
-                "w_max_ratio": float(z[3]) if z is not None else None,
-                "delay_samples": int(best["delay"]),
-                "position_quantum": box.position_quantum,
-                "velocity_noise": box.velocity_noise,
-                "seed": box.seed,
-            },
-            "evaluations": count,
-        }
+        out[prop] = WorstCase(
+            grid=g if g > -math.inf else None,
+            grid_unbounded=g == math.inf,
+            searched=searched if searched > -math.inf else None,
+            unbounded=searched == math.inf,  # e.g. never settles (JSON: searched null)
+            state=(float(z[0]), float(z[1])) if z is not None else None,
+            params=CaseParams(
+                a_ratio=float(z[2]) if z is not None else None,
+                w_max_ratio=float(z[3]) if z is not None else None,
+                delay_samples=int(best["delay"]),
+                position_quantum=box.position_quantum,
+                velocity_noise=box.velocity_noise,
+                seed=box.seed,
+            ),
+            evaluations=count,
+        )
     return out
 
 
 def worst_cases(
     law: LawSpec,
     cfg: Config,
-    starts: dict[str, list[dict[str, Any]]],
+    starts: dict[str, list[Start]],
     settings: RobustSettings | None = None,
-) -> dict[str, dict[str, Any]]:
+) -> dict[str, WorstCase]:
     """Search the box for the worst value of each property in ``starts`` under ``law``.
 
     Variables: x1_0 [mm], x2_0 [mm/s] (for ``overshoot_mm`` x2_0 = 0 and
@@ -322,18 +319,16 @@ def worst_cases(
     cfg : Config
         Nominal configuration with its box.
     starts : dict
-        Property (of :data:`PROPERTIES`) -> starting points (:func:`grid_worst`):
-        each ``state`` [x1 mm, x2 mm/s], ``params`` (``a_ratio``, ``w_max_ratio``,
-        ``delay_samples``) and ``value``.
+        Property (of :data:`PROPERTIES`) -> starting points (:func:`grid_worst`).
     settings : RobustSettings, optional
         Population and generations.
 
     Returns
     -------
     dict
-        Per property: ``grid`` (the best starting value), ``searched``, ``state``
-        and ``params`` (with the full mismatch: quantum, noise, seed),
-        ``evaluations`` (trajectories simulated by this law's searches, all properties).
+        Property -> :class:`WorstCase`: the grid's worst (the best starting value),
+        the searched worst, where (state and the full mismatch: quantum, noise,
+        seed), ``evaluations`` (trajectories of this law's searches, all properties).
     """
     s = settings or RobustSettings()
     jobs = search_jobs(nominal_law(law, cfg), cfg, starts, s)

@@ -30,6 +30,7 @@ from ptoverify.studies.robust.maps import (
     robust_maps,
 )
 from ptoverify.studies.robust.margins import linear_loop_margin, margin_job, most_robust
+from ptoverify.studies.robust.results import LawMargins, RobustMaps, WorstCase
 from ptoverify.studies.robust.search import grid_worst, merge_found, search_jobs
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED, Verdict
 
@@ -46,23 +47,23 @@ class RobustResult:
         The nominal configuration (with its box).
     settings : RobustSettings
         Sizes of the study.
-    maps : dict
-        :func:`robust_maps`.
+    maps : RobustMaps
+        Every law's map cells (:func:`ptoverify.studies.robust.maps.robust_maps`).
     margins : dict
-        Per law: :func:`linear_loop_margin` and :func:`no_limit_cycle_margin`.
+        Law -> :class:`LawMargins` (empty when the settings skip the margins).
     worst : dict
-        Per law and property: :func:`worst_case`.
+        Law -> property -> :class:`WorstCase`.
     timings_s : dict
-        Wall time per stage [s].
+        Wall time per stage [s]: ``maps``, ``margins``, ``worst_case``, ``total``.
     backend : str
         ``in-process`` or the Dask scheduler used.
     """
 
     config: Config
     settings: RobustSettings
-    maps: dict[str, Any]
-    margins: dict[str, Any]
-    worst: dict[str, Any]
+    maps: RobustMaps
+    margins: dict[str, LawMargins]
+    worst: dict[str, dict[str, WorstCase]]
     timings_s: dict[str, float] = field(default_factory=dict)
     backend: str = "in-process"
 
@@ -71,10 +72,13 @@ class RobustResult:
         return _finite(
             {
                 "box": self.config.robustness.to_mapping(),
-                "margins": self.margins,
-                "worst": self.worst,
-                "maps": self.maps,
-                "most_robust": most_robust(self.margins),
+                "margins": {law: m.to_json() for law, m in self.margins.items()},
+                "worst": {
+                    law: {prop: w.to_json() for prop, w in by.items()}
+                    for law, by in self.worst.items()
+                },
+                "maps": self.maps.to_json(),
+                "most_robust": most_robust(self.margins).to_json(),
                 "timings_s": self.timings_s,
                 "backend": self.backend,
             }
@@ -127,17 +131,14 @@ def run_robust(
     t0 = time.perf_counter()
     report("margins", 0.0)
     linear = {
-        law: {
-            **linear_loop_margin(law, cfg),
-            **linear_loop_margin(law, cfg, delay_samples=1),
-        }
+        law: (linear_loop_margin(law, cfg), linear_loop_margin(law, cfg, delay_samples=1))
         for law in s.laws
     }
     t_linear = time.perf_counter() - t0
     report("maps", 0.05)
     t1 = time.perf_counter()
     if dask:
-        by_law = robust_maps(cfg, s, runner=dask_runner(dask))["laws"]
+        by_law = robust_maps(cfg, s, runner=dask_runner(dask)).laws
         cells = [by_law[law] for law in s.laws]
     else:
         cells = map_cells(s.laws, cfg, s, seconds=booked)
@@ -167,7 +168,9 @@ def run_robust(
         worst[law] = merge_found(cfg, st, results[at : at + len(js)])
         at += len(js)
     margins = (
-        {law: linear[law] | results[at + i] for i, law in enumerate(s.laws)} if s.margins else {}
+        {law: LawMargins(*linear[law], results[at + i]) for i, law in enumerate(s.laws)}
+        if s.margins
+        else {}
     )
     scans = booked.get("margins", 0.0)
     timings["margins"] = (t_linear if s.margins else 0.0) + scans
@@ -182,13 +185,13 @@ def run_robust(
 GATE_LAW = "pto"  #: the law the robustness gates judge (the corrected PTO)
 
 
-def describe_case(case: dict[str, Any]) -> str:
+def describe_case(case: WorstCase) -> str:
     """Describe a worst case in words, with units (no Python repr).
 
     Parameters
     ----------
-    case : dict
-        A :func:`worst_case` entry (``state`` [mm, mm/s] and ``params``).
+    case : WorstCase
+        A worst case (``state`` [mm, mm/s] and ``params``).
 
     Returns
     -------
@@ -198,21 +201,22 @@ def describe_case(case: dict[str, Any]) -> str:
 
     Examples
     --------
-    >>> describe_case({"state": [1.0, -2.0], "params": {"a_ratio": 1.25, "w_max_ratio": 1.0,
-    ...     "delay_samples": 1, "position_quantum": 0.001, "velocity_noise": 0.0, "seed": 0}})
+    >>> from ptoverify.studies.robust.results import CaseParams
+    >>> describe_case(WorstCase(0.5, False, 0.6, False, (1.0, -2.0),
+    ...     CaseParams(1.25, 1.0, 1, 0.001, 0.0, 0), 100))
     'x0 = (1 mm, -2 mm/s), a_true/a = 1.25, drive limit 1 w_max, delay 1 sample(s), encoder 0.001 mm, velocity noise 0 mm/s (seed 0)'
     """
-    x = case.get("state") or [float("nan"), float("nan")]
-    p = case.get("params") or {}
+    x = case.state or (None, None)
+    p = case.params
 
     def g(v: Any) -> str:
         return "?" if v is None else f"{float(v):.4g}"
 
     return (
-        f"x0 = ({g(x[0])} mm, {g(x[1])} mm/s), a_true/a = {g(p.get('a_ratio'))}, "
-        f"drive limit {g(p.get('w_max_ratio'))} w_max, delay {p.get('delay_samples')} sample(s), "
-        f"encoder {g(p.get('position_quantum'))} mm, velocity noise "
-        f"{g(p.get('velocity_noise'))} mm/s (seed {p.get('seed')})"
+        f"x0 = ({g(x[0])} mm, {g(x[1])} mm/s), a_true/a = {g(p.a_ratio)}, "
+        f"drive limit {g(p.w_max_ratio)} w_max, delay {p.delay_samples} sample(s), "
+        f"encoder {g(p.position_quantum)} mm, velocity noise "
+        f"{g(p.velocity_noise)} mm/s (seed {p.seed})"
     )
 
 
@@ -238,8 +242,8 @@ def robust_gates(result: RobustResult, law: str = GATE_LAW) -> list[Verdict]:
     box = result.config.robustness
     worst = result.worst.get(law, {})
     out = []
-    lc = worst.get("limit_cycle_mm", {})
-    v = lc.get("searched")
+    lc = worst.get("limit_cycle_mm")
+    v = None if lc is None else lc.searched
     where = f" at {describe_case(lc)}" if v else ""
     if v is None:
         out.append(
@@ -266,10 +270,10 @@ def robust_gates(result: RobustResult, law: str = GATE_LAW) -> list[Verdict]:
                 "mm",
             )
         )
-    st = worst.get("settling_ratio_nt", {})
-    v = st.get("searched")
+    st = worst.get("settling_ratio_nt")
+    v = None if st is None else st.searched
     limit = box.settling_ratio_limit
-    if v is None and not st.get("unbounded"):
+    if st is None or (v is None and not st.unbounded):
         out.append(
             Verdict(
                 "robust-settling",
@@ -282,7 +286,7 @@ def robust_gates(result: RobustResult, law: str = GATE_LAW) -> list[Verdict]:
             )
         )
     else:
-        value = math.inf if st.get("unbounded") else float(v)
+        value = math.inf if st.unbounded else float(v)
         out.append(
             Verdict(
                 "robust-settling",
