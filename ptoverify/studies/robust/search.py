@@ -33,6 +33,7 @@ from scipy.optimize import differential_evolution
 from scipy.stats import qmc
 
 from ptoverify.config import Config
+from ptoverify.errors import InputError
 from ptoverify.model.laws import Law
 from ptoverify.sim.lockstep import Ask, run_together
 from ptoverify.sim.simulate import Mismatch
@@ -236,9 +237,7 @@ def search_jobs(
         Jobs of :func:`ptoverify.sim.lockstep.run_together`; their results go to
         :func:`merge_found`.
     """
-    if s.search_population < 5:
-        from ptoverify.errors import InputError
-
+    if s.search_population < 5:  # SciPy's differential evolution needs five members
         raise InputError(
             f"robust: the search population must be at least 5, got {s.search_population}"
         )
