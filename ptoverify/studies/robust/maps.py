@@ -379,10 +379,13 @@ class Probe:
         The law, initial states [mm], [mm/s] and mismatch (per-state arrays allowed).
     settle : bool
         Also measure the settling ratio (needs N* of each true plant).
+    cycles_only : bool
+        Measure the limit-cycle amplitude only (the margin scans need nothing else).
     """
 
     ask: Ask
     settle: bool = True
+    cycles_only: bool = False
 
 
 def evaluate_probes(
@@ -412,11 +415,13 @@ def evaluate_probes(
     list of dict
         Per probe, arrays of shape (n,): ``stride_overs`` [-], ``limit_cycle_mm`` [mm],
         ``overshoot_mm`` [mm], and with ``settle`` ``settling_s`` [s] and
-        ``settling_ratio_nt`` [-].
+        ``settling_ratio_nt`` [-]; with ``cycles_only`` ``limit_cycle_mm`` alone.
     """
 
     def measure(k: int, b: BatchResult) -> dict[str, NDArray[np.float64]]:
         ask = probes[k].ask
+        if probes[k].cycles_only:
+            return {"limit_cycle_mm": _limit_cycle_mm(b.x1)}
         return _measure(b, cfg, ask.x1, ask.x2, b.mismatch, probes[k].settle, with_tf=False)
 
     return simulate_asks(

@@ -259,6 +259,7 @@ def margin_job(
                         stage="margins",
                     ),
                     settle=False,
+                    cycles_only=True,
                 )
                 for r in parts
             ]
