@@ -1,7 +1,7 @@
 """Batched simulation of the robustness study against the simple per-case simulation.
 
-``simulate_segments`` (several laws and mismatches in one run) and
-``run_lockstep`` (jobs gathered into rounds) must give each case exactly what
+``simulate_segments`` (several laws and mismatches in one run), ``simulate_asks``
+(asks in runs) and ``run_together`` (searches side by side) must give each case exactly what
 the case simulated alone gives: ``simulate_batch`` with its own mismatch, and
 that in turn the independent scalar loop (``plant.flow`` per sample, a delay
 line, a quantizer, ``law.scalar``).  The study's results must not depend on how
@@ -17,7 +17,7 @@ import pytest
 from ptoverify.config import paper_config
 from ptoverify.model.laws import Region, make_law
 from ptoverify.model.plant import flow
-from ptoverify.sim.lockstep import Ask, run_lockstep
+from ptoverify.sim.lockstep import Ask, run_together, simulate_asks
 from ptoverify.sim.simulate import Mismatch, simulate_batch, simulate_segments
 from ptoverify.studies.robust import (
     RobustSettings,
@@ -122,58 +122,77 @@ def test_segments_against_the_independent_scalar_loop(seed):
         np.testing.assert_allclose(both.x2[:, j], ref[:, 1], rtol=1e-9, atol=1e-7, err_msg=law.name)
 
 
-def test_lockstep_results_do_not_depend_on_rounds():
-    """The same jobs in rounds of 1 state or all at once give the same trajectories."""
-    rng = np.random.default_rng(7)
-    steps = 80
+def test_run_together_merges_batches_and_stops_on_errors():
+    """One batch per round, in job order; a failing batch stops every job waiting on it."""
+    calls = []
 
-    def job(law, x1, x2, m, rider):
-        (b,) = yield [Ask(law, x1, x2, m, rider=rider)]
-        (again,) = yield [Ask(law, b.x1[-1].copy(), b.x2[-1].copy(), m, rider=rider)]
-        return np.concatenate([b.x1, again.x1[1:]])
+    def batch_fn(xs):
+        calls.append(list(xs))
+        if any(x < 0 for x in xs):
+            raise ValueError("negative")
+        return [2 * x for x in xs]
 
-    def jobs():
-        out = []
-        for i, name in enumerate(["pd", "pto", "to", "pto"]):
-            x1, x2 = rng.uniform(-30.0, 30.0, 3), rng.uniform(-200.0, 200.0, 3)
-            out.append((LAWS[name], x1, x2, _random_case(rng, 3), i % 2 == 1))
-        return out
+    def job(k):
+        return lambda ev: [ev([k, k + 10]), ev([k + 20])]
 
-    cases = jobs()
-    wide = run_lockstep([job(*c) for c in cases], P, steps)
-    narrow = run_lockstep([job(*c) for c in cases], P, steps, round_states=1)
-    assert wide.rounds < narrow.rounds
-    for (law, x1, x2, m, _), a, b in zip(cases, wide.results, narrow.results, strict=True):
-        assert np.array_equal(a, b)
-        alone = simulate_batch(law, P, x1, x2, steps, mismatch=m)
-        assert np.array_equal(a[: steps + 1], alone.x1)
+    got = run_together(batch_fn, [job(k) for k in (1, 2, 3)])
+    assert got == [[[2 * k, 2 * k + 20], [2 * k + 40]] for k in (1, 2, 3)]
+    assert calls == [[1, 11, 2, 12, 3, 13], [21, 22, 23]], "one batch per round, job order"
+    with pytest.raises(ValueError, match="negative"):
+        run_together(batch_fn, [lambda ev: ev([1]), lambda ev: ev([-1]), lambda ev: None])
+
+
+def test_run_together_equals_the_jobs_one_by_one():
+    """Jobs of different lengths (one finishes early, one asks nothing) get what the
+    batch function alone gives them; the batches are fewer."""
+    calls = []
+
+    def batch_fn(xs):
+        calls.append(len(xs))
+        return [x**2 + 1 for x in xs]
+
+    def job(k, rounds):
+        def run(ev):
+            x, out = k, []
+            for _ in range(rounds):
+                (x,) = ev([x % 97])
+                out.append(x)
+            return out
+
+        return run
+
+    jobs = [job(3, 4), job(5, 1), job(7, 0), job(11, 6)]
+    alone = [j(batch_fn) for j in jobs]
+    n_alone = len(calls)
+    calls.clear()
+    assert run_together(batch_fn, jobs) == alone
+    assert len(calls) == 6 < n_alone
 
 
 @pytest.mark.parametrize("round_states", [1, 5, 10_000])
-def test_lockstep_reusing_memory_gives_the_same_trajectories(round_states):
-    """reuse=True (one memory for every round's trajectories) sends each job what fresh
-    arrays give, also for asks of one yield simulated in different rounds (round_states
-    1: the earlier ones are kept as copies while the job waits for the rest)."""
-    rng = np.random.default_rng(11)
-    steps = 60
-
-    def job(law, x1, x2, m):
-        kept = []
-        for _ in range(3):  # three yields of two asks each; a copy of what it keeps
-            a, b = yield [Ask(law, x1, x2, m), Ask(law, -x1, x2[::-1].copy(), m)]
-            kept.append(np.concatenate([a.x1, a.x2, a.u, a.region, b.x1, b.region], axis=None))
-            x1, x2 = a.x1[-1].copy(), b.x2[-1].copy()
-        return np.concatenate(kept)
-
-    cases = []
-    for name in ("pd", "pto", "to", "pto-printed"):
+def test_simulate_asks_does_not_depend_on_run_size(round_states):
+    """Asks in runs of any size give each ask what simulate_batch gives it alone."""
+    rng = np.random.default_rng(7)
+    steps = 80
+    asks = []
+    for name in ("pd", "pto", "to", "pto", "pto-printed"):
         x1, x2 = rng.uniform(-30.0, 30.0, 3), rng.uniform(-200.0, 200.0, 3)
-        cases.append((LAWS[name], x1, x2, _random_case(rng, 3)))
-    fresh = run_lockstep([job(*c) for c in cases], P, steps, round_states=round_states)
-    reused = run_lockstep([job(*c) for c in cases], P, steps, round_states=round_states, reuse=True)
-    assert fresh.rounds == reused.rounds
-    for a, b in zip(fresh.results, reused.results, strict=True):
-        assert np.array_equal(a, b)
+        asks.append(Ask(LAWS[name], x1, x2, _random_case(rng, 3), stage=name))
+    seconds = {}
+    got = simulate_asks(
+        asks,
+        P,
+        steps,
+        lambda k, b: (k, b.x1.copy(), b.region.copy()),
+        round_states=round_states,
+        seconds=seconds,
+    )
+    for k, (ask, (j, x1, region)) in enumerate(zip(asks, got, strict=True)):
+        alone = simulate_batch(ask.law, P, ask.x1, ask.x2, steps, mismatch=ask.mismatch)
+        assert j == k
+        assert np.array_equal(x1, alone.x1) and np.array_equal(region, alone.region), k
+    assert set(seconds) == {"pd", "pto", "to", "pto-printed"}
+    assert all(v >= 0.0 for v in seconds.values())
 
 
 TINY = RobustSettings(n1=5, n2=4, rest=4, n_a=3, n_w=2, search_iterations=2, search_population=6)
@@ -185,14 +204,14 @@ def _same(a, b) -> bool:
 
 
 def test_study_does_not_depend_on_round_size(monkeypatch):
-    """Maps, margins and worst cases with rounds of one ask each equal the default rounds."""
-    import ptoverify.studies.robust as robust_mod
+    """Maps, margins and worst cases with runs of one state each equal the default runs."""
+    import ptoverify.studies.robust.maps as maps_mod
 
     box = dataclasses.replace(CFG.robustness, velocity_noise=1.0, delay_samples=(0, 2))
     cfg = dataclasses.replace(CFG, robustness=box)
     s = dataclasses.replace(TINY, laws=("pd",))
     wide = run_robust(cfg, s).to_json()
-    monkeypatch.setattr(robust_mod, "BATCH_STATES", 1)
+    monkeypatch.setattr(maps_mod, "BATCH_STATES", 1)
     narrow = run_robust(cfg, s).to_json()
     for key in ("maps", "margins", "worst"):
         assert _same(wide[key], narrow[key]), key
@@ -202,12 +221,16 @@ def test_study_parts_equal_the_parts_run_alone():
     """run_robust's interleaved simulations give what each part gives run on its own."""
     s = dataclasses.replace(TINY, laws=("pto", "pd"))
     res = run_robust(CFG, s)
-    assert _same(res.maps, robust_maps(CFG, s))
+    assert _same(res.maps.to_json(), robust_maps(CFG, s).to_json())
     for law in s.laws:
         alone = no_limit_cycle_margin(law, CFG, s)
-        assert _same({k: res.margins[law][k] for k in alone}, alone)
-        starts = {p: grid_worst(res.maps["laws"][law], p) for p in s.properties}
-        assert _same(res.worst[law], worst_cases(law, CFG, starts, s))
+        assert res.margins[law].no_limit_cycle == alone
+        starts = {p: grid_worst(res.maps.laws[law], p) for p in s.properties}
+        alone = worst_cases(law, CFG, starts, s)
+        assert _same(
+            {p: w.to_json() for p, w in res.worst[law].items()},
+            {p: w.to_json() for p, w in alone.items()},
+        )
 
 
 @pytest.mark.parametrize("n", [4, 400])

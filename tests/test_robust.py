@@ -14,17 +14,17 @@ from ptoverify.sim.simulate import Mismatch, simulate_batch
 from ptoverify.studies.properties import default_steps, initial_grid, law_properties, oscillating
 from ptoverify.studies.robust import (
     RobustSettings,
-    choices_without_replacement,
     grid_worst,
     horizon_steps,
-    latin_hypercube,
     linear_loop_margin,
     linear_loop_radii,
     map_states,
     no_limit_cycle_margin,
     robust_maps,
+    run_robust,
     trajectory_properties,
     worst_case,
+    worst_cases,
 )
 
 CFG = paper_config()
@@ -117,12 +117,12 @@ def test_zero_box_maps_equal_nominal_simulation():
     )
     cfg = dataclasses.replace(CFG, robustness=box)
     maps = robust_maps(cfg, dataclasses.replace(TINY, laws=("to",)))
-    (cell,) = maps["laws"]["to"]
+    (cell,) = maps.laws["to"]
     x1, x2 = map_states(cfg, TINY)
     nominal = simulate_batch(make_law("to", CFG), CFG.plant, x1, x2, horizon_steps(cfg))
     window = nominal.x1[-max(20, horizon_steps(cfg) // 4) :]
-    assert cell["limit_cycle_states"] == int(oscillating(window, 1e-3).sum())
-    assert cell["limit_cycle_states"] > 0, "sampled TO limit-cycles nominally (a known finding)"
+    assert cell.limit_cycle_states == int(oscillating(window, 1e-3).sum())
+    assert cell.limit_cycle_states > 0, "sampled TO limit-cycles nominally (a known finding)"
 
 
 @pytest.mark.parametrize("law_name, gains", [("pd", ("kp", "kd")), ("pto", ("k1", "k2"))])
@@ -139,7 +139,7 @@ def test_linear_margin_endpoints_against_independent_eigenvalues(law_name, gains
         Ad, Bd, *_ = cont2discrete((A, B, np.eye(2), np.zeros((2, 1))), p.sample_time, method="zoh")
         return np.abs(np.linalg.eigvals(Ad - Bd @ k)).max()
 
-    lo, hi = linear_loop_margin(law_name, CFG)["linear_loop_a_ratio_stable"]
+    lo, hi = linear_loop_margin(law_name, CFG).interval
     for end in (lo, hi):
         if end is not None:
             assert abs(radius(end) - 1.0) < 1e-9, f"spectral radius at the endpoint {end}"
@@ -179,12 +179,12 @@ def test_linear_loop_radii_against_scipy_and_one_by_one(law_name):
 
 
 def test_linear_margin_of_to_is_none_and_unstable_design_is_reported():
-    assert linear_loop_margin("to", CFG)["linear_loop_a_ratio_stable"] is None
+    assert linear_loop_margin("to", CFG).interval is None
 
     bad = dataclasses.replace(CFG, pd=dataclasses.replace(CFG.pd, kp=1e5))
     assert sampled_spectral_radius(bad.plant.a, bad.plant.T, 1e5, bad.pd.kd) > 1
     m = linear_loop_margin("pd", bad)
-    assert m["linear_loop_a_ratio_stable"] is None and "unstable" in m["linear_loop_note"]
+    assert m.interval is None and "unstable" in m.note
 
 
 def _trap_law(cfg):
@@ -209,18 +209,18 @@ def test_search_finds_planted_worst_case_the_grid_misses(seed):
     s = RobustSettings(n1=7, n2=6, rest=6, n_a=3, n_w=2, search_iterations=20, search_population=40)
     box = dataclasses.replace(CFG.robustness, delay_samples=(0, 0), seed=seed)
     cfg = dataclasses.replace(CFG, robustness=box)
-    (cells,) = robust_maps(cfg, dataclasses.replace(s, laws=(_trap_law,)))["laws"].values()
-    assert all(c["not_settled"] == 0 for c in cells), "the grid must miss the trap"
+    (cells,) = robust_maps(cfg, dataclasses.replace(s, laws=(_trap_law,))).laws.values()
+    assert all(c.not_settled == 0 for c in cells), "the grid must miss the trap"
     w = worst_case(_trap_law, "settling_ratio_nt", cfg, grid_worst(cells, "settling_ratio_nt"), s)
-    assert w["grid"] is not None
-    assert w["unbounded"] and w["searched"] == math.inf, "the search did not find the trap"
-    x1, x2 = w["state"]
+    assert w.grid is not None
+    assert w.unbounded and w.searched == math.inf, "the search did not find the trap"
+    x1, x2 = w.state
     # reproducible: the reported state and parameters never settle either
     m = Mismatch(
-        a_ratio=w["params"]["a_ratio"],
-        w_max_ratio=w["params"]["w_max_ratio"],
-        delay_samples=w["params"]["delay_samples"],
-        position_quantum=w["params"]["position_quantum"],
+        a_ratio=w.params.a_ratio,
+        w_max_ratio=w.params.w_max_ratio,
+        delay_samples=w.params.delay_samples,
+        position_quantum=w.params.position_quantum,
     )
     again = trajectory_properties(_trap_law, cfg, np.array([x1]), np.array([x2]), m)
     assert again["settling_ratio_nt"][0] == math.inf
@@ -261,7 +261,7 @@ def test_no_limit_cycle_margin_against_a_brute_force_scan():
         )
         return not (props["limit_cycle_mm"] > 0).any()
 
-    lo, hi = no_limit_cycle_margin("pto", CFG, TINY, rtol=1e-3)["no_limit_cycle_a_ratio"]
+    lo, hi = no_limit_cycle_margin("pto", CFG, TINY, rtol=1e-3).interval
     assert hi is not None and 1.0 < hi < 10.0
     assert clean(hi), f"limit cycle at the reported edge {hi}"
     scan = np.geomspace(1.0, 10.0, 40)
@@ -273,126 +273,38 @@ def test_no_limit_cycle_margin_against_a_brute_force_scan():
 
 def test_maps_do_not_depend_on_batching(monkeypatch):
     """Cells simulated together or in batches of one cell give the same maps, bit for bit."""
-    import ptoverify.studies.robust as robust_mod
+    import ptoverify.studies.robust.maps as maps_mod
 
     s = dataclasses.replace(TINY, laws=("pto",))
     together = robust_maps(CFG, s)
-    monkeypatch.setattr(robust_mod, "BATCH_STATES", 1)
-    assert robust_maps(CFG, s) == together
+    monkeypatch.setattr(maps_mod, "BATCH_STATES", 1)
+    assert robust_maps(CFG, s).to_json() == together.to_json()
 
 
-@pytest.mark.parametrize("seed", [0, 7, 12345])
-@pytest.mark.parametrize(("n", "d"), [(1, 4), (13, 4), (40, 3)])
-def test_latin_hypercube_draws_as_scipy_does(seed, n, d):
-    """The search's own LHS equals SciPy's scrambled LatinHypercube draw for draw,
-    leaves the parent generator where SciPy leaves it, and is a Latin hypercube."""
-    from scipy.stats import qmc
-
-    mine_rng, ref_rng = np.random.default_rng(seed), np.random.default_rng(seed)
-    mine = latin_hypercube(mine_rng, n, d)
-    ref = qmc.LatinHypercube(d=d, rng=ref_rng).random(n)
-    np.testing.assert_array_equal(mine, ref)
-    assert mine_rng.random() == ref_rng.random()
-    assert ((mine >= 0) & (mine < 1)).all()
-    for col in mine.T:  # exactly one point per stratum [j/n, (j+1)/n)
-        assert sorted(np.floor(col * n).astype(int)) == list(range(n))
+def test_search_is_deterministic_for_a_seed():
+    """Two runs of the seeded search give the same worst cases; another seed differs."""
+    s = dataclasses.replace(TINY, laws=("pto",))
+    (cells,) = robust_maps(CFG, s).laws.values()
+    starts = {p: grid_worst(cells, p) for p in ("overshoot_mm", "settling_ratio_nt")}
+    one = worst_cases("pto", CFG, starts, s)
+    assert worst_cases("pto", CFG, starts, s) == one
+    other = dataclasses.replace(CFG, robustness=dataclasses.replace(CFG.robustness, seed=5))
+    assert worst_cases("pto", other, starts, s) != one, "the seed does not reach the search"
+    for prop, w in one.items():
+        assert w.searched >= w.grid, f"{prop}: searched below the grid's worst"
 
 
-@pytest.mark.parametrize("seed", range(40))
-@pytest.mark.parametrize(
-    ("pop", "k", "times"),
-    [(23, 2, 24), (23, 3, 24), (5, 4, 7), (2, 1, 3), (1, 1, 2), (20000, 5, 4), (3 * 10**9, 2, 40)],
-)
-def test_choices_without_replacement_draws_as_numpy_does(seed, pop, k, times):
-    """The search's batched draws equal NumPy's Generator.choice calls one by one, and
-    leave the generator where they leave it (an odd 32-bit draw first: a buffered half
-    word; the last case redraws often, Lemire's rejection, so it runs the calls)."""
-    mine_rng, ref_rng = np.random.default_rng(seed), np.random.default_rng(seed)
-    if seed % 2:
-        mine_rng.integers(0, 2**32, dtype=np.uint32), ref_rng.integers(0, 2**32, dtype=np.uint32)
-    mine = choices_without_replacement(mine_rng, pop, k, times)
-    ref = [ref_rng.choice(pop, k, replace=False).tolist() for _ in range(times)]
-    assert mine.tolist() == ref
-    assert mine_rng.integers(0, 2**32, dtype=np.uint32) == ref_rng.integers(
-        0, 2**32, dtype=np.uint32
-    )
-    assert mine_rng.random() == ref_rng.random()
+def test_search_population_below_five_is_an_input_error():
+    from ptoverify.errors import InputError
 
-
-@pytest.mark.parametrize(("pop", "k", "times"), [(5, 0, 3), (0, 0, 2), (5, 0, 0), (4, 4, 3)])
-def test_choices_without_replacement_edge_sizes_draw_as_numpy_does(pop, k, times):
-    """No picks (k = 0) and every member (k = pop): NumPy's calls, one by one."""
-    mine_rng, ref_rng = np.random.default_rng(9), np.random.default_rng(9)
-    mine = choices_without_replacement(mine_rng, pop, k, times)
-    ref = [ref_rng.choice(pop, k, replace=False).tolist() for _ in range(times)]
-    assert mine.shape == (times, k) and mine.tolist() == ref
-    assert mine_rng.bit_generator.state == ref_rng.bit_generator.state
-
-
-def test_choices_fall_back_to_numpy_where_its_algorithm_differs(monkeypatch):
-    """The batch is checked against this NumPy's Generator.choice once per process; a
-    batch that draws differently (as a NumPy release changing its algorithm would) is
-    never used: every draw is then NumPy's own call."""
-    import ptoverify.studies.robust as robust_mod
-
-    real = robust_mod._floyd_batch
-
-    def off_by_one(rng, pop, k, times):
-        picks = real(rng, pop, k, times)
-        return None if picks is None else (picks + 1) % pop
-
-    monkeypatch.setattr(robust_mod, "_floyd_batch", off_by_one)
-    robust_mod._floyd_is_numpys.cache_clear()
-    try:
-        assert not robust_mod._floyd_is_numpys()
-        mine_rng, ref_rng = np.random.default_rng(5), np.random.default_rng(5)
-        mine = choices_without_replacement(mine_rng, 23, 3, 24)
-        ref = [ref_rng.choice(23, 3, replace=False).tolist() for _ in range(24)]
-        assert mine.tolist() == ref and mine_rng.random() == ref_rng.random()
-    finally:
-        robust_mod._floyd_is_numpys.cache_clear()
-
-
-@pytest.mark.parametrize(
-    ("n1", "box"),
-    [
-        (7, {}),
-        (6, {"position_quantum": 0.02, "delay_samples": (0, 2), "a_ratio": (0.5, 2.0)}),
-    ],
-)
-def test_mirrored_maps_equal_simulating_every_state(monkeypatch, n1, box):
-    """Without noise the maps simulate one state of each mirrored pair: the maps equal
-    those with every state simulated, bit for bit, for every law (odd and even grids,
-    a coarse quantizer, delays, a wide box)."""
-    import ptoverify.studies.robust as robust_mod
-
-    cfg = dataclasses.replace(CFG, robustness=dataclasses.replace(CFG.robustness, **box))
-    s = dataclasses.replace(TINY, n1=n1, n2=7, rest=10)
-    x1, x2 = map_states(cfg, s)
-    assert np.array_equal(np.sort(x1), np.sort(-x1)) and np.array_equal(np.sort(x2), np.sort(-x2))
-    halved = robust_maps(cfg, s)
-    monkeypatch.setattr(robust_mod, "mirror_pairs", lambda x1, x2: None)
-    assert robust_maps(cfg, s) == halved
-
-
-def test_noise_keeps_every_state_simulated(monkeypatch):
-    """Velocity noise is not odd (the same noise sequence for a state and its mirror):
-    the maps then do not pair states."""
-    import ptoverify.studies.robust as robust_mod
-
-    asked = []
-    monkeypatch.setattr(robust_mod, "mirror_pairs", lambda x1, x2: asked.append(1))
-    cfg = dataclasses.replace(
-        CFG, robustness=dataclasses.replace(CFG.robustness, velocity_noise=1.0)
-    )
-    robust_maps(cfg, dataclasses.replace(TINY, laws=("pd",)))
-    assert asked == []
+    with pytest.raises(InputError, match="at least 5"):
+        run_robust(CFG, dataclasses.replace(TINY, search_population=4, laws=("pd",)))
 
 
 @pytest.mark.parametrize("law_name", ["to", "pd", "pto", "pto-printed"])
 def test_mirrored_state_has_the_same_properties(law_name):
-    """The premise of the mirrored maps: from (-x1, -x2) every measured property equals
-    that from (x1, x2), bit for bit, on mismatched plants with a quantizer and delays."""
+    """The laws are odd and so is the mismatched loop: from (-x1, -x2) every measured
+    property equals that from (x1, x2), bit for bit, with a quantizer and delays."""
     x1, x2 = map_states(CFG, dataclasses.replace(TINY, n1=9, n2=7, rest=10))
     rng = np.random.default_rng(3)
     n = x1.size
@@ -408,30 +320,3 @@ def test_mirrored_state_has_the_same_properties(law_name):
     for k in a:
         assert np.array_equal(a[k], b[k], equal_nan=True), k
     assert np.nanmax(a["settling_ratio_nt"]) > 1.0
-
-
-def _offset_pd(cfg):
-    """A law that is not odd: the PD law regulating to x1 = 0.3 mm (a user's factory)."""
-    base = make_law("pd", cfg)
-    return Law(
-        "pd-offset",
-        lambda x1, x2: base.vector(x1 - 0.3, x2),
-        lambda x1, x2: base.scalar(x1 - 0.3, x2),
-        base.w_max,
-    )
-
-
-def test_a_law_not_known_odd_has_every_state_simulated(monkeypatch):
-    """robust_maps and no_limit_cycle_margin take law factories; a law not known to be
-    odd (Law.odd False) is simulated from every state, not mirrored: the results equal
-    those with the pairing switched off."""
-    import ptoverify.studies.robust as robust_mod
-
-    assert not _offset_pd(CFG).odd
-    assert all(make_law(name, CFG).odd for name in ("to", "pd", "pto", "pto-printed"))
-    s = dataclasses.replace(TINY, n1=7, n2=7, rest=10, laws=(_offset_pd,))
-    maps = robust_maps(CFG, s)
-    margin = no_limit_cycle_margin(_offset_pd, CFG, s)
-    monkeypatch.setattr(robust_mod, "mirror_pairs", lambda x1, x2: None)
-    assert robust_maps(CFG, s) == maps
-    assert no_limit_cycle_margin(_offset_pd, CFG, s) == margin

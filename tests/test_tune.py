@@ -18,8 +18,7 @@ from ptoverify.model.mintime import discrete_min_steps, min_time
 from ptoverify.sim.exact import exact_metrics
 from ptoverify.sim.simulate import simulate
 from ptoverify.studies.claims import fair_comparison
-from ptoverify.studies.properties import initial_grid, law_properties
-from ptoverify.studies.sweep import mirror_pairs
+from ptoverify.studies.properties import law_properties
 from ptoverify.studies.tune import (
     BOUNDS,
     TuneBudget,
@@ -291,6 +290,7 @@ def test_grid_counts_are_the_gate_properties(monkeypatch):
     from ptoverify.config import Config, PDGains, Plant, PTOSettings
     from ptoverify.model.laws import pto_law
     from ptoverify.studies import tune as tune_mod
+    from ptoverify.studies.tune import measure as measure_mod
 
     for cfg, law in ((CFG, "pto"), (CFG, "pd"), (CFG, "to")):
         lp = law_properties(make_law(law, cfg), cfg)
@@ -299,17 +299,15 @@ def test_grid_counts_are_the_gate_properties(monkeypatch):
         assert strides == (lp.stride_overs if law == "pto" else 0)
     assert tune_mod.grid_counts(CFG, "to")[0] > 0, "the sampled TO law chatters"
     # a PTO without its zone on plants where that strides over (the gate's own failing
-    # case): on a grid that is not exactly symmetric (every state simulated) and on one
-    # that is (one state of each mirrored pair simulated, counted for both)
-    monkeypatch.setattr(tune_mod, "make_law", lambda name, c: pto_law(c, None))
-    for position_range, symmetric in ((20.0, False), (25.0, True)):
+    # case), on grids that are and are not exactly symmetric
+    monkeypatch.setattr(measure_mod, "make_law", lambda name, c: pto_law(c, None))
+    for position_range in (20.0, 25.0):
         stride_cfg = Config(
             "stride",
             Plant(a=100.0, w_max=100.0, sample_time=0.003, position_range=position_range),
             PDGains(kp=50.0, kd=0.5),
             PTOSettings(d=0.3, k1=50.0, k2=1.0),
         )
-        assert (mirror_pairs(*initial_grid(stride_cfg)[:2]) is not None) == symmetric
         lp = law_properties(pto_law(stride_cfg, None), stride_cfg)
         assert lp.stride_overs > 0
         assert tune_mod.grid_counts(stride_cfg, "pto") == (lp.limit_cycles, lp.stride_overs)
@@ -325,7 +323,8 @@ def test_limit_cycle_band_is_the_gate_default():
 
 @pytest.mark.parametrize("law, d", [("pd", None), ("pto", 0.3), ("pto", 1.0), ("pto", 2.3)])
 def test_screen_agrees_with_the_simulate_json_path(law, d):
-    from ptoverify.studies import tune as tune_mod
+    from ptoverify.studies.tune import measure as tune_mod
+    from ptoverify.studies.tune import screen as screen_mod
 
     rng = np.random.default_rng(9)
     if law == "pd":
@@ -335,12 +334,12 @@ def test_screen_agrees_with_the_simulate_json_path(law, d):
             {"d": d, "k1": 10 ** rng.uniform(1, 3.45), "k2": rng.uniform(0, 10)} for _ in range(60)
         ]
     batch = [{k: float(v) for k, v in g.items()} for g in batch]
-    raws = tune_mod._StepScreen(CFG, law, True)(batch)
+    raws = screen_mod.StepScreen(CFG, law, True)(batch)
     feasible = 0
     for g, raw in zip(batch, raws):
         for bound in (0.05, 1.0):
             ref = tune_mod.evaluate(CFG, law, g, max_overshoot=bound)
-            cand = tune_mod._screened(
+            cand = screen_mod.screened_candidate(
                 CFG, law, g, raw, objective="settling_2pct", max_overshoot=bound, worst_ratio=None
             )
             assert cand.feasible == ref.feasible, (g, cand.reason, ref.reason)
@@ -356,7 +355,7 @@ def test_screen_agrees_with_the_simulate_json_path(law, d):
 
 
 def test_side_by_side_searches_are_the_searches_one_by_one(monkeypatch):
-    from ptoverify.studies import tune as tune_mod
+    from ptoverify.studies.tune import search as search_mod
 
     kw = {
         "max_overshoot": 0.05,
@@ -369,10 +368,9 @@ def test_side_by_side_searches_are_the_searches_one_by_one(monkeypatch):
     together = tune(CFG, "pto", "step", **kw)
 
     def one_by_one(batch_fn, jobs):
-        for job in jobs:
-            job(batch_fn)
+        return [job(batch_fn) for job in jobs]
 
-    monkeypatch.setattr(tune_mod, "_lockstep", one_by_one)
+    monkeypatch.setattr(search_mod, "run_together", one_by_one)
     alone = tune(CFG, "pto", "step", **kw)
     assert together.best == alone.best and together.front == alone.front
     assert together.evaluations == alone.evaluations
@@ -420,7 +418,7 @@ def test_tune_is_deterministic():
 
 
 def test_batched_worst_ratios_are_worst_ratio_nt():
-    from ptoverify.studies.tune import _worst_ratios, tuned_config
+    from ptoverify.studies.tune.measure import tuned_config, worst_ratios
 
     rng = np.random.default_rng(12)
     for law in ("pd", "pto"):
@@ -437,27 +435,4 @@ def test_batched_worst_ratios_are_worst_ratio_nt():
             ]
         gs = [{k: float(v) for k, v in g.items()} for g in gs]
         want = [worst_ratio_nt(tuned_config(CFG, law, g), law, n1=4, n2=4) for g in gs]
-        assert _worst_ratios(CFG, law, gs, 4, 4) == want
-
-
-def test_lockstep_merges_batches_and_stops_on_errors():
-    from ptoverify.studies import tune as tune_mod
-
-    calls = []
-
-    def batch_fn(xs):
-        calls.append(list(xs))
-        if any(x < 0 for x in xs):
-            raise InputError("negative")
-        return [2 * x for x in xs]
-
-    got = {}
-
-    def job(ev, k):
-        got[k] = [ev([k, k + 10]), ev([k + 20])]
-
-    tune_mod._lockstep(batch_fn, [lambda ev, k=k: job(ev, k) for k in (1, 2, 3)])
-    assert got == {k: [[2 * k, 2 * k + 20], [2 * k + 40]] for k in (1, 2, 3)}
-    assert calls == [[1, 11, 2, 12, 3, 13], [21, 22, 23]], "one batch per round, job order"
-    with pytest.raises(InputError, match="negative"):
-        tune_mod._lockstep(batch_fn, [lambda ev: ev([1]), lambda ev: ev([-1]), lambda ev: None])
+        assert worst_ratios(CFG, law, gs, 4, 4) == want

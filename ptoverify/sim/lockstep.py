@@ -1,30 +1,31 @@
-"""Many dependent simulation workloads advanced together, one simulation per round.
+"""Several searches advanced side by side, their evaluations merged into one batch.
 
-A study such as the robustness study is made of sequential workloads: a
-differential evolution needs one generation's trajectories before it draws the
-next, a bisection one bracket before the next.  Each workload is small, and a
-small batch costs what a large one does per sample (the law's and the
-integrator's fixed overhead per call).  Here each workload is a *job*, a
-generator that yields the simulations it needs next (:class:`Ask`) and is sent
-their trajectories; :func:`run_lockstep` gathers the asks of all jobs into
-rounds and runs each round as one :func:`ptoverify.sim.simulate.simulate_segments`
-call, in which the asks of one law, and of the laws of one
-:class:`~ptoverify.model.laws.LawFamily`, share one evaluation per sample.
+A study is often made of sequential workloads: a differential evolution
+(:func:`scipy.optimize.differential_evolution`) needs one generation's values
+before it draws the next, a margin scan one bracket before the next.  Each is
+small, and a small batch costs what a large one does per sample (the law's and
+the integrator's fixed overhead per call).  :func:`run_together` runs each
+workload (a *job*) in a thread of its own with an evaluator in place of the
+batch function; whenever every running job waits on its evaluator, their
+requests are joined into one call of the batch function, and the answers handed
+back.  A job sees what the batch function alone would give it (the evaluation is
+per item), so the outcome is that of running the jobs one after the other, and as
+deterministic; only the number of batches drops.
 
-Every trajectory is bit for bit the one :func:`ptoverify.sim.simulate.simulate_batch`
-gives for its ask alone (states are independent), so what the jobs compute does
-not depend on how their asks were grouped into rounds.
-
-Riders.  An ask marked ``rider`` (e.g. a margin scan, which nothing waits for)
-only joins a round in which its law is evaluated anyway, or a round with no
-other work; it then adds states to an evaluation, not evaluations.
+:func:`simulate_asks` is the batch function of simulation studies: the asks of one
+call are simulated by :func:`ptoverify.sim.simulate.simulate_segments` (the asks of
+one law, and of the laws of one :class:`~ptoverify.model.laws.LawFamily`, share one
+evaluation per sample), in runs of at most ``round_states`` states, and each ask's
+trajectories are measured at once (so a round keeps measured values, not
+trajectories).
 """
 
 from __future__ import annotations
 
+import threading
 import time
-from collections.abc import Generator
-from dataclasses import dataclass, field
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -32,16 +33,116 @@ from numpy.typing import NDArray
 
 from ptoverify.config import Plant
 from ptoverify.model.laws import Law
-from ptoverify.sim.simulate import BatchResult, Mismatch, TrajectoryBuffers, simulate_segments
+from ptoverify.sim.simulate import BatchResult, Mismatch, simulate_segments
 
-__all__ = ["Ask", "Job", "LockstepRun", "run_lockstep", "ROUND_STATES"]
+__all__ = ["Ask", "run_together", "simulate_asks", "ROUND_STATES"]
 
-ROUND_STATES = 16384  #: states simulated per round (memory: ~25 bytes x states x samples)
+ROUND_STATES = 16384  #: most states per simulation (memory: ~25 bytes x states x samples)
+
+#: A job: called with an evaluator (a drop-in for the batch function), returns its result.
+Job = Callable[[Callable[[list[Any]], list[Any]]], Any]
+
+
+def run_together(batch_fn: Callable[[list[Any]], list[Any]], jobs: Sequence[Job]) -> list[Any]:
+    """Run jobs side by side, their evaluation requests merged into one batch.
+
+    Each job is called with an evaluator ``ev(items) -> answers`` in a thread of its
+    own; whenever every running job waits on its evaluator, the requests are joined
+    (in job order) into one call of ``batch_fn`` in the calling thread and the
+    answers handed back.  ``batch_fn`` must answer item by item (an item's answer
+    does not depend on the other items), so each job sees what ``batch_fn`` alone
+    would give it.  An exception in a job, or in ``batch_fn`` (every job waiting on
+    that batch then sees it), is raised here once all jobs have stopped (the first
+    job's, in job order).
+
+    Parameters
+    ----------
+    batch_fn : callable
+        ``batch_fn(items) -> answers``, one answer per item, in order.
+    jobs : sequence of callable
+        ``job(ev) -> result``.
+
+    Returns
+    -------
+    list
+        Each job's result, in the order of the jobs.
+
+    Examples
+    --------
+    >>> calls = []
+    >>> def square(xs):
+    ...     calls.append(len(xs))
+    ...     return [x * x for x in xs]
+    >>> def job(k):
+    ...     return lambda ev: sum(ev([k, k + 1])) + sum(ev([k]))
+    >>> run_together(square, [job(1), job(2)]), calls
+    ([6, 17], [4, 2])
+    """
+    if len(jobs) < 2:
+        return [job(batch_fn) for job in jobs]
+    cv = threading.Condition()
+    pending: dict[int, list] = {}
+    answers: dict[int, list | BaseException] = {}
+    results: list[Any] = [None] * len(jobs)
+    running = set(range(len(jobs)))
+    errors: dict[int, BaseException] = {}
+
+    def evaluator(i: int) -> Callable[[list], list]:
+        def ev(items: list) -> list:
+            with cv:
+                pending[i] = list(items)
+                cv.notify_all()
+                while i not in answers:
+                    cv.wait()
+                out = answers.pop(i)
+            if isinstance(out, BaseException):  # the batch failed: stop this job too
+                raise out
+            return out
+
+        return ev
+
+    def run(i: int) -> None:
+        try:
+            results[i] = jobs[i](evaluator(i))
+        except BaseException as exc:  # noqa: BLE001 - re-raised below
+            errors[i] = exc
+        finally:
+            with cv:
+                running.discard(i)
+                cv.notify_all()
+
+    threads = [threading.Thread(target=run, args=(i,), daemon=True) for i in range(len(jobs))]
+    for th in threads:
+        th.start()
+    with cv:
+        while True:
+            while running and not running <= pending.keys():
+                cv.wait()
+            if not running:
+                break
+            order = sorted(pending)
+            try:
+                merged = batch_fn([x for i in order for x in pending[i]])
+            except BaseException as exc:  # noqa: BLE001 - handed to every waiting job
+                for i in order:
+                    answers[i] = exc
+            else:
+                at = 0
+                for i in order:
+                    n = len(pending[i])
+                    answers[i], at = merged[at : at + n], at + n
+            pending.clear()
+            cv.notify_all()
+    for th in threads:
+        th.join()
+    if errors:
+        raise errors[min(errors)]
+    return results
 
 
 @dataclass(frozen=True)
 class Ask:
-    """One simulation a job needs: a law from initial states under a mismatch.
+    """One simulation to run: a law from initial states under a mismatch.
 
     Attributes
     ----------
@@ -51,17 +152,15 @@ class Ask:
         Initial states [mm], [mm/s].
     mismatch : Mismatch or None
         True plant and measurement (None or identity: the nominal loop).
-    rider : bool
-        May wait for a round that evaluates its law anyway (module docstring).
     stage : str
-        Label the time of this simulation is booked to (:attr:`LockstepRun.seconds`).
+        Label the time of this simulation is booked to (``seconds`` of
+        :func:`simulate_asks`).
     """
 
     law: Law
     x1: NDArray[np.float64]
     x2: NDArray[np.float64]
     mismatch: Mismatch | None = None
-    rider: bool = False
     stage: str = ""
 
     @property
@@ -70,191 +169,96 @@ class Ask:
         return int(np.size(self.x1))
 
 
-#: A job: yields a list of asks, is sent their trajectories (one BatchResult per ask,
-#: in order), and returns its result.
-Job = Generator[list[Ask], list[BatchResult], Any]
-
-
-@dataclass
-class LockstepRun:
-    """What :func:`run_lockstep` returns.
-
-    Attributes
-    ----------
-    results : list
-        Each job's return value, in the order of the jobs.
-    rounds : int
-        Simulations run.
-    state_steps : int
-        Trajectory samples simulated (states x samples, summed over rounds).
-    seconds : dict
-        Wall time [s] per ask stage: each round's simulation time shared by the
-        stages of its asks in proportion to their states, plus the time the jobs
-        spent (measuring, deciding) after receiving that stage's trajectories.
-    """
-
-    results: list[Any]
-    rounds: int = 0
-    state_steps: int = 0
-    seconds: dict[str, float] = field(default_factory=dict)
-
-
 def _family(law: Law) -> Any:
     """Return the group of a law's asks: its family's key, else the law itself."""
     return ("family", law.family.key) if law.family is not None else ("law", id(law))
 
 
-def run_lockstep(
-    jobs: list[Job],
+def simulate_asks(
+    asks: Sequence[Ask],
     plant: Plant,
     steps: int,
+    measure: Callable[[int, BatchResult], Any],
     *,
     round_states: int = ROUND_STATES,
-    on_round: Any = None,
-    reuse: bool = False,
-) -> LockstepRun:
-    """Run jobs to completion, their asks gathered into rounds of one simulation each.
+    seconds: dict[str, float] | None = None,
+) -> list[Any]:
+    """Simulate asks in few runs and measure each: ``[measure(k, trajectories of ask k)]``.
 
-    Each round takes the waiting asks that are not riders in the order they were
-    asked, as long as the round stays within ``round_states`` states (at least
-    one), then the riders whose law the round evaluates (any rider when the round
-    has nothing else), within the same limit.  A job is resumed once all the
-    asks of its last yield are simulated.
+    Consecutive asks are simulated together while a run stays within
+    ``round_states`` states (an ask larger than that runs alone), the asks of a run
+    ordered by law family and law (one evaluation per sample for them).  Every
+    trajectory is bit for bit the one :func:`ptoverify.sim.simulate.simulate_batch`
+    gives for its ask alone, so the answers do not depend on the grouping.
 
     Parameters
     ----------
-    jobs : list of generator
-        The jobs (:data:`Job`).
+    asks : sequence of Ask
+        The simulations.
     plant : Plant
         Design plant and sample time.
     steps : int
         Samples per trajectory.
+    measure : callable
+        ``measure(k, batch) -> answer`` for ask ``k`` (its index in ``asks``);
+        ``batch`` holds that ask's trajectories (shape (steps + 1, n) states,
+        (steps, n) inputs) and its mismatch.
     round_states : int
-        Most states per round (an ask larger than this runs alone).
-    on_round : callable, optional
-        ``on_round(rounds_done, jobs_done, jobs_total)`` after each round (progress).
-    reuse : bool
-        Write every round's trajectories into the same memory
-        (:class:`ptoverify.sim.simulate.TrajectoryBuffers`: the pages are faulted in
-        once, not at every round).  The trajectories sent to a job are then
-        overwritten by the next round, so they are valid only until the job
-        yields its next asks: for jobs that keep nothing of them (measured
-        values are new arrays).  The values simulated are the same.
+        Most states per simulation run.
+    seconds : dict, optional
+        Wall time [s] added per ask stage: each run's time (simulation and
+        measurement) shared by its asks in proportion to their states.
 
     Returns
     -------
-    LockstepRun
-        The jobs' results and the run's counts and times.
+    list
+        The answers, in the order of ``asks``.
 
     Examples
     --------
     >>> from ptoverify.config import paper_config
     >>> from ptoverify.model.laws import pd_law
     >>> cfg = paper_config()
-    >>> def job(x0):
-    ...     (b,) = yield [Ask(pd_law(cfg), np.array([x0]), np.array([0.0]))]
-    ...     return float(b.x1[-1, 0])
-    >>> run = run_lockstep([job(5.0), job(-5.0)], cfg.plant, 300)
-    >>> run.rounds, [abs(v) < 1e-6 for v in run.results]
-    (1, [True, True])
+    >>> asks = [Ask(pd_law(cfg), np.array([x0]), np.array([0.0])) for x0 in (5.0, -5.0)]
+    >>> ends = simulate_asks(asks, cfg.plant, 300, lambda k, b: float(b.x1[-1, 0]))
+    >>> [abs(v) < 1e-6 for v in ends]
+    [True, True]
     """
-    out = LockstepRun([None] * len(jobs))
-    buffers = TrajectoryBuffers() if reuse else None
-    waiting: dict[int, list] = {}  # job -> [asks, trajectories, still to simulate]
-    queue: list[tuple[int, int]] = []  # (job, ask) in the order asked
-    done = 0
-
-    def book(stage: str, seconds: float) -> None:
-        out.seconds[stage] = out.seconds.get(stage, 0.0) + seconds
-
-    def resume(j: int, sent: list[BatchResult] | None, stage: str) -> None:
-        nonlocal done
-        t = time.perf_counter()
-        try:
-            while True:
-                asks = jobs[j].send(sent) if sent is not None else next(jobs[j])
-                if asks:
-                    break
-                sent = []  # nothing to simulate: answer at once
-        except StopIteration as stop:
-            out.results[j] = stop.value
-            done += 1
-            return
-        finally:
-            book(stage, time.perf_counter() - t)
-        waiting[j] = [list(asks), [None] * len(asks), len(asks)]
-        queue.extend((j, i) for i in range(len(asks)))
-
-    for j in range(len(jobs)):
-        resume(j, None, "")
-    while queue:
-        chosen: list[tuple[int, int]] = []
-        size = 0
-        laws: set[int] = set()
-        for j, i in queue:
-            ask = waiting[j][0][i]
-            if ask.rider or (chosen and size + ask.size > round_states):
-                continue
-            chosen.append((j, i))
-            size += ask.size
-            laws.add(id(ask.law))
-        for j, i in queue:
-            ask = waiting[j][0][i]
-            if not ask.rider or (laws and id(ask.law) not in laws):
-                continue
-            if chosen and size + ask.size > round_states:
-                continue
-            chosen.append((j, i))
-            size += ask.size
-        taken = set(chosen)
-        queue = [q for q in queue if q not in taken]
-        # the asks of one law next to each other, and the laws of one family
-        # (laws.LawFamily): one evaluation of them per sample
+    out: list[Any] = [None] * len(asks)
+    runs: list[list[int]] = []
+    size = 0
+    for k, ask in enumerate(asks):
+        if not runs or size + ask.size > round_states:
+            runs.append([])
+            size = 0
+        runs[-1].append(k)
+        size += ask.size
+    for run in runs:
         order: dict[Any, int] = {}
-        for j, i in chosen:
-            law = waiting[j][0][i].law
-            order.setdefault(_family(law), len(order))
-            order.setdefault(id(law), len(order))
-        chosen.sort(
-            key=lambda q: (
-                order[_family(waiting[q[0]][0][q[1]].law)],
-                order[id(waiting[q[0]][0][q[1]].law)],
-            )
-        )
-        asks = [waiting[j][0][i] for j, i in chosen]
+        for k in run:
+            order.setdefault(_family(asks[k].law), len(order))
+            order.setdefault(id(asks[k].law), len(order))
+        run.sort(key=lambda k: (order[_family(asks[k].law)], order[id(asks[k].law)]))
         t = time.perf_counter()
         batch = simulate_segments(
-            [(a.law, a.x1, a.x2, a.mismatch) for a in asks], plant, steps, buffers=buffers
+            [(asks[k].law, asks[k].x1, asks[k].x2, asks[k].mismatch) for k in run], plant, steps
         )
-        elapsed = time.perf_counter() - t
-        out.rounds += 1
-        out.state_steps += size * steps
         start = 0
-        ready = []
-        for (j, i), ask in zip(chosen, asks, strict=True):
-            sl = slice(start, start + ask.size)
-            start += ask.size
-            book(ask.stage, elapsed * ask.size / max(size, 1))
-            w = waiting[j]
-            w[1][i] = BatchResult(
-                batch.x1[:, sl], batch.x2[:, sl], batch.u[:, sl], batch.region[:, sl], ask.mismatch
+        for k in run:
+            sl = slice(start, start + asks[k].size)
+            start += asks[k].size
+            b = BatchResult(
+                batch.x1[:, sl],
+                batch.x2[:, sl],
+                batch.u[:, sl],
+                batch.region[:, sl],
+                asks[k].mismatch,
             )
-            w[2] -= 1
-            if w[2] == 0:
-                ready.append((j, ask.stage))
-        if buffers is not None:  # a job still waiting keeps copies: the next round reuses
-            done_now = {j for j, _ in ready}
-            for j, i in chosen:
-                if j not in done_now:
-                    b = waiting[j][1][i]
-                    waiting[j][1][i] = BatchResult(
-                        b.x1.copy(), b.x2.copy(), b.u.copy(), b.region.copy(), b.mismatch
-                    )
-        for j, stage in ready:
-            sent = waiting.pop(j)[1]
-            resume(j, sent, stage)
-        if on_round is not None:
-            on_round(out.rounds, done, len(jobs))
-    if waiting:  # a job waits on nothing: cannot happen (every ask is queued)
-        raise RuntimeError("run_lockstep: a job is waiting on asks that were never queued")
+            out[k] = measure(k, b)
+        if seconds is not None:
+            elapsed = time.perf_counter() - t
+            for k in run:
+                stage = asks[k].stage
+                share = elapsed * asks[k].size / max(start, 1)
+                seconds[stage] = seconds.get(stage, 0.0) + share
     return out

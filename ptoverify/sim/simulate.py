@@ -49,7 +49,6 @@ __all__ = [
     "Mismatch",
     "simulate_batch",
     "simulate_segments",
-    "TrajectoryBuffers",
 ]
 
 
@@ -647,8 +646,6 @@ def simulate_segments(
     segments: list[Segment],
     plant: Plant,
     steps: int,
-    *,
-    buffers: TrajectoryBuffers | None = None,
 ) -> BatchResult:
     """Run several :func:`simulate_batch` calls as one: each segment its law, states and mismatch.
 
@@ -669,9 +666,6 @@ def simulate_segments(
         Design plant and sample time (the laws').
     steps : int
         Number of samples.
-    buffers : TrajectoryBuffers, optional
-        Memory to write the trajectories into (the previous run's there are
-        overwritten); default fresh arrays.  The values are the same.
 
     Returns
     -------
@@ -690,57 +684,7 @@ def simulate_segments(
     >>> bool((both.x1[:, 1] == one.x1[:, 0]).all())
     True
     """
-    return _simulate_mismatch(segments, plant, steps, buffers)
-
-
-class TrajectoryBuffers:
-    """Memory reused by successive :func:`simulate_segments` runs for their trajectories.
-
-    A run's arrays (states, inputs, regions: about 25 bytes per state and
-    sample) are carved from flat buffers kept here, grown when a run needs
-    more.  Fresh arrays of that size are new pages from the kernel at every
-    run, and faulting them in and zeroing them costs a sizeable share of a
-    run; here a sequence of runs (the rounds of :func:`ptoverify.sim.lockstep.run_lockstep`)
-    pays it once.  A run's trajectories are overwritten by the next run given
-    the same buffers, so use them only where nothing keeps them that long.
-
-    Examples
-    --------
-    >>> from ptoverify.config import paper_config
-    >>> from ptoverify.model.laws import pd_law
-    >>> cfg, buf = paper_config(), TrajectoryBuffers()
-    >>> seg = [(pd_law(cfg), [5.0], [0.0], Mismatch(a_ratio=0.9))]
-    >>> first = simulate_segments(seg, cfg.plant, 50, buffers=buf).x1.copy()
-    >>> bool((simulate_segments(seg, cfg.plant, 50, buffers=buf).x1 == first).all())
-    True
-    """
-
-    def __init__(self) -> None:
-        self._flat: dict[str, NDArray] = {}
-
-    def take(self, name: str, rows: int, cols: int, dtype: type = np.float64) -> NDArray:
-        """Return a C-contiguous (rows, cols) array of ``dtype`` on the buffer ``name``.
-
-        Parameters
-        ----------
-        name : str
-            Which buffer (one per array of a run).
-        rows, cols : int
-            Shape [-].
-        dtype : type
-            Element type.
-
-        Returns
-        -------
-        ndarray
-            Uninitialised; its memory is the buffer's, so the array the last call
-            returned for ``name`` is overwritten by writes to it.
-        """
-        size = rows * cols
-        buf = self._flat.get(name)
-        if buf is None or buf.size < size or buf.dtype != np.dtype(dtype):
-            buf = self._flat[name] = np.empty(size, dtype=dtype)
-        return buf[:size].reshape(rows, cols)
+    return _simulate_mismatch(segments, plant, steps)
 
 
 def _kin(a: Law, b: Law) -> bool:
@@ -752,7 +696,6 @@ def _simulate_mismatch(
     segments: list[Segment],
     plant: Plant,
     steps: int,
-    buffers: TrajectoryBuffers | None = None,
 ) -> BatchResult:
     """Run the loop of :func:`simulate_batch` with true plants and measurement models.
 
@@ -801,12 +744,8 @@ def _simulate_mismatch(
         )
         start += k
     n = start
-    if buffers is None:
-        X1, X2 = np.empty((steps + 1, n)), np.empty((steps + 1, n))
-        U, R = np.empty((steps, n)), np.empty((steps, n), dtype=np.int8)
-    else:  # every entry is written below (row 0, then each sample's rows)
-        X1, X2 = buffers.take("x1", steps + 1, n), buffers.take("x2", steps + 1, n)
-        U, R = buffers.take("u", steps, n), buffers.take("region", steps, n, np.int8)
+    X1, X2 = np.empty((steps + 1, n)), np.empty((steps + 1, n))
+    U, R = np.empty((steps, n)), np.empty((steps, n), dtype=np.int8)
     cat = (
         (lambda key: np.concatenate([g[key] for g in segs])) if segs else (lambda key: np.empty(0))
     )

@@ -1,0 +1,45 @@
+"""Fair comparisons: tune PD (kp, kd) and PTO (d, k1, k2) before judging the paper.
+
+measure   one set of gains: Candidate, tuned_config, response_metrics (the
+          ``simulate --json`` path), evaluate, worst_ratio_nt, grid_counts
+screen    many gain sets' step responses in one simulation (the search's screen)
+search    tune: SciPy's differential evolution (searches side by side through
+          ptoverify.sim.lockstep.run_together), a compass polish, the checks;
+          TuneResult, pareto_front
+fair      fair_tunings: both laws tuned under shared overshoot bounds (FairTunings)
+"""
+
+from ptoverify.studies.tune.fair import FAIR_BOUNDS, FairTunings, TuneBudget, fair_tunings
+from ptoverify.studies.tune.measure import (
+    BOUNDS,
+    LIMIT_CYCLE_BAND,
+    OBJECTIVES,
+    WORST_GRID,
+    Candidate,
+    evaluate,
+    grid_counts,
+    response_metrics,
+    tuned_config,
+    worst_ratio_nt,
+)
+from ptoverify.studies.tune.search import TuneResult, pareto_front, tune
+
+__all__ = [
+    "BOUNDS",
+    "FAIR_BOUNDS",
+    "LIMIT_CYCLE_BAND",
+    "OBJECTIVES",
+    "WORST_GRID",
+    "Candidate",
+    "FairTunings",
+    "TuneBudget",
+    "TuneResult",
+    "evaluate",
+    "fair_tunings",
+    "grid_counts",
+    "pareto_front",
+    "response_metrics",
+    "tune",
+    "tuned_config",
+    "worst_ratio_nt",
+]
