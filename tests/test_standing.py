@@ -82,7 +82,7 @@ def test_delay_row_and_gate_finding_follow_the_delay_margin(base):
     q = "Tolerates a one-sample computation delay?"
     assert _rows(data)[q][1].startswith("no")
     gates = rs._finding_gates(results_view(data))[0]
-    assert "with one sample of delay the PTO's linear zone is unstable" in gates
+    assert "with one sample of computation delay the PTO's linear zone is unstable" in gates
     m["linear_loop_a_ratio_stable_delay1"] = [0.5, 1.2]
     assert _rows(data)[q][1] == "yes"
     assert "delay" not in rs._finding_gates(results_view(data))[0]

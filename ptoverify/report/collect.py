@@ -356,7 +356,7 @@ def _stage_core(cfg: Config, figdir: Path | None) -> dict[str, Any]:
 
     props = all_properties(cfg)
     ctx = GateContext(cfg, given_pto_properties=props["pto"])
-    here = [g for g in GATES if g != SYMBOLIC_GATE and g not in POLE_GATES]
+    here = [g for g in GATES if g != SYMBOLIC_GATE and g not in POLE_GATES + PROOF_GATES]
     return {
         "zone": zone_summary(cfg),
         "properties": {k: v.to_json() for k, v in props.items()},
@@ -385,12 +385,32 @@ def _stage_sweep(cfg: Config, figdir: Path | None) -> dict[str, Any]:
 
 
 def _stage_robust(cfg: Config, figdir: Path | None) -> dict[str, Any]:
-    """Run the robustness study at :data:`ROBUST_SETTINGS` and draw its heat maps."""
-    res = _robust(cfg)
+    """Run the robustness study at :data:`ROBUST_SETTINGS`, judge its gates, draw its maps."""
+    res, gates = _robust(cfg)
     return {
         "robust": res,
+        "_checks": gates,
         "_files": [] if figdir is None else _plots().save_robust(res["maps"], figdir),
     }
+
+
+def _stage_proofs(cfg: Config, figdir: Path | None) -> dict[str, Any]:
+    """Prove the corrected PTO and PD over the envelope (interval arithmetic), with their gates."""
+    from ptoverify.studies.checks import run_checks
+    from ptoverify.studies.prove import nominal_proof
+    from ptoverify.studies.prove.run import prove_law
+
+    proofs = {"pto": nominal_proof(cfg), "pd": prove_law(cfg, "pd")}
+    files = []
+    if figdir is not None:
+        for law, proof in proofs.items():
+            files.append(_plots().save_proof_map(proof, figdir / f"proof_bound_{law}.png"))
+    out = {}
+    for law, proof in proofs.items():
+        j = proof.to_json()
+        j.pop("timings_s", None)
+        out[law] = j
+    return {"proofs": out, "_files": files, "_checks": run_checks(cfg, list(PROOF_GATES))}
 
 
 def _stage_tuning(cfg: Config, figdir: Path | None) -> dict[str, Any]:
@@ -466,6 +486,8 @@ def _plots():
 SYMBOLIC_GATE = "derivation-identities-vs-numerics"
 #: The gates that read the loops' poles: they run beside the poles (their own stage).
 POLE_GATES = ("pd-sampled-stable", "linear-zone-sampled-stable")
+#: The gates that read the proofs: they run beside them (their own stage).
+PROOF_GATES = ("proof-no-stride-over", "proof-reach")
 
 #: The report's stages, longest first as measured in a worker (the order a pool starts
 #: them in; the short ones last, so the workers end together).
@@ -477,6 +499,7 @@ _STAGE_FUNCTIONS: dict[str, Callable[[Config, Path | None], dict[str, Any]]] = {
     "tuning": _stage_tuning,
     "ground truth": _stage_ground_truth,
     "paper figures": _stage_figures,
+    "proofs": _stage_proofs,
     "poles": _stage_poles,
 }
 _SKIP_STAGE = {"robust": "robustness", "tuning": "tuning"}
@@ -550,7 +573,7 @@ def collect(
         An unknown ``skip`` stage or ``jobs`` < 1.
     """
     from ptoverify.errors import InputError
-    from ptoverify.studies.checks import GATES, summarize
+    from ptoverify.studies.checks import GATES, ROBUST_GATES, summarize
 
     bad = sorted(set(skip) - set(SKIPPABLE))
     if bad:
@@ -582,11 +605,16 @@ def collect(
         traces += part.pop("_traces", [])
         checks += part.pop("_checks", [])
         out.update(part)
-    order = list(GATES)
+    order = [*GATES, *ROBUST_GATES]
     checks.sort(key=lambda v: order.index(v.name))
     out["checks"] = [c.to_json() for c in checks]
     out["skipped"] = sorted(set(skip))
     out["summary"] = _summary(out, summarize(checks))
+    for kind, group in (
+        ("gates_nominal", [c for c in checks if c.name not in ROBUST_GATES]),
+        ("gates_perturbed", [c for c in checks if c.name in ROBUST_GATES]),
+    ):
+        out["summary"][kind] = summarize(group)
     out["_files"] = files
     out["_traces"] = traces
     out["_timings"] = {name: done[name][1] for name in names}
@@ -662,17 +690,18 @@ def _run_in_pool(
             raise
 
 
-def _robust(cfg: Config) -> dict[str, Any]:
-    """Run the robustness study at :data:`ROBUST_SETTINGS` (JSON, settings included)."""
+def _robust(cfg: Config) -> tuple[dict[str, Any], list]:
+    """Run the robustness study at :data:`ROBUST_SETTINGS`: its JSON and its gates."""
     from dataclasses import asdict
 
-    from ptoverify.studies.robust import RobustSettings, run_robust
+    from ptoverify.studies.robust import RobustSettings, robust_gates, run_robust
 
     settings = RobustSettings(**ROBUST_SETTINGS)
-    res = run_robust(cfg, settings).to_json()
+    result = run_robust(cfg, settings)
+    res = result.to_json()
     res.pop("timings_s", None)
     res["settings"] = asdict(settings)
-    return res
+    return res, robust_gates(result)
 
 
 def tuning_results(cfg: Config) -> dict[str, Any]:
@@ -829,6 +858,7 @@ def build_sections(
         ("properties", "Closed-loop properties over the grid", rs.properties(res)),
         ("claims", "Section 6 claims", rs.claims(res, figures)),
         ("sweep", "Suboptimality maps", rs.sweep(res, figures)),
+        ("proofs", "Proved over the continuum", rs.proofs(res, figures)),
         ("robustness", "Robustness under model mismatch", rs.robustness(res, figures)),
         ("tuning", "Can any tuning reproduce the paper?", rs.tuning(res, figures)),
         ("environment", "Environment", rs.environment(res)),

@@ -37,6 +37,7 @@ TOP_LEVEL = (
     "responses",
     "sweep",
     "robust",
+    "proofs",
     "tuning",
     "skipped",
     "environment",

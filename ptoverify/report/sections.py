@@ -113,6 +113,10 @@ CAPTIONS: dict[str, str] = {
     "over a_true / a_design and the w_max ratio.",
     "robust_settling_nt": "Worst settling / (N* T) over the states, per law and delay (never: "
     "some state never settles).",
+    "proof_bound_pto": "Certified number of samples to reach the target ellipse from each cell "
+    "of the envelope, corrected PTO (interval arithmetic; grey: unproven).",
+    "proof_bound_pd": "Certified number of samples to reach the target ellipse from each cell "
+    "of the envelope, PD (interval arithmetic; grey: unproven).",
     "tuning_pareto": "Settling against overshoot on the step: the Pareto fronts of PD and PTO "
     "over every candidate evaluated, the best tunings (stars), the paper's gains (squares) and "
     "the floor.",
@@ -370,29 +374,24 @@ def _finding_robust(res: Any) -> tuple[str, str, str] | None:
     return (text + ".", "robustness", "robustness")
 
 
-def _finding_gates(res: dict[str, Any]) -> tuple[str, str, str]:
-    g = res["summary"]["gates"]
+def _finding_gates(res: Any) -> tuple[str, str, str]:
+    s = res["summary"]
+    nom, per = s["gates_nominal"], s["gates_perturbed"]
     failed = [c["name"] for c in res["checks"] if c["status"] != "pass"]
-    rob = res["robust"]
-    delay = (
-        rob is not None
-        and "pto" in rob["margins"]
-        and rob["margins"]["pto"]["linear_loop_a_ratio_stable_delay1"] is None
-    )
-    return (
-        f"{g['pass']} of {g['total']} verification gates pass on the nominal plant "
-        f"({g['fail']} fail, {g['unverified']} unverified)"
-        + (f": not passing {', '.join(failed)}" if failed else "")
+    text = (
+        f"{nom['pass']} of {nom['total']} verification gates pass on the nominal plant"
         + (
-            "; the gates assume no computation delay, and with one sample of delay the PTO's "
-            "linear zone is unstable (section robustness)"
-            if delay
-            else ""
+            f"; under the [robustness] box's perturbations {per['pass']} of {per['total']} pass"
+            if per["total"]
+            else "; the gates under perturbation were not run (robustness skipped)"
         )
-        + ".",
-        "summary",
-        "gate table",
+        + (f" (not passing: {', '.join(failed)})" if failed else "")
     )
+    rob = res["robust"]
+    if rob is not None and "pto" in rob["margins"]:
+        if rob["margins"]["pto"]["linear_loop_a_ratio_stable_delay1"] is None:
+            text += "; with one sample of computation delay the PTO's linear zone is unstable"
+    return (text + ".", "summary", "gate table")
 
 
 def headline(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
@@ -1287,6 +1286,81 @@ def sweep(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     for key in sorted(figures):
         if key.startswith("sweep"):
             blocks += figure(figures, key)
+    return blocks
+
+
+# ------------------------------------------------------------------ proofs
+_PROOF_WORDS = {
+    "input-bound": "|u| <= w_max",
+    "no-stride-over-strict": "no stride-over (strict: never beyond the w_max curve)",
+    "no-stride-over-relaxed": "no stride-over (relaxed: the linear strip allowed)",
+    "reach": "reaches the target ellipse within the certified bound",
+}
+
+
+def proofs(res: Any, figures: dict[str, str]) -> list[Block]:
+    """Show what is proved for every initial state of the envelope, and what is not."""
+    pr = res["proofs"]
+    blocks = [
+        Block(
+            "p",
+            text="Proved over the continuum of initial states (|x1| <= position_range, "
+            "|x2| <= w_max) with outward-rounded interval arithmetic and python-flint arb "
+            "certificates (`ptoverify prove`): each property is proved, refuted with a "
+            "certified counterexample, or unproven with the region where the proof fails. "
+            "Coverage is the fraction of the envelope's area proved.",
+        )
+    ]
+    rows = []
+    for law, p in pr.items():
+        for name, prop in p["properties"].items():
+            region = prop["unproven_region"]
+            where = (
+                f"{region['cells']} cells in x1 {fmt(region['bounding_box'][0])} to "
+                f"{fmt(region['bounding_box'][1])} mm, x2 {fmt(region['bounding_box'][2])} to "
+                f"{fmt(region['bounding_box'][3])} mm/s"
+                if region
+                else "none"
+            )
+            rows.append(
+                [
+                    _law(law),
+                    _PROOF_WORDS.get(name, name),
+                    prop["status"],
+                    qty(100 * prop["coverage"], "%"),
+                    where,
+                ]
+            )
+    blocks.append(table(["law", "property", "status", "coverage", "unproven where"], rows))
+    rows = [
+        [
+            _law(law),
+            f"{p['bound_samples']} samples" if p["bound_samples"] is not None else "n/a",
+            f"{p['simulated_worst_samples']} samples"
+            if p["simulated_worst_samples"] is not None
+            else "n/a",
+            f"{p['simulation_over_bound']} of {p['simulated_states']}",
+            qty(p["suboptimality"]["certified_max_ratio_nt"], "-")
+            + f" outside |x1| < {qty(p['suboptimality']['excluded_radius'], 'mm')}",
+            str(p["cells"]),
+        ]
+        for law, p in pr.items()
+    ]
+    blocks.append(
+        table(
+            [
+                "law",
+                "certified worst samples to the ellipse",
+                "simulated worst (same ellipse)",
+                "simulated states over their cell's bound",
+                "certified samples / N* over the envelope",
+                "cells",
+            ],
+            rows,
+        )
+    )
+    for law in pr:
+        blocks += figure(figures, f"proof_bound_{law}")
     return blocks
 
 
