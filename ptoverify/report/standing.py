@@ -282,7 +282,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
 
 
 def _proved_stride(res: Mapping) -> str:
-    """What the proofs add about stride-overs of the corrected PTO ("" when not run)."""
+    """Return what the proofs add about stride-overs of the corrected PTO ("" if none ran)."""
     pr = res["proofs"] if "proofs" in res else None
     if not pr or "pto" not in pr:
         return ""
