@@ -479,14 +479,14 @@ def _chunk(fh, path, first_line: int) -> list[str]:
         text = fh.readline(_MAX_LINE)
         if not text:
             break
+        if "\x00" in text:
+            raise InputError(
+                f"table '{path}' line {first_line + k}: NUL bytes; not a CSV text file"
+            )
         if len(text) >= _MAX_LINE and not text.endswith("\n"):
             raise InputError(
                 f"table '{path}' line {first_line + k}: longer than {_MAX_LINE} characters "
                 "(a row holds three numbers)"
-            )
-        if "\x00" in text:
-            raise InputError(
-                f"table '{path}' line {first_line + k}: NUL bytes; not a CSV text file"
             )
         lines.append(text)
     return lines
