@@ -105,7 +105,7 @@ from ptoverify.conform.agreement import (
     table_coverage,
     ties,
 )
-from ptoverify.conform.isolation import IsolatedLaw, LawAborted
+from ptoverify.conform.isolation import MEMORY_LIMIT_BYTES, IsolatedLaw, LawAborted
 from ptoverify.conform.userlaw import (
     DEFAULT_TIMEOUT_S,
     LawFault,
@@ -841,6 +841,7 @@ def conform_spec(
     n_band: int = N_BAND,
     keep: dict | None = None,
     after: Callable | None = None,
+    memory_limit: int | None = MEMORY_LIMIT_BYTES,
 ) -> ConformResult:
     """Judge ``MODULE:FUNCTION`` or ``file.py:FUNCTION`` isolated in a child process.
 
@@ -866,6 +867,8 @@ def conform_spec(
         is judged (inside the same child process and ``timeout``), e.g. to
         simulate responses for a report.  A fault or an abort there is recorded
         in ``keep["after_error"]`` and changes no property.
+    memory_limit : int or None
+        Address-space limit of the law's process [bytes].
 
     Returns
     -------
@@ -874,7 +877,9 @@ def conform_spec(
         ``isolation`` and leaves the properties not yet evaluated ``unverified``.
     """
     t0 = time.perf_counter()
-    with IsolatedLaw(spec, cfg, timeout=timeout) as user:  # the child is killed on every path
+    with IsolatedLaw(
+        spec, cfg, timeout=timeout, memory_limit=memory_limit
+    ) as user:  # the child is killed on every path
         return _judge_isolated(
             user, spec, cfg, t0, rtol, sweep, grid, n_random, n_band, keep, after
         )
