@@ -283,6 +283,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     given = [flags[k] for k, v in mismatch.items() if v is not None]
     if given:
         raise InputError(f"the plant/measurement mismatch options need --x0 (got {given[0]})")
+    _check_reference_options(args, cfg)
     run = run_simulation(
         cfg,
         args.law,
@@ -312,12 +313,42 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     if args.json:
         print_json(run.to_json())
     else:
-        for key, value in run.summary().items():
+        summary = run.summary()
+        metrics, grid = run.metrics()  # everything computed before anything is printed
+        for key, value in summary.items():
             print(f"{key:>30}: {value}")
-        metrics, grid = run.metrics()
         for key, value in metrics.items():
             print(f"{key:>30}: {value} (sample grid: {grid[key]})")
     return 0
+
+
+def _check_reference_options(args: argparse.Namespace, cfg: Config) -> None:
+    """Reject reference options no simulation can serve, before anything runs.
+
+    Heights within 1000 x the position range (as ``--x0`` and ``mintime``
+    accept states), a ramp speed in (0, 1000 w_max], and a sine frequency in
+    (0, 1 / (2 T)): above the Nyquist frequency of the sampled loop the sine is
+    not a reference the loop can see.
+    """
+    p = cfg.plant
+    far = 1e3 * p.position_range
+    for flag, value in (("--step", args.step), ("--ramp-to", args.ramp_to)):
+        if value is not None and abs(value) > far:
+            raise InputError(
+                f"{flag} {value:g} mm is beyond 1000 x the position range ({far:g} mm)"
+            )
+    if args.amplitude is not None and not 0 <= args.amplitude <= far:
+        raise InputError(f"--amplitude must be in [0, {far:g}] mm, got {args.amplitude:g}")
+    if args.ramp_speed is not None and not 0 < args.ramp_speed <= 1e3 * p.w_max:
+        raise InputError(
+            f"--ramp-speed must be in (0, {1e3 * p.w_max:g}] mm/s, got {args.ramp_speed:g}"
+        )
+    nyquist = 0.5 / p.sample_time
+    if args.frequency is not None and not 0 < args.frequency < nyquist:
+        raise InputError(
+            f"--frequency must be in (0, {nyquist:g}) Hz (below the Nyquist frequency "
+            f"1 / (2 T), T = {p.sample_time:g} s), got {args.frequency:g}"
+        )
 
 
 def _simulate_regulation(args: argparse.Namespace, cfg: Config, mismatch: dict) -> int:
