@@ -426,6 +426,10 @@ def _cmd_robust(args: argparse.Namespace) -> int:
     from ptoverify.progress import stderr_bar
 
     cfg = _config(args)
+    if args.dask is not None:
+        from ptoverify.studies.cluster import check_dask_address
+
+        check_dask_address(args.dask)  # bad input at once, before any computation
     if not 3 <= args.grid <= 101:
         raise InputError(f"--grid must be in [3, 101], got {args.grid}")
     if not 0 <= args.generations <= 500:

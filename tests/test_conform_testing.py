@@ -92,9 +92,9 @@ def module_level(x1, x2, cfg):
 
 
 def test_law_spec_names_module_level_functions_and_refuses_closures():
-    assert law_spec(module_level) == f"{__name__}:module_level" or law_spec(
-        module_level
-    ).endswith("test_conform_testing.py:module_level")
+    assert law_spec(module_level) == f"{__name__}:module_level" or law_spec(module_level).endswith(
+        "test_conform_testing.py:module_level"
+    )
     assert law_spec("pkg.mod:f") == "pkg.mod:f"
 
     def closure(x1, x2, cfg):

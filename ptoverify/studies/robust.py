@@ -51,7 +51,6 @@ from __future__ import annotations
 
 import functools
 import math
-import re
 import time
 from collections.abc import Callable, Generator
 from dataclasses import dataclass, field, replace
@@ -68,6 +67,7 @@ from ptoverify.model.plant import zoh_matrices
 from ptoverify.model.reach import zonotope_steps_each
 from ptoverify.sim.lockstep import Ask, Job, run_lockstep
 from ptoverify.sim.simulate import BatchResult, Mismatch, simulate_batch
+from ptoverify.studies import cluster as dask_cluster
 from ptoverify.studies.properties import oscillating, stride_over_counts
 from ptoverify.studies.sweep import even_points, mirror_pairs, settle_steps
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED, Verdict
@@ -506,8 +506,8 @@ def _maps_dict(cfg: Config, s: RobustSettings, laws: dict) -> dict[str, Any]:
     }
 
 
-DASK_CONNECT_TIMEOUT_S = 10.0  #: how long to wait for a Dask scheduler [s]
-_ADDRESS = re.compile(r"^(tcp|tls|ucx|inproc|ws|wss)://[^\s/:]+(:\d{1,5})?$|^local$")
+#: how long to wait for a Dask scheduler [s]
+DASK_CONNECT_TIMEOUT_S = dask_cluster.DASK_CONNECT_TIMEOUT_S
 
 
 def check_dask_address(address: str) -> str:
@@ -534,11 +534,7 @@ def check_dask_address(address: str) -> str:
     >>> check_dask_address("tcp://127.0.0.1:8786")
     'tcp://127.0.0.1:8786'
     """
-    if not _ADDRESS.match(address):
-        raise InputError(
-            f"--dask must be 'local' or a scheduler address like tcp://HOST:PORT, got {address!r}"
-        )
-    return address
+    return dask_cluster.check_dask_address(address)  # one validation: studies.cluster
 
 
 def dask_runner(address: str) -> Runner:
@@ -577,7 +573,7 @@ def dask_runner(address: str) -> Runner:
             ):
                 return client.gather(client.map(_map_task, *zip(*tasks, strict=True), pure=False))
         try:
-            client = Client(address, timeout=DASK_CONNECT_TIMEOUT_S)
+            client = dask_cluster.connect(address, DASK_CONNECT_TIMEOUT_S)  # every step time-boxed
         except OSError as exc:  # TimeoutError and refused connections
             raise ClusterError(
                 f"cannot reach the Dask scheduler at {address} within "
