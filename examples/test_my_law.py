@@ -20,7 +20,7 @@ def test_my_law_conforms():
 
 
 def sluggish(x1, x2, cfg):
-    """Reference law 5 % short of w_max in the bang-bang region (vectorized, as numpy code is).
+    """Return the reference law 5 % short of w_max in the bang-bang region (vectorized).
 
     At module level: ``assert_conforms`` loads the law by name in its own process.
     """
