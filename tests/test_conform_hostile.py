@@ -266,3 +266,15 @@ def test_failing_conform_into_a_closed_pipe_still_fails(tmp_path):
     )
     p = shell(f"{sys.executable} -m ptoverify conform --law {path}:f | true")
     assert p.returncode == 1, p.stderr
+
+
+def test_wrong_function_name_lists_the_callables_defined(capsys, tmp_path):
+    path = tmp_path / "mylaw.py"
+    path.write_text(
+        "import numpy as np\nfrom ptoverify.conform.gate import reference_law\n"
+        "def pto(x1, x2, cfg):\n    return reference_law(x1, x2, cfg)\n"
+        "def helper():\n    pass\n"
+    )
+    code, out, err = run(capsys, "conform", "--law", f"{path}:pto_law", "--timeout", "60")
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert "(callables defined there: helper, pto)" in err, err  # not np or reference_law
