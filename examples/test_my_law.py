@@ -19,18 +19,23 @@ def test_my_law_conforms():
     assert_conforms(LAW)
 
 
-@pytest.mark.slow
-def test_a_slow_law_is_rejected():
-    """The helper fails loudly: a law 5 % short of w_max in the bang-bang region."""
+def sluggish(x1, x2, cfg):
+    """Return the reference law 5 % short of w_max in the bang-bang region (vectorized).
+
+    At module level: ``assert_conforms`` loads the law by name in its own process.
+    """
     import numpy as np
 
     from ptoverify.conform.gate import reference_law
 
-    def sluggish(x1, x2, cfg):  # vectorized, as numpy code usually is
-        u = np.asarray(reference_law(x1, x2, cfg))
-        out = np.where(np.abs(u) == cfg.plant.w_max, 0.95 * u, u)
-        return float(out) if out.ndim == 0 else out
+    u = np.asarray(reference_law(x1, x2, cfg))
+    out = np.where(np.abs(u) == cfg.plant.w_max, 0.95 * u, u)
+    return float(out) if out.ndim == 0 else out
 
+
+@pytest.mark.slow
+def test_a_slow_law_is_rejected():
+    """The helper fails loudly: a law 5 % short of w_max in the bang-bang region."""
     with pytest.raises(AssertionError, match="agreement/BANG_P") as exc:
         assert_conforms(sluggish)
     assert "first failing state" in str(exc.value)

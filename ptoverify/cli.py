@@ -19,10 +19,8 @@ import csv
 import io
 import json
 import math
-import os
 import re
 import sys
-import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -32,14 +30,18 @@ from ptoverify import __version__
 from ptoverify.config import Config, load_config
 from ptoverify.errors import ClusterError, InputError, SolverError
 from ptoverify.outdir import (
+    ENVIRONMENT_ERRNOS,
     OutputBusy,
     Terminated,
     check_target,
     discard,
+    guarded_std_streams,
     make_temp,
+    os_error,
     publish,
     sigterm_raises,
 )
+from ptoverify.outdir import write_atomic as _write_atomic
 
 __all__ = ["main", "build_parser"]
 
@@ -108,19 +110,8 @@ def print_json(obj: Any) -> None:
 
 
 def write_atomic(path: str | Path, text: str) -> None:
-    """Write a text file atomically (temp file in the same folder, then rename)."""
-    path = Path(path)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent or ".")
-    except OSError as exc:
-        raise InputError(f"cannot write '{path}': {exc.strerror or exc}") from None
-    try:
-        with os.fdopen(fd, "w", newline="") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
-        raise InputError(f"cannot write '{path}': {exc.strerror or exc}") from None
+    """Write a text file atomically (see :func:`ptoverify.outdir.write_atomic`)."""
+    _write_atomic(path, text)
 
 
 def _config(args: argparse.Namespace) -> Config:
@@ -292,6 +283,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     given = [flags[k] for k, v in mismatch.items() if v is not None]
     if given:
         raise InputError(f"the plant/measurement mismatch options need --x0 (got {given[0]})")
+    _check_reference_options(args, cfg)
     run = run_simulation(
         cfg,
         args.law,
@@ -321,12 +313,42 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     if args.json:
         print_json(run.to_json())
     else:
-        for key, value in run.summary().items():
+        summary = run.summary()
+        metrics, grid = run.metrics()  # everything computed before anything is printed
+        for key, value in summary.items():
             print(f"{key:>30}: {value}")
-        metrics, grid = run.metrics()
         for key, value in metrics.items():
             print(f"{key:>30}: {value} (sample grid: {grid[key]})")
     return 0
+
+
+def _check_reference_options(args: argparse.Namespace, cfg: Config) -> None:
+    """Reject reference options no simulation can serve, before anything runs.
+
+    Heights within 1000 x the position range (as ``--x0`` and ``mintime``
+    accept states), a ramp speed in (0, 1000 w_max], and a sine frequency in
+    (0, 1 / (2 T)): above the Nyquist frequency of the sampled loop the sine is
+    not a reference the loop can see.
+    """
+    p = cfg.plant
+    far = 1e3 * p.position_range
+    for flag, value in (("--step", args.step), ("--ramp-to", args.ramp_to)):
+        if value is not None and abs(value) > far:
+            raise InputError(
+                f"{flag} {value:g} mm is beyond 1000 x the position range ({far:g} mm)"
+            )
+    if args.amplitude is not None and not 0 <= args.amplitude <= far:
+        raise InputError(f"--amplitude must be in [0, {far:g}] mm, got {args.amplitude:g}")
+    if args.ramp_speed is not None and not 0 < args.ramp_speed <= 1e3 * p.w_max:
+        raise InputError(
+            f"--ramp-speed must be in (0, {1e3 * p.w_max:g}] mm/s, got {args.ramp_speed:g}"
+        )
+    nyquist = 0.5 / p.sample_time
+    if args.frequency is not None and not 0 < args.frequency < nyquist:
+        raise InputError(
+            f"--frequency must be in (0, {nyquist:g}) Hz (below the Nyquist frequency "
+            f"1 / (2 T), T = {p.sample_time:g} s), got {args.frequency:g}"
+        )
 
 
 def _simulate_regulation(args: argparse.Namespace, cfg: Config, mismatch: dict) -> int:
@@ -404,6 +426,10 @@ def _cmd_robust(args: argparse.Namespace) -> int:
     from ptoverify.progress import stderr_bar
 
     cfg = _config(args)
+    if args.dask is not None:
+        from ptoverify.studies.cluster import check_dask_address
+
+        check_dask_address(args.dask)  # bad input at once, before any computation
     if not 3 <= args.grid <= 101:
         raise InputError(f"--grid must be in [3, 101], got {args.grid}")
     if not 0 <= args.generations <= 500:
@@ -1374,39 +1400,66 @@ def main(argv: list[str] | None = None) -> int:
         input; 130 interrupted.
     """
     argv = sys.argv[1:] if argv is None else list(argv)
+    with guarded_std_streams():  # a closed pipe keeps the run's own exit code
+        return _run(argv)
+
+
+def _outputs(argv: list[str]) -> str | None:
+    """List the output options given, to name in an OS error without a file name."""
+    flags = ("--out", "--csv", "--junit", "--report", "--emit-grid")
+    named = [f"{a} {b}" for a, b in zip(argv, argv[1:]) if a in flags]
+    return ", ".join(named) or None
+
+
+def _say(text: str) -> None:
+    print(f"ptoverify: {text}", file=sys.stderr)
+
+
+def _run(argv: list[str]) -> int:
+    """Run one command line inside the guarded streams; return the exit code."""
     debug = "--debug" in argv  # known even if parsing fails
     try:
         args = build_parser().parse_args(argv)
         debug = bool(getattr(args, "debug", False))
         with sigterm_raises():
-            return int(args.handler(args))
+            code = int(args.handler(args))
+        sys.stdout.flush()  # a write that fails shows here, inside the handlers below
+        return code
     except Terminated:
-        print("ptoverify: error: terminated (SIGTERM); nothing written", file=sys.stderr)
+        _say("error: terminated (SIGTERM); nothing written")
         return 143
     except OutputBusy as exc:
-        print(f"ptoverify: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        _say(f"error: {_one_line(exc)}")
         return 1
     except (SolverError, ClusterError) as exc:  # the input was fine; the run could not be done
-        print(f"ptoverify: error: {_one_line(exc)}", file=sys.stderr)
+        _say(f"error: {_one_line(exc)}")
         return 1
     except InputError as exc:
-        print(f"ptoverify: error: {_one_line(exc)}", file=sys.stderr)
+        _say(f"error: {_one_line(exc)}")
         return 2
     except KeyboardInterrupt:
-        print("ptoverify: error: interrupted", file=sys.stderr)
+        _say("error: interrupted")
         return 130
-    except BrokenPipeError:  # e.g. `ptoverify ... | head`
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
-    except Exception as exc:  # noqa: BLE001 - anything else is a bug, never "bad input"
-        if debug:
-            raise
-        print(
-            f"ptoverify: internal error: {type(exc).__name__}: {_one_line(exc)[:300]} "
-            "(a bug; rerun with --debug for the traceback)",
-            file=sys.stderr,
-        )
+    except BrokenPipeError as exc:  # not through the guarded streams: the verdict is unknown
+        _say(f"error: a pipe closed before the run ended ({_one_line(exc)}); no verdict")
         return 1
+    except OSError as exc:
+        if exc.errno not in ENVIRONMENT_ERRNOS or debug:
+            return _internal(exc, debug)
+        _say(f"error: {_one_line(os_error(exc, exc.filename or _outputs(argv)))}")
+        return 2
+    except Exception as exc:  # noqa: BLE001 - anything else is a bug, never "bad input"
+        return _internal(exc, debug)
+
+
+def _internal(exc: Exception, debug: bool) -> int:
+    if debug:
+        raise exc
+    _say(
+        f"internal error: {type(exc).__name__}: {_one_line(exc)[:300]} "
+        "(a bug; rerun with --debug for the traceback)"
+    )
+    return 1
 
 
 if __name__ == "__main__":

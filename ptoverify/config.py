@@ -18,7 +18,10 @@ The configuration format is the one in ``shared/DESIGN.md``::
 
 Every rejection is a :class:`~ptoverify.errors.ConfigError` whose message
 names the key and the value.  Ranges: a, w_max, position_range <= 1e6;
-1e-7 <= sample_time <= 1 s and 1e-6 <= a T <= 20; 0 <= d <= position_range;
+1e-7 <= sample_time <= 1 s and 0.01 <= a T <= 20 (the plant's time constant
+at most 100 samples); position_range / (w_max T) <= 2000 samples to cross the
+range at full speed (the work of zone, check, sweep, robust and report grows
+with both; README "Limits"); 0 <= d <= position_range;
 gains 0 <= kp T, k1 T <= 1e4 and 0 <= kd, k2 <= 1e4 (far beyond the sampled
 stability limits, so unstable gains reach the gates; see ``_check_gains``).
 """
@@ -350,8 +353,8 @@ LIMITS = {
     "w_max": 1e6,
     "position_range": 1e6,
     "sample_time": (1e-7, 1.0),
-    "aT": (1e-6, 20.0),
-    "samples_across_range": 1e6,
+    "aT": (0.01, 20.0),
+    "samples_across_range": 2000.0,
     "gain_T": 1e4,
     "gain": 1e4,
 }
@@ -577,6 +580,8 @@ def robustness_from_mapping(raw: Any, plant: dict[str, float]) -> Robustness:
         "delay_samples", raw.get("delay_samples", list(base.delay_samples)), 0, 10, integer=True
     )
     scalars = {}
+    if "position_quantum" not in raw:  # the default never exceeds its own limit
+        raw = {**raw, "position_quantum": min(base.position_quantum, 0.1 * plant["position_range"])}
     limits = {
         "position_quantum": (0.0, 0.1 * plant["position_range"]),
         "velocity_noise": (0.0, plant["w_max"]),

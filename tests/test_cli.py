@@ -1,4 +1,6 @@
 import json
+import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -333,3 +335,119 @@ def test_building_the_parser_loads_no_numerics():
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "[]"
+
+
+# ------------------------------------------------------------------ OS errors and file modes
+def _subprocess(argv, stdout=subprocess.PIPE, timeout=120):
+    import os
+    import subprocess as sp
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    return sp.run(
+        [sys.executable, "-m", "ptoverify", *argv],
+        stdout=stdout,
+        stderr=sp.PIPE,
+        text=True,
+        timeout=timeout,
+        env=dict(os.environ, PYTHONPATH=str(root)),
+    )
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+@pytest.mark.parametrize(
+    "argv",
+    [["mintime", "5", "0", "--json"], ["zone"], ["simulate", "--law", "pd"]],
+    ids=lambda a: a[0],
+)
+def test_stdout_on_a_full_device_is_exit_2_naming_it(argv):
+    with open("/dev/full", "w") as full:
+        p = _subprocess(argv, stdout=full)
+    lines = p.stderr.strip().splitlines()
+    assert p.returncode == 2, p.stderr
+    assert lines == ["ptoverify: error: cannot write 'standard output': No space left on "
+                     "device (ENOSPC)"], p.stderr  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["simulate", "--law", "pd", "--csv", "{long}.csv"],
+        ["conform", "--emit-grid", "{long}.csv"],
+        ["report", "--out", "{long}"],
+        ["sweep", "--out", "{long}"],
+        ["report", "--out", "{deep}"],
+    ],
+    ids=["csv", "emit-grid", "report", "sweep", "path-max"],
+)
+def test_overlong_names_are_exit_2_naming_the_file(capsys, tmp_path, argv):
+    long = str(tmp_path / ("n" * 300))
+    deep = str(tmp_path / "/".join(["d" * 250] * 20))  # beyond PATH_MAX (4096)
+    argv = [a.format(long=long, deep=deep) for a in argv]
+    code, out, err = run(capsys, *argv)
+    assert code == 2 and out == "", err
+    assert err.count("\n") == 1 and "File name too long (ENAMETOOLONG)" in err, err
+    assert "nnnnnnnnnn" in err or "dddddddddd" in err, "the file is named"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_environment_os_error_without_a_file_names_the_output(capsys, monkeypatch, tmp_path):
+    """ENOSPC deep inside a writer (no file name on the error) names the output option."""
+    import errno
+
+    import ptoverify.commands as commands
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(commands, "mintime_states", full)
+    states = tmp_path / "s.csv"
+    states.write_text("x1,x2\n1,0\n")
+    code, out, err = run(capsys, "mintime", "--states", str(states), "--out", "o.csv")
+    assert code == 2 and out == ""
+    assert (
+        err.strip()
+        == "ptoverify: error: cannot write '--out o.csv': No space left on device (ENOSPC)"
+    )
+
+
+def test_other_os_errors_stay_internal_errors(capsys, monkeypatch):
+    """Only the environment's errors (ENOSPC, ENAMETOOLONG, EACCES, ...) are exit 2."""
+    import errno
+
+    import ptoverify.studies.groundtruth as gt
+
+    def bug(*args, **kwargs):
+        raise OSError(errno.EBADF, "Bad file descriptor")
+
+    monkeypatch.setattr(gt, "min_time", bug)
+    code, out, err = run(capsys, "mintime", "5", "0")
+    assert code == 1 and err.startswith("ptoverify: internal error: OSError")
+
+
+@pytest.fixture
+def umask_022():
+    import os
+
+    old = os.umask(0o022)
+    yield
+    os.umask(old)
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["conform", "--emit-grid", "{f}"],
+        ["simulate", "--law", "pd", "--csv", "{f}"],
+        ["simulate", "--law", "pd", "--x0", "1", "0", "--csv", "{f}"],
+        ["check", "--gate", "zoh-vs-integrator", "--junit", "{f}"],
+    ],
+    ids=["emit-grid", "csv", "csv-x0", "junit"],
+)
+def test_written_files_respect_the_umask(capsys, tmp_path, umask_022, argv):
+    f = tmp_path / "out.file"
+    code, _, err = run(capsys, *[a.format(f=f) for a in argv])
+    assert code in (0, 1), err
+    assert oct(f.stat().st_mode & 0o777) == oct(0o644), "mode is 0666 less the umask 022"
+    assert [p.name for p in tmp_path.iterdir()] == ["out.file"], "no temporary left"

@@ -472,6 +472,26 @@ def _chunk_error(path, lines, first_line: int, cols: dict, cfg: Config | None) -
     return InputError(f"table '{path}' near line {first_line}: malformed row")
 
 
+def _chunk(fh, path, first_line: int) -> list[str]:
+    """Read up to _CHUNK_LINES lines, each at most _MAX_LINE long, without NUL bytes."""
+    lines = []
+    for k in range(_CHUNK_LINES):
+        text = fh.readline(_MAX_LINE)
+        if not text:
+            break
+        if "\x00" in text:
+            raise InputError(
+                f"table '{path}' line {first_line + k}: NUL bytes; not a CSV text file"
+            )
+        if len(text) >= _MAX_LINE and not text.endswith("\n"):
+            raise InputError(
+                f"table '{path}' line {first_line + k}: longer than {_MAX_LINE} characters "
+                "(a row holds three numbers)"
+            )
+        lines.append(text)
+    return lines
+
+
 def _far(x1, x2, cfg: Config):
     """States beyond 1000 x the envelope (as ``mintime`` rejects them)."""
     p = cfg.plant
@@ -479,6 +499,33 @@ def _far(x1, x2, cfg: Config):
 
 
 _CHUNK_LINES = 500_000  #: table lines parsed per numpy call
+_MAX_HEADER = 1 << 16  #: longest header line read [characters]
+_MAX_LINE = 1 << 12  #: longest data line accepted [characters] (three numbers need < 100)
+
+
+def _header(path, head: str) -> list[str]:
+    """Parse and check a table's header: named columns, none twice, no byte-order mark."""
+    if "\x00" in head:
+        raise InputError(f"table '{path}' line 1: NUL bytes; not a CSV text file")
+    if head.startswith("\ufeff"):
+        raise InputError(
+            f"table '{path}' starts with a UTF-8 byte-order mark (BOM, bytes EF BB BF) before "
+            "the header; save it as UTF-8 without BOM"
+        )
+    if not head.strip():
+        raise InputError(f"table '{path}' is empty")
+    if len(head) >= _MAX_HEADER and not head.endswith("\n"):
+        raise InputError(f"table '{path}' line 1: header longer than {_MAX_HEADER} characters")
+    header = [h.strip() for h in next(csv.reader([head]))]
+    seen: set[str] = set()
+    for name in header:
+        if name in seen and name:
+            raise InputError(
+                f"table '{path}': column '{name}' appears twice in header {','.join(header)}; "
+                "which one is meant is ambiguous"
+            )
+        seen.add(name)
+    return header
 
 
 def read_table(path: str | Path, cfg: Config | None = None) -> tuple[NDArray, NDArray, NDArray]:
@@ -508,7 +555,6 @@ def read_table(path: str | Path, cfg: Config | None = None) -> tuple[NDArray, ND
         that is not a finite number or a state far outside the envelope (line
         and column named).
     """
-    import itertools
     import os
     import stat
 
@@ -521,10 +567,8 @@ def read_table(path: str | Path, cfg: Config | None = None) -> tuple[NDArray, ND
     chunks = []
     try:
         with fh:
-            head = fh.readline()
-            if not head.strip():
-                raise InputError(f"table '{path}' is empty")
-            header = [h.strip() for h in next(csv.reader([head]))]
+            head = fh.readline(_MAX_HEADER)
+            header = _header(path, head)
             cols = {}
             for name in ("x1", "x2", "u"):
                 if name not in header:
@@ -535,7 +579,7 @@ def read_table(path: str | Path, cfg: Config | None = None) -> tuple[NDArray, ND
                 cols[name] = header.index(name)
             line = 2
             while True:
-                lines = list(itertools.islice(fh, _CHUNK_LINES))
+                lines = _chunk(fh, path, line)
                 if not lines:
                     break
                 try:

@@ -105,16 +105,14 @@ from ptoverify.conform.agreement import (
     table_coverage,
     ties,
 )
+from ptoverify.conform.isolation import MEMORY_LIMIT_BYTES, IsolatedLaw, LawAborted
 from ptoverify.conform.userlaw import (
     DEFAULT_TIMEOUT_S,
-    IsolatedLaw,
-    LawAborted,
     LawFault,
     UserLaw,
     load_callable,
     wrap_callable,
 )
-from ptoverify.errors import InputError
 from ptoverify.model.laws import Law, Region
 from ptoverify.verdict import FAIL, NOT_RUN, PASS, UNVERIFIED, Verdict
 
@@ -843,6 +841,7 @@ def conform_spec(
     n_band: int = N_BAND,
     keep: dict | None = None,
     after: Callable | None = None,
+    memory_limit: int | None = MEMORY_LIMIT_BYTES,
 ) -> ConformResult:
     """Judge ``MODULE:FUNCTION`` or ``file.py:FUNCTION`` isolated in a child process.
 
@@ -868,6 +867,8 @@ def conform_spec(
         is judged (inside the same child process and ``timeout``), e.g. to
         simulate responses for a report.  A fault or an abort there is recorded
         in ``keep["after_error"]`` and changes no property.
+    memory_limit : int or None
+        Address-space limit of the law's process [bytes].
 
     Returns
     -------
@@ -876,15 +877,20 @@ def conform_spec(
         ``isolation`` and leaves the properties not yet evaluated ``unverified``.
     """
     t0 = time.perf_counter()
-    user = IsolatedLaw(spec, cfg, timeout=timeout)
+    with IsolatedLaw(
+        spec, cfg, timeout=timeout, memory_limit=memory_limit
+    ) as user:  # the child is killed on every path
+        return _judge_isolated(
+            user, spec, cfg, t0, rtol, sweep, grid, n_random, n_band, keep, after
+        )
+
+
+def _judge_isolated(user, spec, cfg, t0, rtol, sweep, grid, n_random, n_band, keep, after):
     grid = conformance_grid(cfg) if grid is None else grid  # while the child loads
     try:
         user.ready()
     except LawAborted as ab:
         return _aborted(None, {}, [], ab, {}, t0, cfg, spec, user.close())
-    except InputError:
-        user.close()
-        raise
     failures = list(user.init_failures)
     timings = {"detect": time.perf_counter() - t0}
     props: dict[str, Verdict] = {}

@@ -13,6 +13,19 @@ Decisions (see also :mod:`ptoverify.conform.gate`):
 * Vectorized when an array call of 8 probe states returns an array of their
   shape equal to element-wise calls to 1e-12 w_max; otherwise a scalar loop.
 * Pure function: two passes over the probe states must return the same u.
+* The law gets copies of the states (a law that writes into its input arrays
+  cannot move the states it is judged at) and the configuration it must not
+  change: a change (``object.__setattr__`` on the frozen dataclass) is a
+  finding at the call that made it.
+* What the law returns must be a real number: a Python ``int`` or ``float``,
+  a NumPy integer or floating scalar, or (vectorized) an array of such a dtype.
+  ``bool``, complex, strings, bytes and objects (even an object array of
+  floats) are a non-number: bad input (exit 2), never cast.  Where the array
+  call returns a non-real dtype, the law is called state by state and each
+  answer is checked.
+* Anything the law raises, ``BaseException`` included (``SystemExit``,
+  ``pytest.skip``'s outcome), is a finding; only ``KeyboardInterrupt`` passes
+  through in the caller's own process (the user pressed Ctrl-C).
 """
 
 from __future__ import annotations
@@ -36,10 +49,9 @@ from ptoverify.errors import InputError
 __all__ = [
     "load_callable",
     "LawFault",
-    "LawAborted",
     "UserLaw",
-    "IsolatedLaw",
     "wrap_callable",
+    "check_output",
     "DEFAULT_TIMEOUT_S",
 ]
 
@@ -111,11 +123,36 @@ def load_callable(spec: str) -> Callable:
     obj: Any = module
     for part in attr.split("."):
         if not hasattr(obj, part):
-            raise InputError(f"--law '{spec}': '{mod_name}' has no attribute '{attr}'")
+            names = _defined_callables(obj)
+            shown = ", ".join(names[:20]) + (" ..." if len(names) > 20 else "")
+            raise InputError(
+                f"--law '{spec}': '{mod_name}' has no attribute '{attr}'"
+                + (
+                    f" (callables defined there: {shown})"
+                    if names
+                    else " (it defines no callables)"
+                )
+            )
         obj = getattr(obj, part)
     if not callable(obj):
         raise InputError(f"--law '{spec}': '{attr}' is not callable ({type(obj).__name__})")
     return obj
+
+
+def _defined_callables(obj: Any) -> list[str]:
+    """Public callables defined in a module (not imported into it), or an object's."""
+    own = getattr(obj, "__name__", None)
+    try:
+        items = vars(obj).items()
+    except TypeError:
+        return []
+    return sorted(
+        k
+        for k, v in items
+        if callable(v)
+        and not k.startswith("_")
+        and (not inspect.ismodule(obj) or getattr(v, "__module__", None) == own)
+    )
 
 
 # ------------------------------------------------------------------ wrapping
@@ -128,20 +165,74 @@ class LawFault(Exception):
         self.message = message
 
 
-def _as_number(value: Any, state: tuple[float, float]) -> float:
-    """Convert a scalar return value to float; wrong type is bad input (exit 2)."""
-    if isinstance(value, bool) or np.ndim(value) != 0:
-        raise InputError(
-            f"the law returned {type(value).__name__} (shape {np.shape(value)}) at "
-            f"state ({state[0]!r}, {state[1]!r}); expected one number u [mm/s]"
+_REAL_KINDS = "iuf"  #: accepted NumPy dtype kinds: signed, unsigned integer, floating
+
+
+def check_output(value: Any, state: tuple[float, float], n: int | None = None) -> NDArray:
+    """Validate what a law returned: real numbers only, never a silent cast.
+
+    Parameters
+    ----------
+    value : object
+        The law's return value.
+    state : (float, float)
+        The (first) state of the call [mm], [mm/s], for the message.
+    n : int, optional
+        Number of states of an array call (None: one state, a scalar expected).
+
+    Returns
+    -------
+    ndarray of float64
+        u [mm/s]: 0-d for one state, shape (n,) for an array call.
+
+    Raises
+    ------
+    InputError
+        A non-number (bool, complex, string, bytes, object) or a wrong shape.
+    """
+    where = f"at state ({state[0]!r}, {state[1]!r})"
+    if n is None:
+        real = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+            value, (bool, np.bool_)
         )
-    try:
-        return float(value)
-    except (TypeError, ValueError):
+        if isinstance(value, np.ndarray) and value.ndim == 0:
+            real = value.dtype.kind in _REAL_KINDS
+        if not real:
+            shape = f" (shape {np.shape(value)})" if np.ndim(value) else ""
+            raise InputError(
+                f"the law returned {type(value).__name__}{shape} {where}; expected one real "
+                "number u [mm/s] (int or float; bool, complex, str and objects are rejected)"
+            )
+        return np.asarray(value, dtype=float)
+    if isinstance(value, np.ndarray):
+        arr = value
+    else:
+        try:
+            arr = np.asarray(value)
+        except (TypeError, ValueError):
+            arr = np.asarray(None, dtype=object)
+    if arr.dtype.kind not in _REAL_KINDS:
         raise InputError(
-            f"the law returned {type(value).__name__} at state ({state[0]!r}, "
-            f"{state[1]!r}); expected one number u [mm/s]"
-        ) from None
+            f"the law returned {type(value).__name__} of dtype {arr.dtype} for {n} states "
+            f"from {where}; expected real numbers (integer or floating dtype)"
+        )
+    if arr.shape != (n,):
+        raise InputError(f"the law returned shape {arr.shape} for {n} states")
+    return arr.astype(float)
+
+
+def _changed(now: Any, before: Any, path: str = "cfg") -> str | None:
+    """Path of the first field of a (nested) dataclass that differs, or None."""
+    import dataclasses
+
+    if dataclasses.is_dataclass(before) and not isinstance(before, type):
+        for f in dataclasses.fields(before):
+            hit = _changed(getattr(now, f.name, None), getattr(before, f.name), f"{path}.{f.name}")
+            if hit:
+                return hit
+        return None
+    same = now == before or (now != now and before != before)  # NaN stays NaN
+    return None if same else f"{path}: {before!r} -> {now!r}"
 
 
 @dataclass
@@ -160,6 +251,8 @@ class UserLaw:
         Why that mode was chosen.
     calls : int
         Number of calls made so far.
+    in_child : bool
+        True in the isolated child: ``KeyboardInterrupt`` from the law is a finding too.
     """
 
     fn: Callable
@@ -167,43 +260,63 @@ class UserLaw:
     mode: str = "scalar"
     reason: str = ""
     calls: int = 0
+    in_child: bool = False
 
-    def scalar(self, x1: float, x2: float) -> float:
-        """Evaluate at one state; LawFault on exception or non-finite u."""
+    def __post_init__(self):
+        import copy
+
+        self._pristine = copy.deepcopy(self.cfg)
+
+    def _fault(self, exc: BaseException, state: tuple[float, float], what: str) -> LawFault:
+        if isinstance(exc, KeyboardInterrupt) and not self.in_child:
+            raise exc
+        return LawFault(state, f"the law raised {type(exc).__name__}{what}: {exc}")
+
+    def _check_cfg(self, state: tuple[float, float]) -> None:
+        """Raise LawFault when the law changed its configuration (a frozen dataclass)."""
+        if self.cfg is not self._pristine and self.cfg != self._pristine:
+            hit = _changed(self.cfg, self._pristine)
+            raise LawFault(state, f"the law changed its configuration argument ({hit})")
+
+    def _one(self, x1: float, x2: float) -> float:
         self.calls += 1
         try:
             value = self.fn(x1, x2, self.cfg)
-        except (Exception, SystemExit) as exc:  # noqa: BLE001 - any user exception is a finding
-            raise LawFault((x1, x2), f"the law raised {type(exc).__name__}: {exc}") from None
-        u = _as_number(value, (x1, x2))
+        except BaseException as exc:  # noqa: BLE001 - anything the user code raises is a finding
+            raise self._fault(exc, (x1, x2), "") from None
+        u = float(check_output(value, (x1, x2)))
         if not math.isfinite(u):
             raise LawFault((x1, x2), f"the law returned u = {u!r}")
         return u
 
+    def scalar(self, x1: float, x2: float) -> float:
+        """Evaluate at one state; LawFault on exception, non-finite u or a changed cfg."""
+        u = self._one(float(x1), float(x2))
+        self._check_cfg((x1, x2))
+        return u
+
     def __call__(self, x1: NDArray, x2: NDArray) -> NDArray[np.float64]:
-        """Evaluate on 1-D arrays [mm], [mm/s]; returns u [mm/s]."""
-        x1 = np.asarray(x1, dtype=float).ravel()
-        x2 = np.asarray(x2, dtype=float).ravel()
+        """Evaluate on 1-D arrays [mm], [mm/s]; returns u [mm/s] (the law gets copies)."""
+        x1 = np.array(x1, dtype=float).ravel()
+        x2 = np.array(x2, dtype=float).ravel()
+        first = (float(x1[0]), float(x2[0])) if x1.size else (math.nan, math.nan)
         if self.mode == "scalar":
-            return np.array([self.scalar(float(a), float(b)) for a, b in zip(x1, x2)], dtype=float)
+            u = np.array([self._one(float(a), float(b)) for a, b in zip(x1, x2)], dtype=float)
+            self._check_cfg(first)
+            return u
         self.calls += 1
         try:
-            value = self.fn(x1, x2, self.cfg)
-        except (Exception, SystemExit) as exc:  # noqa: BLE001 - locate the failing state element-wise
+            value = self.fn(x1.copy(), x2.copy(), self.cfg)
+        except BaseException as exc:  # noqa: BLE001 - locate the failing state element-wise
+            self._fault(exc, first, "")
             for a, b in zip(x1, x2):
                 self.scalar(float(a), float(b))
             raise LawFault(
-                (float(x1[0]), float(x2[0])),
+                first,
                 f"the law raised {type(exc).__name__} on arrays but no element raised alone: {exc}",
             ) from None
-        try:
-            u = np.asarray(value, dtype=float)
-        except (TypeError, ValueError):
-            raise InputError(
-                f"the law returned {type(value).__name__} for arrays; expected a float array"
-            ) from None
-        if u.shape != x1.shape:
-            raise InputError(f"the law returned shape {u.shape} for {x1.size} states")
+        self._check_cfg(first)
+        u = check_output(value, first, x1.size)
         bad = np.flatnonzero(~np.isfinite(u))
         if bad.size:
             i = int(bad[0])
@@ -263,8 +376,15 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
         )
     law.reason = ""
     try:
-        vec = np.asarray(fn(p1, p2, cfg), dtype=float)
-    except (Exception, SystemExit) as exc:  # noqa: BLE001 - any failure on arrays means: scalar loop
+        vec = fn(p1.copy(), p2.copy(), cfg)
+        law._check_cfg((float(p1[0]), float(p2[0])))
+        vec = check_output(vec, (float(p1[0]), float(p2[0])), p1.size)
+    except LawFault as fault:
+        return law, [failure("evaluation", fault.state, fault.message)]
+    except InputError as exc:
+        law.reason = f"an array call returned no array of real numbers ({exc})"
+    except BaseException as exc:  # noqa: BLE001 - any failure on arrays means: scalar loop
+        law._fault(exc, (float(p1[0]), float(p2[0])), "")
         law.reason = f"takes one state per call (an array call raised {type(exc).__name__})"
     else:
         if vec.shape != p1.shape:
@@ -286,225 +406,4 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
 
 
 # ------------------------------------------------------------------ isolation
-#: per-call budget of an isolated law: this many seconds plus _CALL_PER_STATE_S per state
-CALL_BASE_S = 10.0
-_CALL_PER_STATE_S = 1e-3
-#: address-space limit of the law's process (RLIMIT_AS, where the OS has it) [bytes]
-MEMORY_LIMIT_BYTES = 4 << 30
 DEFAULT_TIMEOUT_S = 120.0  #: whole conformance of an isolated law [s]
-
-
-class LawAborted(Exception):
-    """The isolated law's process hung, ended or lost its pipe: nothing more can be evaluated.
-
-    A finding (exit 1): every property not evaluated yet is ``unverified``.
-
-    Parameters
-    ----------
-    message : str
-        What happened to the law's process.
-    """
-
-    def __init__(self, message: str):
-        super().__init__(message)
-        self.message = message
-
-
-def _child_main(conn, spec: str, cfg: Config, out_path: str, memory_limit: int | None) -> None:
-    """Body of the law's process: load, detect the mode, then answer batches."""
-    import os
-    import sys
-
-    fd = os.open(out_path, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os.dup2(fd, 1)
-    os.dup2(fd, 2)
-    os.close(fd)
-    if memory_limit:
-        try:
-            import resource
-
-            _, hard = resource.getrlimit(resource.RLIMIT_AS)
-            lim = memory_limit if hard == resource.RLIM_INFINITY else min(memory_limit, hard)
-            resource.setrlimit(resource.RLIMIT_AS, (lim, hard))
-        except (ImportError, ValueError, OSError):
-            pass  # no RLIMIT_AS on this OS: the time limits still hold
-    try:
-        user, failures = wrap_callable(load_callable(spec), cfg)
-    except InputError as exc:
-        conn.send(("input", str(exc)))
-        return
-    conn.send(("ready", user.mode, user.reason, failures))
-    while True:
-        msg = conn.recv()
-        if msg[0] == "stop":
-            return
-        try:
-            conn.send(("ok", user(msg[1], msg[2])))
-        except LawFault as fault:
-            conn.send(("fault", fault.state, fault.message))
-        except InputError as exc:
-            conn.send(("input", str(exc)))
-
-
-def _ended(proc) -> str:
-    """Describe how the law's process ended."""
-    import signal
-
-    proc.join(2.0)
-    code = proc.exitcode
-    if code is None:
-        return "the pipe to the law's process was lost (the process is still running)"
-    if code < 0:
-        try:
-            name = signal.Signals(-code).name
-        except ValueError:
-            name = f"signal {-code}"
-        return f"the law's process was killed by {name}"
-    return f"the law's process exited with code {code}"
-
-
-class IsolatedLaw:
-    """A user law loaded and called in a child process (spawned), with time and memory limits.
-
-    Same interface as :class:`UserLaw` (``mode``, ``reason``, ``calls``,
-    ``__call__(x1, x2)``, ``scalar``) once :meth:`ready` has returned (the
-    child loads while the caller prepares its states): calls are sent as arrays, the child
-    loops over states in scalar mode.  The law's stdout and stderr go to a
-    file, returned by :meth:`close`.  A timeout (the whole ``timeout`` or the
-    per-call budget of 10 s + 1 ms per state, the 1 ms scaled up by
-    ``timeout`` / 120 s for a longer ``timeout``), any exit of the child
-    (code 0 included), a signal or a lost pipe raises :class:`LawAborted`.
-
-    Parameters
-    ----------
-    spec : str
-        ``MODULE:FUNCTION`` or ``path/file.py:FUNCTION``.
-    cfg : Config
-        Configuration passed to the law.
-    timeout : float
-        Budget for everything the law does, loading included [s].
-    memory_limit : int or None
-        Address-space limit of the child [bytes] (RLIMIT_AS where available).
-    """
-
-    def __init__(
-        self,
-        spec: str,
-        cfg: Config,
-        *,
-        timeout: float = DEFAULT_TIMEOUT_S,
-        memory_limit: int | None = MEMORY_LIMIT_BYTES,
-    ):
-        import multiprocessing
-        import os
-        import tempfile
-        import time
-
-        self.cfg, self.timeout, self.calls = cfg, timeout, 0
-        check_spec(spec)
-        self._deadline = time.monotonic() + timeout
-        fd, self._out = tempfile.mkstemp(prefix="ptoverify-law-", suffix=".log")
-        os.close(fd)
-        ctx = multiprocessing.get_context("spawn")
-        self._conn, child = ctx.Pipe()
-        self._proc = ctx.Process(
-            target=_child_main, args=(child, spec, cfg, self._out, memory_limit), daemon=True
-        )
-        self._proc.start()
-        child.close()
-        self.init_failures: list[dict] = []
-        self.mode, self.reason = "unknown", "not loaded yet"
-
-    def ready(self) -> None:
-        """Wait until the child has loaded the law and detected its mode.
-
-        Raises
-        ------
-        InputError
-            The law cannot be loaded or has a bad interface (exit 2).
-        LawAborted
-            The child hung, crashed or exited while loading.
-        """
-        msg = self._recv("loading the law and detecting its mode", self.timeout)
-        if msg[0] == "input":
-            self.close()
-            raise InputError(msg[1])
-        _, self.mode, self.reason, self.init_failures = msg
-
-    def _recv(self, what: str, budget: float):
-        import time
-
-        left = self._deadline - time.monotonic()
-        wait = max(0.0, min(budget, left))
-        try:
-            ready = self._conn.poll(wait)
-        except (OSError, EOFError):
-            ready = True
-        if not ready:
-            self._kill()
-            if left <= budget:
-                raise LawAborted(
-                    f"timeout: the law used up the --timeout of {self.timeout:g} s ({what})"
-                )
-            raise LawAborted(f"timeout: the law did not answer within {budget:.3g} s ({what})")
-        try:
-            return self._conn.recv()
-        except (EOFError, OSError):
-            raise LawAborted(f"{_ended(self._proc)} ({what})") from None
-        except Exception as exc:  # noqa: BLE001 - garbage on the pipe from user code
-            self._kill()
-            raise LawAborted(f"unreadable answer from the law's process ({what}): {exc}") from None
-
-    def __call__(self, x1: NDArray, x2: NDArray) -> NDArray[np.float64]:
-        """Evaluate on 1-D arrays [mm], [mm/s] in the child; returns u [mm/s]."""
-        x1 = np.ascontiguousarray(x1, dtype=float).ravel()
-        x2 = np.ascontiguousarray(x2, dtype=float).ravel()
-        what = (
-            f"a call of {x1.size} states from ({x1[0]:.6g}, {x2[0]:.6g})" if x1.size else "a call"
-        )
-        try:
-            self._conn.send(("call", x1, x2))
-        except (OSError, EOFError, ValueError):
-            raise LawAborted(f"{_ended(self._proc)} (sending {what})") from None
-        self.calls += 1 if self.mode == "vectorized" else x1.size
-        per_state = _CALL_PER_STATE_S * max(1.0, self.timeout / DEFAULT_TIMEOUT_S)
-        msg = self._recv(what, CALL_BASE_S + per_state * x1.size)
-        if msg[0] == "ok":
-            u = np.asarray(msg[1], dtype=float)
-            if u.shape != x1.shape:
-                raise LawAborted(f"the law's process answered shape {u.shape} ({what})")
-            return u
-        if msg[0] == "fault":
-            raise LawFault(tuple(msg[1]), msg[2])
-        raise InputError(msg[1])
-
-    def scalar(self, x1: float, x2: float) -> float:
-        """Evaluate at one state (one round trip)."""
-        return float(self(np.array([x1]), np.array([x2]))[0])
-
-    def _kill(self) -> None:
-        if self._proc.is_alive():
-            self._proc.kill()
-        self._proc.join(5.0)
-
-    def close(self) -> str:
-        """Stop the child and return what the law printed (stdout and stderr)."""
-        import os
-
-        try:
-            if self._proc.is_alive():
-                self._conn.send(("stop",))
-                self._proc.join(2.0)
-        except (OSError, EOFError, ValueError):
-            pass
-        self._kill()
-        self._conn.close()
-        try:
-            with open(self._out, errors="replace") as fh:
-                text = fh.read()
-            os.unlink(self._out)
-        except OSError:
-            text = ""
-        return text

@@ -8,5 +8,6 @@ groundtruth  verified_mintime -> GroundTruth: closed form, both OCPs and N* from
 claims       Section 6 and conclusion claims, each measured under every reading
 tune         tune PD (kp, kd) and PTO (d, k1, k2) under the same constraints
 robust       robustness under model mismatch: maps, margins, worst-case search
+cluster      --dask: the address checked up front, connecting to a scheduler time-boxed
 checks       the gates of ``ptoverify check``
 """

@@ -593,30 +593,11 @@ def dask_design_runner(address: str) -> Runner:
     InputError
         A malformed address.
     """
-    from ptoverify.errors import ClusterError
-    from ptoverify.studies.robust import DASK_CONNECT_TIMEOUT_S, check_dask_address
+    from ptoverify.studies.cluster import check_dask_address, dask_map
 
     check_dask_address(address)
 
     def run(tasks: list[tuple]) -> list[DesignPoint]:
-        from dask.distributed import Client, LocalCluster
-
-        if address == "local":
-            with (
-                LocalCluster(
-                    n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
-                ) as cluster,
-                Client(cluster) as client,
-            ):
-                return client.gather(client.map(_task, tasks, pure=False))
-        try:
-            client = Client(address, timeout=DASK_CONNECT_TIMEOUT_S)
-        except OSError as exc:
-            raise ClusterError(
-                f"cannot reach the Dask scheduler at {address} within "
-                f"{DASK_CONNECT_TIMEOUT_S:g} s ({type(exc).__name__}); start it, or use --dask local"
-            ) from None
-        with client:
-            return client.gather(client.map(_task, tasks, pure=False))
+        return dask_map(address, _task, list(tasks))
 
     return run

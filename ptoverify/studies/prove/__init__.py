@@ -93,30 +93,12 @@ def parse_a_interval(text: str, a: float) -> tuple[float, float]:
 
 def _dask_mapper(address: str):
     """Return a ``map``-like callable running jobs on a dask.distributed cluster."""
-    from ptoverify.studies.robust import check_dask_address
+    from ptoverify.studies.cluster import check_dask_address, dask_map
 
     check_dask_address(address)
 
     def run(fn, jobs):
-        from dask.distributed import Client, LocalCluster
-
-        from ptoverify.errors import ClusterError
-
-        jobs = list(jobs)
-        if address == "local":
-            with (
-                LocalCluster(
-                    n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
-                ) as cluster,
-                Client(cluster) as client,
-            ):
-                return client.gather(client.map(fn, jobs, pure=False))
-        try:
-            client = Client(address, timeout=30)
-        except OSError as exc:
-            raise ClusterError(f"cannot reach the Dask scheduler at {address} ({exc})") from None
-        with client:
-            return client.gather(client.map(fn, jobs, pure=False))
+        return dask_map(address, fn, list(jobs))
 
     return run
 

@@ -2,16 +2,15 @@
 
 from __future__ import annotations
 
-import re
 from typing import Any
 
-from ptoverify.errors import ClusterError, InputError
+from ptoverify.studies import cluster as dask_cluster
 from ptoverify.studies.robust.maps import Runner, map_task
 
 __all__ = ["DASK_CONNECT_TIMEOUT_S", "check_dask_address", "dask_runner"]
 
-DASK_CONNECT_TIMEOUT_S = 10.0  #: how long to wait for a Dask scheduler [s]
-_ADDRESS = re.compile(r"^(tcp|tls|ucx|inproc|ws|wss)://[^\s/:]+(:\d{1,5})?$|^local$")
+#: how long to wait for a Dask scheduler [s]
+DASK_CONNECT_TIMEOUT_S = dask_cluster.DASK_CONNECT_TIMEOUT_S
 
 
 def check_dask_address(address: str) -> str:
@@ -38,11 +37,7 @@ def check_dask_address(address: str) -> str:
     >>> check_dask_address("tcp://127.0.0.1:8786")
     'tcp://127.0.0.1:8786'
     """
-    if not _ADDRESS.match(address):
-        raise InputError(
-            f"--dask must be 'local' or a scheduler address like tcp://HOST:PORT, got {address!r}"
-        )
-    return address
+    return dask_cluster.check_dask_address(address)  # one validation: studies.cluster
 
 
 def dask_runner(address: str) -> Runner:
@@ -70,24 +65,11 @@ def dask_runner(address: str) -> Runner:
     check_dask_address(address)
 
     def run(tasks: list[tuple]) -> list[Any]:
-        from dask.distributed import Client, LocalCluster
-
-        if address == "local":
-            with (
-                LocalCluster(
-                    n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
-                ) as cluster,
-                Client(cluster) as client,
-            ):
-                return client.gather(client.map(map_task, *zip(*tasks, strict=True), pure=False))
-        try:
-            client = Client(address, timeout=DASK_CONNECT_TIMEOUT_S)
-        except OSError as exc:  # TimeoutError and refused connections
-            raise ClusterError(
-                f"cannot reach the Dask scheduler at {address} within "
-                f"{DASK_CONNECT_TIMEOUT_S:g} s ({type(exc).__name__}); start it, or use --dask local"
-            ) from None
-        with client:
-            return client.gather(client.map(map_task, *zip(*tasks, strict=True), pure=False))
+        return dask_cluster.dask_map(address, _star_map_task, list(tasks))
 
     return run
+
+
+def _star_map_task(task: tuple) -> Any:
+    """Run one map task from its argument tuple (a picklable top-level function)."""
+    return map_task(*task)

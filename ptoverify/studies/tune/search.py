@@ -556,8 +556,9 @@ def tune_checked(
             break
     if best is None:
         raise InputError(
-            f"tune: no {law} gains in the search range meet the constraints "
-            f"(overshoot <= {max_overshoot} mm, stable, no limit cycle)"
+            f"tune: no {law} gains in the search range meet the constraints ("
+            + ("" if max_overshoot is None else f"overshoot <= {max_overshoot:g} mm, ")
+            + "stable, no limit cycle)"
         )
     runner_up = None
     if find_runner_up:

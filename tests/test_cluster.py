@@ -1,0 +1,118 @@
+"""``--dask``: addresses checked up front (exit 2 at once), connecting time-boxed (exit 1).
+
+The listeners are real local sockets: one accepts and never answers, one
+answers garbage.  Both must end the run with exit 1 within the 10 s the README
+states; malformed addresses end it with exit 2 before any computation.
+"""
+
+import os
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from ptoverify.errors import ClusterError, InputError
+from ptoverify.studies.cluster import check_dask_address, connect
+
+ROOT = Path(__file__).resolve().parents[1]
+PROMISED_S = 10.0  #: README: an unreachable scheduler is exit 1 within this [s]
+
+
+def cli(*argv, timeout=60):
+    t = time.monotonic()
+    p = subprocess.run(
+        [sys.executable, "-m", "ptoverify", *argv],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env=dict(os.environ, PYTHONPATH=str(ROOT)),
+        cwd=ROOT,
+    )
+    return p.returncode, p.stdout, p.stderr, time.monotonic() - t
+
+
+@pytest.mark.parametrize("address", ["local", "tcp://127.0.0.1:8786", "tcp://node-1:1"])
+def test_good_addresses(address):
+    assert check_dask_address(address) == address
+
+
+@pytest.mark.parametrize(
+    "address, words",
+    [
+        ("", "scheduler address like"),
+        ("inproc://127.0.0.1/1/2", "inproc:// is not"),
+        ("tls://127.0.0.1:8786", "tls:// is not"),
+        ("ucx://127.0.0.1:8786", "ucx:// is not"),
+        ("ws://127.0.0.1:8786", "ws:// is not"),
+        ("tcp://127.0.0.1:65536", "port 65536 is not in 1..65535"),
+        ("tcp://127.0.0.1:0", "port 0 is not"),
+        ("tcp://127.0.0.1", "scheduler address like"),
+        ("tcp://:8786", "scheduler address like"),
+        ("127.0.0.1:8786", "scheduler address like"),
+        ("tcp://a b:1", "scheduler address like"),
+    ],
+)
+def test_bad_addresses_are_bad_input(address, words):
+    with pytest.raises(InputError, match=words.replace(".", r"\.").replace("/", "/")):
+        check_dask_address(address)
+
+
+@pytest.mark.parametrize("address", ["", "inproc://x", "tls://h:1", "tcp://h:99999"])
+def test_cli_rejects_bad_addresses_at_once(address):
+    code, out, err, took = cli("robust", "--dask", address, "--json")
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert err.startswith("ptoverify: error: --dask")
+    assert took < PROMISED_S
+
+
+class Listener:
+    """A local TCP listener that accepts, then stays silent or sends garbage."""
+
+    def __init__(self, garbage: bytes = b""):
+        self.sock = socket.socket()
+        self.sock.bind(("127.0.0.1", 0))
+        self.sock.listen(8)
+        self.garbage, self.conns = garbage, []
+        self.address = f"tcp://127.0.0.1:{self.sock.getsockname()[1]}"
+        threading.Thread(target=self.serve, daemon=True).start()
+
+    def serve(self):
+        while True:
+            try:
+                conn, _ = self.sock.accept()
+            except OSError:
+                return
+            self.conns.append(conn)
+            if self.garbage:
+                conn.sendall(self.garbage)
+
+    def close(self):
+        for c in [*self.conns, self.sock]:
+            c.close()
+
+
+@pytest.mark.parametrize("garbage", [b"", b"\xff" * 64], ids=["silent", "garbage"])
+def test_connect_is_time_boxed(garbage):
+    listener = Listener(garbage)
+    try:
+        t = time.monotonic()
+        with pytest.raises(ClusterError, match="cannot reach the Dask scheduler"):
+            connect(listener.address, timeout=2.0)
+        assert time.monotonic() - t < 5.0
+    finally:
+        listener.close()
+
+
+@pytest.mark.slow
+def test_cli_against_a_silent_listener_is_exit_1_within_the_promise():
+    listener = Listener()
+    try:
+        code, out, err, took = cli("robust", "--dask", listener.address, "--json", "--quiet")
+    finally:
+        listener.close()
+    assert code == 1 and out == "" and "cannot reach the Dask scheduler" in err, err
+    assert took < PROMISED_S, f"exit after {took:.1f} s"
