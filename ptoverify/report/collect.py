@@ -7,9 +7,9 @@ gates), the robustness study, the tuning comparison, the suboptimality sweep,
 the ground truth (with the environment), the paper's figures and the poles.  Each stage
 draws its own figures (:mod:`ptoverify.report.plots`, which only draws) from its own
 results, so nothing large travels between processes.  The stages share only
-the configuration, so they run in a pool of spawned Python processes
-(``jobs``, default one per available CPU), longest first; with ``jobs=1`` they
-run in this process one after the other, and the results are the same either
+the configuration, so they can run in a pool of spawned Python processes
+(``jobs`` > 1), longest first; with ``jobs=1``, the default, they run in this
+process one after the other, and the results are the same either
 way.  Work shared inside a stage (the corrected zone and its grid check, the
 corrected PTO's closed-loop properties, the claims) is memoized per frozen
 configuration in the numeric modules, and the properties section hands its
@@ -513,21 +513,20 @@ def _run_stage(name: str, cfg: Config, figdir: Path | None) -> tuple[dict[str, A
 
 
 def default_jobs() -> int:
-    """Worker processes ``collect`` uses by default: the CPUs this process may use.
+    """Worker processes ``collect`` uses by default: 1, every stage in this process.
+
+    Measured on this project's shared 2-core machine (3 runs each, taken in turn,
+    issue 23): ``report --jobs 2`` took a median 26.5 s of wall time and
+    ``--jobs 1`` 25.1 s (at a load average of ~3; 118.6 s against 104.2 s at
+    ~17).  The pool gains less than the 1.3x that would justify it, so the
+    default is one process; ``--jobs N`` runs a pool of N.
 
     Returns
     -------
     int
-        ``len(os.sched_getaffinity(0))`` where available, else ``os.cpu_count()``
-        (at least 1).
+        1.
     """
-    import os
-
-    try:
-        n = len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        n = os.cpu_count() or 1
-    return max(1, n)
+    return 1
 
 
 # ------------------------------------------------------------------ collect
