@@ -278,8 +278,7 @@ def point_config(cfg: Config, sample_time: float, bandwidth_hz: float, reading: 
 def _margin(law: str, cfg: Config, gains: tuple[float, float], delay: int) -> tuple[float, float]:
     """(lo, hi) of the linear loop's stable a_true / a_design interval."""
     pd = replace(cfg, pd=PDGains(kp=gains[0], kd=gains[1]))
-    key = "linear_loop_a_ratio_stable" + ("_delay1" if delay else "")
-    got = linear_loop_margin("pd", pd, delay_samples=delay)[key]
+    got = linear_loop_margin("pd", pd, delay_samples=delay).interval
     if got is None:
         return math.nan, math.nan
     lo, hi = got
