@@ -7,6 +7,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
+import matplotlib
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
@@ -334,9 +335,12 @@ def test_saved_png_is_the_figure_drawn(tmp_path):
     ax = fig.add_subplot()
     ax.imshow(np.random.default_rng(0).random((30, 40)), cmap="viridis")
     ax.set_title("noise")
+    before = dict(matplotlib.rcParams)
     path = plots.write_png(fig, tmp_path / "f.png")
+    assert dict(matplotlib.rcParams) == before, "the caller's rcParams are back"
     canvas = FigureCanvasAgg(fig)
-    canvas.draw()
+    with matplotlib.rc_context(plots.RENDER_RC):
+        canvas.draw()
     drawn = np.asarray(canvas.buffer_rgba())
     with Image.open(path) as img:
         assert img.info["dpi"] == pytest.approx((plots.DPI, plots.DPI), abs=0.01)

@@ -26,6 +26,7 @@ conformance  plot_du_map, plot_conform_response, save_conform_figures (conform -
 from ptoverify.report.plots.common import (
     DPI,
     REGION_STYLE,
+    RENDER_RC,
     SIZE,
     STYLE,
     new_axes,
@@ -70,6 +71,7 @@ from ptoverify.report.plots.studies import (
 __all__ = [
     "DPI",
     "SIZE",
+    "RENDER_RC",
     "STYLE",
     "REGION_STYLE",
     "new_figure",
