@@ -71,7 +71,8 @@ commands    the numeric side of commands that compose several steps: run_simulat
             (simulate), run_regulation (simulate --x0), run_zone, run_robust_study,
             mintime_states
 plots       Figs. 2-14 for TO, PD, PTO (both), sweep heat maps, zone geometry, collocation
-            convergence, drawn from results passed in (the only module importing matplotlib)
+            convergence, drawn from results passed in (report/plots/: the only package
+            importing matplotlib; Figure + savefig, no pyplot, no backend switch)
 report      collect (every result once, figure_inputs), write_report (atomic);
             report_sections builds the sections; render prints them (HTML, Markdown)
 conform_report  conform --report DIR: the user's law as an atomic HTML/Markdown/JSON report

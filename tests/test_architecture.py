@@ -253,8 +253,17 @@ def test_cli_imports_no_solver():
     assert offenders(lambda m: m == "ptoverify.cli", _solver) == []
 
 
+#: The plotting modules: the ``plots`` package and its modules.
+PLOTTING = "ptoverify.report.plots"
+
+
+def _plotting(module: str) -> bool:
+    return module == PLOTTING or module.startswith(PLOTTING + ".")
+
+
 def test_plots_import_no_simulator():
-    assert offenders(lambda m: m == "ptoverify.report.plots", _simulator) == []
+    assert [m for m in modules() if _plotting(m) and m != PLOTTING], "the plotting modules"
+    assert offenders(_plotting, _simulator) == []
 
 
 def test_simulator_rule_separates_results_from_computations():
@@ -277,7 +286,7 @@ def test_simulator_rule_separates_results_from_computations():
 
 
 def test_only_plots_imports_matplotlib():
-    assert offenders(lambda m: m != "ptoverify.report.plots", _is(["matplotlib"])) == []
+    assert offenders(lambda m: not _plotting(m), _is(["matplotlib"])) == []
 
 
 def test_numeric_modules_never_import_the_output_layer():
@@ -317,3 +326,287 @@ def test_no_private_name_imports():
 
 def test_no_private_name_imports_except_pending():
     assert offenders(lambda m: m not in PENDING["private"], _private) == []
+
+
+# ------------------------------------------------------------------ third-party internals
+#: Packages whose private names (``_x``, not dunders) no module may touch (issue 23).
+THIRD_PARTY = (
+    "numpy",
+    "scipy",
+    "matplotlib",
+    "sympy",
+    "mpmath",
+    "casadi",
+    "control",
+    "dask",
+    "distributed",
+    "flint",
+)
+
+#: Documented public extension points of those packages that a module may subclass,
+#: as "package.module.Class".  None is needed today; an entry needs a link to the
+#: package's documentation saying it is meant to be subclassed.
+EXTENSION_POINTS: frozenset[str] = frozenset()
+
+#: Files that still use third-party private names, awaiting other helpers' parts of
+#: issue 23 (the lead empties it at merge; it may only shrink).  robust.py,
+#: derivations/evaluate.py and report/collect.py copy algorithms or play gc tricks
+#: but read no private name: this test does not see those.
+PENDING_PRIVATE = frozenset({"derivations/lambertw.py"})  # ctx._im, mpmath's
+
+
+def _is_private(name: str) -> bool:
+    return name.startswith("_") and not (name.startswith("__") and name.endswith("__"))
+
+
+def _third_party(dotted: str) -> bool:
+    return dotted.split(".")[0] in THIRD_PARTY
+
+
+def _root(node: ast.AST) -> ast.AST:
+    """The innermost object of ``a.b(c)[d].e``: the Name ``a`` (or whatever starts it)."""
+    while isinstance(node, (ast.Attribute, ast.Call, ast.Subscript, ast.Starred)):
+        node = node.func if isinstance(node, ast.Call) else node.value
+    return node
+
+
+class _PrivateUse(ast.NodeVisitor):
+    """Third-party private names and subclasses in one module's syntax tree.
+
+    A name is third-party when it is bound by an import of a :data:`THIRD_PARTY`
+    package (``import numpy as np``, ``from matplotlib.ft2font import FT2Font``) or
+    assigned from an expression that starts with such a name (``font = get_font(p)``,
+    ``fig, ax = plt.subplots()``), in the module or in the function that uses it.
+    Flagged: importing a private module or name of those packages; reading ``_name``
+    on a third-party name, on a chain or call starting from one
+    (``np.random._x``, ``get_font(p)._layout(s)``), or through ``getattr`` with a
+    literal; and any class whose base is a third-party name (outside
+    :data:`EXTENSION_POINTS`).
+    """
+
+    def __init__(self) -> None:
+        self.scopes: list[dict[str, str]] = [{}]
+        self.found: list[tuple[int, str]] = []
+
+    def origin(self, node: ast.AST) -> str | None:
+        """Third-party dotted origin of an expression's root name, else None."""
+        root = _root(node)
+        if isinstance(root, ast.Name):
+            for scope in reversed(self.scopes):
+                if root.id in scope:
+                    return scope[root.id]
+        return None
+
+    def flag(self, node: ast.AST, what: str) -> None:
+        self.found.append((node.lineno, what))
+
+    def visit_Import(self, node: ast.Import) -> None:
+        for alias in node.names:
+            if _third_party(alias.name):
+                if any(_is_private(p) for p in alias.name.split(".")):
+                    self.flag(node, f"import {alias.name}")
+                bound = alias.asname or alias.name.split(".")[0]
+                self.scopes[-1][bound] = alias.name if alias.asname else bound
+
+    def visit_ImportFrom(self, node: ast.ImportFrom) -> None:
+        base = node.module or ""
+        if node.level or not _third_party(base):
+            return
+        for alias in node.names:
+            full = f"{base}.{alias.name}"
+            if any(_is_private(p) for p in full.split(".")):
+                self.flag(node, f"from {base} import {alias.name}")
+            self.scopes[-1][alias.asname or alias.name] = full
+
+    def _bind(self, target: ast.AST, origin: str | None) -> None:
+        if isinstance(target, ast.Name):
+            if origin is not None:
+                self.scopes[-1][target.id] = origin
+            else:
+                self.scopes[-1].pop(target.id, None)
+        elif isinstance(target, (ast.Tuple, ast.List)):
+            for t in target.elts:
+                self._bind(t, origin)
+
+    def visit_Assign(self, node: ast.Assign) -> None:
+        self.generic_visit(node)
+        origin = self.origin(node.value)
+        for target in node.targets:
+            self._bind(target, origin)
+
+    def visit_AnnAssign(self, node: ast.AnnAssign) -> None:
+        self.generic_visit(node)
+        if node.value is not None:
+            self._bind(node.target, self.origin(node.value))
+
+    def visit_With(self, node: ast.With) -> None:
+        for item in node.items:
+            self.visit(item.context_expr)
+            if item.optional_vars is not None:
+                self._bind(item.optional_vars, self.origin(item.context_expr))
+        for stmt in node.body:
+            self.visit(stmt)
+
+    def visit_Attribute(self, node: ast.Attribute) -> None:
+        if _is_private(node.attr):
+            origin = self.origin(node.value)
+            if origin is not None:
+                self.flag(node, f"{origin}...{node.attr}")
+        self.generic_visit(node)
+
+    def visit_Call(self, node: ast.Call) -> None:
+        func = node.func
+        if isinstance(func, ast.Name) and func.id in ("getattr", "hasattr", "setattr"):
+            if len(node.args) >= 2 and isinstance(node.args[1], ast.Constant):
+                name = node.args[1].value
+                origin = self.origin(node.args[0])
+                if isinstance(name, str) and _is_private(name) and origin is not None:
+                    self.flag(node, f"{func.id}({origin}, {name!r})")
+        self.generic_visit(node)
+
+    def visit_ClassDef(self, node: ast.ClassDef) -> None:
+        for base in node.bases:
+            origin = self.origin(base)
+            if origin is not None:
+                full = origin if isinstance(base, ast.Name) else f"{origin}:{ast.unparse(base)}"
+                if full not in EXTENSION_POINTS:
+                    self.flag(node, f"class {node.name}({ast.unparse(base)}) subclasses {full}")
+        self.scopes.append({})
+        self.generic_visit(node)
+        self.scopes.pop()
+
+    def _function(self, node: ast.FunctionDef | ast.AsyncFunctionDef | ast.Lambda) -> None:
+        self.scopes.append({})
+        self.generic_visit(node)
+        self.scopes.pop()
+
+    visit_FunctionDef = visit_AsyncFunctionDef = visit_Lambda = _function
+
+
+#: Underscore names that are public API of the standard library (namedtuple's).
+STDLIB_PUBLIC = frozenset({"_replace", "_asdict", "_fields", "_make", "_field_defaults"})
+
+
+def defined_names(trees: list[ast.AST]) -> set[str]:
+    """Every name the given sources define: functions, classes, variables, attributes
+    assigned, parameters, keywords and import aliases."""
+    out = set()
+    for tree in trees:
+        for n in ast.walk(tree):
+            if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                out.add(n.name)
+            elif isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store):
+                out.add(n.id)
+            elif isinstance(n, ast.Attribute) and isinstance(n.ctx, (ast.Store, ast.Del)):
+                out.add(n.attr)
+            elif isinstance(n, ast.alias):
+                out.add(n.asname or n.name.split(".")[-1])
+            elif isinstance(n, ast.arg):
+                out.add(n.arg)
+            elif isinstance(n, ast.keyword) and n.arg:
+                out.add(n.arg)
+    return out
+
+
+def _other_imports(tree: ast.AST) -> set[str]:
+    """Names bound by imports of modules that are not :data:`THIRD_PARTY` (stdlib, ours)."""
+    out = set()
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Import):
+            out |= {a.asname or a.name.split(".")[0] for a in n.names if not _third_party(a.name)}
+        elif isinstance(n, ast.ImportFrom) and (n.level or not _third_party(n.module or "")):
+            out |= {a.asname or a.name for a in n.names}
+    return out
+
+
+def third_party_private_uses(source: str, defined: set[str] | None = None) -> list[tuple[int, str]]:
+    """(line, what) of every use of a third-party private name or internal subclass.
+
+    Besides what :class:`_PrivateUse` resolves, an ``obj._name`` read whose ``_name``
+    nothing in ``defined`` (default: the source itself; for the repository, every
+    module of the two packages) defines, on an object not reached from a standard
+    library import, is flagged: it can only be another package's private name
+    (``ctx._im`` on an mpmath context passed in as a parameter).
+    """
+    tree = ast.parse(source)
+    checker = _PrivateUse()
+    checker.visit(tree)
+    found = set(checker.found)
+    defined = defined_names([tree]) if defined is None else defined
+    other = _other_imports(tree)
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Attribute) and _is_private(n.attr):
+            if n.attr in defined or n.attr in STDLIB_PUBLIC:
+                continue
+            root = _root(n.value)
+            if isinstance(root, ast.Name) and root.id in other:
+                continue
+            found.add((n.lineno, f"{ast.unparse(n)}: {n.attr} is defined by no module of ours"))
+    return sorted(found)
+
+
+def private_offenders() -> dict[str, list[tuple[int, str]]]:
+    """Repository-relative file -> its third-party private uses (files with any)."""
+    paths = list(modules().values())
+    sources = {p: p.read_text() for p in paths}
+    defined = defined_names([ast.parse(src) for src in sources.values()])
+    out = {}
+    for path, src in sources.items():
+        found = third_party_private_uses(src, defined)
+        if found:
+            out[path.relative_to(ROOT).as_posix()] = found
+    return out
+
+
+def test_private_name_checker_on_synthetic_sources():
+    bad = {
+        "import numpy as np\nnp._foo\n": "np._foo",
+        "import numpy as np\nx = np.random._pcg64\n": "a chain from np",
+        "from matplotlib._api import x\n": "from a private module",
+        "from numpy.random import _pickle\n": "a private name",
+        "import matplotlib._color_data\n": "import of a private module",
+        "from matplotlib.backends.backend_agg import RendererAgg\nclass R(RendererAgg):\n  pass\n": (
+            "subclassing"
+        ),
+        "import scipy.stats as st\nclass G(st.rv_continuous):\n  pass\n": "attribute base",
+        (
+            "from matplotlib.font_manager import get_font\n"
+            "def f(p, s):\n    font = get_font(p)\n    return font._layout(s)\n"
+        ): "a name bound from a third-party call",
+        "from matplotlib.font_manager import get_font\nget_font(1)._render_glyph(2)\n": "call",
+        "import mpmath\ndef f(ctx):\n    c = mpmath.mp\n    return c._im(1)\n": "mpmath ctx",
+        "import numpy as np\ngetattr(np, '_x')\n": "getattr with a literal",
+        "import matplotlib.pyplot as plt\nfig, ax = plt.subplots()\nax._children\n": "tuple",
+        "import numpy as np\nwith np.errstate() as e:\n    e._x\n": "with",
+        "def near(ctx, z):\n    return ctx._im(z) >= 0\n": "a parameter's undefined _name",
+    }
+    for src, why in bad.items():
+        assert third_party_private_uses(src), f"missed: {why}\n{src}"
+    good = [
+        "import numpy as np\nnp.__version__\nnp.random.default_rng(0).integers(3)\n",
+        "class A:\n    _x = 1\nA()._x\nself = A()\nself._x\n",
+        "from ptoverify.model import curves\ncurves._private\n",  # ours: the import rule
+        "import numpy as np\nclass B:\n    _y = 0\nx = np.zeros(3)\nx = B()\nx._y\n",  # rebound
+        "import numpy as np\ndef f():\n    np = None\n    return np\n",
+        "from matplotlib.figure import Figure\nclass Mine:\n    fig = Figure\n",
+        "class A:\n    def __init__(self):\n        self._n = 1\n\ndef f(a):\n    return a._n\n",
+        "import sys\nsys._getframe(0)\n",  # the standard library's, not a dependency's
+        "def f(row):\n    return row._replace(x=1)\n",
+    ]
+    for src in good:
+        assert third_party_private_uses(src) == [], src
+
+
+def test_no_third_party_private_names():
+    """No module of ptoverify/ or derivations/ reads a third-party private name or
+    subclasses a third-party class; files still being fixed by others are listed in
+    PENDING_PRIVATE; the plotting modules have none."""
+    found = private_offenders()
+    assert not [f for f in found if f.startswith("ptoverify/report/plots")], found
+    assert set(found) <= PENDING_PRIVATE, {f: found[f] for f in set(found) - PENDING_PRIVATE}
+
+
+def test_pending_private_files_still_offend():
+    """PENDING_PRIVATE only shrinks: a listed file that no longer offends is removed."""
+    fixed = sorted(PENDING_PRIVATE - set(private_offenders()))
+    assert fixed == [], f"remove from PENDING_PRIVATE: {fixed}"

@@ -216,7 +216,7 @@ def test_every_module_is_seen():
         "ptoverify.model.zones",
         "ptoverify.model.laws",
         "ptoverify.model.curves",
-        "ptoverify.report.plots",
+        "ptoverify.report.plots.paper",
     } <= mods
 
 

@@ -242,10 +242,15 @@ def test_convergence_figures(tmp_path):
     from ptoverify.report.plots import plot_convergence, plot_switch_profiles
 
     study = convergence_study(PLANTS["paper"], [(5.0, 0.0)], intervals=(10, 20))
-    ax = plot_convergence(study)
-    assert len(ax.get_lines()) == 2
-    ax = plot_switch_profiles(study, 0)
-    ax.figure.savefig(tmp_path / "switch.png")
+    drawn = plot_convergence(study)
+    line = drawn["x0 = (5 mm, 0 mm/s)"]
+    assert_allclose(line.get_xdata(), study.intervals, err_msg="N of each point")
+    assert_allclose(line.get_ydata(), study.rel_error[0], err_msg="relative t_f error drawn")
+    assert "slope -2" in drawn and len(line.axes.get_lines()) == 2
+    drawn = plot_switch_profiles(study, 0)
+    assert {"N = 10", "N = 20", "switch (closed form)"} <= set(drawn)
+    assert drawn["switch (closed form)"].get_xdata()[0] == study.t_switch_exact[0]
+    drawn["N = 10"].figure.savefig(tmp_path / "switch.png")
     assert (tmp_path / "switch.png").stat().st_size > 0
 
 

@@ -114,9 +114,9 @@ CAPTIONS: dict[str, str] = {
     "robust_settling_nt": "Worst settling / (N* T) over the states, per law and delay (never: "
     "some state never settles).",
     "proof_bound_pto": "Certified number of samples to reach the target ellipse from each cell "
-    "of the envelope, corrected PTO (interval arithmetic; grey: unproven).",
+    "of the envelope, corrected PTO (interval arithmetic; red: unproven).",
     "proof_bound_pd": "Certified number of samples to reach the target ellipse from each cell "
-    "of the envelope, PD (interval arithmetic; grey: unproven).",
+    "of the envelope, PD (interval arithmetic; red: unproven).",
     "tuning_pareto": "Settling against overshoot on the step: the Pareto fronts of PD and PTO "
     "over every candidate evaluated, the best tunings (stars), the paper's gains (squares) and "
     "the floor.",
