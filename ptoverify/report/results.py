@@ -105,6 +105,8 @@ class Results:
     """
 
     __slots__ = ("_data", "_path")
+    _data: dict[str, Any]
+    _path: str
 
     def __init__(self, data: dict[str, Any], path: str = "results") -> None:
         object.__setattr__(self, "_data", dict(data))
