@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import functools
 import math
-import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass
@@ -397,23 +396,13 @@ def stride_over_counts(
 STRIDE_BLOCK = 65536  #: samples per block of :func:`stride_over_counts`
 
 
-#: The arrays of the last grid run finished in this process, for the next to write
-#: into (at most one set, about 85 MB on the default grid; see :func:`grid_simulation`).
-_SPARE: list[BatchResult] = []
-_SPARE_LOCK = threading.Lock()
-
-
 @contextmanager
 def grid_simulation(
     law: Law, cfg: Config, x1: np.ndarray, x2: np.ndarray, steps: int
 ) -> Iterator[BatchResult]:
     """``simulate_batch(law, cfg.plant, x1, x2, steps)`` for the length of a ``with`` block.
 
-    The run writes into the arrays of the previous run that has left its block, if
-    their shapes fit (``simulate_batch(..., out=...)``: the same values, without the
-    page faults of about 85 MB of fresh arrays per run of the gate grid), and leaves
-    its own for the next.  The arrays must not be used after the block.  Thread safe:
-    concurrent runs each take the spare set or fresh arrays.
+    Kept for its callers; the run is a plain :func:`simulate_batch` call.
 
     Parameters
     ----------
@@ -431,14 +420,7 @@ def grid_simulation(
     BatchResult
         The trajectories.
     """
-    with _SPARE_LOCK:
-        spare = _SPARE.pop() if _SPARE else None
-    res = simulate_batch(law, cfg.plant, x1, x2, steps, out=spare)
-    try:
-        yield res
-    finally:
-        with _SPARE_LOCK:
-            _SPARE[:] = [res]
+    yield simulate_batch(law, cfg.plant, x1, x2, steps)
 
 
 def law_properties(
