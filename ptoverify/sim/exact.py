@@ -44,7 +44,7 @@ more than :data:`TIME_TOL_SAMPLES` sample periods (times), :data:`POSITION_TOL`
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
@@ -81,6 +81,7 @@ __all__ = [
     "Trajectory",
     "Compared",
     "ExactMetrics",
+    "ResponseMetrics",
     "grid_rise_time",
     "rise_time",
     "linear_zone_time",
@@ -488,6 +489,41 @@ class Compared:
 
 
 @dataclass(frozen=True)
+class ResponseMetrics:
+    """The ``simulate --json`` ``metrics`` of one response (DESIGN.md).
+
+    Attributes
+    ----------
+    overshoot_mm : float
+        Overshoot past the final value [mm] (NaN for a sine).
+    settling_2pct_s : float
+        Settling time under the ``2pct`` definition [s] (NaN: never settles).
+    settling_0p01mm_s : float
+        Settling time under the ``0p01mm`` definition [s] (NaN: never settles).
+    rise_time_s : float
+        10-90 % rise time [s] (NaN unless a step or ramp).
+    phase_delay_deg : float or None
+        Phase delay of x1 behind a sine [deg]; None unless the reference is a sine.
+    """
+
+    overshoot_mm: float
+    settling_2pct_s: float
+    settling_0p01mm_s: float
+    rise_time_s: float
+    phase_delay_deg: float | None = None
+
+    def to_json(self) -> dict[str, float | None]:
+        """Return the JSON object: one key per field (NaN as None; no phase unless a sine)."""
+        out = {}
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name == "phase_delay_deg" and v is None:
+                continue
+            out[f.name] = None if v is None or math.isnan(v) else float(v)
+        return out
+
+
+@dataclass(frozen=True)
 class ExactMetrics:
     """Metrics of one response, exact and on the grid, by key (:data:`METRIC_KEYS`).
 
@@ -524,9 +560,30 @@ class ExactMetrics:
         ``grid=True`` the same keys hold the sample-grid values
         (``simulate --json`` ``metrics_grid``).
         """
-        keys = [k for k in METRIC_KEYS[:5] if k != "phase_delay_deg" or self.signal.kind == "sine"]
+        return self.response(grid=grid).to_json()
+
+    def response(self, *, grid: bool = False) -> ResponseMetrics:
+        """Return the ``simulate --json`` metrics as a :class:`ResponseMetrics`.
+
+        Parameters
+        ----------
+        grid : bool
+            The sample-grid values instead of the exact ones.
+
+        Returns
+        -------
+        ResponseMetrics
+            The five metrics (phase only for a sine).
+        """
         pick = self.grid() if grid else self.exact()
-        return {k: None if math.isnan(v := pick[k]) else v for k in keys}
+        phase = pick["phase_delay_deg"] if self.signal.kind == "sine" else None
+        return ResponseMetrics(
+            pick["overshoot_mm"],
+            pick["settling_2pct_s"],
+            pick["settling_0p01mm_s"],
+            pick["rise_time_s"],
+            phase,
+        )
 
     def differing(self) -> list[str]:
         """Keys whose exact and grid values differ beyond tolerance."""
