@@ -52,20 +52,20 @@ from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.errors import InputError
 from ptoverify.sim.flow import (
+    Pieces,
     Signal,
     Trajectory,
-    _arr,
-    _crossing,
-    _derivs,
-    _e_derivs,
-    _extrema,
-    _flow,
-    _Pieces,
-    _pieces,
-    _ref_parts,
-    _split,
-    _value,
+    as_float_array,
     as_signal,
+    error_derivatives,
+    interval_extrema,
+    monotone_pieces,
+    piece_crossing,
+    piece_error_derivatives,
+    piece_value,
+    reference_parts,
+    split_intervals,
+    zoh_flow,
 )
 from ptoverify.sim.settling import DEFINITIONS, SettlingDefinition, overshoot, settling_time
 
@@ -116,9 +116,9 @@ METRIC_KEYS = (
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 
 
-def _first_reach(p: _Pieces, level: float, sgn: float, xv=None) -> float:
+def _first_reach(p: Pieces, level: float, sgn: float, xv=None) -> float:
     """First time [s] with sgn (x1(t) - level) >= 0 on x1-pieces p, exactly; NaN if never."""
-    xv = _value(p, p.brk, "x1") if xv is None else xv
+    xv = piece_value(p, p.brk, "x1") if xv is None else xv
     v = sgn * (xv - level) >= 0
     if not v.any():
         return math.nan
@@ -126,7 +126,7 @@ def _first_reach(p: _Pieces, level: float, sgn: float, xv=None) -> float:
     j = int(np.nonzero(v[k])[0][0])
     if j == 0:
         return float(p.t0[k])
-    return _crossing(p, k, p.brk[k, j - 1], p.brk[k, j], level, "x1")
+    return piece_crossing(p, k, p.brk[k, j - 1], p.brk[k, j], level, "x1")
 
 
 def rise_time(tr: Trajectory, target: float, *, low: float = 0.1, high: float = 0.9) -> float:
@@ -158,24 +158,24 @@ def rise_time(tr: Trajectory, target: float, *, low: float = 0.1, high: float = 
     x0 = float(tr.x1[0])
     if target == x0:
         return math.nan
-    return _rise(_pieces(tr, None, "x1"), x0, target, low, high)
+    return _rise(monotone_pieces(tr, None, "x1"), x0, target, low, high)
 
 
-def _rise(p: _Pieces, x0: float, target: float, low: float, high: float, xv=None) -> float:
+def _rise(p: Pieces, x0: float, target: float, low: float, high: float, xv=None) -> float:
     t_lo, t_hi = _rise_pair(p, x0, target, low, high, xv)
     return t_hi - t_lo
 
 
-def _rise_pair(p: _Pieces, x0: float, target: float, low: float, high: float, xv=None):
+def _rise_pair(p: Pieces, x0: float, target: float, low: float, high: float, xv=None):
     """Absolute first times [s] x1 reaches the low and the high level."""
     sgn = 1.0 if target > x0 else -1.0
-    xv = _value(p, p.brk, "x1") if xv is None else xv
+    xv = piece_value(p, p.brk, "x1") if xv is None else xv
     t_lo = _first_reach(p, x0 + low * (target - x0), sgn, xv)
     t_hi = _first_reach(p, x0 + high * (target - x0), sgn, xv)
     return t_lo, t_hi
 
 
-def _preimage(p: _Pieces, k: int, s0: float, s1: float, v0: float, v1: float, lim: float, what):
+def _preimage(p: Pieces, k: int, s0: float, s1: float, v0: float, v1: float, lim: float, what):
     """[lo, hi] of s in [s0, s1] with |f(s)| <= lim for f monotone (None if empty)."""
     if max(v0, v1) < -lim or min(v0, v1) > lim:
         return None
@@ -189,13 +189,13 @@ def _preimage(p: _Pieces, k: int, s0: float, s1: float, v0: float, v1: float, li
 
 def _cross_generic(p, k, s0, s1, level, what):
     if what == "e":
-        return _crossing(p, k, s0, s1, level, "e")
+        return piece_crossing(p, k, s0, s1, level, "e")
 
-    slope, amp, w = _ref_parts(p)
+    slope, amp, w = reference_parts(p)
     g = (float(p.x2[k]), float(p.u[k]), float(p.t0[k]), float(slope[k]), amp, w, p.a)
 
     def f(s: float) -> float:
-        return float(_derivs(*g, s, 1)[0]) - level
+        return float(error_derivatives(*g, s, 1)[0]) - level
 
     f0, f1 = f(s0), f(s1)
     if f0 * f1 > 0:
@@ -248,19 +248,19 @@ def linear_zone_time(tr: Trajectory, ref: Any, d: float, *, v_max: float = math.
     >>> round(linear_zone_time(tr, Signal("step", 1.0), 0.5), 6)  # ln(2) / 20
     0.034657
     """
-    return _linear_zone(_pieces(tr, as_signal(ref)), d, v_max) - float(tr.t[0])
+    return _linear_zone(monotone_pieces(tr, as_signal(ref)), d, v_max) - float(tr.t[0])
 
 
-def _linear_zone(p: _Pieces, d: float, v_max: float, ev=None) -> float:
+def _linear_zone(p: Pieces, d: float, v_max: float, ev=None) -> float:
     """Absolute first entry time [s] into the zone on e-pieces p; NaN if never."""
     if math.isfinite(v_max):  # refine so that e' is monotone on every piece too
-        z2 = np.where(np.isnan(z := _extrema(p, 2)), p.h[:, None], z)
+        z2 = np.where(np.isnan(z := interval_extrema(p, 2)), p.h[:, None], z)
         brk = np.sort(np.concatenate([p.brk, z2], 1), 1)
-        q = _Pieces(p.t0, p.h, p.x1, p.x2, p.u, p.a, p.sig, brk)
-        e, e2 = _value(q, brk, "e"), -_e_derivs(q, brk)[0]
+        q = Pieces(p.t0, p.h, p.x1, p.x2, p.u, p.a, p.sig, brk)
+        e, e2 = piece_value(q, brk, "e"), -piece_error_derivatives(q, brk)[0]
     else:
         q, brk = p, p.brk
-        e = _value(p, brk, "e") if ev is None else ev
+        e = piece_value(p, brk, "e") if ev is None else ev
         e2 = np.zeros_like(e)
     lo, hi = brk[:, :-1], brk[:, 1:]
 
@@ -336,7 +336,7 @@ def sine_phase(
     if n_per < 1:
         return math.nan, math.nan, (math.nan, tb)
     ta = tb - n_per * per
-    t0, h, x1, x2, u = _split(tr, None, (ta,))
+    t0, h, x1, x2, u = split_intervals(tr, None, (ta,))
     keep = t0 >= ta
     t0, h, x1, x2, u = t0[keep], h[keep], x1[keep], x2[keep], u[keep]
     w = sig.omega
@@ -344,7 +344,7 @@ def sine_phase(
     node = (np.arange(J)[:, None] + 0.5 * (_GL_X[None, :] + 1.0)).ravel() / J  # in (0, 1)
     wt = np.tile(_GL_W, J) / (2.0 * J)
     s = h[:, None] * node[None, :]
-    y1, _ = _flow(x1[:, None], x2[:, None], u[:, None], s, tr.a)
+    y1, _ = zoh_flow(x1[:, None], x2[:, None], u[:, None], s, tr.a)
     tt = t0[:, None] + s
     hw = h[:, None] * wt[None, :]
     sn, cs = np.sin(w * tt), np.cos(w * tt)
@@ -405,7 +405,7 @@ def grid_rise_time(
     >>> round(grid_rise_time(t, 1 - np.exp(-10 * t), 1.0), 3)
     0.22
     """
-    t, x = _arr(t), _arr(x)
+    t, x = as_float_array(t), as_float_array(x)
     x0 = float(x[0]) if start is None else float(start)
     if target == x0:
         return math.nan
@@ -670,7 +670,7 @@ def metrics_from_arrays(
         details["t_peak_s"] = float(ov.t_peak[0])
         rt = err = nan
         if target != y1[0]:
-            t_lo, t_hi = _rise_pair(_pieces(tr, None, "x1"), float(y1[0]), target, 0.1, 0.9)
+            t_lo, t_hi = _rise_pair(monotone_pieces(tr, None, "x1"), float(y1[0]), target, 0.1, 0.9)
             rt, err = t_hi - t_lo, acc.time(t_lo, "x1") + acc.time(t_hi, "x1")
         vals["rise_time_s"] = Compared(
             rt, grid_rise_time(tt, y1, target), TIME_TOL_SAMPLES * T, err
@@ -688,7 +688,7 @@ def metrics_from_arrays(
     if d is None:
         vals["linear_zone_s"] = Compared(nan, nan, TIME_TOL_SAMPLES * T, nan)
     else:
-        ez = _linear_zone(_pieces(tr, sig), d, v_max) - float(tt[0])
+        ez = _linear_zone(monotone_pieces(tr, sig), d, v_max) - float(tt[0])
         inside = (np.abs(e_grid) < d) & (np.abs(y2 - sig.r_dot(tt)) <= v_max)
         gz = _grid_first(tt, inside) - float(tt[0])
         err = acc.time(float(tt[0]) + ez, "e") if ez > 0 else (0.0 if ez == 0 else nan)
@@ -952,7 +952,7 @@ def settling_times_batch(
     >>> round(float(st.time[0]), 6), float(st.grid[0])  # ln(50) / 10, then the sample after
     (0.391202, 0.4)
     """
-    x1, x2, u = _arr(x1), _arr(x2), _arr(u)
+    x1, x2, u = as_float_array(x1), as_float_array(x2), as_float_array(u)
     if x1.ndim == 1:
         x1, x2, u = x1[:, None], x2[:, None], u[:, None]
     steps = x1.shape[0] - 1

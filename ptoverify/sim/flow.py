@@ -130,7 +130,19 @@ def as_signal(ref: Any) -> Signal:
     return Signal(str(kind), float(ref.amplitude), float(rate))
 
 
-def _arr(x: ArrayLike) -> NDArray[np.float64]:
+def as_float_array(x: ArrayLike) -> NDArray[np.float64]:
+    """Return x as a float array.
+
+    Parameters
+    ----------
+    x : array_like
+        Values [any unit].
+
+    Returns
+    -------
+    ndarray
+        The values as float64.
+    """
     return np.asarray(x, dtype=float)
 
 
@@ -172,7 +184,7 @@ class Trajectory:
         trajectories on the same sample times; u then has shape (n,) or (n, k)
         (or one trailing row more).
         """
-        t, x1, x2, u = _arr(t), _arr(x1), _arr(x2), _arr(u)
+        t, x1, x2, u = as_float_array(t), as_float_array(x1), as_float_array(x2), as_float_array(u)
         n = t.size - 1
         if n < 1 or t.ndim != 1 or x1.shape[:1] != t.shape or x2.shape != x1.shape:
             raise InputError("t must be 1-D of length >= 2 and x1, x2 of one shape, t's rows")
@@ -216,20 +228,52 @@ class Trajectory:
         x1, x2 : ndarray
             Position [mm] and velocity [mm/s].
         """
-        tq = _arr(tq)
+        tq = as_float_array(tq)
         k = np.clip(np.searchsorted(self.t, tq, side="right") - 1, 0, self.intervals - 1)
-        return _flow(self.x1[k], self.x2[k], self.u[k], tq - self.t[k], self.a)
+        return zoh_flow(self.x1[k], self.x2[k], self.u[k], tq - self.t[k], self.a)
 
 
-def _flow(x1, x2, u, s, a):
+def zoh_flow(x1, x2, u, s, a):
+    """Exact ZOH flow of eq. (7) over offsets s (broadcasting).
+
+    Parameters
+    ----------
+    x1, x2 : array_like
+        State at the start [mm], [mm/s].
+    u : array_like
+        Held input [mm/s].
+    s : array_like
+        Time offsets [s].
+    a : float or array_like
+        Bandwidth [rad/s].
+
+    Returns
+    -------
+    x1, x2 : ndarray
+        State after s [mm], [mm/s].
+    """
     g = -np.expm1(-a * s)
     dv = x2 - u
     return x1 + u * s + dv * g / a, x2 - dv * g
 
 
 @dataclass(frozen=True)
-class _Pieces:
-    """Intervals (split at the reference's cuts) and their monotone pieces of e."""
+class Pieces:
+    """Intervals (split at the reference's cuts) and their monotone pieces of e.
+
+    Attributes
+    ----------
+    t0, h : ndarray, shape (m,)
+        Interval starts and lengths [s].
+    x1, x2, u : ndarray, shape (m,)
+        State at each start [mm], [mm/s] and held input [mm/s].
+    a : float
+        Bandwidth [rad/s].
+    sig : Signal or None
+        The reference (None: x1 itself).
+    brk : ndarray, shape (m, K)
+        Piece boundaries as offsets [s], sorted, first 0, last h.
+    """
 
     t0: NDArray[np.float64]  # (m,) interval starts [s]
     h: NDArray[np.float64]  # (m,) lengths [s]
@@ -243,7 +287,7 @@ class _Pieces:
     def at(self, s):
         """Return (x1, x2, r, r') at offsets s (broadcast against (m, 1))."""
         c = (slice(None),) + (None,) * (np.ndim(s) - 1)
-        y1, y2 = _flow(self.x1[c], self.x2[c], self.u[c], s, self.a)
+        y1, y2 = zoh_flow(self.x1[c], self.x2[c], self.u[c], s, self.a)
         tt = self.t0[c] + s
         if self.sig is None:
             return y1, y2, np.zeros_like(y1), np.zeros_like(y1)
@@ -253,10 +297,22 @@ class _Pieces:
         return y1, y2, r, slope + amp * w * np.cos(w * tt)
 
 
-def _split(tr: Trajectory, sig: Signal | None, extra: tuple[float, ...] = ()):
+def split_intervals(tr: Trajectory, sig: Signal | None, extra: tuple[float, ...] = ()):
     """Interval arrays with the reference's cuts (and ``extra`` times) inserted.
 
-    t0 and h have shape (m,); x1, x2, u have the trajectory's shape with m rows.
+    Parameters
+    ----------
+    tr : Trajectory
+        The record.
+    sig : Signal or None
+        The reference (its cuts: the ramp's end).
+    extra : tuple of float
+        More cut times [s].
+
+    Returns
+    -------
+    tuple
+        t0, h of shape (m,) [s]; x1, x2, u with m rows [mm], [mm/s], [mm/s].
     """
     t0, h = tr.t[:-1], np.diff(tr.t)
     x1, x2, u = tr.x1[:-1], tr.x2[:-1], tr.u
@@ -266,7 +322,7 @@ def _split(tr: Trajectory, sig: Signal | None, extra: tuple[float, ...] = ()):
         s = c - t0[k]
         if s <= 0.0 or s >= h[k]:
             continue
-        y1, y2 = _flow(x1[k], x2[k], u[k], s, tr.a)
+        y1, y2 = zoh_flow(x1[k], x2[k], u[k], s, tr.a)
         t0 = np.insert(t0, k + 1, c)
         h = np.insert(h, k + 1, h[k] - s)
         h[k] = s
@@ -286,8 +342,24 @@ def _cos_roots(theta0, dtheta, c):
     return out
 
 
-def _newton(fdf, lo, hi, flo, tol):
+def bracketed_newton(fdf, lo, hi, flo, tol):
     """Vectorized safeguarded Newton on brackets [lo, hi] with one sign change.
+
+    Parameters
+    ----------
+    fdf : callable
+        x -> (f(x), f'(x)), vectorized.
+    lo, hi : ndarray
+        Brackets [s].
+    flo : ndarray
+        f(lo).
+    tol : float
+        Stopping width [s].
+
+    Returns
+    -------
+    ndarray
+        The roots [s].
 
     ``fdf(x)`` returns (f, f').  A Newton step that leaves the bracket is
     replaced by bisection; iteration stops within ``tol`` of the root.
@@ -310,8 +382,33 @@ def _newton(fdf, lo, hi, flo, tol):
     return x
 
 
-def _derivs(x2, u, t0, slope, amp, w, a, s, order):
-    """e^(order) and e^(order + 1) at offsets s [s] (order 1 or 2), per-interval parameters."""
+def error_derivatives(x2, u, t0, slope, amp, w, a, s, order):
+    """Return e^(order) and e^(order + 1) at offsets s (order 1 or 2).
+
+    Parameters
+    ----------
+    x2, u : array_like
+        Velocity at the interval's start and held input [mm/s].
+    t0 : array_like
+        Interval start [s].
+    slope : array_like
+        Ramp slope on the interval [mm/s].
+    amp : float
+        Sine amplitude [mm] (0: none).
+    w : float
+        Sine angular frequency [rad/s].
+    a : float
+        Bandwidth [rad/s].
+    s : array_like
+        Offsets [s].
+    order : int
+        1 or 2 [-].
+
+    Returns
+    -------
+    tuple of ndarray
+        The two derivatives [mm/s^order], [mm/s^(order + 1)].
+    """
     dv = (x2 - u) * np.exp(-a * s)
     th = w * (t0 + s)
     c, sn = np.cos(th), np.sin(th)
@@ -321,26 +418,63 @@ def _derivs(x2, u, t0, slope, amp, w, a, s, order):
     return d2, -amp * w**3 * c - a * a * dv
 
 
-def _ref_parts(p: _Pieces):
-    """Per-interval slope [mm/s], sine amplitude [mm] and omega [rad/s] of the reference."""
+def reference_parts(p: Pieces):
+    """Return per-interval slope, sine amplitude and omega of the reference.
+
+    Parameters
+    ----------
+    p : Pieces
+        The intervals.
+
+    Returns
+    -------
+    tuple
+        Slope [mm/s] of shape (m,), amplitude [mm], omega [rad/s].
+    """
     sig = p.sig
     if sig is None:
         return np.zeros(p.h.size), 0.0, 0.0
     return sig.slope(p.t0 + 0.5 * p.h), sig.amplitude * (sig.kind == "sine"), sig.omega
 
 
-def _e_derivs(p: _Pieces, s):
-    """e'(s) [mm/s] and e''(s) [mm/s^2] at offsets s of shape (m, K)."""
-    slope, amp, w = _ref_parts(p)
+def piece_error_derivatives(p: Pieces, s):
+    """Return e'(s) [mm/s] and e''(s) [mm/s^2] at offsets s of shape (m, K).
+
+    Parameters
+    ----------
+    p : Pieces
+        The intervals.
+    s : ndarray, shape (m, K)
+        Offsets [s].
+
+    Returns
+    -------
+    tuple of ndarray
+        e' [mm/s] and e'' [mm/s^2].
+    """
+    slope, amp, w = reference_parts(p)
     c = (slice(None), None)
-    return _derivs(p.x2[c], p.u[c], p.t0[c], slope[c], amp, w, p.a, s, 1)
+    return error_derivatives(p.x2[c], p.u[c], p.t0[c], slope[c], amp, w, p.a, s, 1)
 
 
-def _extrema(p0: _Pieces, order: int) -> NDArray[np.float64]:
-    """Zeros in (0, h) of e' (order 1) or e'' (order 2) per interval, shape (m, 3)."""
+def interval_extrema(p0: Pieces, order: int) -> NDArray[np.float64]:
+    """Return zeros in (0, h) of e' (order 1) or e'' (order 2) per interval.
+
+    Parameters
+    ----------
+    p0 : Pieces
+        The intervals.
+    order : int
+        1 or 2 [-].
+
+    Returns
+    -------
+    ndarray, shape (m, 3)
+        Offsets [s], NaN where none.
+    """
     a, h = p0.a, p0.h
     m = h.size
-    slope, amp, w = _ref_parts(p0)
+    slope, amp, w = reference_parts(p0)
     if not (w > 0.0 and amp != 0.0):  # e' = v - x2(s): one closed-form root; e'' != 0
         out = np.full((m, 3), np.nan)
         if order == 1:
@@ -362,8 +496,8 @@ def _extrema(p0: _Pieces, order: int) -> NDArray[np.float64]:
     lo, hi = brk[:, :-1], brk[:, 1:]
     c = (slice(None), None)
     args = (p0.x2[c], p0.u[c], p0.t0[c], slope[c], amp, w, a)
-    flo = _derivs(*args, lo, order)[0]
-    fhi = _derivs(*args, hi, order)[0]
+    flo = error_derivatives(*args, lo, order)[0]
+    fhi = error_derivatives(*args, hi, order)[0]
     out = np.full(lo.shape, np.nan)
     has = (flo * fhi < 0) & (hi > lo)
     if has.any():
@@ -372,33 +506,104 @@ def _extrema(p0: _Pieces, order: int) -> NDArray[np.float64]:
         g = (p0.x2[k], p0.u[k], p0.t0[k], slope[k], amp, w, a)
         # a few ulps of the absolute time t0 + s: the precision any time of the record has
         tol = 4.0 * np.finfo(float).eps * float(np.max(np.abs(p0.t0) + h))
-        out[idx] = _newton(lambda x: _derivs(*g, x, order), lo[idx], hi[idx], flo[idx], tol)
+        out[idx] = bracketed_newton(
+            lambda x: error_derivatives(*g, x, order), lo[idx], hi[idx], flo[idx], tol
+        )
     return np.where((out > 0) & (out < h[:, None]), out, np.nan)
 
 
-def _pieces(tr: Trajectory, sig: Signal | None, what: str = "e") -> _Pieces:
-    """Split the record into pieces on which e (what='e') or x1 (what='x1') is monotone."""
-    t0, h, x1, x2, u = _split(tr, sig)
-    return _pieces_of(t0, h, x1, x2, u, tr.a, sig if what == "e" else None, 1)
+def monotone_pieces(tr: Trajectory, sig: Signal | None, what: str = "e") -> Pieces:
+    """Split the record into pieces on which e (what='e') or x1 (what='x1') is monotone.
+
+    Parameters
+    ----------
+    tr : Trajectory
+        The record.
+    sig : Signal or None
+        The reference.
+    what : str
+        ``e`` or ``x1``.
+
+    Returns
+    -------
+    Pieces
+        The pieces.
+    """
+    t0, h, x1, x2, u = split_intervals(tr, sig)
+    return pieces_of_intervals(t0, h, x1, x2, u, tr.a, sig if what == "e" else None, 1)
 
 
-def _pieces_of(t0, h, x1, x2, u, a: float, sig: Signal | None, order: int) -> _Pieces:
-    """Pieces of intervals (1-D arrays) on which e (order 1) or e' (order 2) is monotone."""
-    p = _Pieces(t0, h, x1, x2, u, a, sig, np.empty((0, 0)))
-    z = _extrema(p, order)
+def pieces_of_intervals(t0, h, x1, x2, u, a: float, sig: Signal | None, order: int) -> Pieces:
+    """Return pieces of intervals on which e (order 1) or e' (order 2) is monotone.
+
+    Parameters
+    ----------
+    t0, h : ndarray, shape (m,)
+        Interval starts and lengths [s].
+    x1, x2, u : ndarray, shape (m,)
+        Start states [mm], [mm/s] and inputs [mm/s].
+    a : float
+        Bandwidth [rad/s].
+    sig : Signal or None
+        The reference.
+    order : int
+        1 or 2 [-].
+
+    Returns
+    -------
+    Pieces
+        The pieces.
+    """
+    p = Pieces(t0, h, x1, x2, u, a, sig, np.empty((0, 0)))
+    z = interval_extrema(p, order)
     z = z[:, ~np.isnan(z).all(axis=0)]  # columns no interval uses
     brk = np.concatenate([np.zeros((h.size, 1)), np.where(np.isnan(z), h[:, None], z)], axis=1)
     brk = np.concatenate([np.sort(brk, axis=1), h[:, None]], axis=1)
-    return _Pieces(t0, h, x1, x2, u, a, sig, brk)
+    return Pieces(t0, h, x1, x2, u, a, sig, brk)
 
 
-def _value(p: _Pieces, s, what: str):
+def piece_value(p: Pieces, s, what: str):
+    """Return e (what='e') or x1 at offsets s.
+
+    Parameters
+    ----------
+    p : Pieces
+        The intervals.
+    s : ndarray
+        Offsets [s].
+    what : str
+        ``e`` or ``x1``.
+
+    Returns
+    -------
+    ndarray
+        Values [mm].
+    """
     y1, _, r, _ = p.at(s)
     return r - y1 if what == "e" else y1
 
 
-def _crossing(p: _Pieces, k: int, s0: float, s1: float, level: float, what: str) -> float:
-    """Exact time [s] where the monotone e (or x1) of interval k crosses level in [s0, s1]."""
+def piece_crossing(p: Pieces, k: int, s0: float, s1: float, level: float, what: str) -> float:
+    """Return the time where the monotone e (or x1) of interval k crosses level.
+
+    Parameters
+    ----------
+    p : Pieces
+        The intervals.
+    k : int
+        Interval index [-].
+    s0, s1 : float
+        The monotone piece [s].
+    level : float
+        Level [mm].
+    what : str
+        ``e`` or ``x1``.
+
+    Returns
+    -------
+    float
+        Absolute time [s].
+    """
     x1k, dv, uk, a, t0 = float(p.x1[k]), float(p.x2[k] - p.u[k]), float(p.u[k]), p.a, float(p.t0[k])
     sig = p.sig if what == "e" else None
     kind = sig.kind if sig else ""
@@ -406,7 +611,7 @@ def _crossing(p: _Pieces, k: int, s0: float, s1: float, level: float, what: str)
     r0 = float(sig.r(t0)) if sig else 0.0
     slope = float(sig.slope(t0 + 0.5 * float(p.h[k]))) if sig else 0.0
 
-    def f(s: float) -> float:  # eq. (7) in scalar arithmetic, as _flow
+    def f(s: float) -> float:  # eq. (7) in scalar arithmetic, as zoh_flow
         y1 = x1k + uk * s + dv * -math.expm1(-a * s) / a
         if sig is None:
             return y1 - level

@@ -31,12 +31,12 @@ from ptoverify.errors import InputError
 from ptoverify.sim.flow import (
     Signal,
     Trajectory,
-    _derivs,
-    _flow,
-    _newton,
-    _pieces_of,
-    _split,
     as_signal,
+    bracketed_newton,
+    error_derivatives,
+    pieces_of_intervals,
+    split_intervals,
+    zoh_flow,
 )
 
 __all__ = [
@@ -296,7 +296,7 @@ def _last_exit(tr: Trajectory, sig: Signal, band: float, order: int, T: float): 
     (|e'| <= |e'_k| up to the extremum); for a sine every later interval is
     examined.
     """
-    t0, h, x1, x2, u = _split(tr, sig)
+    t0, h, x1, x2, u = split_intervals(tr, sig)
     m, k = x1.shape
     slope = sig.slope(t0 + 0.5 * h)[:, None]
     amp, w = sig.amplitude * (sig.kind == "sine"), sig.omega
@@ -323,10 +323,10 @@ def _last_exit(tr: Trajectory, sig: Signal, band: float, order: int, T: float): 
     last = np.full(k, float(tr.t[0]))
     if ci.size == 0:
         return last, ended
-    p = _pieces_of(t0[ci], h[ci], x1[ci, cc], x2[ci, cc], u[ci, cc], tr.a, sig, order)
+    p = pieces_of_intervals(t0[ci], h[ci], x1[ci, cc], x2[ci, cc], u[ci, cc], tr.a, sig, order)
     slope_c = slope[ci, 0]
     dargs = (p.x2[:, None], p.u[:, None], p.t0[:, None], slope_c[:, None], amp, w, p.a)
-    ev = _e_at(p, p.brk) if order == 1 else _derivs(*dargs, p.brk, 1)[0]
+    ev = _e_at(p, p.brk) if order == 1 else error_derivatives(*dargs, p.brk, 1)[0]
     K = ev.shape[1]
     out = np.abs(ev) > band
     hit = np.flatnonzero(out.any(axis=1))
@@ -351,10 +351,10 @@ def _last_exit(tr: Trajectory, sig: Signal, band: float, order: int, T: float): 
             gd = (p.x2[f], p.u[f], p.t0[f], slope_c[f], amp, w, p.a)
 
             def fdf(s):
-                d1, d2 = _derivs(*gd, s, 1)
+                d1, d2 = error_derivatives(*gd, s, 1)
                 return d1 - level, d2
 
-        s = _newton(fdf, lo, hi, fdf(lo)[0], 4.0 * np.finfo(float).eps * T)
+        s = bracketed_newton(fdf, lo, hi, fdf(lo)[0], 4.0 * np.finfo(float).eps * T)
         last[col] = p.t0[f] + s
     return last, ended
 
@@ -367,7 +367,7 @@ def _e_at(p, s):
 
 def _e_and_slope(x1k, x2k, uk, t0, slope, amp, w, a, sig, s, level):
     """e(s) - level [mm] and e'(s) [mm/s] on intervals (vectorized; eq. 7)."""
-    y1, y2 = _flow(x1k, x2k, uk, s, a)
+    y1, y2 = zoh_flow(x1k, x2k, uk, s, a)
     if sig.kind == "sine":
         r, rd = amp * np.sin(w * (t0 + s)), amp * w * np.cos(w * (t0 + s))
     else:
@@ -435,7 +435,7 @@ def overshoot(trajectory: Trajectory, target: float) -> Overshoot:
         s_star = np.log1p(-x2 / U) / tr.a
     inner = np.isfinite(s_star) & (s_star > 0) & (s_star < h)
     s_star = np.where(inner, s_star, 0.0)
-    y1, _ = _flow(x1, x2, U, s_star, tr.a)
+    y1, _ = zoh_flow(x1, x2, U, s_star, tr.a)
     cand = sgn * (np.where(inner, y1, x1) - target)
     cand_t = t0 + s_star
     also = sgn * (X1 - target)  # the samples themselves
