@@ -67,7 +67,13 @@ from ptoverify.sim.flow import (
     split_intervals,
     zoh_flow,
 )
-from ptoverify.sim.settling import DEFINITIONS, SettlingDefinition, overshoot, settling_time
+from ptoverify.sim.settling import (
+    DEFINITIONS,
+    Settling,
+    SettlingDefinition,
+    overshoot,
+    settling_time,
+)
 
 __all__ = [
     "TIGHT_BAND",
@@ -654,7 +660,11 @@ def metrics_from_arrays(
     e_grid = sig.r(tt) - y1
     nan = math.nan
     set2, set01, ov = _core(tr, sig, band, step_fraction)
-    band2 = set2.definition.position_band(abs(sig.amplitude))
+    band2 = (
+        STEP_FRACTION * abs(sig.amplitude)
+        if step_fraction is None
+        else step_fraction * abs(sig.amplitude)
+    )
     acc = _Accuracy(tr, sig)
     vals: dict[str, Compared] = {}
     details: dict[str, float] = {"band_2pct_mm": band2, "t_peak_s": nan}
@@ -701,13 +711,16 @@ def _core(tr: Trajectory, sig: Signal, band: float, step_fraction: float | None)
 
     Returns (Settling, Settling, Overshoot or None): the definitions of the
     registry when ``band`` and ``step_fraction`` are theirs (2 % and 0.01 mm by
-    default), else ad-hoc ones; the overshoot for a step or ramp only.
+    default), else ad-hoc ones; the overshoot for a step or ramp only.  A band
+    of zero width (a fraction of a reference of size 0) settles never: NaN.
     """
     frac = STEP_FRACTION if step_fraction is None else step_fraction
     d2 = _named(SettlingDefinition("custom", "fraction band", band_fraction=frac))
     d01 = _named(SettlingDefinition("custom", "tight band", band_mm=band))
     ov = overshoot(tr, float(sig.r(tr.t[-1]))) if sig.kind in ("step", "ramp") else None
-    return settling_time(tr, sig, d2), settling_time(tr, sig, d01), ov
+    nan = np.full(1, math.nan)
+    set2 = settling_time(tr, sig, d2) if sig.amplitude != 0 else Settling(d2, nan, nan, math.nan)
+    return set2, settling_time(tr, sig, d01), ov
 
 
 def _named(d: SettlingDefinition) -> SettlingDefinition:
