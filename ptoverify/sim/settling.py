@@ -103,14 +103,20 @@ class SettlingDefinition:
         return math.inf if self.velocity_band_mm is None else a * self.velocity_band_mm
 
     def band_text(self) -> str:
-        """Return the box in words, e.g. ``|e| <= 0.01 mm, |e'| <= a 0.01 mm/s``."""
+        """Return the box in words, e.g. ``abs(e) <= 0.01 mm, abs(e') <= a * 0.01 mm``.
+
+        Returns
+        -------
+        str
+            The box (no ``|``, so that it fits a Markdown table cell).
+        """
         pos = (
-            f"|e| <= {self.band_mm:g} mm"
+            f"abs(e) <= {self.band_mm:g} mm"
             if self.band_mm is not None
-            else f"|e| <= {100 * self.band_fraction:g} % of the reference's size"
+            else f"abs(e) <= {100 * self.band_fraction:g} % of the reference's size"
         )
         if self.velocity_band_mm is not None:
-            pos += f", |e'| <= a x {self.velocity_band_mm:g} mm/s"
+            pos += f", abs(e') <= a * {self.velocity_band_mm:g} mm [mm/s]"
         return pos
 
 
@@ -287,9 +293,10 @@ def _last_exit(tr: Trajectory, sig: Signal, band: float, order: int, T: float): 
     """Absolute last time [s] |e| (order 1) or |e'| (order 2) exceeds band, per column.
 
     Returns (time, ended): t_0 where never outside; ``ended`` where the record
-    ends outside.  The last exit lies in the interval of the last sample
-    outside, or in a later interval whose samples are both inside but whose
-    piece between them leaves the band.  Only those intervals are split into
+    ends outside.  The last exit lies in the last interval with an end outside
+    (its start, or its end as the left limit: e' jumps where a ramp ends), or
+    in a later interval whose ends are both inside but whose piece between
+    them leaves the band.  Only those intervals are split into
     monotone pieces.  For a step or ramp reference, e' = r' - x2 is monotone on
     each interval (x2 is), so e' has no interior excursion, and e has one only
     where e' changes sign on the interval and |e_k| + h |e'_k| reaches the band
@@ -300,22 +307,24 @@ def _last_exit(tr: Trajectory, sig: Signal, band: float, order: int, T: float): 
     m, k = x1.shape
     slope = sig.slope(t0 + 0.5 * h)[:, None]
     amp, w = sig.amplitude * (sig.kind == "sine"), sig.omega
+    x1_end = np.concatenate([x1[1:], tr.x1[-1:]])
+    x2_end = np.concatenate([x2[1:], tr.x2[-1:]])
     if order == 1:
-        e_start = sig.r(t0)[:, None] - x1
+        e_start, e_end = sig.r(t0)[:, None] - x1, sig.r(t0 + h)[:, None] - x1_end
         e_last = float(sig.r(tr.t[-1])) - tr.x1[-1]
-    else:
+    else:  # e' jumps where the ramp ends: the end of an interval is its left limit
         e_start = slope + amp * w * np.cos(w * t0)[:, None] - x2
+        e_end = slope + amp * w * np.cos(w * (t0 + h))[:, None] - x2_end
         e_last = float(sig.r_dot(tr.t[-1])) - tr.x2[-1]
     ended = np.abs(e_last) > band
-    outs = np.abs(e_start) > band
+    outs = (np.abs(e_start) > band) | (np.abs(e_end) > band)
     rows = np.arange(m)[:, None]
     L = np.where(outs.any(axis=0), m - 1 - outs[::-1].argmax(axis=0), -1)
     cand = rows == L[None, :]
     if sig.kind == "sine":
         cand |= rows > L[None, :]
     elif order == 1:
-        d_start = slope - x2
-        d_end = slope - np.concatenate([x2[1:], tr.x2[-1:]])
+        d_start, d_end = slope - x2, slope - x2_end
         with np.errstate(invalid="ignore"):
             reach = np.abs(e_start) + h[:, None] * np.abs(d_start) >= band * (1.0 - 1e-9)
             cand |= (rows > L[None, :]) & (d_start * d_end < 0.0) & reach
