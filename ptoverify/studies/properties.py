@@ -27,7 +27,12 @@ chattering
     A sample whose region differs from both neighbours while the neighbours
     agree (A, B, A in consecutive samples).
 overshoot
-    For the rest states, max over k of -sgn(x1_0) x1_k beyond ``band`` [mm].
+    For the rest states, the overshoot past the origin on the exact trajectory
+    between samples (:func:`ptoverify.sim.settling.overshoot`) beyond ``band`` [mm].
+not settled
+    NaN settling time under the definition ``0p001mm``
+    (:data:`ptoverify.sim.settling.DEFINITIONS`; ``band`` at its default): the
+    record ends outside |x1| <= band.
 """
 
 from __future__ import annotations
@@ -43,6 +48,14 @@ import numpy as np
 from ptoverify.config import Config
 from ptoverify.model.curves import level_side, switching_function
 from ptoverify.model.laws import Law, Region, make_law
+from ptoverify.sim.flow import Trajectory
+from ptoverify.sim.settling import (
+    DEFINITIONS,
+    SettlingDefinition,
+    definition,
+    overshoot,
+    settling_time,
+)
 from ptoverify.sim.simulate import BatchResult, simulate_batch
 from ptoverify.verdict import tie_band
 
@@ -80,7 +93,7 @@ class LawProperties:
     limit_cycles : int
         States with sustained oscillation at the end of the horizon.
     not_settled : int
-        States whose final |x1| exceeds ``band`` [mm].
+        States whose record ends outside |x1| <= ``band`` [mm] (NaN settling time).
     time_to_linear_max_s, time_to_linear_median_s : float
         Time to reach |x1| < d [s]; inf if some state never does.
     never_linear : int
@@ -431,7 +444,7 @@ def law_properties(
     n2: int = 101,
     rest: int = 200,
     steps: int | None = None,
-    band: float = 1e-3,
+    band: float = DEFINITIONS["0p001mm"].band_mm,
     window: int | None = None,
 ) -> LawProperties:
     """Simulate ``law`` from the grid and measure the closed-loop properties.
@@ -482,8 +495,15 @@ def _measure(law, cfg, res, x1, x2, is_rest, steps, window, band) -> LawProperti
     entry = np.where(entered, np.abs(X2[np.maximum(first_in, 0), np.arange(x1.size)]), 0.0)
     chat = (R[1:-1] != R[:-2]) & (R[1:-1] != R[2:]) & (R[:-2] == R[2:])
     osc = oscillating(X1[-window:], band)
+    t = np.arange(X1.shape[0]) * T
     over = np.zeros(x1.size)  # only the states at rest can overshoot
-    over[is_rest] = (-np.sign(x1[is_rest])[None, :] * X1[:, is_rest]).max(axis=0)
+    rest = np.flatnonzero(is_rest)
+    traj = Trajectory(t, X1[:, rest], X2[:, rest], res.u[:, rest], p.a)
+    over[rest] = overshoot(traj, 0.0).value
+    box = definition("0p001mm")
+    if band != box.band_mm:
+        box = SettlingDefinition("properties", "the properties' band", band_mm=band)
+    settled = settling_time(Trajectory(t, X1, X2, res.u, p.a), None, box).time
     max_u = float(np.abs(res.u).max())
     return LawProperties(
         law=law.name,
@@ -494,7 +514,7 @@ def _measure(law, cfg, res, x1, x2, is_rest, steps, window, band) -> LawProperti
         states_with_stride_over=int(np.unique(j_stride).size),
         crossings_into_linear=int(np.count_nonzero(cross & ~lands_out)),
         limit_cycles=int(osc.sum()),
-        not_settled=int((np.abs(X1[-1]) > band).sum()),
+        not_settled=int(np.isnan(settled).sum()),
         time_to_linear_max_s=float(t_lin.max()),
         time_to_linear_median_s=float(np.median(t_lin)),
         never_linear=int(never.sum()),
