@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from ptoverify.cli import main
-from ptoverify.conform import agreement as agreement_mod
 from ptoverify.conform.agreement import read_table
 from ptoverify.conform.gate import MIN_PER_REGION, conformance_grid, reference_law
 from ptoverify.errors import InputError
@@ -89,7 +88,6 @@ def test_state_far_outside_envelope_is_bad_input(capsys, tmp_path, value):
 
 
 def test_error_line_named_across_chunks(monkeypatch, tmp_path):
-    monkeypatch.setattr(agreement_mod, "_CHUNK_LINES", 7)
     rows = ["x1,x2,u"] + [f"{i * 0.01},0.0,0.0" for i in range(30)]
     rows[23] = "0.5,abc,0.0"  # line 24 of the file, in the fourth chunk
     rows.insert(10, "")  # a blank line still counts as a line
@@ -99,11 +97,10 @@ def test_error_line_named_across_chunks(monkeypatch, tmp_path):
         read_table(table)
 
 
-def test_chunked_read_equals_whole(monkeypatch, tmp_path, paper_cfg):
+def test_read_round_trips(tmp_path, paper_cfg):
     x1, x2 = conformance_grid(paper_cfg, n=11, n_curve=11)
     u = reference_law(x1, x2, paper_cfg)
     table = write(tmp_path / "t.csv", x1, x2, u)
-    monkeypatch.setattr(agreement_mod, "_CHUNK_LINES", 97)
     got = read_table(table, paper_cfg)
     for a, b in zip(got, (x1, x2, u)):
         assert np.array_equal(a, b), "round trip through repr is exact"

@@ -258,14 +258,13 @@ def test_one_family_in_one_call_equals_each_law_alone(n):
 
 
 def test_long_delay_runs_and_mixed_delays_in_one_run():
-    """States of one delay in long runs (row slices) beside per-state delays (a gather)."""
-    from ptoverify.sim.simulate import DELAY_RUN
-
+    """States of one delay in long runs beside per-state delays, in one run."""
+    long_run = 515  # states of one delay in a row
     rng = np.random.default_rng(9)
     steps = 60
     segments = []
     for delay in (2, None, 0, 1, None):
-        n = DELAY_RUN + 3 if delay is not None else 7
+        n = long_run if delay is not None else 7
         m = _random_case(rng, n)
         if delay is not None:
             m = Mismatch(m.a_ratio, m.w_max_ratio, delay, m.position_quantum, 0.0, m.seed)

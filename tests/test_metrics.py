@@ -13,6 +13,8 @@ from ptoverify.model.laws import Region, make_law
 from ptoverify.model.plant import flow
 from ptoverify.sim import exact
 from ptoverify.sim import metrics as m
+from ptoverify.sim.flow import Trajectory
+from ptoverify.sim.settling import DEFINITIONS, SettlingDefinition, settling_time
 from ptoverify.sim.simulate import SIGNALS, Reference, simulate
 
 T = 0.002
@@ -20,30 +22,20 @@ t = np.arange(0, 1.0 + T / 2, T)
 
 
 def test_settling_time_of_exponential():
-    """e = e^{-t/tau} enters |e| <= b at tau ln(1/b); on samples, the first sample after it."""
-    tau, b = 0.05, 0.02
-    exact = tau * math.log(1 / b)
-    ts = m.settling_time(t, np.exp(-t / tau), b)
-    assert exact <= ts < exact + T, f"settling {ts} vs {exact}"
-    assert math.isnan(m.settling_time(t, np.sin(40 * t), 0.5)), "never settles"
-    assert math.isnan(m.settling_time(t, np.exp(-t / tau), b, hold=2.0)), "tail shorter than hold"
-    assert m.settling_time(t, np.zeros_like(t), b) == 0.0
-
-
-def test_overshoot_of_second_order_step():
-    """Underdamped step: overshoot = exp(-pi zeta / sqrt(1 - zeta^2)) of the step (closed form)."""
-    zeta, wn, step = 0.3, 60.0, 5.0
-    tt = np.linspace(0, 1, 200001)  # fine grid: peak found to ~1e-8 relative
-    wd = wn * math.sqrt(1 - zeta**2)
-    x = step * (
-        1
-        - np.exp(-zeta * wn * tt)
-        * (np.cos(wd * tt) + zeta / math.sqrt(1 - zeta**2) * np.sin(wd * tt))
-    )
-    expect = step * math.exp(-math.pi * zeta / math.sqrt(1 - zeta**2))
-    assert_allclose(m.overshoot(x, step), expect, rtol=1e-6, err_msg="overshoot")
-    assert m.overshoot(-x, -step) == pytest.approx(expect, rel=1e-6), "downward step"
-    assert m.overshoot(step * (1 - np.exp(-tt)), step) == 0.0, "monotone: no overshoot"
+    """x1 = e^{-a t} (u = 0, an exact ZOH record) enters |x1| <= b at ln(1/b) / a (closed
+    form); on the samples, the first sample after it."""
+    a, b = 20.0, 0.02
+    tr = Trajectory.from_samples(t, np.exp(-a * t), -a * np.exp(-a * t), np.zeros(t.size - 1), a)
+    closed = math.log(1 / b) / a
+    st = settling_time(tr, None, SettlingDefinition("b", "test", band_mm=b))
+    assert_allclose(st.time[0], closed, rtol=1e-12, err_msg="settling time, closed form")
+    assert closed <= st.grid[0] < closed + T, f"grid settling {st.grid[0]} vs {closed}"
+    tiny = SettlingDefinition("tiny", "test", band_mm=1e-30)
+    assert math.isnan(settling_time(tr, None, tiny).time[0]), "ends outside: never settles"
+    held = SettlingDefinition("held", "test", band_mm=b, hold_s=2.0)
+    assert math.isnan(settling_time(tr, None, held).time[0]), "tail shorter than hold"
+    rest = Trajectory.from_samples(t, 0 * t, 0 * t, np.zeros(t.size - 1), a)
+    assert settling_time(rest, None, "0p01mm").time[0] == 0.0, "never outside: 0"
 
 
 def test_oscillation_amplitude_and_reversals():
@@ -227,11 +219,11 @@ def test_summarize_time_metrics_between_samples(paper_cfg, law, sig):
 
 
 def test_sample_grid_metrics_have_one_definition():
-    """metrics' sample-grid settling, overshoot and rise time are exact.py's grid twins."""
-    assert m.settling_time is exact.grid_settling_time
-    assert m.overshoot is exact.grid_overshoot
+    """metrics' rise time is exact.py's grid twin; the bands are the registry's."""
     assert m.rise_time is exact.grid_rise_time
     assert (m.TIGHT_BAND, m.STEP_FRACTION) == (exact.TIGHT_BAND, exact.STEP_FRACTION)
+    assert m.TIGHT_BAND == DEFINITIONS["0p01mm"].band_mm
+    assert m.STEP_FRACTION == DEFINITIONS["2pct"].band_fraction
 
 
 def _dense(res, a, per):
@@ -272,7 +264,8 @@ def test_simulate_json_metrics_between_samples(capsys, paper_cfg, law, sig):
         out_idx = np.flatnonzero(np.abs(e) > band)
         dense_ts = t[out_idx[-1] + 1] if out_idx.size else 0.0  # never outside: 0
         assert dense_ts - dt <= got[key] <= dense_ts, key
-        assert grid[key] == m.settling_time(res.t, res.e, band), key
+        out_k = np.flatnonzero(np.abs(res.e) > band)  # the first sample after the last out
+        assert grid[key] == (res.t[out_k[-1] + 1] if out_k.size else 0.0), key
     lo, hi = (np.argmax(x1 >= f * target) for f in (0.1, 0.9))
     assert abs(got["rise_time_s"] - (t[hi] - t[lo])) <= dt, "rise time"
     assert grid["rise_time_s"] == m.rise_time(res.t, res.x1, target)

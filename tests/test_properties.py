@@ -130,26 +130,3 @@ def test_crossing_masks_against_the_definition(name):
     cols = slice(3, -4)  # a view of a larger batch, as the robustness study passes them
     counts = stride_over_counts(b.x1[:, cols], b.x2[:, cols], b.region[:, cols], cfg)
     assert counts.tolist() == want[0][:, cols].sum(axis=0).tolist()
-
-
-def test_grid_simulation_reuses_the_last_arrays_with_fresh_values():
-    from ptoverify.sim.simulate import simulate_batch
-    from ptoverify.studies.properties import grid_simulation
-
-    x1, x2, _ = initial_grid(PAPER, 11, 11, 5)
-    laws = [make_law(name, PAPER) for name in ("to", "pd", "pto")]
-    with grid_simulation(laws[0], PAPER, x1, x2, 80) as first:
-        held = first.x1
-    for law in laws[1:]:
-        fresh = simulate_batch(law, PAPER.plant, x1, x2, 80)
-        with grid_simulation(law, PAPER, x1, x2, 80) as res:
-            assert res.x1 is held  # the spare arrays, written over
-            for got, want in zip(
-                (res.x1, res.x2, res.u, res.region),
-                (fresh.x1, fresh.x2, fresh.u, fresh.region),
-                strict=True,
-            ):
-                assert np.array_equal(got, want)
-    # a run of another size does not write into them
-    with grid_simulation(laws[1], PAPER, x1[:7], x2[:7], 80) as other:
-        assert other.x1 is not held and other.x1.shape == (81, 7)

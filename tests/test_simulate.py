@@ -220,3 +220,68 @@ def test_cli_simulate_custom_sine(capsys):
     }
     assert main(["simulate", "--signal", "ramp", "--step", "3"]) == 2
     assert "does not apply" in capsys.readouterr().err
+
+
+def _expm_zoh(a, T):
+    """Ad, Bd of the ZOH plant from the matrix exponential of the augmented system."""
+    from scipy.linalg import expm
+
+    M = np.zeros((3, 3))
+    M[0, 1], M[1, 1], M[1, 2] = 1.0, -a, a
+    E = expm(M * T)
+    return E[:2, :2], E[:2, 2]
+
+
+@pytest.mark.parametrize("law_name", ["to", "pd", "pto"])
+@pytest.mark.parametrize(("quantum", "noise"), [(0.0, 0.0), (1e-3, 0.0), (0.0, 2.0), (5e-3, 1.0)])
+def test_one_simulator_against_expm_with_every_mismatch(paper_cfg, law_name, quantum, noise):
+    """Each sample of a mismatched batch, checked on its own: the command is the law of the
+    measured state (quantizer, seeded noise), the drive applies the command of sample
+    k - delay clipped to the true limit, and the state moves by the true plant's ZOH
+    matrices from scipy.linalg.expm (an independent reference for eq. 7)."""
+    from ptoverify.sim.simulate import Mismatch
+
+    p = paper_cfg.plant
+    law = make_law(law_name, paper_cfg)
+    rng = np.random.default_rng(11)
+    n, steps = 400, 50
+    x1, x2 = rng.uniform(-50.0, 50.0, n), rng.uniform(-300.0, 300.0, n)
+    m = Mismatch(
+        a_ratio=rng.uniform(0.5, 2.0, n),
+        w_max_ratio=rng.uniform(0.5, 1.0, n),
+        delay_samples=rng.integers(0, 4, n),
+        position_quantum=quantum,
+        velocity_noise=noise,
+        seed=3,
+    )
+    b = simulate_batch(law, p, x1, x2, steps, mismatch=m)
+    seq = np.random.default_rng(3).normal(0.0, noise, steps + 1) if noise else np.zeros(steps + 1)
+    cols = np.arange(n)
+    picked = range(0, n, 37)  # a spread of states, each with its own true a
+    zoh = {j: _expm_zoh(p.a * m.a_ratio[j], p.T) for j in picked}
+    for k in range(steps):
+        y1 = quantum * np.round(b.x1[k] / quantum) if quantum else b.x1[k]
+        u, region = law.vector(y1, b.x2[k] + seq[k])
+        assert np.array_equal(b.u[k], u) and np.array_equal(b.region[k], region), k
+        w = p.w_max * m.w_max_ratio
+        applied = np.clip(b.u[np.maximum(k - m.delay_samples, 0), cols], -w, w)
+        for j in picked:
+            Ad, Bd = zoh[j]
+            want = Ad @ [b.x1[k, j], b.x2[k, j]] + Bd * applied[j]
+            got = [b.x1[k + 1, j], b.x2[k + 1, j]]
+            assert_allclose(got, want, rtol=1e-11, atol=1e-9, err_msg=f"flow, k={k} j={j}")
+
+
+def test_single_trajectory_is_the_batch_on_one_state(paper_cfg):
+    """simulate() of a step is simulate_batch() of the law shifted by the step, bit for bit."""
+    from ptoverify.model.laws import Law
+
+    p = paper_cfg.plant
+    for name in ("pd", "pto"):
+        law = make_law(name, paper_cfg)
+        res = simulate(law, p, "step")
+        r = res.reference.amplitude
+        shifted = Law(name, lambda x1, x2, law=law: law.vector(x1 - r, x2), law.scalar, law.w_max)
+        b = simulate_batch(shifted, p, [0.0], [0.0], res.t.size - 1)
+        assert np.array_equal(res.x1, b.x1[:, 0]) and np.array_equal(res.x2, b.x2[:, 0]), name
+        assert np.array_equal(res.u[:-1], b.u[:, 0]), name

@@ -291,44 +291,6 @@ def test_laws_are_odd_bit_for_bit(name):
     assert np.array_equal(r_m, mirror[r])
 
 
-def test_mirrored_half_equals_simulating_every_state():
-    """run_sweep simulates half of the symmetric grid and mirrors it: its settling times
-    equal settling_times over every state, for each law, both readings, odd and even counts."""
-    cfg = paper_config()
-    p = cfg.plant
-    for n1, n2 in ((9, 7), (8, 5)):
-        s = SweepSettings(n1=n1, n2=n2)
-        res = run_sweep(cfg, s)
-        vband = p.a * s.band
-        for name in s.laws:
-            ref = settling_times(
-                make_law(name, cfg),
-                p,
-                res.x1.ravel(),
-                res.x2.ravel(),
-                res.steps,
-                s.band,
-                vband,
-                s.hold,
-            )
-            got = res.laws[name]
-            assert np.array_equal(got.settle_time.ravel(), ref.time, equal_nan=True), name
-            assert np.array_equal(got.grid.settle_time.ravel(), ref.grid, equal_nan=True), name
-            half = settling_times(  # the public mirrored path (tune.worst_ratio_nt's)
-                make_law(name, cfg),
-                p,
-                res.x1.ravel(),
-                res.x2.ravel(),
-                res.steps,
-                s.band,
-                vband,
-                s.hold,
-                mirror=True,
-            )
-            assert np.array_equal(half.time, ref.time, equal_nan=True), name
-            assert np.array_equal(half.grid, ref.grid, equal_nan=True), name
-
-
 def test_mirror_pairs_spread_values_to_mirrors_and_refuse_unpaired_states():
     from ptoverify.studies.sweep import mirror_pairs
 

@@ -22,7 +22,6 @@ decisions).  Here:
 
 from __future__ import annotations
 
-import csv
 import functools
 import math
 from pathlib import Path
@@ -446,99 +445,19 @@ def table_coverage(x1: NDArray, x2: NDArray, cfg: Config) -> dict:
     }
 
 
-def _chunk_error(path, lines, first_line: int, cols: dict, cfg: Config | None) -> InputError:
-    """Locate the first bad line of a chunk that numpy rejected (slow path, one chunk)."""
-    for line, row in enumerate(csv.reader(lines), start=first_line):
-        if not any(f.strip() for f in row):
-            continue
-        vals = {}
-        for name, j in cols.items():
-            text = row[j].strip() if j < len(row) else ""
-            try:
-                v = float(text)
-            except ValueError:
-                v = math.nan
-            if not math.isfinite(v):
-                return InputError(
-                    f"table '{path}' line {line}: column {name} = {text!r} is not a finite number"
-                )
-            vals[name] = v
-        if cfg is not None and _far(vals["x1"], vals["x2"], cfg):
-            return InputError(
-                f"table '{path}' line {line}: state ({vals['x1']:g}, {vals['x2']:g}) is far "
-                f"outside the envelope (|x1| <= {1e3 * cfg.plant.position_range:g} mm, "
-                f"|x2| <= {1e3 * cfg.plant.w_max:g} mm/s accepted)"
-            )
-    return InputError(f"table '{path}' near line {first_line}: malformed row")
-
-
-def _chunk(fh, path, first_line: int) -> list[str]:
-    """Read up to _CHUNK_LINES lines, each at most _MAX_LINE long, without NUL bytes."""
-    lines = []
-    for k in range(_CHUNK_LINES):
-        text = fh.readline(_MAX_LINE)
-        if not text:
-            break
-        if "\x00" in text:
-            raise InputError(
-                f"table '{path}' line {first_line + k}: NUL bytes; not a CSV text file"
-            )
-        if len(text) >= _MAX_LINE and not text.endswith("\n"):
-            raise InputError(
-                f"table '{path}' line {first_line + k}: longer than {_MAX_LINE} characters "
-                "(a row holds three numbers)"
-            )
-        lines.append(text)
-    return lines
-
-
 def _far(x1, x2, cfg: Config):
     """States beyond 1000 x the envelope (as ``mintime`` rejects them)."""
     p = cfg.plant
     return (np.abs(x1) > 1e3 * p.position_range) | (np.abs(x2) > 1e3 * p.w_max)
 
 
-_CHUNK_LINES = 500_000  #: table lines parsed per numpy call
-_MAX_HEADER = 1 << 16  #: longest header line read [characters]
-_MAX_LINE = 1 << 12  #: longest data line accepted [characters] (three numbers need < 100)
-
-
-def _header(path, head: str) -> list[str]:
-    """Parse and check a table's header: named columns, none twice, no byte-order mark."""
-    if "\x00" in head:
-        raise InputError(f"table '{path}' line 1: NUL bytes; not a CSV text file")
-    if head.startswith("\ufeff"):
-        raise InputError(
-            f"table '{path}' starts with a UTF-8 byte-order mark (BOM, bytes EF BB BF) before "
-            "the header; save it as UTF-8 without BOM"
-        )
-    if not head.strip():
-        raise InputError(f"table '{path}' is empty")
-    if len(head) >= _MAX_HEADER and not head.endswith("\n"):
-        raise InputError(f"table '{path}' line 1: header longer than {_MAX_HEADER} characters")
-    header = [h.strip() for h in next(csv.reader([head]))]
-    seen: set[str] = set()
-    for name in header:
-        if name in seen and name:
-            raise InputError(
-                f"table '{path}': column '{name}' appears twice in header {','.join(header)}; "
-                "which one is meant is ambiguous"
-            )
-        seen.add(name)
-    return header
-
-
 def read_table(path: str | Path, cfg: Config | None = None) -> tuple[NDArray, NDArray, NDArray]:
-    """Read a CSV with a header naming columns x1, x2, u (others ignored), in chunks.
-
-    Only regular files are read (a device or a FIFO is bad input at once).
-    Chunks of 500000 lines are parsed by numpy, so memory stays about twice
-    the table's numeric size.
+    """Read a CSV with a header naming columns x1, x2, u (others ignored).
 
     Parameters
     ----------
     path : str or Path
-        CSV file.
+        CSV file (:func:`ptoverify.tables.read_columns`).
     cfg : Config, optional
         When given, states beyond 1000 x the envelope (|x1| > 1000
         position_range or |x2| > 1000 w_max, as ``mintime``) are bad input.
@@ -555,59 +474,19 @@ def read_table(path: str | Path, cfg: Config | None = None) -> tuple[NDArray, ND
         that is not a finite number or a state far outside the envelope (line
         and column named).
     """
-    import os
-    import stat
+    from ptoverify.tables import read_columns
 
-    try:
-        if not stat.S_ISREG(os.stat(path).st_mode):
-            raise InputError(f"table '{path}' is not a regular file")
-        fh = open(path, newline="", encoding="utf-8")
-    except OSError as exc:
-        raise InputError(f"cannot read table '{path}': {exc.strerror or exc}") from None
-    chunks = []
-    try:
-        with fh:
-            head = fh.readline(_MAX_HEADER)
-            header = _header(path, head)
-            cols = {}
-            for name in ("x1", "x2", "u"):
-                if name not in header:
-                    raise InputError(
-                        f"table '{path}': no column '{name}' in header {','.join(header)} "
-                        "(need x1, x2, u)"
-                    )
-                cols[name] = header.index(name)
-            line = 2
-            while True:
-                lines = _chunk(fh, path, line)
-                if not lines:
-                    break
-                try:
-                    arr = np.loadtxt(
-                        lines,
-                        delimiter=",",
-                        usecols=tuple(cols.values()),
-                        ndmin=2,
-                        comments=None,
-                        quotechar='"',
-                    )
-                except ValueError:
-                    raise _chunk_error(path, lines, line, cols, cfg) from None
-                bad = not np.isfinite(arr).all()
-                if cfg is not None and arr.size:
-                    bad = bad or bool(_far(arr[:, 0], arr[:, 1], cfg).any())
-                if bad:
-                    raise _chunk_error(path, lines, line, cols, cfg)
-                chunks.append(arr)
-                line += len(lines)
-    except UnicodeDecodeError as exc:
-        raise InputError(f"cannot read table '{path}': not UTF-8 text ({exc.reason})") from None
-    except csv.Error as exc:
-        raise InputError(f"table '{path}': malformed CSV: {exc}") from None
-    if not sum(c.shape[0] for c in chunks):
-        raise InputError(f"table '{path}' has a header but no rows")
-    out = tuple(np.concatenate([c[:, k] for c in chunks]) for k in range(3))
-    return out[0], out[1], out[2]
+    (x1, x2, u), lines = read_columns(path, ("x1", "x2", "u"), what="table")
+    if cfg is not None:
+        far = np.flatnonzero(_far(x1, x2, cfg))
+        if far.size:
+            k = int(far[0])
+            raise InputError(
+                f"table '{path}' line {lines[k]}: state ({x1[k]:g}, {x2[k]:g}) is far "
+                f"outside the envelope (|x1| <= {1e3 * cfg.plant.position_range:g} mm, "
+                f"|x2| <= {1e3 * cfg.plant.w_max:g} mm/s accepted)"
+            )
+    return x1, x2, u
 
 
 # ------------------------------------------------------------------ agreement

@@ -469,52 +469,10 @@ def read_states(path: str | Path) -> tuple[NDArray[np.float64], NDArray[np.float
         row with a missing field or a field that is not a finite number (its
         line named).
     """
-    import csv
+    from ptoverify.tables import read_columns
 
-    p = Path(path)
-    if not p.is_file():
-        why = "does not exist" if not p.exists() else "is not a regular file"
-        raise InputError(f"states file '{path}' {why}")
-    try:
-        with open(p, newline="") as fh:
-            rows = list(csv.reader(fh))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read states file '{path}': {exc}") from None
-    except csv.Error as exc:
-        raise InputError(f"states file '{path}': malformed CSV: {exc}") from None
-    if not rows:
-        raise InputError(f"states file '{path}' is empty")
-    header = [h.strip() for h in rows[0]]
-    missing = [c for c in ("x1", "x2") if c not in header]
-    if missing:
-        raise InputError(
-            f"states file '{path}': no column {', '.join(missing)} in header "
-            f"'{','.join(header)}' (need x1, x2)"
-        )
-    j1, j2 = header.index("x1"), header.index("x2")
-    width = max(j1, j2) + 1
-    lines = [i for i, r in enumerate(rows[1:], start=2) if any(f.strip() for f in r)]
-    if not lines:
-        raise InputError(f"states file '{path}' has a header but no rows")
-    for i in lines:
-        if len(rows[i - 1]) < width:
-            raise InputError(f"states file '{path}' line {i}: missing field (need x1, x2)")
-    cols = []
-    for name, j in (("x1", j1), ("x2", j2)):
-        text = [rows[i - 1][j] for i in lines]
-        try:
-            v = np.array(text, dtype=float)
-        except ValueError:
-            v = np.array([_to_float(t) for t in text])
-        bad = np.flatnonzero(~np.isfinite(v))
-        if bad.size:
-            k = int(bad[0])
-            raise InputError(
-                f"states file '{path}' line {lines[k]}: {name} = {text[k].strip()!r} "
-                "is not a finite number"
-            )
-        cols.append(v)
-    return cols[0], cols[1]
+    (x1, x2), _ = read_columns(path, ("x1", "x2"), what="states file")
+    return x1, x2
 
 
 def _to_float(text: str) -> float:

@@ -2,8 +2,13 @@
 
 Catalogue
 ---------
-simulate  Reference (step/ramp/sine), simulate, Mismatch, simulate_batch, simulate_segments
-lockstep  run_together (searches side by side, batches merged), simulate_asks
-exact     metrics between samples on the exact ZOH flow: overshoot, settling, rise time
-metrics   summarize, oscillation_amplitude, sign_reversals, ramp_lag, sine_fit, phase_delay
+reference  Reference (step/ramp/sine), SIGNALS, reference
+simulate   simulate, Mismatch, simulate_batch (the one loop), simulate_segments
+lockstep   run_together (searches side by side, batches merged), simulate_asks
+flow       Signal, Trajectory and the monotone pieces of the exact ZOH flow
+settling   SettlingDefinition, DEFINITIONS, settling_time, overshoot (named definitions)
+events     rise time, linear-zone entry, sine phase between samples
+exact      exact_metrics: every metric between samples and on the grid (Compared)
+metrics    summarize, oscillation_amplitude, sign_reversals, ramp_lag, sine_fit, phase_delay
+runs       run_simulation: the path of ``ptoverify simulate``
 """

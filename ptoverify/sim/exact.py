@@ -44,13 +44,37 @@ more than :data:`TIME_TOL_SAMPLES` sample periods (times), :data:`POSITION_TOL`
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.errors import InputError
+from ptoverify.sim.events import (
+    grid_first,
+    grid_phase,
+    grid_rise_time,
+    linear_zone_entry,
+    linear_zone_time,
+    rise_pair,
+    rise_time,
+    sine_phase,
+)
+from ptoverify.sim.flow import (
+    Signal,
+    Trajectory,
+    as_float_array,
+    as_signal,
+    monotone_pieces,
+)
+from ptoverify.sim.settling import (
+    DEFINITIONS,
+    Settling,
+    SettlingDefinition,
+    overshoot,
+    settling_time,
+)
 
 __all__ = [
     "TIGHT_BAND",
@@ -64,11 +88,8 @@ __all__ = [
     "Trajectory",
     "Compared",
     "ExactMetrics",
-    "grid_settling_time",
-    "grid_overshoot",
+    "ResponseMetrics",
     "grid_rise_time",
-    "overshoot",
-    "settling_time",
     "rise_time",
     "linear_zone_time",
     "sine_phase",
@@ -79,9 +100,9 @@ __all__ = [
     "settling_times_batch",
 ]
 
-TIGHT_BAND = 0.01
+TIGHT_BAND = DEFINITIONS["0p01mm"].band_mm
 """Tight settling band [mm] (2 % of the paper's linear zone d = 0.5 mm)."""
-STEP_FRACTION = 0.02
+STEP_FRACTION = DEFINITIONS["2pct"].band_fraction
 """Classical settling band as a fraction of the reference's size [-]."""
 TIME_TOL_SAMPLES = 0.01
 """Time metrics differ when |exact - grid| > 0.01 T (T the median sample period)."""
@@ -98,858 +119,6 @@ METRIC_KEYS = (
     "linear_zone_s",
 )
 """Keys of :meth:`ExactMetrics.exact` (the first five are ``simulate --json`` ``metrics``)."""
-
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
-
-
-@dataclass(frozen=True)
-class Signal:
-    """A reference r(t) for t >= 0: step, ramp or sine.
-
-    Attributes
-    ----------
-    kind : str
-        ``step`` (r = amplitude), ``ramp`` (r = sign(A) min(|rate| t, |A|)) or
-        ``sine`` (r = amplitude sin(2 pi rate t)).
-    amplitude : float
-        Step height, ramp end value or sine amplitude [mm].
-    rate : float
-        Ramp speed [mm/s] or sine frequency [Hz]; unused for a step.
-
-    Examples
-    --------
-    >>> Signal("ramp", 30.0, 200.0).r(np.array([0.1, 0.2])).tolist()
-    [20.0, 30.0]
-    """
-
-    kind: str
-    amplitude: float
-    rate: float = 0.0
-
-    def __post_init__(self) -> None:
-        """Validate the kind and the numbers."""
-        if self.kind not in ("step", "ramp", "sine"):
-            raise InputError(f"unknown reference kind '{self.kind}' (step, ramp, sine)")
-        if not (math.isfinite(self.amplitude) and math.isfinite(self.rate)):
-            raise InputError("reference amplitude and rate must be finite")
-        if self.kind in ("ramp", "sine") and self.rate == 0.0:
-            raise InputError(f"a {self.kind} needs a nonzero rate")
-
-    @property
-    def omega(self) -> float:
-        """Angular frequency of the sine part [rad/s] (0 unless a sine)."""
-        return 2.0 * math.pi * abs(self.rate) if self.kind == "sine" else 0.0
-
-    @property
-    def cuts(self) -> tuple[float, ...]:
-        """Times [s] where r' jumps (the ramp's end)."""
-        return (abs(self.amplitude / self.rate),) if self.kind == "ramp" else ()
-
-    def r(self, t: ArrayLike) -> NDArray[np.float64]:
-        """Return r(t) [mm] at times t [s]."""
-        t = np.asarray(t, dtype=float)
-        if self.kind == "step":
-            return np.full_like(t, self.amplitude)
-        if self.kind == "ramp":
-            return math.copysign(1.0, self.amplitude) * np.minimum(
-                abs(self.rate) * t, abs(self.amplitude)
-            )
-        return self.amplitude * np.sin(self.omega * t)
-
-    def slope(self, t: ArrayLike) -> NDArray[np.float64]:
-        """Return the slope of r's linear part [mm/s] (the ramp's speed while it moves)."""
-        t = np.asarray(t, dtype=float)
-        if self.kind != "ramp":
-            return np.zeros_like(t)
-        moving = abs(self.rate) * t < abs(self.amplitude)
-        return np.where(moving, math.copysign(abs(self.rate), self.amplitude), 0.0)
-
-    def r_dot(self, t: ArrayLike) -> NDArray[np.float64]:
-        """Return r'(t) [mm/s]; at the ramp's end, the right derivative (0)."""
-        t = np.asarray(t, dtype=float)
-        w = self.omega
-        return self.slope(t) + self.amplitude * w * np.cos(w * t) * (self.kind == "sine")
-
-
-def as_signal(ref: Any) -> Signal:
-    """Read a reference from a :class:`Signal`, a Reference-like object or a tuple.
-
-    Parameters
-    ----------
-    ref : Signal, object or tuple
-        A :class:`Signal`; any object with ``name`` (or ``kind``), ``amplitude``
-        and ``rate`` (or ``speed``, ``frequency``) attributes, as
-        ``ptoverify.sim.simulate.Reference``; or a tuple
-        ``(kind, amplitude[, rate])``.
-
-    Returns
-    -------
-    Signal
-
-    Examples
-    --------
-    >>> as_signal(("sine", 5.0, 5.0)).omega == 10 * math.pi
-    True
-    """
-    if isinstance(ref, Signal):
-        return ref
-    if isinstance(ref, tuple):
-        return Signal(*ref)
-    kind = getattr(ref, "kind", None) or getattr(ref, "name", None)
-    if kind is None or not hasattr(ref, "amplitude"):
-        raise InputError(f"cannot read a reference from {type(ref).__name__}")
-    rate = next(
-        (v for n in ("rate", "speed", "frequency") if (v := getattr(ref, n, None)) is not None),
-        0.0,
-    )
-    return Signal(str(kind), float(ref.amplitude), float(rate))
-
-
-def _arr(x: ArrayLike) -> NDArray[np.float64]:
-    return np.asarray(x, dtype=float)
-
-
-@dataclass(frozen=True)
-class Trajectory:
-    """The exact continuous trajectory of a sampled response (ZOH, eq. 7).
-
-    Attributes
-    ----------
-    t : ndarray, shape (n + 1,)
-        Sample times [s], increasing.
-    x1, x2 : ndarray, shape (n + 1,)
-        Position [mm] and velocity [mm/s] at the samples.
-    u : ndarray, shape (n,)
-        Input held on [t_k, t_k+1) [mm/s].
-    a : float
-        Bandwidth [rad/s].
-
-    Examples
-    --------
-    >>> tr = Trajectory.from_samples([0.0, 0.1], [0.0, 0.0], [0.0, 0.0], [0.0], 10.0)
-    >>> tr.intervals
-    1
-    """
-
-    t: NDArray[np.float64]
-    x1: NDArray[np.float64]
-    x2: NDArray[np.float64]
-    u: NDArray[np.float64]
-    a: float
-
-    @classmethod
-    def from_samples(
-        cls, t: ArrayLike, x1: ArrayLike, x2: ArrayLike, u: ArrayLike, a: float
-    ) -> Trajectory:
-        """Validate and wrap sample arrays (u may carry one trailing unused value)."""
-        t, x1, x2, u = _arr(t), _arr(x1), _arr(x2), _arr(u)
-        n = t.size - 1
-        if n < 1 or t.ndim != 1 or x1.shape != t.shape or x2.shape != t.shape:
-            raise InputError("t, x1, x2 must be 1-D of one length >= 2")
-        if u.shape not in ((n,), (n + 1,)):
-            raise InputError("u must hold one input per interval (n or n + 1 values)")
-        u = u[:n]
-        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(x1)) and np.all(np.isfinite(x2))):
-            raise InputError("non-finite sample data")
-        if not (np.all(np.isfinite(u)) and np.all(np.diff(t) > 0)):
-            raise InputError("u must be finite and t strictly increasing")
-        if not (math.isfinite(a) and a > 0):
-            raise InputError(f"bandwidth a must be positive, got {a}")
-        return cls(t, x1, x2, u, float(a))
-
-    @classmethod
-    def from_result(cls, res: Any, plant: Any) -> Trajectory:
-        """Wrap a SimResult-like object (t, x1, x2, u) and a plant (``a``, or a float)."""
-        a = plant if isinstance(plant, (int, float)) else plant.a
-        return cls.from_samples(res.t, res.x1, res.x2, res.u, float(a))
-
-    @property
-    def intervals(self) -> int:
-        """Number of sample intervals n."""
-        return self.t.size - 1
-
-    @property
-    def period(self) -> float:
-        """Median sample period [s]."""
-        return float(np.median(np.diff(self.t)))
-
-    def state(self, tq: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Exact state at times tq in [t_0, t_n] (eq. 7 from the last sample).
-
-        Parameters
-        ----------
-        tq : array_like
-            Times [s].
-
-        Returns
-        -------
-        x1, x2 : ndarray
-            Position [mm] and velocity [mm/s].
-        """
-        tq = _arr(tq)
-        k = np.clip(np.searchsorted(self.t, tq, side="right") - 1, 0, self.intervals - 1)
-        return _flow(self.x1[k], self.x2[k], self.u[k], tq - self.t[k], self.a)
-
-
-def _flow(x1, x2, u, s, a):
-    g = -np.expm1(-a * s)
-    dv = x2 - u
-    return x1 + u * s + dv * g / a, x2 - dv * g
-
-
-@dataclass(frozen=True)
-class _Pieces:
-    """Intervals (split at the reference's cuts) and their monotone pieces of e."""
-
-    t0: NDArray[np.float64]  # (m,) interval starts [s]
-    h: NDArray[np.float64]  # (m,) lengths [s]
-    x1: NDArray[np.float64]
-    x2: NDArray[np.float64]
-    u: NDArray[np.float64]
-    a: float
-    sig: Signal | None
-    brk: NDArray[np.float64]  # (m, K) piece boundaries in s, sorted, first 0, last h
-
-    def at(self, s):
-        """Return (x1, x2, r, r') at offsets s (broadcast against (m, 1))."""
-        c = (slice(None),) + (None,) * (np.ndim(s) - 1)
-        y1, y2 = _flow(self.x1[c], self.x2[c], self.u[c], s, self.a)
-        tt = self.t0[c] + s
-        if self.sig is None:
-            return y1, y2, np.zeros_like(y1), np.zeros_like(y1)
-        w, amp = self.sig.omega, self.sig.amplitude * (self.sig.kind == "sine")
-        slope = self.sig.slope(self.t0 + 0.5 * self.h)[c]
-        r = self.sig.r(tt) if self.sig.kind != "ramp" else self.sig.r(self.t0)[c] + slope * s
-        return y1, y2, r, slope + amp * w * np.cos(w * tt)
-
-
-def _split(tr: Trajectory, sig: Signal | None, extra: tuple[float, ...] = ()):
-    """Interval arrays with the reference's cuts (and ``extra`` times) inserted."""
-    t0, h = tr.t[:-1], np.diff(tr.t)
-    x1, x2, u = tr.x1[:-1], tr.x2[:-1], tr.u
-    cuts = [c for c in (*(sig.cuts if sig else ()), *extra) if tr.t[0] < c < tr.t[-1]]
-    for c in cuts:
-        k = int(np.searchsorted(t0, c, side="right") - 1)
-        s = c - t0[k]
-        if s <= 0.0 or s >= h[k]:
-            continue
-        y1, y2 = _flow(x1[k], x2[k], u[k], s, tr.a)
-        t0 = np.insert(t0, k + 1, c)
-        h = np.insert(h, k + 1, h[k] - s)
-        h[k] = s
-        x1, x2, u = np.insert(x1, k + 1, y1), np.insert(x2, k + 1, y2), np.insert(u, k + 1, u[k])
-    return t0, h, x1, x2, u
-
-
-def _cos_roots(theta0, dtheta, c):
-    """Offsets (m, 2) in [0, dtheta] where cos(theta0 + x) = c (NaN if none); dtheta < 2 pi."""
-    ok = np.abs(c) <= 1.0
-    al = np.arccos(np.clip(c, -1.0, 1.0))
-    out = np.full(np.shape(theta0) + (2,), np.nan)
-    for j, alpha in enumerate((al, -al)):
-        x = np.mod(alpha - theta0, 2.0 * math.pi)
-        out[..., j] = np.where(ok & (x <= dtheta), x, np.nan)
-    return out
-
-
-def _newton(fdf, lo, hi, flo, tol):
-    """Vectorized safeguarded Newton on brackets [lo, hi] with one sign change.
-
-    ``fdf(x)`` returns (f, f').  A Newton step that leaves the bracket is
-    replaced by bisection; iteration stops within ``tol`` of the root.
-    """
-    x = 0.5 * (lo + hi)
-    live = np.ones(x.shape, dtype=bool)
-    for _ in range(200):
-        fx, dfx = fdf(x)
-        same = np.sign(fx) == np.sign(flo)
-        lo, flo = np.where(same, x, lo), np.where(same, fx, flo)
-        hi = np.where(same, hi, x)
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            xn = x - fx / dfx
-        xn = np.where((xn > lo) & (xn < hi), xn, 0.5 * (lo + hi))
-        done = (fx == 0) | (np.abs(xn - x) <= tol) | (hi - lo <= tol)
-        x = np.where(live & (fx != 0), xn, x)
-        live &= ~done
-        if not live.any():
-            break
-    return x
-
-
-def _derivs(x2, u, t0, slope, amp, w, a, s, order):
-    """e^(order) and e^(order + 1) at offsets s [s] (order 1 or 2), per-interval parameters."""
-    dv = (x2 - u) * np.exp(-a * s)
-    th = w * (t0 + s)
-    c, sn = np.cos(th), np.sin(th)
-    d2 = -amp * w * w * sn + a * dv
-    if order == 1:
-        return slope + amp * w * c - u - dv, d2
-    return d2, -amp * w**3 * c - a * a * dv
-
-
-def _ref_parts(p: _Pieces):
-    """Per-interval slope [mm/s], sine amplitude [mm] and omega [rad/s] of the reference."""
-    sig = p.sig
-    if sig is None:
-        return np.zeros(p.h.size), 0.0, 0.0
-    return sig.slope(p.t0 + 0.5 * p.h), sig.amplitude * (sig.kind == "sine"), sig.omega
-
-
-def _e_derivs(p: _Pieces, s):
-    """e'(s) [mm/s] and e''(s) [mm/s^2] at offsets s of shape (m, K)."""
-    slope, amp, w = _ref_parts(p)
-    c = (slice(None), None)
-    return _derivs(p.x2[c], p.u[c], p.t0[c], slope[c], amp, w, p.a, s, 1)
-
-
-def _extrema(p0: _Pieces, order: int) -> NDArray[np.float64]:
-    """Zeros in (0, h) of e' (order 1) or e'' (order 2) per interval, shape (m, 3)."""
-    a, h = p0.a, p0.h
-    m = h.size
-    slope, amp, w = _ref_parts(p0)
-    if not (w > 0.0 and amp != 0.0):  # e' = v - x2(s): one closed-form root; e'' != 0
-        out = np.full((m, 3), np.nan)
-        if order == 1:
-            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-                out[:, 0] = np.log1p((p0.x2 - slope) / (slope - p0.u)) / a
-            out = np.where((out > 0) & (out < h[:, None]), out, np.nan)
-        return out
-    if w * float(h.max()) >= 2.0 * math.pi:
-        raise InputError("a sine reference needs more than one sample per period")
-    # e^{as} e^(order) is monotone between the closed-form roots of
-    # cos(w t + psi + phi) = c: at most one zero of e^(order) between them
-    psi = 0.0 if order == 1 else 0.5 * math.pi
-    cc = a * (p0.u - slope) / (abs(amp) * w * math.hypot(a, w)) if order == 1 else np.zeros(m)
-    shift = 0.0 if amp > 0 else math.pi
-    r = _cos_roots(w * p0.t0 + psi + math.atan2(w, a) + shift, w * h, cc) / w
-    brk = np.zeros((m, 4))
-    brk[:, 1:] = h[:, None]
-    brk[:, 1:3] = np.sort(np.where(np.isnan(r), h[:, None], r), axis=1)
-    lo, hi = brk[:, :-1], brk[:, 1:]
-    c = (slice(None), None)
-    args = (p0.x2[c], p0.u[c], p0.t0[c], slope[c], amp, w, a)
-    flo = _derivs(*args, lo, order)[0]
-    fhi = _derivs(*args, hi, order)[0]
-    out = np.full(lo.shape, np.nan)
-    has = (flo * fhi < 0) & (hi > lo)
-    if has.any():
-        idx = np.nonzero(has)
-        k = idx[0]
-        g = (p0.x2[k], p0.u[k], p0.t0[k], slope[k], amp, w, a)
-        # a few ulps of the absolute time t0 + s: the precision any time of the record has
-        tol = 4.0 * np.finfo(float).eps * float(np.max(np.abs(p0.t0) + h))
-        out[idx] = _newton(lambda x: _derivs(*g, x, order), lo[idx], hi[idx], flo[idx], tol)
-    return np.where((out > 0) & (out < h[:, None]), out, np.nan)
-
-
-def _pieces(tr: Trajectory, sig: Signal | None, what: str = "e") -> _Pieces:
-    """Split the record into pieces on which e (what='e') or x1 (what='x1') is monotone."""
-    t0, h, x1, x2, u = _split(tr, sig)
-    p = _Pieces(t0, h, x1, x2, u, tr.a, sig if what == "e" else None, np.empty((0, 0)))
-    z = _extrema(p, 1)
-    brk = np.concatenate([np.zeros((h.size, 1)), np.where(np.isnan(z), h[:, None], z)], axis=1)
-    brk = np.concatenate([np.sort(brk, axis=1), h[:, None]], axis=1)
-    return _Pieces(t0, h, x1, x2, u, tr.a, p.sig, brk)
-
-
-def _value(p: _Pieces, s, what: str):
-    y1, _, r, _ = p.at(s)
-    return r - y1 if what == "e" else y1
-
-
-def _crossing(p: _Pieces, k: int, s0: float, s1: float, level: float, what: str) -> float:
-    """Exact time [s] where the monotone e (or x1) of interval k crosses level in [s0, s1]."""
-    x1k, dv, uk, a, t0 = float(p.x1[k]), float(p.x2[k] - p.u[k]), float(p.u[k]), p.a, float(p.t0[k])
-    sig = p.sig if what == "e" else None
-    kind = sig.kind if sig else ""
-    amp, w = (sig.amplitude, sig.omega) if sig else (0.0, 0.0)
-    r0 = float(sig.r(t0)) if sig else 0.0
-    slope = float(sig.slope(t0 + 0.5 * float(p.h[k]))) if sig else 0.0
-
-    def f(s: float) -> float:  # eq. (7) in scalar arithmetic, as _flow
-        y1 = x1k + uk * s + dv * -math.expm1(-a * s) / a
-        if sig is None:
-            return y1 - level
-        r = amp * math.sin(w * (t0 + s)) if kind == "sine" else r0 + slope * s
-        return r - y1 - level
-
-    f0, f1 = f(s0), f(s1)
-    if f0 == 0.0 or s1 <= s0:
-        return float(p.t0[k] + s0)
-    if f1 == 0.0 or f0 * f1 > 0:  # touching the level at the end of the piece
-        return float(p.t0[k] + s1)
-    # time resolution: 4 ulps of the piece's length (about 1e-18 s for T = 2 ms), so
-    # bisection ends in about 50 steps even for a crossing next to s0
-    from scipy.optimize import brentq
-
-    s = brentq(
-        f,
-        s0,
-        s1,
-        xtol=4.0 * np.finfo(float).eps * (s1 - s0),
-        rtol=4.0 * np.finfo(float).eps,
-        maxiter=200,
-    )
-    return float(p.t0[k] + s)
-
-
-def overshoot(tr: Trajectory, target: float) -> tuple[float, float]:
-    """Overshoot past a final value on the continuous trajectory.
-
-    The extrema of x1 between samples are at s* = ln((u - x2k)/u) / a when
-    0 < s* < T_k (closed form), so the maximum is exact.
-
-    Parameters
-    ----------
-    tr : Trajectory
-        The response.
-    target : float
-        Final value of the reference [mm]; the direction of travel is
-        sign(target - x1(t_0)).
-
-    Returns
-    -------
-    overshoot : float
-        max(0, max_t s (x1(t) - target)) [mm].
-    t_peak : float
-        Time of that maximum [s] (NaN when the overshoot is 0).
-
-    Examples
-    --------
-    >>> from ptoverify.model.plant import flow
-    >>> x1, x2 = flow(0.0, 20.0, -1.0, 0.1, 100.0)  # one sample of 0.1 s
-    >>> tr = Trajectory.from_samples([0.0, 0.1], [0.0, x1], [20.0, x2], [-1.0], 100.0)
-    >>> ov, tp = overshoot(tr, 0.15)  # both samples are below 0.15 mm
-    >>> round(ov, 6), round(tp, 6)  # peak at s* = ln(21) / 100
-    (0.019555, 0.030445)
-    """
-    t0, h, x1, x2, u = tr.t[:-1], np.diff(tr.t), tr.x1[:-1], tr.x2[:-1], tr.u
-    sgn = 1.0 if target >= tr.x1[0] else -1.0
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        s_star = np.log1p(-x2 / u) / tr.a
-    inner = np.isfinite(s_star) & (s_star > 0) & (s_star < h)
-    s_star = np.where(inner, s_star, 0.0)
-    y1, _ = _flow(x1, x2, u, s_star, tr.a)
-    cand_t = np.concatenate([t0 + s_star, tr.t[-1:]])
-    cand = sgn * (np.concatenate([np.where(inner, y1, x1), tr.x1[-1:]]) - target)
-    also = sgn * (tr.x1 - target)  # the samples themselves
-    j, i = int(np.argmax(cand)), int(np.argmax(also))
-    best, tb = (cand[j], cand_t[j]) if cand[j] >= also[i] else (also[i], tr.t[i])
-    return (float(best), float(tb)) if best > 0 else (0.0, math.nan)
-
-
-def settling_time(tr: Trajectory, ref: Any, band: float) -> float:
-    """Last exit time of |e(t)| = |r(t) - x1(t)| from a band, exactly.
-
-    Parameters
-    ----------
-    tr : Trajectory
-        The response.
-    ref : Signal or Reference-like
-        The reference (see :func:`as_signal`).
-    band : float
-        Half-width of the band [mm], > 0.
-
-    Returns
-    -------
-    float
-        Settling time measured from t_0 [s]: 0 if |e| <= band throughout, NaN
-        if |e(t_n)| > band.
-
-    Examples
-    --------
-    >>> t = np.linspace(0.0, 0.2, 101)
-    >>> x1 = 1.0 - np.exp(-20.0 * t)
-    >>> tr = Trajectory.from_samples(t, x1, 20.0 * np.exp(-20.0 * t), np.zeros(100), 20.0)
-    >>> round(settling_time(tr, Signal("step", 1.0), 0.1), 6)  # ln(10) / 20
-    0.115129
-    """
-    p = _pieces(tr, as_signal(ref))
-    return _settling(p, band) - float(tr.t[0])
-
-
-def _settling(p: _Pieces, band: float, ev=None) -> float:
-    """Absolute last exit time [s] of |e| from the band on pieces p (t0[0] if never out)."""
-    ev = _value(p, p.brk, "e") if ev is None else ev
-    out = np.abs(ev) > band
-    if not out.any():
-        return float(p.t0[0])
-    k = int(np.nonzero(out.any(axis=1))[0][-1])
-    j = int(np.nonzero(out[k])[0][-1])
-    if j == p.brk.shape[1] - 1:  # outside at the end of interval k
-        return math.nan if k == p.h.size - 1 else float(p.t0[k] + p.h[k])
-    lvl = math.copysign(band, float(ev[k, j]))
-    return _crossing(p, k, float(p.brk[k, j]), float(p.brk[k, j + 1]), lvl, "e")
-
-
-def _first_reach(p: _Pieces, level: float, sgn: float, xv=None) -> float:
-    """First time [s] with sgn (x1(t) - level) >= 0 on x1-pieces p, exactly; NaN if never."""
-    xv = _value(p, p.brk, "x1") if xv is None else xv
-    v = sgn * (xv - level) >= 0
-    if not v.any():
-        return math.nan
-    k = int(np.nonzero(v.any(axis=1))[0][0])
-    j = int(np.nonzero(v[k])[0][0])
-    if j == 0:
-        return float(p.t0[k])
-    return _crossing(p, k, p.brk[k, j - 1], p.brk[k, j], level, "x1")
-
-
-def rise_time(tr: Trajectory, target: float, *, low: float = 0.1, high: float = 0.9) -> float:
-    """Rise time from ``low`` to ``high`` of the way from x1(t_0) to target.
-
-    Parameters
-    ----------
-    tr : Trajectory
-        The response.
-    target : float
-        Final value [mm], different from x1(t_0).
-    low, high : float
-        Fractions [-].
-
-    Returns
-    -------
-    float
-        First continuous time x1 reaches the high level minus the first time it
-        reaches the low level [s]; NaN if either is never reached.
-
-    Examples
-    --------
-    >>> t = np.linspace(0.0, 0.3, 31)
-    >>> tr = Trajectory.from_samples(t, 1 - np.exp(-20 * t), 20 * np.exp(-20 * t),
-    ...                              np.zeros(30), 20.0)
-    >>> round(rise_time(tr, 1.0), 6)  # ln(9) / 20
-    0.109861
-    """
-    x0 = float(tr.x1[0])
-    if target == x0:
-        return math.nan
-    return _rise(_pieces(tr, None, "x1"), x0, target, low, high)
-
-
-def _rise(p: _Pieces, x0: float, target: float, low: float, high: float, xv=None) -> float:
-    t_lo, t_hi = _rise_pair(p, x0, target, low, high, xv)
-    return t_hi - t_lo
-
-
-def _rise_pair(p: _Pieces, x0: float, target: float, low: float, high: float, xv=None):
-    """Absolute first times [s] x1 reaches the low and the high level."""
-    sgn = 1.0 if target > x0 else -1.0
-    xv = _value(p, p.brk, "x1") if xv is None else xv
-    t_lo = _first_reach(p, x0 + low * (target - x0), sgn, xv)
-    t_hi = _first_reach(p, x0 + high * (target - x0), sgn, xv)
-    return t_lo, t_hi
-
-
-def _preimage(p: _Pieces, k: int, s0: float, s1: float, v0: float, v1: float, lim: float, what):
-    """[lo, hi] of s in [s0, s1] with |f(s)| <= lim for f monotone (None if empty)."""
-    if max(v0, v1) < -lim or min(v0, v1) > lim:
-        return None
-    lo, hi = s0, s1
-    if abs(v0) > lim:
-        lo = _cross_generic(p, k, s0, s1, math.copysign(lim, v0), what) - p.t0[k]
-    if abs(v1) > lim:
-        hi = _cross_generic(p, k, s0, s1, math.copysign(lim, v1), what) - p.t0[k]
-    return lo, hi
-
-
-def _cross_generic(p, k, s0, s1, level, what):
-    if what == "e":
-        return _crossing(p, k, s0, s1, level, "e")
-
-    slope, amp, w = _ref_parts(p)
-    g = (float(p.x2[k]), float(p.u[k]), float(p.t0[k]), float(slope[k]), amp, w, p.a)
-
-    def f(s: float) -> float:
-        return float(_derivs(*g, s, 1)[0]) - level
-
-    f0, f1 = f(s0), f(s1)
-    if f0 * f1 > 0:
-        return float(p.t0[k] + (s0 if abs(f0) < abs(f1) else s1))
-    # time resolution: 4 ulps of the piece's length (about 1e-18 s for T = 2 ms), so
-    # bisection ends in about 50 steps even for a crossing next to s0
-    from scipy.optimize import brentq
-
-    s = brentq(
-        f,
-        s0,
-        s1,
-        xtol=4.0 * np.finfo(float).eps * (s1 - s0),
-        rtol=4.0 * np.finfo(float).eps,
-        maxiter=200,
-    )
-    return float(p.t0[k] + s)
-
-
-def linear_zone_time(tr: Trajectory, ref: Any, d: float, *, v_max: float = math.inf) -> float:
-    """First time the continuous state enters {|x1 - r| <= d, |x2 - r'| <= v_max}.
-
-    Both the position error e1 = -e and the velocity error e2 = -e' are split
-    into pieces where each is monotone (extrema of e from e' = 0, of e' from
-    e'' = 0, closed form or bracketed Newton), so on each piece the set is one
-    interval whose ends are exact crossings.
-
-    Parameters
-    ----------
-    tr : Trajectory
-        The response.
-    ref : Signal or Reference-like
-        The reference.
-    d : float
-        Half-width of the zone in position error [mm] (PTO: the linear zone d;
-        inf: everywhere).
-    v_max : float
-        Bound on the velocity error [mm/s] (default inf: no condition).
-
-    Returns
-    -------
-    float
-        Entry time measured from t_0 [s]; NaN if never.
-
-    Examples
-    --------
-    >>> t = np.linspace(0.0, 0.3, 31)
-    >>> tr = Trajectory.from_samples(t, 1 - np.exp(-20 * t), 20 * np.exp(-20 * t),
-    ...                              np.zeros(30), 20.0)
-    >>> round(linear_zone_time(tr, Signal("step", 1.0), 0.5), 6)  # ln(2) / 20
-    0.034657
-    """
-    return _linear_zone(_pieces(tr, as_signal(ref)), d, v_max) - float(tr.t[0])
-
-
-def _linear_zone(p: _Pieces, d: float, v_max: float, ev=None) -> float:
-    """Absolute first entry time [s] into the zone on e-pieces p; NaN if never."""
-    if math.isfinite(v_max):  # refine so that e' is monotone on every piece too
-        z2 = np.where(np.isnan(z := _extrema(p, 2)), p.h[:, None], z)
-        brk = np.sort(np.concatenate([p.brk, z2], 1), 1)
-        q = _Pieces(p.t0, p.h, p.x1, p.x2, p.u, p.a, p.sig, brk)
-        e, e2 = _value(q, brk, "e"), -_e_derivs(q, brk)[0]
-    else:
-        q, brk = p, p.brk
-        e = _value(p, brk, "e") if ev is None else ev
-        e2 = np.zeros_like(e)
-    lo, hi = brk[:, :-1], brk[:, 1:]
-
-    def meets(v, lim):  # a monotone piece meets the band [-lim, lim] somewhere
-        return (np.minimum(v[:, :-1], v[:, 1:]) <= lim) & (np.maximum(v[:, :-1], v[:, 1:]) >= -lim)
-
-    cand = meets(e, d) & meets(e2, v_max) & (hi >= lo)
-    for k, j in zip(*np.nonzero(cand), strict=True):
-        s0, s1 = float(lo[k, j]), float(hi[k, j])
-        a1 = _preimage(q, k, s0, s1, float(e[k, j]), float(e[k, j + 1]), d, "e")
-        if a1 is None:
-            continue
-        if math.isfinite(v_max):
-            a2 = _preimage(q, k, s0, s1, -float(e2[k, j]), -float(e2[k, j + 1]), v_max, "d1")
-            if a2 is None or max(a1[0], a2[0]) > min(a1[1], a2[1]):
-                continue
-            a1 = (max(a1[0], a2[0]), 0.0)
-        return float(q.t0[k] + a1[0])
-    return math.nan
-
-
-def _wrap_deg(d: float) -> float:
-    d = (d + 180.0) % 360.0 - 180.0
-    return 180.0 if d == -180.0 else d
-
-
-def sine_phase(
-    tr: Trajectory, ref: Any, *, t_from: float | None = None
-) -> tuple[float, float, tuple[float, float]]:
-    """Phase delay of x1 behind a sine reference, continuous least squares.
-
-    The fundamental y = A sin(w t) + B cos(w t) + C is fitted to x1(t) and to
-    r(t) over the largest whole number of periods that ends at t_n and starts at
-    or after ``t_from``.  Over whole periods the three functions are orthogonal,
-    so A = 2/L int x1 sin, B = 2/L int x1 cos, C = 1/L int x1; the integrals are
-    8-point Gauss-Legendre per sample interval on panels with (a + w) h <= 1
-    (remainder below 2e-23 of the integral's scale: exact to round-off).
-
-    Parameters
-    ----------
-    tr : Trajectory
-        The response.
-    ref : Signal or Reference-like
-        A sine reference.
-    t_from : float, optional
-        Start of the steady part [s]; default t_0 plus one period.
-
-    Returns
-    -------
-    delay_deg : float
-        phase(r) - phase(x1) wrapped to (-180, 180] [deg], positive when x1 lags.
-    amplitude_ratio : float
-        Amplitude of x1's fundamental over r's [-].
-    window : tuple of float
-        The fitted window (t_a, t_b) [s].
-
-    Examples
-    --------
-    >>> t = np.linspace(0.0, 1.0, 1001)
-    >>> w = 2 * np.pi * 5.0
-    >>> x1 = np.sin(w * t - 0.1)  # any smooth data; u chosen to match x2 at each end
-    >>> tr = Trajectory.from_samples(t, x1, w * np.cos(w * t - 0.1), np.zeros(1000), 1e-9)
-    >>> round(sine_phase(tr, Signal("sine", 1.0, 5.0))[0], 2)  # not a ZOH response
-    5.73
-    """
-    sig = as_signal(ref)
-    if sig.kind != "sine":
-        raise InputError("the phase delay needs a sine reference")
-    per = 1.0 / abs(sig.rate)
-    tb = float(tr.t[-1])
-    start = float(tr.t[0]) + per if t_from is None else max(t_from, float(tr.t[0]))
-    n_per = math.floor((tb - start) / per + 1e-9)
-    if n_per < 1:
-        return math.nan, math.nan, (math.nan, tb)
-    ta = tb - n_per * per
-    t0, h, x1, x2, u = _split(tr, None, (ta,))
-    keep = t0 >= ta
-    t0, h, x1, x2, u = t0[keep], h[keep], x1[keep], x2[keep], u[keep]
-    w = sig.omega
-    J = max(1, math.ceil((tr.a + w) * float(h.max())))
-    node = (np.arange(J)[:, None] + 0.5 * (_GL_X[None, :] + 1.0)).ravel() / J  # in (0, 1)
-    wt = np.tile(_GL_W, J) / (2.0 * J)
-    s = h[:, None] * node[None, :]
-    y1, _ = _flow(x1[:, None], x2[:, None], u[:, None], s, tr.a)
-    tt = t0[:, None] + s
-    hw = h[:, None] * wt[None, :]
-    sn, cs = np.sin(w * tt), np.cos(w * tt)
-    L = tb - ta
-    phases, amps = [], []
-    for y in (sig.amplitude * sn, y1):  # r(t) = A sin(w t)
-        A, B = 2.0 / L * np.sum(hw * y * sn), 2.0 / L * np.sum(hw * y * cs)
-        phases.append(math.degrees(math.atan2(B, A)))
-        amps.append(math.hypot(A, B))
-    return _wrap_deg(phases[0] - phases[1]), amps[1] / amps[0], (ta, tb)
-
-
-def _grid_phase(t, x1, r, freq: float, ta: float) -> float:
-    """Sample-grid phase delay [deg]: least squares on the samples in (t_a, t_n]."""
-    sel = t > ta + 1e-9 * (t[1] - t[0])
-    w = 2.0 * math.pi * abs(freq)
-    M = np.column_stack([np.sin(w * t[sel]), np.cos(w * t[sel]), np.ones(int(sel.sum()))])
-    coef, *_ = np.linalg.lstsq(M, np.column_stack([r[sel], x1[sel]]), rcond=None)
-    (ar, ax), (br, bx) = coef[0], coef[1]
-    return _wrap_deg(math.degrees(math.atan2(br, ar) - math.atan2(bx, ax)))
-
-
-def grid_settling_time(t: ArrayLike, e: ArrayLike, band: float, *, hold: float = 0.0) -> float:
-    """Settling time on the sample grid: the sample after the last one outside the band.
-
-    t_s = t_k for the first sample k such that |e_j| <= band for every j >= k
-    up to the end of the record.  A record that ends outside the band, or whose
-    settled tail is shorter than ``hold``, has not settled: NaN.  This is the
-    sample-grid twin of :func:`settling_time` (the ``grid`` value of
-    :class:`Compared`), and ``ptoverify.sim.metrics.settling_time``.
-
-    Parameters
-    ----------
-    t : array_like, shape (n,)
-        Sample times [s].
-    e : array_like, shape (n,)
-        Error [mm] (or any signal that should settle to 0).
-    band : float
-        Half-width of the band [same unit as e], > 0.
-    hold : float
-        Shortest settled tail that counts as settled [s] (default 0).
-
-    Returns
-    -------
-    float
-        Settling time [s] measured from t[0]; NaN if it never settles.
-
-    Examples
-    --------
-    >>> t = np.linspace(0, 1, 1001)
-    >>> round(grid_settling_time(t, np.exp(-10 * t), 0.1), 3)
-    0.231
-    """
-    t, e = _arr(t), _arr(e)
-    outside = np.flatnonzero(np.abs(e) > band)
-    k = 0 if outside.size == 0 else outside[-1] + 1
-    if k >= t.size or t[-1] - t[k] < hold:
-        return math.nan
-    return float(t[k] - t[0])
-
-
-def grid_overshoot(x: ArrayLike, target: float, start: float = 0.0) -> float:
-    """Overshoot on the samples: largest excursion past the target, in the direction of travel.
-
-    The sample-grid twin of :func:`overshoot` (and ``ptoverify.sim.metrics.overshoot``).
-
-    Parameters
-    ----------
-    x : array_like
-        Position [mm].
-    target : float
-        Final value of the reference [mm].
-    start : float
-        Initial value [mm]; the direction of travel is sign(target - start).
-
-    Returns
-    -------
-    float
-        max(0, max_k s (x_k - target)) [mm], s = sign(target - start).
-
-    Examples
-    --------
-    >>> grid_overshoot([0.0, 4.0, 5.3, 4.9, 5.0], 5.0)
-    0.2999999999999998
-    """
-    s = 1.0 if target >= start else -1.0
-    return float(max(0.0, np.max(s * (_arr(x) - target))))
-
-
-def grid_rise_time(
-    t: ArrayLike,
-    x: ArrayLike,
-    target: float,
-    *,
-    low: float = 0.1,
-    high: float = 0.9,
-    start: float | None = None,
-) -> float:
-    """Rise time on the samples, from ``low`` to ``high`` of the way from ``start`` to target.
-
-    The sample-grid twin of :func:`rise_time` (and ``ptoverify.sim.metrics.rise_time``):
-    the first sample at or past the high level minus the first at or past the low level.
-
-    Parameters
-    ----------
-    t : array_like
-        Sample times [s].
-    x : array_like
-        Position [mm].
-    target : float
-        Final value [mm], different from ``start``.
-    low, high : float
-        Fractions of the way [-].
-    start : float, optional
-        Initial value [mm]; default x[0].
-
-    Returns
-    -------
-    float
-        Rise time [s]; NaN if a level is never reached.
-
-    Examples
-    --------
-    >>> t = np.linspace(0, 1, 1001)
-    >>> round(grid_rise_time(t, 1 - np.exp(-10 * t), 1.0), 3)
-    0.22
-    """
-    t, x = _arr(t), _arr(x)
-    x0 = float(x[0]) if start is None else float(start)
-    if target == x0:
-        return math.nan
-    sgn = 1.0 if target > x0 else -1.0
-    lo, hi = (x0 + f * (target - x0) for f in (low, high))
-    return _grid_first(t, sgn * (x - hi) >= 0) - _grid_first(t, sgn * (x - lo) >= 0)
-
-
-def _grid_first(t, y) -> float:
-    k = np.flatnonzero(y)
-    return float(t[k[0]]) if k.size else math.nan
 
 
 @dataclass(frozen=True)
@@ -1022,6 +191,41 @@ class Compared:
 
 
 @dataclass(frozen=True)
+class ResponseMetrics:
+    """The ``simulate --json`` ``metrics`` of one response (DESIGN.md).
+
+    Attributes
+    ----------
+    overshoot_mm : float
+        Overshoot past the final value [mm] (NaN for a sine).
+    settling_2pct_s : float
+        Settling time under the ``2pct`` definition [s] (NaN: never settles).
+    settling_0p01mm_s : float
+        Settling time under the ``0p01mm`` definition [s] (NaN: never settles).
+    rise_time_s : float
+        10-90 % rise time [s] (NaN unless a step or ramp).
+    phase_delay_deg : float or None
+        Phase delay of x1 behind a sine [deg]; None unless the reference is a sine.
+    """
+
+    overshoot_mm: float
+    settling_2pct_s: float
+    settling_0p01mm_s: float
+    rise_time_s: float
+    phase_delay_deg: float | None = None
+
+    def to_json(self) -> dict[str, float | None]:
+        """Return the JSON object: one key per field (NaN as None; no phase unless a sine)."""
+        out = {}
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name == "phase_delay_deg" and v is None:
+                continue
+            out[f.name] = None if v is None or math.isnan(v) else float(v)
+        return out
+
+
+@dataclass(frozen=True)
 class ExactMetrics:
     """Metrics of one response, exact and on the grid, by key (:data:`METRIC_KEYS`).
 
@@ -1058,9 +262,30 @@ class ExactMetrics:
         ``grid=True`` the same keys hold the sample-grid values
         (``simulate --json`` ``metrics_grid``).
         """
-        keys = [k for k in METRIC_KEYS[:5] if k != "phase_delay_deg" or self.signal.kind == "sine"]
+        return self.response(grid=grid).to_json()
+
+    def response(self, *, grid: bool = False) -> ResponseMetrics:
+        """Return the ``simulate --json`` metrics as a :class:`ResponseMetrics`.
+
+        Parameters
+        ----------
+        grid : bool
+            The sample-grid values instead of the exact ones.
+
+        Returns
+        -------
+        ResponseMetrics
+            The five metrics (phase only for a sine).
+        """
         pick = self.grid() if grid else self.exact()
-        return {k: None if math.isnan(v := pick[k]) else v for k in keys}
+        phase = pick["phase_delay_deg"] if self.signal.kind == "sine" else None
+        return ResponseMetrics(
+            pick["overshoot_mm"],
+            pick["settling_2pct_s"],
+            pick["settling_0p01mm_s"],
+            pick["rise_time_s"],
+            phase,
+        )
 
     def differing(self) -> list[str]:
         """Keys whose exact and grid values differ beyond tolerance."""
@@ -1130,25 +355,28 @@ def metrics_from_arrays(
     tt, y1, y2 = tr.t, tr.x1, tr.x2
     e_grid = sig.r(tt) - y1
     nan = math.nan
-    band2, p, ev, core = _core_metrics(tr, sig, band, step_fraction)
+    set2, set01, ov = _core(tr, sig, band, step_fraction)
+    band2 = (
+        STEP_FRACTION * abs(sig.amplitude)
+        if step_fraction is None
+        else step_fraction * abs(sig.amplitude)
+    )
     acc = _Accuracy(tr, sig)
     vals: dict[str, Compared] = {}
     details: dict[str, float] = {"band_2pct_mm": band2, "t_peak_s": nan}
-    for key, b in (("settling_2pct_s", band2), ("settling_0p01mm_s", band)):
-        ex = core[key]
-        g = grid_settling_time(tt, e_grid, b) if b > 0 else nan
+    for key, st in (("settling_2pct_s", set2), ("settling_0p01mm_s", set01)):
+        ex = float(st.time[0])
         err = acc.time(float(tt[0]) + ex, "e") if ex > 0 else (0.0 if ex == 0 else nan)
-        vals[key] = Compared(ex, g, TIME_TOL_SAMPLES * T, err)
-    if sig.kind in ("step", "ramp"):
+        vals[key] = Compared(ex, float(st.grid[0]), TIME_TOL_SAMPLES * T, err)
+    if ov is not None:
         target = float(sig.r(tt[-1]))
-        ov, tp = core["overshoot_mm"], core["t_peak_s"]
-        g = grid_overshoot(y1, target, float(y1[0]))
-        vals["overshoot_mm"] = Compared(ov, g, POSITION_TOL, acc.position)
-        details["t_peak_s"] = tp
+        vals["overshoot_mm"] = Compared(
+            float(ov.value[0]), float(ov.grid[0]), POSITION_TOL, acc.position
+        )
+        details["t_peak_s"] = float(ov.t_peak[0])
         rt = err = nan
-        if target != y1[0]:  # for a step r is constant: the e-pieces are the x1-pieces
-            q, xv = (p, target - ev) if sig.kind == "step" else (_pieces(tr, None, "x1"), None)
-            t_lo, t_hi = _rise_pair(q, float(y1[0]), target, 0.1, 0.9, xv)
+        if target != y1[0]:
+            t_lo, t_hi = rise_pair(monotone_pieces(tr, None, "x1"), float(y1[0]), target, 0.1, 0.9)
             rt, err = t_hi - t_lo, acc.time(t_lo, "x1") + acc.time(t_hi, "x1")
         vals["rise_time_s"] = Compared(
             rt, grid_rise_time(tt, y1, target), TIME_TOL_SAMPLES * T, err
@@ -1158,7 +386,7 @@ def metrics_from_arrays(
         vals["rise_time_s"] = Compared(nan, nan, TIME_TOL_SAMPLES * T, nan)
     if sig.kind == "sine":
         ph, ratio, (ta, tb) = sine_phase(tr, sig)
-        g = _grid_phase(tt, y1, sig.r(tt), sig.rate, ta) if math.isfinite(ta) else nan
+        g = grid_phase(tt, y1, sig.r(tt), sig.rate, ta) if math.isfinite(ta) else nan
         vals["phase_delay_deg"] = Compared(ph, g, PHASE_TOL_DEG, acc.phase_deg(sig))
         details.update(amplitude_ratio=ratio, fit_from_s=ta, fit_to_s=tb)
     else:
@@ -1166,36 +394,42 @@ def metrics_from_arrays(
     if d is None:
         vals["linear_zone_s"] = Compared(nan, nan, TIME_TOL_SAMPLES * T, nan)
     else:
-        ez = _linear_zone(p, d, v_max, ev) - float(tt[0])
+        ez = linear_zone_entry(monotone_pieces(tr, sig), d, v_max) - float(tt[0])
         inside = (np.abs(e_grid) < d) & (np.abs(y2 - sig.r_dot(tt)) <= v_max)
-        gz = _grid_first(tt, inside) - float(tt[0])
+        gz = grid_first(tt, inside) - float(tt[0])
         err = acc.time(float(tt[0]) + ez, "e") if ez > 0 else (0.0 if ez == 0 else nan)
         vals["linear_zone_s"] = Compared(ez, gz, TIME_TOL_SAMPLES * T, err)
     return ExactMetrics(sig, {k: vals[k] for k in METRIC_KEYS}, details)
 
 
-def _core_metrics(tr: Trajectory, sig: Signal, band: float, step_fraction: float | None):
-    """Compute the exact settling times and overshoot of :func:`metrics_from_arrays`.
+def _core(tr: Trajectory, sig: Signal, band: float, step_fraction: float | None):
+    """Settling under the classical and the tight definitions, and the overshoot.
 
-    Returns the 2 % band [mm], the e-pieces and their values at the breaks (for the
-    rise time), and ``settling_2pct_s``, ``settling_0p01mm_s`` [s] (NaN for a band
-    <= 0), ``overshoot_mm`` [mm] and ``t_peak_s`` [s] (NaN unless a step or ramp).
+    Returns (Settling, Settling, Overshoot or None): the definitions of the
+    registry when ``band`` and ``step_fraction`` are theirs (2 % and 0.01 mm by
+    default), else ad-hoc ones; the overshoot for a step or ramp only.  A band
+    of zero width (a fraction of a reference of size 0) settles never: NaN.
     """
-    nan = math.nan
-    big = STEP_FRACTION if step_fraction is None else step_fraction
-    band2 = big * abs(sig.amplitude)
-    t0 = float(tr.t[0])
-    p = _pieces(tr, sig)
-    ev = _value(p, p.brk, "e")
-    out = {
-        key: _settling(p, b, ev) - t0 if b > 0 else nan
-        for key, b in (("settling_2pct_s", band2), ("settling_0p01mm_s", band))
-    }
-    ov = tp = nan
-    if sig.kind in ("step", "ramp"):
-        ov, tp = overshoot(tr, float(sig.r(tr.t[-1])))
-    out.update(overshoot_mm=ov, t_peak_s=tp)
-    return band2, p, ev, out
+    frac = STEP_FRACTION if step_fraction is None else step_fraction
+    d2 = _named(SettlingDefinition("custom", "fraction band", band_fraction=frac))
+    d01 = _named(SettlingDefinition("custom", "tight band", band_mm=band))
+    ov = overshoot(tr, float(sig.r(tr.t[-1]))) if sig.kind in ("step", "ramp") else None
+    nan = np.full(1, math.nan)
+    set2 = settling_time(tr, sig, d2) if sig.amplitude != 0 else Settling(d2, nan, nan, math.nan)
+    return set2, settling_time(tr, sig, d01), ov
+
+
+def _named(d: SettlingDefinition) -> SettlingDefinition:
+    """Return the registry's definition with the box and hold of ``d``, else ``d``."""
+    for known in DEFINITIONS.values():
+        if (known.band_mm, known.band_fraction, known.velocity_band_mm, known.hold_s) == (
+            d.band_mm,
+            d.band_fraction,
+            d.velocity_band_mm,
+            d.hold_s,
+        ):
+            return known
+    return d
 
 
 def settling_and_overshoot(
@@ -1248,8 +482,12 @@ def settling_and_overshoot(
         reference = getattr(res, "reference", None) or _infer(res)
     a = plant if isinstance(plant, (int, float)) else plant.a
     tr = Trajectory.from_samples(res.t, res.x1, res.x2, res.u, float(a))
-    core = _core_metrics(tr, as_signal(reference), band, step_fraction)[3]
-    return {k: core[k] for k in ("overshoot_mm", "settling_2pct_s", "settling_0p01mm_s")}
+    set2, set01, ov = _core(tr, as_signal(reference), band, step_fraction)
+    return {
+        "overshoot_mm": math.nan if ov is None else float(ov.value[0]),
+        "settling_2pct_s": float(set2.time[0]),
+        "settling_0p01mm_s": float(set01.time[0]),
+    }
 
 
 class _Accuracy:
@@ -1423,7 +661,7 @@ def settling_times_batch(
     >>> round(float(st.time[0]), 6), float(st.grid[0])  # ln(50) / 10, then the sample after
     (0.391202, 0.4)
     """
-    x1, x2, u = _arr(x1), _arr(x2), _arr(u)
+    x1, x2, u = as_float_array(x1), as_float_array(x2), as_float_array(u)
     if x1.ndim == 1:
         x1, x2, u = x1[:, None], x2[:, None], u[:, None]
     steps = x1.shape[0] - 1
@@ -1431,123 +669,10 @@ def settling_times_batch(
         raise InputError("x1, x2 must be (steps + 1, n) and u (steps, n), steps >= 1")
     if not (band_x1 > 0 and band_x2 > 0 and a > 0 and T > 0 and hold >= 0):
         raise InputError("bands, a and T must be positive and hold >= 0")
-    cols = np.arange(x1.shape[1])
-    L1, L2, E1 = _scan_back(x1, x2, u, a, T, band_x1, band_x2)
-    ended = (L1 == steps) | (L2 == steps)
-    # the piece of x1's last exit: after the excursion of E1, or from the sample L1
-    from_exc = (E1 >= 0) & (E1 >= L1) & ~ended
-    from_smp = (L1 >= 0) & ~from_exc & ~ended
-    t1 = np.zeros(cols.size)
-    tol = 4.0 * np.finfo(float).eps * T
-    for sel, after in ((from_exc, True), (from_smp, False)):
-        c = cols[sel]
-        k = (E1 if after else L1)[c]
-        xk, vk, uk = x1[k, c], x2[k, c], u[k, c]
-        s_star, y_star = _x1_extremum(xk, vk, uk, a, T)
-        if after:  # from the excursion's extremum (outside) to the next sample (inside)
-            lo, hi, level = s_star, np.full(c.size, T), np.copysign(band_x1, y_star)
-        else:  # from the sample outside to the extremum (inside) or the next sample
-            lo, hi = np.zeros(c.size), np.where(np.isfinite(s_star), s_star, T)
-            level = np.copysign(band_x1, xk)
-        t1[c] = k * T + _x1_crossing(xk, vk, uk, a, level, lo, hi, tol)
-    # x2: closed form in the interval after its last sample outside
-    t2 = np.zeros(cols.size)
-    c = cols[(L2 >= 0) & ~ended]
-    k = L2[c]
-    vk, uk = x2[k, c], u[k, c]
-    lvl = np.copysign(band_x2, vk)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s2 = np.log1p((vk - lvl) / (lvl - uk)) / a
-    t2[c] = k * T + np.clip(np.nan_to_num(s2, nan=T), 0.0, T)
-    t_end = steps * T
-    ts = np.maximum(t1, t2)
-    ts = np.where(ended | (t_end - ts < hold - 1e-9 * T), np.nan, ts)
-    kg = np.maximum(L1, L2) + 1
-    hold_steps = math.ceil(hold / T - 1e-9)
-    grid = np.where(steps - kg >= hold_steps, kg * T, np.nan)
-    eps = float(np.finfo(float).eps)
-    return BatchSettling(ts, grid, 4.0 * eps * T + 4.0 * eps * t_end)
-
-
-def _scan_back(x1, x2, u, a: float, T: float, b1: float, b2: float):  # noqa: N803
-    """Last samples outside each band (L1, L2) and last x1 excursion at or after L1 (E1).
-
-    Scans blocks of samples from the record's end backwards (blocks of about
-    32k values stay in cache) and stops once every column's L1 and L2 are
-    known.  -1 where none.  An excursion in interval k needs an interior zero of
-    x2 (x2k x2k+1 < 0) and |x1k| + T |x2k| > b1 (on [0, s*] |x2| <= |x2k|, so
-    |x1(s*) - x1k| < T |x2k|); only those candidates get the closed-form s*.
-    """
-    steps, n = x1.shape[0] - 1, x1.shape[1]
-    L1 = np.where(np.abs(x1[steps]) > b1, steps, -1)
-    L2 = np.where(np.abs(x2[steps]) > b2, steps, -1)
-    kk, cc = [], []
-    # columns still scanned: a column whose L1 and L2 are both known is done (its
-    # candidates in earlier rows all lie before L1 and are dropped), so once fewer
-    # than half the scanned columns are pending, only those are read on
-    act = np.arange(n)
-    hi = steps
-    while hi > 0:
-        pend = (L1[act] < 0) | (L2[act] < 0)
-        left = int(np.count_nonzero(pend))
-        if left == 0:
-            break
-        if 2 * left < act.size:
-            act = act[pend]
-        full = act.size == n
-        rows = max(1, 32768 // act.size)
-        lo = max(0, hi - rows)
-        if full:  # samples lo..hi-1: the intervals' starts
-            y1, y2, z2, l1, l2 = x1[lo:hi], x2[lo:hi], x2[lo + 1 : hi + 1], L1, L2
-        else:
-            y1, y2, z2 = x1[lo:hi, act], x2[lo:hi, act], x2[lo + 1 : hi + 1, act]
-            l1, l2 = L1[act], L2[act]
-        idx = np.arange(lo + 1, hi + 1, dtype=np.int32)[:, None]  # row + 1
-        ax1, ax2 = np.abs(y1), np.abs(y2)
-        for L, ay, b in ((l1, ax1, b1), (l2, ax2, b2)):
-            r = ((ay > b) * idx).max(axis=0)  # last row outside + 1, 0 if none
-            if r.any():
-                np.copyto(L, r - 1, where=(L < 0) & (r > 0))
-        if not full:
-            L1[act], L2[act] = l1, l2
-        ax2 *= T
-        ax2 += ax1
-        c = ax2 > b1
-        with np.errstate(invalid="ignore"):
-            c &= (y2 * z2) < 0.0
-        if c.any():
-            k, j = np.nonzero(c)
-            k += lo
-            if not full:
-                j = act[j]
-            keep = k >= L1[j]  # L1 found in an earlier row later on is < lo <= k
-            kk.append(k[keep])
-            cc.append(j[keep])
-        hi = lo
-    kk = np.concatenate(kk) if kk else np.zeros(0, dtype=np.int64)
-    cc = np.concatenate(cc) if cc else np.zeros(0, dtype=np.int64)
-    _, y_ex = _x1_extremum(x1[kk, cc], x2[kk, cc], u[kk, cc], a, T)
-    exc = np.abs(y_ex) > b1  # NaN (no interior extremum) compares False
-    E1 = np.full(n, -1)
-    np.maximum.at(E1, cc[exc], kk[exc])
-    return L1, L2, E1
-
-
-def _x1_extremum(x1k, x2k, uk, a: float, T: float):  # noqa: N803
-    """Interior extremum (s*, x1(s*)) of x1 on each sample, NaN where none in (0, T)."""
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        s = np.log1p(-x2k / uk) / a
-    s = np.where((s > 0.0) & (s < T), s, np.nan)
-    return s, _flow(x1k, x2k, uk, s, a)[0]
-
-
-def _x1_crossing(x1k, x2k, uk, a: float, level, lo, hi, tol: float):
-    """Offset s in [lo, hi] where the monotone x1(s) of eq. (7) equals level (Newton)."""
-    if np.size(x1k) == 0:
-        return np.zeros(0)
-    dv = x2k - uk
-
-    def fdf(s):
-        return x1k + uk * s + dv * -np.expm1(-a * s) / a - level, uk + dv * np.exp(-a * s)
-
-    return _newton(fdf, lo, hi, fdf(lo)[0], tol)
+    vb = None if math.isinf(band_x2) else band_x2 / a
+    box = _named(
+        SettlingDefinition("custom", "box", band_mm=band_x1, velocity_band_mm=vb, hold_s=hold)
+    )
+    tr = Trajectory(np.arange(steps + 1) * T, x1, x2, u, float(a))
+    st = settling_time(tr, None, box)
+    return BatchSettling(st.time, st.grid, st.accuracy)

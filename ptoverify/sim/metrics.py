@@ -5,21 +5,20 @@ the controller's samples t_k = k T only.  :func:`summarize` reports the time
 metrics of a :class:`~ptoverify.sim.simulate.SimResult` on the exact continuous
 trajectory between the samples (:mod:`ptoverify.sim.exact`: overshoot, settling,
 rise time, linear-zone entry, sine phase), with the sample-grid value of the
-same definition beside each under the key suffixed ``_grid``.  The sample-grid
-definitions of settling, overshoot and rise time are
-:func:`ptoverify.sim.exact.grid_settling_time`, :func:`~ptoverify.sim.exact.grid_overshoot`
-and :func:`~ptoverify.sim.exact.grid_rise_time`, exported here under their older
-names :func:`settling_time`, :func:`overshoot`, :func:`rise_time`: one
-definition of each.
+same definition beside each under the key suffixed ``_grid``.  Settling and
+overshoot are :func:`ptoverify.sim.settling.settling_time` and
+:func:`~ptoverify.sim.settling.overshoot` under the named definitions of
+:data:`ptoverify.sim.settling.DEFINITIONS`; :func:`rise_time` is
+:func:`ptoverify.sim.exact.grid_rise_time`.
 
 The paper's wording each metric stands for:
 
-* :func:`settling_time` -- "adjustment time" (Sec. 6.1, Sec. 7): the time after
-  which |e| stays within a band until the end of the record.  Two bands are
-  used: 2 % of the step height (the classical band), and a tight band of
-  0.01 mm (:data:`TIGHT_BAND`, 2 % of the linear zone d = 0.5 mm).
-* :func:`overshoot` -- "with the same overshoot" (Sec. 6.1), "avoids ...
-  overshoots" (Sec. 7).
+* settling -- "adjustment time" (Sec. 6.1, Sec. 7): the time after which |e|
+  stays within a band until the end of the record, under the definitions
+  ``2pct`` (the classical band) and ``0p01mm`` (:data:`TIGHT_BAND`, 2 % of the
+  linear zone d = 0.5 mm).
+* overshoot -- "with the same overshoot" (Sec. 6.1), "avoids ... overshoots"
+  (Sec. 7).
 * :func:`oscillation_amplitude` and :func:`sign_reversals` -- "persistent
   oscillations in the steady-state phase" (Sec. 6.1), "series position and
   velocity oscillations" (Sec. 6.2), "reaches zero without any oscillation".
@@ -43,9 +42,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.sim.exact import STEP_FRACTION, TIGHT_BAND, exact_metrics
-from ptoverify.sim.exact import grid_overshoot as overshoot
 from ptoverify.sim.exact import grid_rise_time as rise_time
-from ptoverify.sim.exact import grid_settling_time as settling_time
 
 if TYPE_CHECKING:  # pragma: no cover
     from ptoverify.sim.simulate import SimResult
@@ -53,8 +50,6 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = [
     "TIGHT_BAND",
     "STEP_FRACTION",
-    "settling_time",
-    "overshoot",
     "oscillation_amplitude",
     "sign_reversals",
     "ramp_lag",

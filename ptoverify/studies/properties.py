@@ -27,14 +27,18 @@ chattering
     A sample whose region differs from both neighbours while the neighbours
     agree (A, B, A in consecutive samples).
 overshoot
-    For the rest states, max over k of -sgn(x1_0) x1_k beyond ``band`` [mm].
+    For the rest states, max over k of -sgn(x1_0) x1_k beyond ``band`` [mm] (on
+    the samples, as the robustness study reads it).
+not settled
+    NaN settling time under the definition ``0p001mm``
+    (:data:`ptoverify.sim.settling.DEFINITIONS`; ``band`` at its default): the
+    record ends outside |x1| <= band.
 """
 
 from __future__ import annotations
 
 import functools
 import math
-import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass
@@ -44,6 +48,13 @@ import numpy as np
 from ptoverify.config import Config
 from ptoverify.model.curves import level_side, switching_function
 from ptoverify.model.laws import Law, Region, make_law
+from ptoverify.sim.flow import Trajectory
+from ptoverify.sim.settling import (
+    DEFINITIONS,
+    SettlingDefinition,
+    definition,
+    settling_time,
+)
 from ptoverify.sim.simulate import BatchResult, simulate_batch
 from ptoverify.verdict import tie_band
 
@@ -81,7 +92,7 @@ class LawProperties:
     limit_cycles : int
         States with sustained oscillation at the end of the horizon.
     not_settled : int
-        States whose final |x1| exceeds ``band`` [mm].
+        States whose record ends outside |x1| <= ``band`` [mm] (NaN settling time).
     time_to_linear_max_s, time_to_linear_median_s : float
         Time to reach |x1| < d [s]; inf if some state never does.
     never_linear : int
@@ -397,23 +408,13 @@ def stride_over_counts(
 STRIDE_BLOCK = 65536  #: samples per block of :func:`stride_over_counts`
 
 
-#: The arrays of the last grid run finished in this process, for the next to write
-#: into (at most one set, about 85 MB on the default grid; see :func:`grid_simulation`).
-_SPARE: list[BatchResult] = []
-_SPARE_LOCK = threading.Lock()
-
-
 @contextmanager
 def grid_simulation(
     law: Law, cfg: Config, x1: np.ndarray, x2: np.ndarray, steps: int
 ) -> Iterator[BatchResult]:
     """``simulate_batch(law, cfg.plant, x1, x2, steps)`` for the length of a ``with`` block.
 
-    The run writes into the arrays of the previous run that has left its block, if
-    their shapes fit (``simulate_batch(..., out=...)``: the same values, without the
-    page faults of about 85 MB of fresh arrays per run of the gate grid), and leaves
-    its own for the next.  The arrays must not be used after the block.  Thread safe:
-    concurrent runs each take the spare set or fresh arrays.
+    Kept for its callers; the run is a plain :func:`simulate_batch` call.
 
     Parameters
     ----------
@@ -431,14 +432,7 @@ def grid_simulation(
     BatchResult
         The trajectories.
     """
-    with _SPARE_LOCK:
-        spare = _SPARE.pop() if _SPARE else None
-    res = simulate_batch(law, cfg.plant, x1, x2, steps, out=spare)
-    try:
-        yield res
-    finally:
-        with _SPARE_LOCK:
-            _SPARE[:] = [res]
+    yield simulate_batch(law, cfg.plant, x1, x2, steps)
 
 
 def law_properties(
@@ -449,7 +443,7 @@ def law_properties(
     n2: int = 101,
     rest: int = 200,
     steps: int | None = None,
-    band: float = 1e-3,
+    band: float = DEFINITIONS["0p001mm"].band_mm,
     window: int | None = None,
 ) -> LawProperties:
     """Simulate ``law`` from the grid and measure the closed-loop properties.
@@ -500,8 +494,15 @@ def _measure(law, cfg, res, x1, x2, is_rest, steps, window, band) -> LawProperti
     entry = np.where(entered, np.abs(X2[np.maximum(first_in, 0), np.arange(x1.size)]), 0.0)
     chat = (R[1:-1] != R[:-2]) & (R[1:-1] != R[2:]) & (R[:-2] == R[2:])
     osc = oscillating(X1[-window:], band)
+    t = np.arange(X1.shape[0]) * T
     over = np.zeros(x1.size)  # only the states at rest can overshoot
+    # on the samples, as robust.trajectory_properties reads it (both move to
+    # settling.overshoot together: tests/test_robust.py ties them)
     over[is_rest] = (-np.sign(x1[is_rest])[None, :] * X1[:, is_rest]).max(axis=0)
+    box = definition("0p001mm")
+    if band != box.band_mm:
+        box = SettlingDefinition("properties", "the properties' band", band_mm=band)
+    settled = settling_time(Trajectory(t, X1, X2, res.u, p.a), None, box).time
     max_u = float(np.abs(res.u).max())
     return LawProperties(
         law=law.name,
@@ -512,7 +513,7 @@ def _measure(law, cfg, res, x1, x2, is_rest, steps, window, band) -> LawProperti
         states_with_stride_over=int(np.unique(j_stride).size),
         crossings_into_linear=int(np.count_nonzero(cross & ~lands_out)),
         limit_cycles=int(osc.sum()),
-        not_settled=int((np.abs(X1[-1]) > band).sum()),
+        not_settled=int(np.isnan(settled).sum()),
         time_to_linear_max_s=float(t_lin.max()),
         time_to_linear_median_s=float(np.median(t_lin)),
         never_linear=int(never.sum()),

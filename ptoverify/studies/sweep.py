@@ -15,14 +15,15 @@ Decisions (the issue is silent on them):
 
 * Grid: 200 x 200 = 40,000 states, evenly spaced and including the envelope's
   corners.  An even count per axis keeps the origin (t_f* = 0) off the grid.
-  States are simulated in chunks of 4,096 (the trajectories of one chunk are
-  held in memory, never the whole grid's).
-* Settled: |x1| <= ``band`` (0.01 mm, :data:`~ptoverify.sim.metrics.TIGHT_BAND`)
+  Every state is simulated (no mirror-halving), in chunks of 2,048 (the
+  trajectories of one chunk are held in memory, never the whole grid's).
+* Settled: the settling definition ``box-0p01mm``
+  (:data:`ptoverify.sim.settling.DEFINITIONS`): |x1| <= ``band`` (0.01 mm)
   and |x2| <= ``velocity_band`` (default a * band: a state coasting with
   u = 0 from the velocity band moves at most x2 / a = band further) on the
   continuous trajectory, from some time on until the end of the horizon.  The
   settling time is the last exit from that box, found exactly between samples
-  on the ZOH flow (:func:`ptoverify.sim.exact.settling_times_batch`), including
+  on the ZOH flow (:func:`ptoverify.sim.settling.settling_time`), including
   excursions out of the box between two samples that are both inside it.  A
   ratio can fall slightly below 1: settling to a band is easier than reaching
   the origin exactly.
@@ -59,8 +60,9 @@ from ptoverify.config import Config, Plant
 from ptoverify.errors import InputError
 from ptoverify.model.laws import LAW_NAMES, make_law
 from ptoverify.model.mintime import discrete_min_steps_batch, min_time
-from ptoverify.sim.exact import BatchSettling, settling_times_batch
-from ptoverify.sim.metrics import TIGHT_BAND
+from ptoverify.sim.exact import BatchSettling
+from ptoverify.sim.flow import Trajectory
+from ptoverify.sim.settling import DEFINITIONS, SettlingDefinition, settling_time
 from ptoverify.sim.simulate import simulate_batch
 
 __all__ = [
@@ -70,6 +72,7 @@ __all__ = [
     "run_sweep",
     "settle_steps",
     "settling_times",
+    "sweep_definition",
     "grid_states",
     "even_points",
     "mirror_pairs",
@@ -101,9 +104,9 @@ class SweepSettings:
 
     n1: int = 200
     n2: int = 200
-    band: float = TIGHT_BAND
+    band: float = DEFINITIONS["box-0p01mm"].band_mm
     velocity_band: float | None = None
-    hold: float = 0.05
+    hold: float = DEFINITIONS["box-0p01mm"].hold_s
     horizon_factor: float = 4.0
     laws: tuple[str, ...] = LAW_NAMES
 
@@ -375,8 +378,8 @@ def settle_steps(
     return np.where(last - k >= hold_steps, k, -1)
 
 
-#: States simulated at once by default (about 80 MB of trajectories at 384 samples).
-CHUNK = 8192
+#: States simulated at once by default (about 20 MB of trajectories at 384 samples).
+CHUNK = 2048
 
 
 def settling_times(
@@ -394,6 +397,11 @@ def settling_times(
 ) -> BatchSettling:
     """Settling times of ``law`` from each state, between samples and on the grid.
 
+    Every state is simulated (:func:`ptoverify.sim.simulate.simulate_batch`) and
+    measured with :func:`ptoverify.sim.settling.settling_time` under the box
+    |x1| <= band, |x2| <= velocity_band held ``hold`` (the registry's
+    ``box-0p01mm`` at the defaults).
+
     Parameters
     ----------
     law : Law
@@ -407,58 +415,63 @@ def settling_times(
     band, velocity_band : float
         Half-widths of the settled box [mm], [mm/s].
     hold : float
-        Shortest settled tail [s] (the grid reading: ceil(hold / T) samples).
+        Shortest settled tail [s].
     chunk : int
-        At most this many states simulated at once, in chunks of nearly equal
-        size (memory: about 25 bytes x chunk x steps).
+        At most this many states simulated at once (memory: about 25 bytes x
+        chunk x steps).
     mirror : bool
-        For an odd law (``Law.odd``) whose states pair up with their mirror images,
-        simulate one state of each pair (the same values; see :func:`mirror_pairs`).
+        Ignored: every state is simulated (kept for older callers).
 
     Returns
     -------
     BatchSettling
-        ``time``: exact last exit from the box [s]; ``grid``: :func:`settle_steps`
-        times T [s]; NaN where not settled (see
-        :func:`ptoverify.sim.exact.settling_times_batch`).
+        ``time``: exact last exit from the box [s]; ``grid``: the first sample
+        from which every later sample is in the box [s]; NaN where not settled.
     """
-    run = _settling_odd if mirror else _settling_chunks
-    return run(law, plant, x1, x2, steps, band, velocity_band, hold, chunk)[0]
-
-
-def _settling_odd(law, plant, x1, x2, steps, band, velocity_band, hold, chunk, b=None):
-    """:func:`_settling_chunks`, one state of each mirrored pair simulated.
-
-    The plant is linear and the suite's laws are odd bit for bit (``Law.odd``;
-    tested in ``tests/test_sweep.py``), so the trajectory from -x0 is the negated
-    trajectory from x0 and its settling times (a box symmetric about the origin)
-    are equal.  For an odd law whose states pair up (:func:`mirror_pairs`; the
-    grid of :func:`grid_states` does), one of each pair is simulated and its
-    times are given to both; otherwise every state is simulated.
-    """
-    pairs = mirror_pairs(x1, x2) if law.odd else None
-    if pairs is None:
-        return _settling_chunks(law, plant, x1, x2, steps, band, velocity_band, hold, chunk, b)
-    reps, where = pairs
-    st, b = _settling_chunks(
-        law, plant, x1[reps], x2[reps], steps, band, velocity_band, hold, chunk, b
-    )
-    return BatchSettling(st.time[where], st.grid[where], st.accuracy), b
-
-
-def _settling_chunks(law, plant, x1, x2, steps, band, velocity_band, hold, chunk, b=None):
-    """:func:`settling_times`, and the last chunk's batch (its arrays are reused with ``b``)."""
+    box = sweep_definition(plant, band, velocity_band, hold)
     ts, tg = np.empty(x1.size), np.empty(x1.size)
     acc = 0.0
-    T = plant.sample_time
-    # chunks of (nearly) equal size, so one chunk's arrays are reused for the next
-    # (fresh arrays of this size cost more in page faults than in arithmetic)
-    size = max(1, -(-x1.size // max(1, -(-x1.size // chunk))))
-    for i in range(0, x1.size, size):
-        b = simulate_batch(law, plant, x1[i : i + size], x2[i : i + size], steps, out=b)
-        st = settling_times_batch(b.x1, b.x2, b.u, plant.a, T, band, velocity_band, hold)
-        ts[i : i + size], tg[i : i + size], acc = st.time, st.grid, max(acc, st.accuracy)
-    return BatchSettling(ts, tg, acc), b
+    t = np.arange(steps + 1) * plant.sample_time
+    for i in range(0, x1.size, chunk):
+        b = simulate_batch(law, plant, x1[i : i + chunk], x2[i : i + chunk], steps)
+        st = settling_time(Trajectory(t, b.x1, b.x2, b.u, plant.a), None, box)
+        ts[i : i + chunk], tg[i : i + chunk], acc = st.time, st.grid, max(acc, st.accuracy)
+    return BatchSettling(ts, tg, acc)
+
+
+def sweep_definition(
+    plant: Plant, band: float, velocity_band: float, hold: float
+) -> SettlingDefinition:
+    """Return the settling definition of a sweep box: ``box-0p01mm`` at the defaults.
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant (a [rad/s]).
+    band, velocity_band : float
+        Half-widths of the box [mm], [mm/s].
+    hold : float
+        Shortest settled tail [s].
+
+    Returns
+    -------
+    SettlingDefinition
+        The registry's ``box-0p01mm`` when the box is its, else an ad-hoc ``sweep-box``.
+    """
+    known = DEFINITIONS["box-0p01mm"]
+    if (band, velocity_band, hold) == (
+        known.band_mm,
+        known.velocity_band(plant.a),
+        known.hold_s,
+    ):
+        return known
+    return SettlingDefinition(
+        "sweep-box",
+        "the sweep's box with non-default settings",
+        band_mm=band,
+        velocity_band_mm=velocity_band / plant.a,
+        hold_s=hold,
+    )
 
 
 def discrete_limit(plant: Plant, x1: NDArray, x2: NDArray) -> NDArray[np.int64]:
@@ -577,7 +590,6 @@ def run_sweep(
     settle: dict[str, BatchSettling] = {}
     secs: dict[str, float] = {}
     skipped: dict[str, str] = {}
-    buffers = None  # one law's simulation arrays, reused by the next
     for i, name in enumerate(s.laws):
         report(f"simulate {name}", (i + 1) / (len(s.laws) + 1))
         try:
@@ -586,8 +598,8 @@ def run_sweep(
             skipped[name] = str(exc)
             continue
         t1 = time.perf_counter()
-        settle[name], buffers = _settling_odd(
-            law, plant, X1.ravel(), X2.ravel(), steps, s.band, vband, s.hold, CHUNK, buffers
+        settle[name] = settling_times(
+            law, plant, X1.ravel(), X2.ravel(), steps, s.band, vband, s.hold, CHUNK
         )
         secs[name] = time.perf_counter() - t1
         timings[f"simulate_{name}"] = secs[name]
