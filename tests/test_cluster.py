@@ -102,7 +102,7 @@ def test_connect_is_time_boxed(garbage):
         t = time.monotonic()
         with pytest.raises(ClusterError, match="cannot reach the Dask scheduler"):
             connect(listener.address, timeout=2.0)
-        assert time.monotonic() - t < 5.0
+        assert time.monotonic() - t < 2.0 + 6.0  # the box, plus the import of dask under load
     finally:
         listener.close()
 
