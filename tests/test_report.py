@@ -41,6 +41,11 @@ def _shared(data: dict) -> dict:
     """The results both fixture runs compute (the skipped stages and figures left out)."""
     out = {k: v for k, v in data.items() if k not in SKIPPABLE + ("skipped",)}
     out["meta"] = {k: v for k, v in data["meta"].items() if k != "figures"}
+    # the robustness stage's gates and the counts that include them exist only when it ran
+    out["checks"] = [c for c in data["checks"] if not c["name"].startswith("robust-")]
+    out["summary"] = {
+        k: v for k, v in data["summary"].items() if k not in ("gates", "gates_perturbed")
+    }
     return out
 
 

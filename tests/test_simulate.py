@@ -285,3 +285,39 @@ def test_single_trajectory_is_the_batch_on_one_state(paper_cfg):
         b = simulate_batch(shifted, p, [0.0], [0.0], res.t.size - 1)
         assert np.array_equal(res.x1, b.x1[:, 0]) and np.array_equal(res.x2, b.x2[:, 0]), name
         assert np.array_equal(res.u[:-1], b.u[:, 0]), name
+
+
+def test_segments_merged_per_law_equal_each_segment_alone():
+    """simulate_segments runs segments of one law as one batch: bit for bit each alone."""
+    from ptoverify.config import paper_config
+    from ptoverify.model.laws import make_law
+    from ptoverify.sim.simulate import Mismatch, simulate_batch, simulate_segments
+
+    cfg = paper_config()
+    rng = np.random.default_rng(7)
+    laws = {name: make_law(name, cfg) for name in ("pd", "pto", "to")}
+    segments = []
+    for k in range(12):
+        law = laws[("pd", "pto", "to")[k % 3]]
+        n = int(rng.integers(1, 6))
+        x1 = rng.uniform(-50, 50, n)
+        x2 = rng.uniform(-300, 300, n)
+        m = Mismatch(
+            a_ratio=float(rng.uniform(0.8, 1.25)),
+            w_max_ratio=float(rng.uniform(0.9, 1.0)),
+            delay_samples=int(rng.integers(0, 3)),
+            position_quantum=(0.0, 0.001)[k % 2],
+            velocity_noise=0.5 if k == 5 else 0.0,
+            seed=k,
+        )
+        segments.append((law, x1, x2, None if k == 0 else m))
+    both = simulate_segments(segments, cfg.plant, 150)
+    start = 0
+    for law, x1, x2, m in segments:
+        one = simulate_batch(law, cfg.plant, x1, x2, 150, mismatch=m)
+        sl = slice(start, start + x1.size)
+        for f in ("x1", "x2", "u", "region"):
+            np.testing.assert_array_equal(
+                getattr(both, f)[:, sl], getattr(one, f), err_msg=f"segment {f}"
+            )
+        start += x1.size

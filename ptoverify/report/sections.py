@@ -1299,7 +1299,19 @@ _PROOF_WORDS = {
 
 
 def proofs(res: Any, figures: dict[str, str]) -> list[Block]:
-    """Show what is proved for every initial state of the envelope, and what is not."""
+    """Show what is proved for every initial state of the envelope, and what is not.
+
+    Parameters
+    ----------
+    res : Results
+        The results (``proofs``: per law the ``prove --json`` object).
+    figures : dict
+        Figure key -> relative path.
+
+    Returns
+    -------
+    list of Block
+    """
     pr = res["proofs"]
     blocks = [
         Block(
@@ -1354,7 +1366,7 @@ def proofs(res: Any, figures: dict[str, str]) -> list[Block]:
                 "simulated worst (same ellipse)",
                 "simulated states over their cell's bound",
                 "certified samples / N* over the envelope",
-                "cells",
+                "cells [count]",
             ],
             rows,
         )

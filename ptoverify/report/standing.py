@@ -47,6 +47,19 @@ def _ms(seconds: float | None) -> str:
 
 
 def reading_words(dim: str, value: Any) -> str:
+    """Return one reading dimension's value in words (``a = f (30 read as rad/s)``).
+
+    Parameters
+    ----------
+    dim : str
+        The dimension (``a``, ``band``, ``pto``, ``tracking``, ``gains``).
+    value : Any
+        Its value in the claims' ``reading``.
+
+    Returns
+    -------
+    str
+    """
     words = READING_WORDS.get(dim, {})
     if value in words:
         return words[value]
@@ -140,7 +153,18 @@ def reviewer_rows(res: Mapping) -> list[list[str]]:
 
 
 def step_readings(res: Mapping) -> dict[str, Mapping]:
-    """Return the 31 % claim's readings at the paper's gains, 2 % band, corrected PTO, by a."""
+    """Return the 31 % claim's readings at the paper's gains, 2 % band, corrected PTO, by a.
+
+    Parameters
+    ----------
+    res : Mapping
+        The results.
+
+    Returns
+    -------
+    dict
+        Reading of a (``2pi*f``, ``f``) -> that reading's record.
+    """
     out: dict[str, Mapping] = {}
     for c in res["claims"]:
         if c["id"] != "step-pd-31-percent":
@@ -307,7 +331,17 @@ def _margins(loop: Mapping) -> str:
 
 
 def ratio_interval(iv: Any) -> str:
-    """Return an a_true / a_design interval in words (an open end: no limit found)."""
+    """Return an a_true / a_design interval in words (an open end: no limit found).
+
+    Parameters
+    ----------
+    iv : sequence or None
+        ``[lo, hi]`` of a_true / a_design [-], an end None where the search found no limit.
+
+    Returns
+    -------
+    str
+    """
     if not iv:
         return "no interval (unstable at the design point)"
     lo, hi = iv

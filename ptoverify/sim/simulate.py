@@ -436,13 +436,52 @@ def simulate_segments(
     >>> bool((both.x1[:, 1] == one.x1[:, 0]).all())
     True
     """
-    runs = [simulate_batch(law, plant, s1, s2, steps, mismatch=m) for law, s1, s2, m in segments]
-    if not runs:
+    if not segments:
         empty = np.empty((steps + 1, 0))
         return BatchResult(empty, empty.copy(), np.empty((steps, 0)), np.empty((steps, 0), np.int8))
+    # segments of one law and one noise-free measurement model run as one batch, their
+    # a ratio, drive limit and delay per state (a state's trajectory does not depend on
+    # the batch it runs in); a noisy segment keeps its own call (its own noise stream)
+    groups: dict[tuple, list[int]] = {}
+    for i, (law, _s1, _s2, m) in enumerate(segments):
+        m = m or Mismatch()
+        key = (id(law), m.position_quantum) if m.velocity_noise == 0 else ("noisy", i)
+        groups.setdefault(key, []).append(i)
+    parts: dict[int, BatchResult] = {}
+    for members in groups.values():
+        law = segments[members[0]][0]
+        s1 = [np.atleast_1d(np.asarray(segments[i][1], dtype=float)) for i in members]
+        s2 = [np.atleast_1d(np.asarray(segments[i][2], dtype=float)) for i in members]
+        ms = [segments[i][3] or Mismatch() for i in members]
+        if len(members) == 1:
+            parts[members[0]] = simulate_batch(law, plant, s1[0], s2[0], steps, mismatch=ms[0])
+            continue
+
+        def per_state(field: str, dtype: type) -> NDArray:
+            return np.concatenate(
+                [
+                    np.broadcast_to(np.asarray(getattr(m, field), dtype=dtype), x.shape)
+                    for m, x in zip(ms, s1, strict=True)
+                ]
+            )
+
+        merged = Mismatch(
+            a_ratio=per_state("a_ratio", float),
+            w_max_ratio=per_state("w_max_ratio", float),
+            delay_samples=per_state("delay_samples", np.int64),
+            position_quantum=ms[0].position_quantum,
+        )
+        run = simulate_batch(
+            law, plant, np.concatenate(s1), np.concatenate(s2), steps, mismatch=merged
+        )
+        start = 0
+        for i, x in zip(members, s1, strict=True):
+            sl = slice(start, start + x.shape[0])
+            parts[i] = BatchResult(run.x1[:, sl], run.x2[:, sl], run.u[:, sl], run.region[:, sl])
+            start += x.shape[0]
     return BatchResult(
         *(
-            np.concatenate([getattr(b, f) for b in runs], axis=1)
+            np.concatenate([getattr(parts[i], f) for i in range(len(segments))], axis=1)
             for f in ("x1", "x2", "u", "region")
         )
     )
