@@ -513,20 +513,27 @@ def _run_stage(name: str, cfg: Config, figdir: Path | None) -> tuple[dict[str, A
 
 
 def default_jobs() -> int:
-    """Worker processes ``collect`` uses by default: 1, every stage in this process.
+    """Worker processes ``collect`` uses by default: the CPUs this process may use.
 
-    Measured on this project's shared 2-core machine (3 runs each, taken in turn,
-    issue 23): ``report --jobs 2`` took a median 26.5 s of wall time and
-    ``--jobs 1`` 25.1 s (at a load average of ~3; 118.6 s against 104.2 s at
-    ~17).  The pool gains less than the 1.3x that would justify it, so the
-    default is one process; ``--jobs N`` runs a pool of N.
+    Measured on this project's 2-core machine, idle (issue 23, final merge): the
+    report took 28.2 s of wall time with ``--jobs 2`` against about 53 s with
+    ``--jobs 1`` (the stages' times add up to 53 s), so the pool earns its place.
+    An earlier measurement at a load average of 3-17 (other sessions running)
+    showed no gain: on a busy machine pass ``--jobs 1``.
 
     Returns
     -------
     int
-        1.
+        ``len(os.sched_getaffinity(0))`` where available, else ``os.cpu_count()``
+        (at least 1).
     """
-    return 1
+    import os
+
+    try:
+        n = len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        n = os.cpu_count() or 1
+    return max(1, n)
 
 
 # ------------------------------------------------------------------ collect
