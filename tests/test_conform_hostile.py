@@ -201,13 +201,17 @@ def test_nul_table_is_rejected_early_in_bounded_memory(tmp_path):
     assert rss_mb < 400, f"peak memory {rss_mb:.0f} MB for a 200 MB table that is rejected"
 
 
-#: run the CLI, then print the peak resident size [KiB]
+#: run the CLI, then print the peak resident size of this process image [KiB]: VmHWM,
+#: not getrusage's ru_maxrss, which Linux carries over exec from the forking parent (a
+#: pytest worker of ~500 MB)
 CHILD_MAXRSS = textwrap.dedent(
     """
-    import resource, sys
+    import sys
     from ptoverify.cli import main
     code = main(sys.argv[1:])
-    print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
+    with open("/proc/self/status") as fh:
+        hwm = next(line for line in fh if line.startswith("VmHWM:"))
+    print(int(hwm.split()[1]))
     sys.exit(code)
     """
 )
