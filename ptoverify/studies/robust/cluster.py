@@ -5,39 +5,13 @@ from __future__ import annotations
 from typing import Any
 
 from ptoverify.studies import cluster as dask_cluster
+from ptoverify.studies.cluster import check_dask_address
 from ptoverify.studies.robust.maps import Runner, map_task
 
 __all__ = ["DASK_CONNECT_TIMEOUT_S", "check_dask_address", "dask_runner"]
 
 #: how long to wait for a Dask scheduler [s]
 DASK_CONNECT_TIMEOUT_S = dask_cluster.DASK_CONNECT_TIMEOUT_S
-
-
-def check_dask_address(address: str) -> str:
-    """Validate ``--dask``: ``local`` or ``PROTOCOL://HOST:PORT``.
-
-    Parameters
-    ----------
-    address : str
-        The address given.
-
-    Returns
-    -------
-    str
-        The address, unchanged.
-
-    Raises
-    ------
-    InputError
-        A malformed address (exit 2); an unreachable one is a
-        :class:`ptoverify.errors.ClusterError` when the run connects.
-
-    Examples
-    --------
-    >>> check_dask_address("tcp://127.0.0.1:8786")
-    'tcp://127.0.0.1:8786'
-    """
-    return dask_cluster.check_dask_address(address)  # one validation: studies.cluster
 
 
 def dask_runner(address: str) -> Runner:
