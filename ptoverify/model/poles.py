@@ -160,10 +160,10 @@ def delayed_loop_radius(a: float, T: float, k_x1: float, k_x2: float, delay: int
     >>> abs(r0 - sampled_spectral_radius(188.5, 0.002, 356.0, 1.15)) < 1e-12
     True
     """
+    if delay == 0:
+        return sampled_spectral_radius(a, T, k_x1, k_x2)  # the undelayed loop, one path
     Ad, Bd = zoh_matrices(a, T)
     K = np.array([[k_x1, k_x2]])
-    if delay == 0:
-        return float(np.abs(np.linalg.eigvals(Ad - Bd @ K)).max())
     n = 2 + delay
     M = np.zeros((n, n))
     M[:2, :2] = Ad
