@@ -30,7 +30,10 @@ __all__ = ["claim_standing", "reviewer_rows", "engineer_rows", "adoption", "READ
 
 #: How each reading dimension of a claim reads in words.
 READING_WORDS: dict[str, dict[Any, str]] = {
-    "a": {"2pi*f": "a = 2 pi f (30 Hz read as a frequency)", "f": "a = f (30 read as rad/s)"},
+    "a": {
+        "2pi*f": "a = 2 pi f (the bandwidth read in Hz)",
+        "f": "a = f (the bandwidth read as rad/s)",
+    },
     "pto": {"corrected": "the corrected PTO", "printed": "the PTO as printed"},
     "tracking": {
         "feed-forward": "feed-forward",
@@ -47,7 +50,7 @@ def _ms(seconds: float | None) -> str:
 
 
 def reading_words(dim: str, value: Any) -> str:
-    """Return one reading dimension's value in words (``a = f (30 read as rad/s)``).
+    """Return one reading dimension's value in words (``a = f (the bandwidth read as rad/s)``).
 
     Parameters
     ----------
@@ -93,7 +96,7 @@ def claim_standing(claim: Mapping) -> tuple[str, str]:
     --------
     >>> r = lambda a, v: {"reading": {"a": a, "band": 0.02}, "verdict": v}
     >>> claim_standing({"readings": [r("2pi*f", "not reproduced"), r("f", "reproduced")]})
-    ('depends', 'holds only with a = f (30 read as rad/s)')
+    ('depends', 'holds only with a = f (the bandwidth read as rad/s)')
     """
     readings = list(claim["readings"])
     ok = [r["verdict"] == "reproduced" for r in readings]
