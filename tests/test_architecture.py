@@ -320,12 +320,66 @@ def test_layer_rule_catches_an_upward_import():
     assert layer_of("ptoverify.config") < layer_of("ptoverify.model.plant")
 
 
+def _package(module: str) -> str:
+    """The package that holds ``module`` (a package's ``__init__`` is its own package)."""
+    return module if (ROOT / module.replace(".", "/")).is_dir() else module.rpartition(".")[0]
+
+
+def private_import_offenders(module_filter) -> list[str]:
+    """Imports of a private name from outside the package that defines it.
+
+    A leading underscore marks a name private to its package (the split modules of
+    ``ptoverify/studies/claims/`` share helpers); importing it from another package,
+    or naming a private module anywhere, is an offence.
+    """
+    out = []
+    for m in modules():
+        if not module_filter(m):
+            continue
+        for target, name, line in imports(m):
+            full = f"{target}.{name}" if name else target
+            if not _private(target, name, full):
+                continue
+            sibling = (
+                name is not None
+                and _is_private(name)
+                and not _private(target, None, target)
+                and _package(target) == _package(m)
+            )
+            if not sibling:
+                out.append(f"{m}:{line} imports {full}")
+    return out
+
+
 def test_no_private_name_imports():
-    assert offenders(lambda m: True, _private) == []
+    assert private_import_offenders(lambda m: True) == []
 
 
 def test_no_private_name_imports_except_pending():
-    assert offenders(lambda m: m not in PENDING["private"], _private) == []
+    assert private_import_offenders(lambda m: m not in PENDING["private"]) == []
+
+
+def test_private_names_stay_inside_their_package(tmp_path, monkeypatch):
+    """A sibling may import ``_x``; a module of another package may not."""
+    (tmp_path / "pkg" / "sub").mkdir(parents=True)
+    files = {
+        "pkg/__init__.py": "",
+        "pkg/sub/__init__.py": "",
+        "pkg/sub/a.py": "_x = 1\n",
+        "pkg/sub/b.py": "from pkg.sub.a import _x\n",
+        "pkg/c.py": "from pkg.sub.a import _x\n",
+    }
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
+    monkeypatch.setattr(sys.modules[__name__], "PACKAGES", ("pkg",))
+    modules.cache_clear()
+    imports.cache_clear()
+    try:
+        assert private_import_offenders(lambda m: True) == ["pkg.c:1 imports pkg.sub.a._x"]
+    finally:
+        modules.cache_clear()
+        imports.cache_clear()
 
 
 # ------------------------------------------------------------------ third-party internals

@@ -16,6 +16,8 @@ from ptoverify.sim import metrics as mt
 from ptoverify.sim.exact import Compared
 from ptoverify.sim.simulate import simulate
 from ptoverify.studies import claims as cl
+from ptoverify.studies.claims import evaluate as cl_evaluate
+from ptoverify.studies.claims import measure as cl_measure
 from ptoverify.studies.tune import TuneBudget, fair_tunings
 
 REQUIRED = {
@@ -276,11 +278,11 @@ def test_compare_true_tie_rule():
 @pytest.fixture
 def fresh_claim_caches():
     """The claims cache their metrics per configuration: isolate a patched run."""
-    cl._metrics.cache_clear()
-    cl._evaluate_all.cache_clear()
+    cl_measure._metrics.cache_clear()
+    cl_evaluate._evaluate_all.cache_clear()
     yield
-    cl._metrics.cache_clear()
-    cl._evaluate_all.cache_clear()
+    cl_measure._metrics.cache_clear()
+    cl_evaluate._evaluate_all.cache_clear()
 
 
 def _quicker_with_pto_rise(monkeypatch, offset):
@@ -291,7 +293,7 @@ def _quicker_with_pto_rise(monkeypatch, offset):
     """
     cfg = paper_config()
     cfgs = {c.plant.a: c for c in (cfg, cfg.with_plant(a=cfg.bandwidth_hz))}
-    real = cl.exact_metrics
+    real = cl_measure.exact_metrics
 
     def patched(res, plant, reference=None, **kw):
         em = real(res, plant, reference, **kw)
@@ -305,11 +307,11 @@ def _quicker_with_pto_rise(monkeypatch, offset):
         vals["rise_time_s"] = dataclasses.replace(own, exact=pd_rise.exact + shift)
         return dataclasses.replace(em, values=vals)
 
-    monkeypatch.setattr(cl, "exact_metrics", patched)
+    monkeypatch.setattr(cl_measure, "exact_metrics", patched)
     entry = next(c for c in cl.CLAIMS if c.id == "conclusion-quicker-response")
     out = cl.evaluate_claims(cfg, (entry,))[0]
-    cl._metrics.cache_clear()
-    cl._evaluate_all.cache_clear()
+    cl_measure._metrics.cache_clear()
+    cl_evaluate._evaluate_all.cache_clear()
     return out
 
 

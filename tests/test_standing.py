@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from ptoverify.report import sections as rs
+from ptoverify.report.sections import front
 from ptoverify.report.collect import results_view
 from ptoverify.report.standing import adoption, claim_standing, engineer_rows, reviewer_rows
 
@@ -84,17 +84,17 @@ def test_delay_row_and_gate_finding_follow_the_delay_margin(base):
     m["linear_loop_a_ratio_stable_delay1"] = None
     q = "Tolerates a one-sample computation delay?"
     assert _rows(data)[q][1].startswith("no")
-    gates = rs._finding_gates(results_view(data))[0]
+    gates = front._finding_gates(results_view(data))[0]
     assert "with one sample of computation delay the PTO's linear zone is unstable" in gates
     m["linear_loop_a_ratio_stable_delay1"] = [0.5, 1.2]
     assert _rows(data)[q][1] == "yes"
-    assert "delay" not in rs._finding_gates(results_view(data))[0]
+    assert "delay" not in front._finding_gates(results_view(data))[0]
     assert "needs delay compensation" not in adoption(results_view(data))
 
 
 def test_settling_finding_names_who_settles_first_under_each_reading(base):
     data = copy.deepcopy(base)
-    text = rs._finding_settling(results_view(data))[0]
+    text = front._finding_settling(results_view(data))[0]
     c = next(c for c in data["claims"] if c["id"] == "step-pd-31-percent")
     prim = next(
         r
@@ -108,7 +108,7 @@ def test_settling_finding_names_who_settles_first_under_each_reading(base):
     first = "PD settles first" if v["settling_pd_s"] < v["settling_pto_s"] else "PTO settles first"
     assert f"(the bandwidth read in Hz) {first}" in text.replace("the corrected PTO", "PTO")
     v["settling_pd_s"], v["settling_pto_s"] = v["settling_pto_s"], v["settling_pd_s"]
-    flipped = rs._finding_settling(results_view(data))[0].replace("the corrected PTO", "PTO")
+    flipped = front._finding_settling(results_view(data))[0].replace("the corrected PTO", "PTO")
     other = "PTO settles first" if first == "PD settles first" else "PD settles first"
     assert f"(the bandwidth read in Hz) {other}" in flipped
 
@@ -117,14 +117,14 @@ def test_claims_finding_says_more_or_less(base):
     data = copy.deepcopy(base)
     c = next(c for c in data["claims"] if c["id"] == "step-pd-31-percent")
     c["measured"] = -20.0
-    assert "needing 20 % less" in rs._finding_claims(results_view(data))[0]
+    assert "needing 20 % less" in front._finding_claims(results_view(data))[0]
     c["measured"] = 25.0
-    assert "needing 25 % more" in rs._finding_claims(results_view(data))[0]
+    assert "needing 25 % more" in front._finding_claims(results_view(data))[0]
 
 
 def test_errata_finding_counts_only_changed_equations(base):
     data = copy.deepcopy(base)
     first = next(r for r in data["derivations"] if r["verdict"] == "erratum")
     first["inherits"] = ["17: unchanged for the map", "18: changes", "20-27: change"]
-    text = rs._finding_errata(results_view(data))[0]
+    text = front._finding_errata(results_view(data))[0]
     assert "changes 2 downstream equation groups (18; 20-27)" in text

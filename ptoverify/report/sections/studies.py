@@ -1,0 +1,349 @@
+"""The sections of the studies: ground truth, zone, poles, properties, claims and sweep."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from ptoverify.report.render import (
+    Block,
+    fmt,
+    qty,
+    table,
+)
+
+from .common import _claim_qty, _law, _ms, _same, figure, measured_quantity
+
+
+# ------------------------------------------------------------------ ground truth
+def ground_truth(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
+    """Compare closed form vs two-phase vs collocation, convergence, N*."""
+    gt = res["ground_truth"]
+    rows = [
+        [
+            s["x0"],
+            s["analytic_s"],
+            s["switch_time_s"],
+            s["two_phase_s"],
+            s["two_phase_rel_error"],
+            s["collocation_s"],
+            s["collocation_rel_error"],
+            s["discrete_steps"],
+            s["discrete_s"],
+            s["discrete_gap_samples"],
+        ]
+        for s in gt["states"]
+    ]
+    conv = gt["convergence"]
+    return [
+        Block(
+            "p",
+            text="Minimum time t_f* from each state: the closed form (SymPy-derived), the "
+            "CasADi two-phase OCP (exact flow per arc), Radau-3 collocation with "
+            "N = 100 intervals, and the discrete-time limit N* (fewest ZOH samples that reach "
+            "the origin exactly). No sampled controller settles exactly in fewer than N* samples.",
+        ),
+        table(
+            [
+                "x0 [mm, mm/s]",
+                "t_f* closed form [s]",
+                "switch [s]",
+                "two-phase [s]",
+                "rel. error [-]",
+                "collocation [s]",
+                "rel. error [-]",
+                "N* [samples]",
+                "N* T [s]",
+                "(N* T - t_f*) / T [samples]",
+            ],
+            rows,
+        ),
+        Block(
+            "p",
+            text=f"Collocation convergence over N = {fmt(conv['intervals'])} intervals: observed "
+            f"order {fmt(conv['order'], 3)} [-] (per state {fmt(conv['order_per_state'], 3)} [-]).",
+        ),
+        *figure(figures, "fig02_trajectories"),
+        *figure(figures, "fig03_saturation"),
+        *figure(figures, "convergence"),
+        *figure(figures, "collocation_switch"),
+    ]
+
+
+def zone(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
+    """Show the printed and corrected construction with reasons."""
+    z = res["zone"]
+    rows = []
+    for key in ("printed", "corrected", "corrected_lenient"):
+        if key in z:
+            v = z[key]
+            rows.append(
+                [
+                    key.replace("_", " "),
+                    v["omega0"],
+                    v["x20_tilde"],
+                    v["margin_mm_s"],
+                    v["valid"],
+                    v["degenerate"],
+                    v["reason"],
+                ]
+            )
+    blocks = [
+        table(
+            [
+                "construction",
+                "omega0 [mm/s]",
+                "x20~ [mm/s]",
+                "worst landing margin [mm/s]",
+                "valid",
+                "degenerate",
+                "reason",
+            ],
+            rows,
+        )
+    ]
+    blocks += figure(figures, "zone_geometry")
+    for key in sorted(figures):
+        if key.startswith(("fig04", "fig05", "fig06")):
+            blocks += figure(figures, key)
+    return blocks
+
+
+def poles(res: dict[str, Any]) -> list[Block]:
+    """Continuous and sampled poles, margins, the Lyapunov caveat."""
+    rows = []
+    for name, lp in res["poles"]["loops"].items():
+        rows.append(
+            [
+                name,
+                lp["gains"],
+                lp["continuous_poles"],
+                lp["continuous_zeta"],
+                lp["sampled_moduli"],
+                lp["gain_margin"],
+                lp["phase_margin_deg"],
+                lp["pole_mismatch"],
+                lp["stable_sampled"],
+                lp["lyapunov_conditions"],
+            ]
+        )
+    ce = res["poles"]["lyapunov_counterexample"]
+    scalars = {k: v for k, v in ce.items() if not isinstance(v, (Mapping, list, tuple))}
+    return [
+        table(
+            [
+                "loop",
+                "gains (k1 or kp [1/s], k2 or kd [-])",
+                "continuous poles (re, im) [rad/s]",
+                "damping [-]",
+                "sampled |z| [-]",
+                "gain margin [-]",
+                "phase margin [deg]",
+                "|python-control - numpy| [-]",
+                "sampled stable",
+                "Section 5 conditions",
+            ],
+            rows,
+        ),
+        Block(
+            "p",
+            text="Section 5's conditions k1 > 0, 1 + k2 > 0 are a continuous-time "
+            "statement; with sampling they do not imply stability: "
+            + "; ".join(
+                f"{k.replace('_', ' ')} = {_unit_from_name(k, v)}" for k, v in scalars.items()
+            ),
+        ),
+    ]
+
+
+def _unit_from_name(name: str, v: Any) -> str:
+    """Show a value with the unit its key names (``_mm``, ``_s``, ``_deg``...)."""
+    for suffix, unit in (
+        ("_mm_s", "mm/s"),
+        ("_mm", "mm"),
+        ("_deg", "deg"),
+        ("_s", "s"),
+        ("_rad_s", "rad/s"),
+        ("_percent", "%"),
+    ):
+        if name.endswith(suffix):
+            return qty(v, unit)
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        return qty(v, "-")
+    return fmt(v)
+
+
+#: Columns of the properties table: key, header with unit.
+_PROPERTY_COLUMNS = (
+    ("states", "states [count]"),
+    ("stride_overs", "stride-overs [count]"),
+    ("crossings_into_linear", "crossings into the linear zone [count]"),
+    ("limit_cycles", "limit cycles [count]"),
+    ("not_settled", "not settled [count]"),
+    ("chattering", "chattering [count]"),
+    ("overshoots", "overshoots [count]"),
+    ("max_overshoot_mm", "max overshoot [mm]"),
+    ("time_to_linear_max_s", "max time to linear zone [s]"),
+    ("max_abs_u", "max |u| [mm/s]"),
+)
+
+
+def properties(res: dict[str, Any]) -> list[Block]:
+    """Stride-overs, limit cycles, chattering, |u| over the grid."""
+    rows = [
+        [_law(law), *[p[k] for k, _ in _PROPERTY_COLUMNS]] for law, p in res["properties"].items()
+    ]
+    return [table(["law", *[h for _, h in _PROPERTY_COLUMNS]], rows)]
+
+
+def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
+    """Every claim: what is measured, paper value, value between samples and on the grid."""
+    rows = []
+    for c in res["claims"]:
+        differs = not _same(c["measured"], c["measured_grid"])
+        rows.append(
+            [
+                f"Sec. {c['section']}",
+                c["signal"],
+                c["claim"],
+                measured_quantity(c),
+                _claim_qty(c["paper_value"], c["unit"]),
+                _claim_qty(c["measured"], c["unit"]),
+                _claim_qty(c["measured_grid"], c["unit"]) if differs else "same",
+                c["verdict"],
+                c["verdict_grid"] or "n/a",
+                c["detail"],
+            ]
+        )
+    readings = []
+    for c in res["claims"]:
+        for r in c["readings"]:
+            differs = not _same(r["measured"], r["measured_grid"])
+            readings.append(
+                [
+                    c["id"],
+                    r["label"],
+                    _claim_qty(r["measured"], c["unit"]),
+                    _claim_qty(r["measured_grid"], c["unit"]) if differs else "same",
+                    r["verdict"],
+                    r["verdict_grid"] or "n/a",
+                    ", ".join(r["ties"] or []) or "none",
+                ]
+            )
+    blocks = [
+        Block(
+            "p",
+            text="'measured' is read on the exact trajectory between samples (the input is "
+            "constant over a sample and the flow is closed form); where the value read on the "
+            "2 ms sample grid differs it is shown next to it, with the verdict the same rule "
+            "gives on the grid. Times are shown in ms.",
+        ),
+        table(
+            [
+                "paper section",
+                "signal",
+                "claim",
+                "what is measured",
+                "paper",
+                "measured, between samples",
+                "on the sample grid",
+                "verdict",
+                "verdict on the grid",
+                "detail (primary reading)",
+            ],
+            rows,
+        ),
+        Block("p", text="Every reading of an ambiguous point is run and reported:"),
+        table(
+            [
+                "claim",
+                "reading",
+                "measured",
+                "on the sample grid",
+                "verdict",
+                "verdict on grid",
+                "true ties",
+            ],
+            readings,
+        ),
+    ]
+    resp = res["responses"]
+    if resp:
+        keys = (
+            ("settling_2pct_s", "2 % settling"),
+            ("settling_0p01mm_s", "0.01 mm settling"),
+            ("rise_time_s", "10-90 % rise"),
+            ("overshoot_mm", "overshoot"),
+        )
+        rows = []
+        for law, by in resp.items():
+            m = by["step"]
+            cells = []
+            for k, _ in keys:
+                ex, gr = m[k], m[f"{k}_grid"]
+                val = _ms(ex) if k.endswith("_s") else qty(ex, "mm")
+                if gr is not None and not _same(ex, gr):
+                    val += f" (grid {_ms(gr) if k.endswith('_s') else qty(gr, 'mm')})"
+                cells.append(val)
+            rows.append([_law(law), *cells])
+        blocks += [
+            Block(
+                "p",
+                text="Step response metrics under the primary reading, between samples "
+                "(sample-grid value in parentheses where it differs):",
+            ),
+            table(["law", *[t for _, t in keys]], rows),
+        ]
+    for key in sorted(figures):
+        if key.startswith(("fig07", "fig08", "fig09", "fig10", "fig11", "fig12", "fig13", "fig14")):
+            blocks += figure(figures, key)
+    return blocks
+
+
+def sweep(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
+    """Settling time over t_f* and over N* T, per law, with percentiles."""
+    sw = res["sweep"]
+    rows = []
+    for law, v in sw["laws"].items():
+        ptf = v["percentiles_ratio_tf"] or {}
+        pnt = v["percentiles_ratio_nt"] or {}
+        rows.append(
+            [
+                _law(law),
+                qty(100 * v["fraction_settled"], "%"),
+                *[ptf[k] for k in ("p50", "p95", "p99", "max")],
+                v["worst_state_tf"],
+                *[pnt[k] for k in ("p50", "p95", "p99", "max")],
+                v["worst_state_nt"],
+            ]
+        )
+    blocks = [
+        Block(
+            "p",
+            text=f"Grid of {sw['grid'][0]} x {sw['grid'][1]} initial states over the envelope, "
+            f"horizon {sw['steps']} samples; settling time read between samples (0.01 mm band, "
+            "staying there), divided by the continuous minimum time t_f* and by the sampled "
+            "limit N* T (zonotope N*).",
+        ),
+        table(
+            [
+                "law",
+                "settled [% of states]",
+                "p50 t/t_f* [-]",
+                "p95 t/t_f* [-]",
+                "p99 t/t_f* [-]",
+                "max t/t_f* [-]",
+                "worst state [mm, mm/s]",
+                "p50 t/(N* T) [-]",
+                "p95 t/(N* T) [-]",
+                "p99 t/(N* T) [-]",
+                "max t/(N* T) [-]",
+                "worst state [mm, mm/s]",
+            ],
+            rows,
+        ),
+    ]
+    for key in sorted(figures):
+        if key.startswith("sweep"):
+            blocks += figure(figures, key)
+    return blocks
