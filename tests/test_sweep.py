@@ -246,14 +246,6 @@ def test_sweep_out_is_a_file(tmp_path, capsys):
     assert capsys.readouterr().err.startswith("ptoverify: error:")
 
 
-@pytest.mark.slow
-def test_full_sweep_runs_every_law():
-    """40,000 states, all laws (its time is measured in benchmarks/, not asserted here)."""
-    res = run_sweep(paper_config())
-    assert res.x1.size >= 40000
-    assert set(res.laws) == {"to", "pd", "pto", "pto-printed"}
-
-
 @pytest.mark.parametrize(("n1", "n2"), [(200, 200), (7, 5), (6, 1), (1, 1)])
 def test_grid_is_even_and_exactly_symmetric(n1, n2):
     """The grid spans the envelope evenly (as linspace does, to round-off) and a state's
