@@ -56,6 +56,12 @@ def test_report_folder_complete_and_reproducible(two_reports):
         assert (one / f).stat().st_size > 1000, f
     figs = sorted((one / "figures").glob("*.png"))
     assert len(figs) >= 20 and all(f.stat().st_size > 5000 for f in figs)
+    # the paper's figures 2 to 14 and the zone's geometry, each a readable size
+    nums = {int(f.name[3:5]) for f in figs if f.name.startswith("fig")}
+    assert nums == set(range(2, 15)), f"figures written: {sorted(nums)}"
+    assert "zone_geometry.png" in {f.name for f in figs}
+    paper = [f for f in figs if f.name.startswith("fig") or f.name == "zone_geometry.png"]
+    assert all(10_000 < f.stat().st_size < 400_000 for f in paper), "a figure's size"
     a, b = _without_meta(one), _without_meta(two)
     assert _shared(a) == _shared(b), "two runs differ beyond the timestamp"
     assert b["skipped"] == sorted(SKIPPABLE) and b["robust"] is None and b["tuning"] is None
