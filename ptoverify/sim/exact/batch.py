@@ -34,7 +34,7 @@ class BatchSettling:
         tail is shorter than ``hold``.
     grid : ndarray, shape (n,)
         Sample-grid settling time [s]: k T for the first sample k after the last
-        sample outside the box (``ptoverify.studies.sweep.settle_steps``); NaN likewise,
+        sample outside the box (:func:`ptoverify.sim.settling.grid_settling`); NaN likewise,
         with the hold counted in whole samples, ceil(hold / T).
     accuracy : float
         Bound on the error of :attr:`time` [s] (see :func:`settling_times_batch`).
