@@ -5,9 +5,9 @@ from __future__ import annotations
 import functools
 import time
 from dataclasses import dataclass
-from functools import lru_cache
 
 from ptoverify.config import Config
+from ptoverify.model.memo import memo
 from ptoverify.sim.lockstep import run_together
 from ptoverify.studies.tune.measure import response_metrics
 from ptoverify.studies.tune.screen import StepScreen
@@ -82,7 +82,7 @@ class FairTunings:
         return self.results[(law, bound)].config
 
 
-@lru_cache(maxsize=8)
+@memo(maxsize=8)
 def _fair_tunings(cfg: Config, budget: TuneBudget) -> FairTunings:
     t0 = time.perf_counter()
     paper = {law: response_metrics(cfg, law, "step") for law in ("pd", "pto")}
