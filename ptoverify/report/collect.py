@@ -727,12 +727,16 @@ def _robust(cfg: Config) -> tuple[dict[str, Any], list]:
     from dataclasses import asdict
 
     from ptoverify.studies.robust import RobustSettings, robust_gates, run_robust
+    from ptoverify.studies.robust.drive import drive_sweeps
+    from ptoverify.studies.robust.maps import SETTLING
 
     settings = RobustSettings(**ROBUST_SETTINGS)
     result = run_robust(cfg, settings)
     res = result.to_json()
     res.pop("timings_s", None)
     res["settings"] = asdict(settings)
+    res["settling"] = SETTLING
+    res["drive"] = drive_sweeps(cfg).to_json()
     return res, robust_gates(result)
 
 
