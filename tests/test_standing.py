@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from ptoverify.report.sections import front
 from ptoverify.report.collect import results_view
+from ptoverify.report.sections import front
 from ptoverify.report.standing import adoption, claim_standing, engineer_rows, reviewer_rows
 
 ROOT = Path(__file__).resolve().parents[1]
