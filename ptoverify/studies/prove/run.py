@@ -18,10 +18,11 @@ import numpy as np
 from flint import arb
 
 from ptoverify.config import Config
-from ptoverify.model.intervals import a_ball, down, step_maps
+from ptoverify.model.intervals import down
 from ptoverify.model.lawbox import LawSpec, enclose, law_spec
 from ptoverify.model.laws import make_law
 from ptoverify.model.plant import step
+from ptoverify.model.zohmaps import a_ball, step_maps
 from ptoverify.studies.prove.graph import Grid, images, longest_path, make_grid, successors
 from ptoverify.studies.prove.stride import (
     Counterexample,
@@ -56,7 +57,7 @@ class Resolution:
     h2: float = 5.0
     h1_max: float = 2.0
     h_edge: float = 0.05
-    steps: int = 40
+    steps: int = 200
 
 
 def fine_extent(spec: LawSpec) -> float:
@@ -441,6 +442,33 @@ def _suboptimality(cfg, grid, bound, radius):
     return float(np.max(bound[use] / n_star))
 
 
+def _counterexample(spec, cfg, balls, reading, tries: int = 3):
+    """Search the failing leaves of the sub-intervals with the largest gaps for a stride-over.
+
+    Each of the ``tries`` sub-intervals where the reading fails over the largest
+    area is searched with the plant's a at its upper end, middle and lower end.
+    """
+    gaps = [float(getattr(bl.stride, reading + "_gap").sum()) for bl in balls]
+    order = [q for q in np.argsort(gaps)[::-1] if gaps[q] > 0][:tries]
+    first = None
+    for q in order:
+        bl = balls[q]
+        leaves = bl.stride.leaves
+        for a in dict.fromkeys((bl.a_hi, 0.5 * (bl.a_lo + bl.a_hi), bl.a_lo)):
+            cex = find_counterexample(
+                spec,
+                cfg,
+                leaves,
+                np.ones(leaves[0].size, dtype=bool),
+                relaxed=reading == "relaxed",
+                a_plant=a,
+            )
+            if cex is not None and cex.confirmed_by_simulation:
+                return cex
+            first = first or cex
+    return first
+
+
 def prove_law(
     cfg: Config,
     name: str,
@@ -515,10 +543,7 @@ def prove_law(
         gap = np.minimum(sum(getattr(bl.stride, reading + "_gap") for bl in balls), full)
         cex = None
         if not ok[area > 0].all() and math.isfinite(spec.d):
-            leaves = balls[0].stride.leaves
-            cex = find_counterexample(
-                spec, cfg, leaves, np.ones(leaves[0].size, dtype=bool), relaxed=reading == "relaxed"
-            )
+            cex = _counterexample(spec, cfg, balls, reading)
         note = ""
         if cex is not None and not cex.confirmed_by_simulation:  # refuted needs both
             note = f"; a state certified in arb but not confirmed by simulate: {cex.x0}"

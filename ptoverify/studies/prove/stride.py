@@ -25,9 +25,10 @@ import numpy as np
 from flint import arb, ctx
 
 from ptoverify.config import Config
-from ptoverify.model.intervals import ARB_PREC, StepMaps, affine_image
+from ptoverify.model.intervals import ARB_PREC
 from ptoverify.model.lawbox import LawSpec, enclose, sigma_point
 from ptoverify.model.laws import make_law
+from ptoverify.model.zohmaps import StepMaps, affine_image
 from ptoverify.sim.simulate import simulate_batch
 from ptoverify.verdict import tie_band
 
@@ -134,7 +135,7 @@ class StrideResult:
 
 
 def stride_check(
-    spec: LawSpec, cfg: Config, maps: StepMaps, boxes, *, depth: int = 24, cap: int = 20_000
+    spec: LawSpec, cfg: Config, maps: StepMaps, boxes, *, depth: int = 24, cap: int = 2_000
 ) -> StrideResult:
     """Prove no stride-over per cell, refining failing cells into quarters.
 
@@ -217,6 +218,8 @@ class Counterexample:
         The next sample lies in |x1| < d (a stride-over only in the strict reading).
     confirmed_by_simulation : bool
         ``simulate``'s one step (floats) shows the same crossing.
+    a_plant : float
+        The plant's bandwidth of the step [rad/s] (the law keeps its design a).
     """
 
     x0: tuple
@@ -226,6 +229,7 @@ class Counterexample:
     sigma1: float
     lands_in_strip: bool
     confirmed_by_simulation: bool
+    a_plant: float = float("nan")
 
     def to_json(self) -> dict:
         """Plain JSON object."""
@@ -240,8 +244,8 @@ def _sigma_arb(a: arb, x1: arb, x2: arb, level: float) -> arb:
     return a * x1 + (lv * h if x2 > 0 else -lv * h if x2 < 0 else 0)
 
 
-def _certify(spec: LawSpec, cfg: Config, x1: float, x2: float):
-    """Certify a stride-over from (x1, x2) in arb; None if it cannot be certified."""
+def _certify(spec: LawSpec, cfg: Config, x1: float, x2: float, a_plant: float):
+    """Certify a stride-over from (x1, x2) in arb, plant's a = a_plant; None if it cannot."""
     p = cfg.plant
     d, w = cfg.pto.d, p.w_max
     tol = tie_band(w, p.a, p.position_range)
@@ -261,9 +265,9 @@ def _certify(spec: LawSpec, cfg: Config, x1: float, x2: float):
             if not ((so > 0) if side < 0 else (so < 0)):
                 return None
         u = side * w
-        e = (-arb(p.a) * arb(p.sample_time)).exp()
+        e = (-arb(a_plant) * arb(p.sample_time)).exp()
         y2 = arb(u) + (arb(x2) - arb(u)) * e
-        y1 = arb(x1) + arb(u) * arb(p.sample_time) + (arb(x2) - arb(u)) * (1 - e) / arb(p.a)
+        y1 = arb(x1) + arb(u) * arb(p.sample_time) + (arb(x2) - arb(u)) * (1 - e) / arb(a_plant)
         if not (y2 > 0 or y2 < 0):
             return None
         s1 = _sigma_arb(a, y1, y2, w)
@@ -278,7 +282,14 @@ def _certify(spec: LawSpec, cfg: Config, x1: float, x2: float):
 
 
 def find_counterexample(
-    spec: LawSpec, cfg: Config, boxes, failing, *, relaxed: bool, limit: int = 400
+    spec: LawSpec,
+    cfg: Config,
+    boxes,
+    failing,
+    *,
+    relaxed: bool,
+    limit: int = 400,
+    a_plant: float | None = None,
 ):
     """Search failing cells for a certified stride-over.
 
@@ -295,25 +306,31 @@ def find_counterexample(
     relaxed : bool
         Search for a crossing that lands outside the strip (relaxed reading).
     limit : int
-        Cells tried at most.
+        Cells tried at most (spread evenly over the failing ones).
+    a_plant : float, optional
+        The plant's bandwidth [rad/s] (default the configuration's); the law
+        keeps the configuration's design.
 
     Returns
     -------
     Counterexample or None
         A state certified in arb and confirmed by one simulated step.
     """
-    idx = np.flatnonzero(failing)[:limit]
+    idx = np.flatnonzero(failing)
+    idx = idx[np.unique(np.linspace(0, idx.size - 1, min(limit, idx.size)).astype(int))]
     law = make_law(spec.name, cfg)
+    a_plant = cfg.plant.a if a_plant is None else a_plant
+    plant = cfg.with_plant(a=a_plant).plant
     for c in idx.tolist():
         for f1, f2 in ((0.5, 0.5), (0.0, 0.0), (1.0, 1.0), (0.0, 1.0), (1.0, 0.0)):
             x1 = float(boxes[0][c] + f1 * (boxes[1][c] - boxes[0][c]))
             x2 = float(boxes[2][c] + f2 * (boxes[3][c] - boxes[2][c]))
-            got = _certify(spec, cfg, x1, x2)
+            got = _certify(spec, cfg, x1, x2, a_plant)
             if got is None or (relaxed and got[4]):
                 continue
             y, u, s0, s1, inside = got
-            b = simulate_batch(law, cfg.plant, [x1], [x2], 1)
+            b = simulate_batch(law, plant, [x1], [x2], 1)
             z1, z2 = float(b.x1[1, 0]), float(b.x2[1, 0])
             sim = bool(b.u[0, 0] == u and abs(z1 - y[0]) < 1e-9 and abs(z2 - y[1]) < 1e-6)
-            return Counterexample((x1, x2), y, u, s0, s1, inside, sim)
+            return Counterexample((x1, x2), y, u, s0, s1, inside, sim, a_plant)
     return None
