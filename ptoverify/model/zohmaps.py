@@ -107,20 +107,37 @@ def _closed_loop(x: arb, T: arb, k: arb_mat):  # noqa: N803
     return a_m - b_m * k, da - db * k
 
 
-def _lin_powers(a: arb, T: float, K: int, gains) -> list:  # noqa: N803
-    """Enclosures (arb matrices) of Acl(a)^j, j = 0..K, for every a in the ball."""
+def _ends(a) -> tuple[arb, arb]:
+    """Return the ends of a's interval as exact arb points (a float pair, or a ball's bounds)."""
+    if isinstance(a, tuple):
+        return arb(a[0]), arb(a[1])
+    return (a, a) if a.rad() == 0 else (a.lower(), a.upper())
+
+
+def _floats(m: arb_mat):
+    """Outward float bounds (lo, hi) of a 2x2 arb matrix, each of shape (2, 2)."""
+    iv = [[arb_interval(m[r, c]) for c in range(2)] for r in range(2)]
+    return np.array([[v[0] for v in row] for row in iv]), np.array(
+        [[v[1] for v in row] for row in iv]
+    )
+
+
+def _lin_powers(lo: arb, hi: arb, T: float, K: int, gains):  # noqa: N803
+    """Float bounds (lo, hi), shape (K + 1, 2, 2), of Acl(a)^j for every a in [lo, hi]."""
     t = arb(T)
     k = arb_mat([[arb(gains[0]), arb(gains[1])]])
     eye = arb_mat([[1, 0], [0, 1]])
-    if a.rad() == 0:
-        acl = _closed_loop(a, t, k)[0]
-        out, power = [], eye
-        for _ in range(K + 1):
-            out.append(power)
+    low = np.full((K + 1, 2, 2), np.inf)
+    high = np.full((K + 1, 2, 2), -np.inf)
+    if not hi > lo:
+        acl = _closed_loop(lo, t, k)[0]
+        power = eye
+        for j in range(K + 1):
+            low[j], high[j] = _floats(power)
             power = power * acl
-        return out
-    lo, hi = a.lower(), a.upper()
-    out = [None] * (K + 1)
+        return low, high
+    # the hull of the pieces' enclosures, taken in floats (a union of arb balls would
+    # round its radius up to 30 bits)
     for i in range(LIN_PIECES):
         piece = (lo + (hi - lo) * i / LIN_PIECES).union(lo + (hi - lo) * (i + 1) / LIN_PIECES)
         c = arb(piece.mid())  # exact point
@@ -129,24 +146,21 @@ def _lin_powers(a: arb, T: float, K: int, gains) -> list:  # noqa: N803
         acl_s, dacl_s = _closed_loop(piece, t, k)
         p_c, p_s, d_s = eye, eye, arb_mat(2, 2)
         for j in range(K + 1):
-            m = p_c + d_s * delta
-            out[j] = m if out[j] is None else _union(out[j], m)
+            m_lo, m_hi = _floats(p_c + d_s * delta)
+            low[j], high[j] = np.minimum(low[j], m_lo), np.maximum(high[j], m_hi)
             p_c, d_s, p_s = p_c * acl_c, d_s * acl_s + p_s * dacl_s, p_s * acl_s
-    return out
+    return low, high
 
 
-def _union(m: arb_mat, n: arb_mat) -> arb_mat:
-    """Entrywise union of two 2x2 arb matrices."""
-    return arb_mat([[m[r, c].union(n[r, c]) for c in range(2)] for r in range(2)])
-
-
-def step_maps(a: arb, T: float, K: int, gains: tuple[float, float] | None = None) -> StepMaps:  # noqa: N803
+def step_maps(a, T: float, K: int, gains: tuple[float, float] | None = None) -> StepMaps:  # noqa: N803
     """Enclose the j-step ZOH maps for j = 0..K in arb, then as float intervals.
 
     Parameters
     ----------
-    a : arb
-        Bandwidth ball [rad/s] (a point or :func:`a_ball`).
+    a : arb or tuple of float
+        Bandwidth [rad/s]: an arb point, a ball (:func:`a_ball`; its bounds, a
+        little wider than the interval it was made from), or (a_lo, a_hi), the
+        interval itself (tightest).
     T : float
         Sampling period [s].
     K : int
@@ -166,29 +180,27 @@ def step_maps(a: arb, T: float, K: int, gains: tuple[float, float] | None = None
     True
     """
     cols = {k: ([], []) for k in ("p", "e", "s1", "s2", "t")}
-    mats = ([], [])
+    lin = None
     with ctx.workprec(ARB_PREC):
         t = arb(T)
         # e_j, p_j are monotone in a: the hull of the two ends' values encloses the range
-        ends = (a,) if a.rad() == 0 else (a.lower(), a.upper())
+        # (taken in floats: a union of arb balls would round its radius up to 30 bits)
+        a_lo, a_hi = _ends(a)
+        ends = (a_lo, a_hi) if a_hi > a_lo else (a_lo,)
         for j in range(K + 1):
-            vals = {"t": j * t}
+            vals = {"t": [j * t]}
             for x in ends:
                 e = (-x * t * j).exp()
                 p = -(-x * t * j).expm1() / x if j else arb(0)
                 for name, v in (("e", e), ("p", p), ("s2", 1 - e), ("s1", j * t - p)):
-                    vals[name] = v if name not in vals else vals[name].union(v)
-            for name, v in vals.items():
-                lo, hi = arb_interval(v)
-                cols[name][0].append(lo)
-                cols[name][1].append(hi)
+                    vals.setdefault(name, []).append(v)
+            for name, vs in vals.items():
+                bounds = [arb_interval(v) for v in vs]
+                cols[name][0].append(min(b[0] for b in bounds))
+                cols[name][1].append(max(b[1] for b in bounds))
         if gains is not None:
-            for power in _lin_powers(a, T, K, gains):
-                iv = [[arb_interval(power[r, c]) for c in range(2)] for r in range(2)]
-                mats[0].append([[iv[r][c][0] for c in range(2)] for r in range(2)])
-                mats[1].append([[iv[r][c][1] for c in range(2)] for r in range(2)])
+            lin = _lin_powers(a_lo, a_hi, T, K, gains)
     arr = {k: (np.array(v[0]), np.array(v[1])) for k, v in cols.items()}
-    lin = (np.array(mats[0]), np.array(mats[1])) if gains is not None else None
     return StepMaps(arr["p"], arr["e"], arr["s1"], arr["s2"], arr["t"], lin)
 
 

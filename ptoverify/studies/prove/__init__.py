@@ -7,6 +7,7 @@
 - :mod:`.certificate`: the certificate's arrays and its independent check.
 - :func:`run_prove`: every law, in-process or on a dask cluster; :class:`ProveRun`.
 - :func:`nominal_proof`: the corrected PTO's nominal proof, memoized for the gates.
+- :func:`interval_proof`: the same over the ``[robustness]`` box's a_ratio (``check --robust``).
 """
 
 from __future__ import annotations
@@ -103,6 +104,29 @@ def parse_a_interval(text: str, a: float) -> tuple[float, float]:
     return lo * a, hi * a
 
 
+def default_pieces(a_interval: tuple[float, float] | None) -> int:
+    """Return the default number of sub-intervals of an a-interval.
+
+    Parameters
+    ----------
+    a_interval : tuple of float or None
+        (a_lo, a_hi) [rad/s]; None: the nominal a.
+
+    Returns
+    -------
+    int
+        The fewest geometric pieces each at most :data:`PIECE_RATIO` wide (1 for a point).
+
+    Examples
+    --------
+    >>> default_pieces((80.0, 125.0))
+    6
+    """
+    if a_interval is None or not a_interval[1] > a_interval[0]:
+        return 1
+    return max(1, math.ceil(math.log(a_interval[1] / a_interval[0]) / math.log(PIECE_RATIO)))
+
+
 def _dask_mapper(address: str):
     """Return a ``map``-like callable running jobs on a dask.distributed cluster."""
     from ptoverify.studies.cluster import check_dask_address, dask_map
@@ -157,12 +181,7 @@ def run_prove(
         raise InputError(f"--excursion must be in [0, position_range], got {excursion:g}")
     t0 = time.perf_counter()
     mapper = _dask_mapper(dask) if dask else map
-    interval = a_interval is not None and a_interval[1] > a_interval[0]
-    n = pieces or (
-        max(1, math.ceil(math.log(a_interval[1] / a_interval[0]) / math.log(PIECE_RATIO)))
-        if interval
-        else 1
-    )
+    n = pieces or default_pieces(a_interval)
     proofs = tuple(
         prove_law(
             cfg,
@@ -196,3 +215,24 @@ def nominal_proof(cfg: Config) -> LawProof:
         The proof of ``pto`` for the nominal a.
     """
     return prove_law(cfg, "pto", n_random=5_000)
+
+
+@functools.lru_cache(maxsize=4)
+def interval_proof(cfg: Config) -> LawProof:
+    """Return the corrected PTO's proof over the ``[robustness]`` box's a_ratio (memoized).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration; the plant's a is any constant in a_ratio x its a.
+
+    Returns
+    -------
+    LawProof
+        The proof of ``pto`` for the a-interval, :func:`default_pieces` sub-intervals.
+    """
+    lo, hi = cfg.robustness.a_ratio
+    a_interval = (lo * cfg.plant.a, hi * cfg.plant.a)
+    return prove_law(
+        cfg, "pto", a_interval=a_interval, pieces=default_pieces(a_interval), n_random=5_000
+    )

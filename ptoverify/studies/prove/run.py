@@ -190,7 +190,7 @@ def prove_ball(
     grid = law_grid(cfg, spec, res, excursion)
     boxes = grid.boxes()
     gains = (spec.g1, spec.g2) if target.certified else None
-    maps = step_maps(ball, p.sample_time, res.steps, gains=gains)
+    maps = step_maps((a_lo, a_hi), p.sample_time, res.steps, gains=gains)
     stride = stride_check(spec, cfg, maps, boxes)
     img = images(spec, maps, target, boxes, p.position_range + excursion, res.steps)
     starts, succ, exits = successors(grid.e1, grid.e2, img)
