@@ -187,3 +187,41 @@ def test_interval_gate_fails_on_a_faulty_configuration():
     bad = dataclasses.replace(cfg, pto=dataclasses.replace(cfg.pto, k2=6.0))
     (v,) = run_checks(bad, [PROOF_INTERVAL_GATE])
     assert v.status in (FAIL, UNVERIFIED), v
+
+
+def _same(p, q):
+    np.testing.assert_array_equal(p.bound, q.bound)
+    for bp, bq in zip(p.balls, q.balls, strict=True):
+        for name in ("strict", "relaxed", "strict_gap", "relaxed_gap"):
+            np.testing.assert_array_equal(getattr(bp.stride, name), getattr(bq.stride, name))
+        for u, v in zip(bp.stride.leaves, bq.stride.leaves, strict=True):
+            np.testing.assert_array_equal(u, v)
+        for u, v in zip(bp.image, bq.image, strict=True):
+            np.testing.assert_array_equal(u, v)
+        np.testing.assert_array_equal(bp.k, bq.k)
+    assert p.to_json()["properties"] == q.to_json()["properties"]
+
+
+def test_cell_blocks_give_the_whole_grid_result_exactly():
+    """Blocks of cells proved apart, then joined: equal to one block (pto, two sub-intervals)."""
+    from ptoverify.studies.prove.run import prove_law
+
+    cfg = paper_config()
+    kw = dict(a_interval=(A0, 1.03 * A0), pieces=2, n_random=0)
+    whole = prove_law(cfg, "pto", **kw)
+    split = prove_law(cfg, "pto", block_cells=7_001, **kw)
+    _same(whole, split)
+    assert whole.property("no-stride-over-strict").status == "refuted"  # leaves were compared
+
+
+@pytest.mark.slow
+def test_dask_cell_blocks_equal_in_process():
+    """Sub-intervals x blocks of cells on a LocalCluster: the in-process result exactly."""
+    from ptoverify.studies.prove import run_prove
+
+    cfg = paper_config()
+    kw = dict(laws=("pd",), a_interval=(0.99 * A0, 1.01 * A0), pieces=2, n_random=100)
+    here = run_prove(cfg, **kw)
+    there = run_prove(cfg, dask="local", block_cells=10_000, **kw)
+    _same(here.proofs[0], there.proofs[0])
+    assert there.backend == "dask:local"

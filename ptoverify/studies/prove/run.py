@@ -1,11 +1,12 @@
 """``ptoverify prove``: proofs over the continuum of initial states, per law.
 
 For each sub-interval of the plant's a (one point, the nominal a, by default)
-:func:`prove_ball` builds the grid, the certified target, the macro-step
-images and the longest-path bounds, and proves no stride-over per cell.  A
-cell's verdict over an a-interval is the conjunction (and its bound the
-maximum) over the sub-intervals, so it holds for every constant a in it.
-:func:`prove_law` gathers the per-cell results into the properties.
+:mod:`.ball` certifies the target, proves no stride-over and builds the
+macro-step images per block of cells (the jobs a cluster runs), then the
+longest-path bounds.  A cell's verdict over an a-interval is the conjunction
+(and its bound the maximum) over the sub-intervals, so it holds for every
+constant a in it.  :func:`prove_law` gathers the per-cell results into the
+properties.
 """
 
 from __future__ import annotations
@@ -19,187 +20,24 @@ from flint import arb
 
 from ptoverify.config import Config
 from ptoverify.model.intervals import down
-from ptoverify.model.lawbox import LawSpec, enclose, law_spec
+from ptoverify.model.lawbox import enclose, law_spec
 from ptoverify.model.laws import make_law
 from ptoverify.model.plant import step
-from ptoverify.model.zohmaps import a_ball, step_maps
-from ptoverify.studies.prove.graph import Grid, images, longest_path, make_grid, successors
-from ptoverify.studies.prove.stride import (
-    Counterexample,
-    StrideResult,
-    find_counterexample,
-    stride_check,
+from ptoverify.studies.prove.ball import (
+    BallResult,
+    Resolution,
+    assemble_ball,
+    ball_target,
+    cell_blocks,
+    law_grid,
+    prove_ball,
+    prove_block,
 )
-from ptoverify.studies.prove.target import Target, box_in_target, certify_decrease, make_target
+from ptoverify.studies.prove.graph import Grid
+from ptoverify.studies.prove.stride import Counterexample, find_counterexample
+from ptoverify.studies.prove.target import Target, make_target
 
 __all__ = ["Resolution", "BallResult", "PropertyResult", "LawProof", "prove_ball", "prove_law"]
-
-
-@dataclass(frozen=True)
-class Resolution:
-    """Grid and macro-step settings.
-
-    Attributes
-    ----------
-    h1 : float
-        Cell width near the origin and the zones [mm].
-    h2 : float
-        Cell height [mm/s].
-    h1_max : float
-        Largest cell width [mm].
-    h_edge : float
-        Cell width at the envelope's edge [mm].
-    steps : int
-        Longest macro-step [samples].
-    """
-
-    h1: float = 0.02
-    h2: float = 5.0
-    h1_max: float = 2.0
-    h_edge: float = 0.05
-    steps: int = 200
-
-
-def fine_extent(spec: LawSpec) -> float:
-    """Half-width of the finely gridded strip [mm]: the zones, the curves, the linear zone.
-
-    Parameters
-    ----------
-    spec : LawSpec
-        The law.
-
-    Returns
-    -------
-    float
-        |x1| below which cells have the fine width, one millimetre beyond the
-        widest of the linear zone, the switching curves within |x2| <= w_max
-        (eqs. 9, 13) and w_max / g1 [mm].
-    """
-    w = spec.w_max
-    level = spec.omega0 if spec.has_zone else w
-    curve = level * (w / level - math.log1p(w / level)) / spec.a
-    extent = max(curve, w / spec.g1 if spec.g1 > 0 else 0.0)
-    if math.isfinite(spec.d):
-        extent = max(extent, spec.d)
-    return extent + 1.0
-
-
-@dataclass(frozen=True)
-class BallResult:
-    """Per-cell results for one sub-interval of a.
-
-    Attributes
-    ----------
-    a_lo, a_hi : float
-        The plant's bandwidth interval [rad/s].
-    target : Target
-        The ellipse (decrease certified for this interval when ``certified``).
-    bound : ndarray
-        Certified samples to the target per cell; inf: unproven.
-    stride : StrideResult
-        No stride-over per cell, in each reading.
-    k : ndarray of int
-        Samples of each cell's macro-step.
-    image : tuple of ndarray
-        Each cell's macro-step image box [mm], [mm/s].
-    u_lo, u_hi : ndarray
-        Input enclosure per cell [mm/s].
-    exits : ndarray of bool
-        The image leaves the grid.
-    """
-
-    a_lo: float
-    a_hi: float
-    target: Target
-    bound: np.ndarray
-    stride: StrideResult
-    k: np.ndarray
-    image: tuple
-    u_lo: np.ndarray
-    u_hi: np.ndarray
-    exits: np.ndarray
-
-
-def law_grid(cfg: Config, spec: LawSpec, res: Resolution, excursion: float) -> Grid:
-    """Return the grid of a proof: the envelope widened by ``excursion`` [mm] along x1.
-
-    Parameters
-    ----------
-    cfg : Config
-        Configuration (position_range [mm], w_max [mm/s]).
-    spec : LawSpec
-        The law.
-    res : Resolution
-        Grid settings.
-    excursion : float
-        Margin allowed beyond the envelope [mm].
-
-    Returns
-    -------
-    Grid
-        The grid.
-    """
-    p = cfg.plant
-    return make_grid(
-        p.position_range + excursion,
-        p.w_max,
-        fine_extent(spec),
-        res.h1,
-        res.h2,
-        res.h1_max,
-        res.h_edge,
-    )
-
-
-def prove_ball(
-    cfg: Config,
-    name: str,
-    a_lo: float,
-    a_hi: float,
-    res: Resolution,
-    excursion: float,
-    target: Target,
-) -> BallResult:
-    """Prove reach and no stride-over on every cell for every a in [a_lo, a_hi].
-
-    Parameters
-    ----------
-    cfg : Config
-        Configuration (the law is designed with its a).
-    name : str
-        Law name.
-    a_lo, a_hi : float
-        The plant's bandwidth interval [rad/s].
-    res : Resolution
-        Grid settings.
-    excursion : float
-        Margin allowed beyond the envelope [mm].
-    target : Target
-        Ellipse (built for the nominal a); its decrease is certified here for the interval.
-
-    Returns
-    -------
-    BallResult
-        Per-cell results.
-    """
-    p = cfg.plant
-    spec = law_spec(name, cfg)
-    ball = arb(a_lo) if a_lo == a_hi else a_ball(a_lo, a_hi)
-    if target.certified and not certify_decrease(target.P, ball, p.sample_time, spec.g1, spec.g2):
-        target = Target(target.P, target.c, False, "decrease not certified for this a-interval")
-    grid = law_grid(cfg, spec, res, excursion)
-    boxes = grid.boxes()
-    gains = (spec.g1, spec.g2) if target.certified else None
-    maps = step_maps((a_lo, a_hi), p.sample_time, res.steps, gains=gains)
-    stride = stride_check(spec, cfg, maps, boxes)
-    img = images(spec, maps, target, boxes, p.position_range + excursion, res.steps)
-    starts, succ, exits = successors(grid.e1, grid.e2, img)
-    if target.certified:
-        in_target = box_in_target(target, boxes)
-        bound = longest_path(starts, succ, img.k, in_target, img.to_target, exits)
-    else:
-        bound = np.full(grid.size, np.inf)
-    return BallResult(a_lo, a_hi, target, bound, stride, img.k, img.box, img.u_lo, img.u_hi, exits)
 
 
 @dataclass(frozen=True)
@@ -480,6 +318,7 @@ def prove_law(
     n_random: int = 20_000,
     mapper=map,
     excluded_radius: float | None = None,
+    block_cells: int | None = None,
 ) -> LawProof:
     """Prove the properties of one law over the envelope.
 
@@ -500,10 +339,14 @@ def prove_law(
     n_random : int
         Seeded random states simulated besides the cell centres.
     mapper : callable
-        ``map``-like callable running the sub-intervals (in-process or a cluster's).
+        ``map``-like callable running the jobs, one per sub-interval and block of
+        cells (in-process or a cluster's).
     excluded_radius : float, optional
         Neighbourhood |x1| < radius [mm] left out of the suboptimality bound
         (default a tenth of position_range).
+    block_cells : int, optional
+        Cells per job (default all: one job per sub-interval); the result does
+        not depend on it.
 
     Returns
     -------
@@ -525,13 +368,22 @@ def prove_law(
         pass
     else:  # no linear zone (TO): no target
         target = Target(target.P, 0.0, False, "the law has no linear zone: no target ellipse")
-    jobs = [
-        (cfg, name, float(edges[q]), float(edges[q + 1]), res, excursion, target)
-        for q in range(len(edges) - 1)
-    ]
-    balls = tuple(mapper(_run_ball, jobs))
-    t1 = time.perf_counter()
     grid = law_grid(cfg, spec, res, excursion)
+    pieces = [(float(edges[q]), float(edges[q + 1])) for q in range(len(edges) - 1)]
+    targets = [ball_target(cfg, spec, a0, a1, target) for a0, a1 in pieces]
+    blocks = cell_blocks(grid.size, block_cells)
+    jobs = [
+        (cfg, spec, a0, a1, res, excursion, tq, block)
+        for (a0, a1), tq in zip(pieces, targets)
+        for block in blocks
+    ]
+    done = list(mapper(_run_block, jobs))
+    nb = len(blocks)
+    balls = tuple(
+        assemble_ball(cfg, spec, a0, a1, res, excursion, tq, done[q * nb : (q + 1) * nb])
+        for q, ((a0, a1), tq) in enumerate(zip(pieces, targets))
+    )
+    t1 = time.perf_counter()
     bound = np.max(np.stack([bl.bound for bl in balls]), axis=0)
     b, area = _envelope_weights(cfg, grid)
     enc = enclose(spec, b)
@@ -598,6 +450,6 @@ def prove_law(
     )
 
 
-def _run_ball(job) -> BallResult:
-    """Run :func:`prove_ball` on a job tuple (picklable for a cluster)."""
-    return prove_ball(*job)
+def _run_block(job):
+    """Run :func:`~ptoverify.studies.prove.ball.prove_block` on a job tuple (picklable)."""
+    return prove_block(*job)

@@ -134,16 +134,33 @@ class StrideResult:
     depth: int
 
 
+def _split(b):
+    """Cut boxes into _SPLIT x _SPLIT children that tile each box exactly."""
+    f = np.arange(_SPLIT) / _SPLIT  # each side cut in _SPLIT: 3 levels at once
+    t1 = np.repeat(f, _SPLIT)[:, None]
+    t2 = np.tile(f, _SPLIT)[:, None]
+    # a child's upper edge is computed exactly as its neighbour's lower edge
+    # (t + 1/8 is exact), and the last one is the box's own edge: no gaps
+    lo1 = b[0] + t1 * (b[1] - b[0])
+    lo2 = b[2] + t2 * (b[3] - b[2])
+    u1, u2 = t1 + 1.0 / _SPLIT, t2 + 1.0 / _SPLIT
+    hi1 = np.where(u1 >= 1.0, b[1], b[0] + u1 * (b[1] - b[0]))
+    hi2 = np.where(u2 >= 1.0, b[3], b[2] + u2 * (b[3] - b[2]))
+    return tuple(v.ravel() for v in (lo1, hi1, lo2, hi2))
+
+
 def stride_check(
-    spec: LawSpec, cfg: Config, maps: StepMaps, boxes, *, depth: int = 24, cap: int = 2_000
+    spec: LawSpec, cfg: Config, maps: StepMaps, boxes, *, depth: int = 24, cap: int = 256
 ) -> StrideResult:
-    """Prove no stride-over per cell, refining failing cells into quarters.
+    """Prove no stride-over per cell, refining failing cells.
 
     A failing box is cut into 8 x 8 children (three halvings of each side, so
     children tile the box exactly: the last child ends at the box's edge); each
-    child is checked again, down to ``depth`` halvings or while fewer than
-    ``cap`` boxes fail.  The verdict of a
-    cell holds where all its leaves pass; the failing leaves' area is its gap.
+    child is checked again, down to ``depth`` halvings, for as long as at most
+    ``cap`` boxes of its cell fail.  Each cell is refined on its own, so the
+    result of a cell does not depend on the other cells checked with it (a
+    cluster may split the cells into blocks).  The verdict of a cell holds where
+    all its leaves pass; the failing leaves' area is its gap.
 
     Parameters
     ----------
@@ -158,46 +175,46 @@ def stride_check(
     depth : int
         Most refinement levels.
     cap : int
-        Most failing boxes carried to the next level.
+        Most failing boxes of one cell carried to the next level.
 
     Returns
     -------
     StrideResult
-        Per-cell verdicts and gaps.
+        Per-cell verdicts and gaps; leaves ordered by cell, then position.
     """
     n = boxes[0].size
     s, r = _check(spec, cfg, maps, boxes)
     owner = np.arange(n)
     cur = boxes
-    fail_s, fail_r = ~s, ~r
-    level = 0
-    while level < depth and (fail_s | fail_r).any() and np.count_nonzero(fail_s | fail_r) <= cap:
-        keep = np.flatnonzero(fail_s | fail_r)
-        b = tuple(v[keep] for v in cur)
-        f = np.arange(_SPLIT) / _SPLIT  # each side cut in _SPLIT: 3 levels at once
-        t1 = np.repeat(f, _SPLIT)[:, None]
-        t2 = np.tile(f, _SPLIT)[:, None]
-        # a child's upper edge is computed exactly as its neighbour's lower edge
-        # (t + 1/8 is exact), and the last one is the box's own edge: no gaps
-        lo1 = b[0] + t1 * (b[1] - b[0])
-        lo2 = b[2] + t2 * (b[3] - b[2])
-        u1, u2 = t1 + 1.0 / _SPLIT, t2 + 1.0 / _SPLIT
-        hi1 = np.where(u1 >= 1.0, b[1], b[0] + u1 * (b[1] - b[0]))
-        hi2 = np.where(u2 >= 1.0, b[3], b[2] + u2 * (b[3] - b[2]))
-        kids = tuple(v.ravel() for v in (lo1, hi1, lo2, hi2))
-        owner = np.tile(owner[keep], _SPLIT * _SPLIT)
-        cur = kids
+    kept = []  # failing leaves no longer refined: (boxes, owner, strict fails, relaxed fails)
+    level = deepest = 0
+    while True:
+        bad = ~s | ~r
+        go = bad & (np.bincount(owner[bad], minlength=n)[owner] <= cap)
+        if level >= depth:
+            go[:] = False
+        stop = bad & ~go
+        kept.append((tuple(v[stop] for v in cur), owner[stop], ~s[stop], ~r[stop]))
+        if not go.any():
+            break
+        cur = _split(tuple(v[go] for v in cur))
+        owner = np.tile(owner[go], _SPLIT * _SPLIT)
         s, r = _check(spec, cfg, maps, cur)
-        fail_s, fail_r = ~s, ~r
         level += 3
-    area = (cur[1] - cur[0]) * (cur[3] - cur[2])
+        deepest = level
+    leaves = tuple(np.concatenate([k[0][q] for k in kept]) for q in range(4))
+    owner = np.concatenate([k[1] for k in kept])
+    fail_s = np.concatenate([k[2] for k in kept])
+    fail_r = np.concatenate([k[3] for k in kept])
+    order = np.lexsort((leaves[2], leaves[0], owner))  # canonical: by cell, then position
+    leaves = tuple(v[order] for v in leaves)
+    owner, fail_s, fail_r = owner[order], fail_s[order], fail_r[order]
+    area = (leaves[1] - leaves[0]) * (leaves[3] - leaves[2])
     gap_s = np.bincount(owner[fail_s], weights=area[fail_s], minlength=n)
     gap_r = np.bincount(owner[fail_r], weights=area[fail_r], minlength=n)
-    bad = fail_s | fail_r
-    leaves = tuple(v[bad] for v in cur)
     strict = np.bincount(owner[fail_s], minlength=n) == 0
     relaxed = np.bincount(owner[fail_r], minlength=n) == 0
-    return StrideResult(strict, relaxed, gap_s, gap_r, leaves, level)
+    return StrideResult(strict, relaxed, gap_s, gap_r, leaves, deepest)
 
 
 @dataclass(frozen=True)
