@@ -225,3 +225,27 @@ def test_dask_cell_blocks_equal_in_process():
     there = run_prove(cfg, dask="local", block_cells=10_000, **kw)
     _same(here.proofs[0], there.proofs[0])
     assert there.backend == "dask:local"
+
+
+def test_min_time_lower_bound_is_below_the_closed_form_minimum_time():
+    """1e5 seeded states and boxes, plants with a <= a_hi: the bound <= t_f* (closed form)."""
+    from ptoverify.model.mintime import min_time
+    from ptoverify.studies.prove.run import min_time_lower
+
+    cfg = paper_config()
+    w, r = cfg.plant.w_max, cfg.plant.position_range
+    rng = np.random.default_rng(14)
+    n = 100_000
+    x1, x2 = rng.uniform(-r, r, n), rng.uniform(-w, w, n)
+    x2[:200] = rng.choice([-w, w], 200)  # the velocity's edges
+    h1, h2 = rng.uniform(0, 0.5, n), rng.uniform(0, 20, n)
+    box = (x1 - h1, x1 + h1, np.maximum(x2 - h2, -w), np.minimum(x2 + h2, w))
+    points = (x1, x1, x2, x2)
+    for a in (LO, A0, HI):
+        t_f = min_time(x1, x2, cfg.with_plant(a=a).plant).t_f
+        for b in (points, box):
+            t = min_time_lower(b, HI, w)
+            assert np.all(t <= t_f), f"a = {a:.1f}: a lower bound above t_f*"
+        # and it is tighter than |x1| / w_max where the state moves away from the origin
+        away = (x1 * x2 > 0) & (np.abs(x1) > 1.0)
+        assert np.all(min_time_lower(points, HI, w)[away] > np.abs(x1[away]) / w)

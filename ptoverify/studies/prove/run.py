@@ -19,7 +19,7 @@ import numpy as np
 from flint import arb
 
 from ptoverify.config import Config
-from ptoverify.model.intervals import down
+from ptoverify.model.intervals import add, div, down, mul
 from ptoverify.model.lawbox import enclose, law_spec
 from ptoverify.model.laws import make_law
 from ptoverify.model.plant import step
@@ -37,7 +37,15 @@ from ptoverify.studies.prove.graph import Grid
 from ptoverify.studies.prove.stride import Counterexample, find_counterexample
 from ptoverify.studies.prove.target import Target, make_target
 
-__all__ = ["Resolution", "BallResult", "PropertyResult", "LawProof", "prove_ball", "prove_law"]
+__all__ = [
+    "Resolution",
+    "BallResult",
+    "PropertyResult",
+    "LawProof",
+    "prove_ball",
+    "prove_law",
+    "min_time_lower",
+]
 
 
 @dataclass(frozen=True)
@@ -266,8 +274,62 @@ def _simulate(cfg, name, target, grid, bound, a_values, n_random, seed=0):
     return worst, over, x1.size
 
 
-def _suboptimality(cfg, grid, bound, radius):
-    """Certified max of bound / N* over proved cells with |x1| >= radius (N* >= |x1| / (w T))."""
+def min_time_lower(box, a_hi: float, w: float) -> np.ndarray:
+    """Certified lower bound of the minimum time t_f* to the origin over boxes [s].
+
+    For x1 > 0: whatever the input |u| <= w, x2(t) >= -w + (x2 + w) exp(-a t),
+    so x1(t) >= x1 - w t + (x2 + w) (1 - exp(-a t)) / a, and with
+    1 - exp(-s) >= s / (1 + s) and a <= a_hi, x1(t) > 0 while
+    w t - x1 - (x2 + w) t / (1 + a_hi t) < 0, i.e. before the positive root of
+    a_hi w t^2 - (a_hi x1 + x2) t - x1 = 0:
+    t_f* >= ((a_hi x1 + x2) + sqrt((a_hi x1 + x2)^2 + 4 a_hi w x1)) / (2 a_hi w)
+    (= x1 / w at x2 = -w).  The root increases in x1 and x2, so its minimum over
+    a box right of x1 = 0 is at the lower-left corner; boxes left of it are
+    mirrored ((x1, x2) -> (-x1, -x2)); boxes that meet x1 = 0 get 0.  Evaluated
+    with outward rounding (np.sqrt is correctly rounded in IEEE 754).
+
+    Parameters
+    ----------
+    box : tuple of ndarray
+        (x1lo, x1hi, x2lo, x2hi) [mm], [mm/s], within |x2| <= w.
+    a_hi : float
+        Largest plant bandwidth covered [rad/s] (the bound holds for every a <= a_hi).
+    w : float
+        Saturation w_max [mm/s].
+
+    Returns
+    -------
+    ndarray
+        Lower bounds of t_f* [s] (0 where the box meets x1 = 0).
+
+    Examples
+    --------
+    >>> t = min_time_lower(tuple(np.array([v]) for v in (6.0, 7.0, -300.0, -290.0)), 100.0, 300.0)
+    >>> bool(0.0199 < t[0] <= 0.02)
+    True
+    """
+    x1lo, x1hi, x2lo, x2hi = (np.asarray(v, dtype=float) for v in box)
+    right, left = x1lo > 0, x1hi < 0
+    z1 = np.where(right, x1lo, np.where(left, -x1hi, 0.0))
+    z2 = np.maximum(np.where(right, x2lo, np.where(left, -x2hi, -w)), -w)
+    av = (a_hi, a_hi)
+    s = add(mul(av, (z1, z1)), (z2, z2))
+    sq = mul(s, s)
+    four_aw = mul((4.0 * a_hi, 4.0 * a_hi), (w, w))  # 4 a_hi is exact
+    disc = add((np.maximum(sq[0], 0.0), sq[1]), mul(four_aw, (z1, z1)))[0]
+    root = down(np.sqrt(np.maximum(disc, 0.0)))
+    num = add(s, (root, root))[0]
+    den = mul((2.0 * a_hi, 2.0 * a_hi), (w, w))[1]
+    t = div((num, num), (den, den))[0]
+    return np.where(right | left, np.maximum(t, 0.0), 0.0)
+
+
+def _suboptimality(cfg, grid, bound, radius, a_hi):
+    """Certified max of bound / N* over proved cells with |x1| >= radius.
+
+    N* T >= t_f* (the sampled input is one continuous input), so N* >=
+    ceil(:func:`min_time_lower` / T), with t_f* bounded for every a <= a_hi.
+    """
     p = cfg.plant
     b = grid.boxes()
     near = np.where((b[0] < 0) & (b[1] > 0), 0.0, np.minimum(np.abs(b[0]), np.abs(b[1])))
@@ -275,8 +337,8 @@ def _suboptimality(cfg, grid, bound, radius):
     use &= np.isfinite(bound)  # over the proved cells
     if not use.any():
         return None
-    wt = float(np.nextafter(p.w_max * p.sample_time, np.inf))  # divided by an upper bound
-    n_star = np.ceil(down(near[use] / wt))  # N* >= t_f*/T >= |x1| / (w T), rounded down
+    t_lo = min_time_lower(tuple(v[use] for v in b), a_hi, p.w_max)
+    n_star = np.ceil(div((t_lo, t_lo), (p.sample_time, p.sample_time))[0])
     return float(np.max(bound[use] / n_star))
 
 
@@ -436,7 +498,9 @@ def prove_law(
         simulated_worst_samples=worst,
         simulated_states=n_sim or 0,
         simulation_over_bound=over or 0,
-        certified_max_ratio_nt=_suboptimality(cfg, grid, bound, radius) if tgt.certified else None,
+        certified_max_ratio_nt=(
+            _suboptimality(cfg, grid, bound, radius, hi) if tgt.certified else None
+        ),
         excluded_radius=radius,
         cells=grid.size,
         grid=grid,
