@@ -12,13 +12,13 @@
 
 from __future__ import annotations
 
-import functools
 import math
 import time
 from dataclasses import dataclass
 
 from ptoverify.config import Config
 from ptoverify.errors import InputError
+from ptoverify.model.memo import memo
 from ptoverify.studies.prove.run import LawProof, Resolution, prove_law
 
 __all__ = [
@@ -211,7 +211,7 @@ def run_prove(
     return ProveRun(proofs, (a_lo, a_hi), excursion, backend, time.perf_counter() - t0)
 
 
-@functools.lru_cache(maxsize=4)
+@memo(maxsize=4)
 def nominal_proof(cfg: Config) -> LawProof:
     """Return the corrected PTO's nominal proof (memoized: the gates share it).
 
@@ -228,7 +228,7 @@ def nominal_proof(cfg: Config) -> LawProof:
     return prove_law(cfg, "pto", n_random=5_000)
 
 
-@functools.lru_cache(maxsize=4)
+@memo(maxsize=4)
 def interval_proof(cfg: Config) -> LawProof:
     """Return the corrected PTO's proof over the ``[robustness]`` box's a_ratio (memoized).
 
