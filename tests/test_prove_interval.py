@@ -249,3 +249,30 @@ def test_min_time_lower_bound_is_below_the_closed_form_minimum_time():
         # and it is tighter than |x1| / w_max where the state moves away from the origin
         away = (x1 * x2 > 0) & (np.abs(x1) > 1.0)
         assert np.all(min_time_lower(points, HI, w)[away] > np.abs(x1[away]) / w)
+
+
+@pytest.mark.slow
+def test_interval_bound_covers_a_million_states_at_both_ends(proof):
+    """1e6 seeded states stepped with the exact ZOH map (model.plant.step) at a_lo and a_hi."""
+    from ptoverify.model.plant import step
+
+    cfg = paper_config()
+    law = make_law("pto", cfg)
+    (p11, p12), (_, p22) = proof.target.P
+    level = proof.target.c * (1 + 1e-9)
+    rng = np.random.default_rng(15)
+    n = 1_000_000
+    x1 = rng.uniform(-cfg.plant.position_range, cfg.plant.position_range, n)
+    x2 = rng.uniform(-cfg.plant.w_max, cfg.plant.w_max, n)
+    bound = _cell_bound(proof, x1, x2)
+    for a in (LO, HI):
+        plant = cfg.with_plant(a=a).plant
+        live = np.flatnonzero(np.isfinite(bound))
+        y1, y2 = x1[live], x2[live]
+        for k in range(proof.bound_samples + 1):
+            inside = p11 * y1 * y1 + 2 * p12 * y1 * y2 + p22 * y2 * y2 <= level
+            assert np.all(inside | (k < bound[live])), f"a = {a:.1f}: outside at its bound {k}"
+            live, y1, y2 = live[~inside], y1[~inside], y2[~inside]
+            u, _r = law(y1, y2)
+            y1, y2 = step(y1, y2, u, plant)
+        assert live.size == 0, f"a = {a:.1f}: a proved state never entered the ellipse"
