@@ -605,7 +605,7 @@ def _add_check(sub) -> None:
         "--robust",
         action="store_true",
         help="also run the robustness gates over the [robustness] box "
-        "(robust-no-limit-cycle, robust-settling; adds about 10 s)",
+        "(robust-no-limit-cycle, robust-settling, proof-reach-a-interval; adds about 20 s)",
     )
     _add_junit(p)
     p.set_defaults(handler=_cmd_check)

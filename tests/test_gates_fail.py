@@ -29,7 +29,7 @@ import ptoverify.studies.claims as claims_mod
 import ptoverify.studies.robust as robust_mod
 import ptoverify.studies.robust.maps as robust_maps_mod
 from ptoverify.config import Config, PDGains, Plant, PTOSettings, Robustness, paper_config
-from ptoverify.studies.checks import GATES, ROBUST_GATES, run_checks
+from ptoverify.studies.checks import GATES, ROBUST_GATES, ROBUST_STUDY_GATES, run_checks
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED
 
 
@@ -290,6 +290,12 @@ def _pto_replaced_in_robust(monkeypatch, law):
     )
 
 
+@perturbation("proof-reach-a-interval", baseline=False)
+def _(monkeypatch, cfg):
+    # a linear zone that is unstable when sampled: no certified target over the a-interval
+    return dataclasses.replace(cfg, pto=dataclasses.replace(cfg.pto, k2=6.0))
+
+
 @perturbation("robust-no-limit-cycle")
 def _(monkeypatch, cfg):
     """The sampled time-optimal law in place of PTO: it chatters around the origin."""
@@ -337,8 +343,8 @@ def test_every_gate_has_a_failing_perturbation():
 def test_robust_gates_fail_at_the_paper_box_and_fail_closed(monkeypatch):
     """At the paper's box the PTO fails both (delay 1); a study that raises is unverified."""
     cfg = paper_config()
-    verdicts = run_checks(cfg, list(ROBUST_GATES))
-    assert [v.name for v in verdicts] == list(ROBUST_GATES)
+    verdicts = run_checks(cfg, list(ROBUST_STUDY_GATES))
+    assert [v.name for v in verdicts] == list(ROBUST_STUDY_GATES)
     assert all(v.status == FAIL for v in verdicts), verdicts
     assert verdicts[0].measured > 0.0, "limit cycle amplitude [mm]"
 
@@ -346,7 +352,7 @@ def test_robust_gates_fail_at_the_paper_box_and_fail_closed(monkeypatch):
         raise FloatingPointError("injected")
 
     monkeypatch.setattr(robust_mod, "run_robust", broken)
-    verdicts = run_checks(cfg, list(ROBUST_GATES))
+    verdicts = run_checks(cfg, list(ROBUST_STUDY_GATES))
     assert all(v.status == UNVERIFIED and "injected" in v.detail for v in verdicts), verdicts
 
 

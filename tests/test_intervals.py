@@ -14,6 +14,7 @@ import pytest
 from flint import arb, ctx
 
 from ptoverify.model import intervals as iv
+from ptoverify.model import zohmaps as zm
 
 N = 20_000  # points per operation
 
@@ -88,14 +89,14 @@ def _exact_image(a, T, x1, x2, u, j):  # noqa: N803
 def test_step_images_enclose_exact_images():
     rng = np.random.default_rng(5)
     a, T, K = 188.49555921538757, 0.002, 12  # noqa: N806
-    maps = iv.step_maps(arb(a), T, K)
+    maps = zm.step_maps(arb(a), T, K)
     n = N // 2
     c1, c2 = rng.uniform(-50, 50, n), rng.uniform(-300, 300, n)
     h1, h2 = 10.0 ** rng.uniform(-4, 0, n), 10.0 ** rng.uniform(-2, 2, n)
     box = (c1 - h1, c1 + h1, c2 - h2, c2 + h2)
     u = rng.choice([-300.0, 300.0], n)
     j = rng.integers(0, K + 1, n)
-    img = iv.affine_image(maps, j, box, (u, u))
+    img = zm.affine_image(maps, j, box, (u, u))
     # corners (where the image box is tight) and interior points
     corner = rng.integers(0, 2, (2, n))
     p1 = np.where(corner[0] == 1, box[1], box[0])
@@ -112,7 +113,7 @@ def test_step_images_enclose_exact_images():
 def test_a_interval_maps_enclose_every_a():
     rng = np.random.default_rng(6)
     T, K = 0.002, 5  # noqa: N806
-    maps = iv.step_maps(iv.a_ball(150.0, 240.0), T, K)
+    maps = zm.step_maps(zm.a_ball(150.0, 240.0), T, K)
     for a in rng.uniform(150.0, 240.0, 200).tolist():
         with ctx.workprec(200):
             for j in range(K + 1):
@@ -124,11 +125,11 @@ def test_a_interval_maps_enclose_every_a():
 
 def test_linear_powers_enclose_arb_matrix_powers():
     a, T, g = 188.49555921538757, 0.002, (323.0, 3.6)  # noqa: N806
-    maps = iv.step_maps(arb(a), T, 8, gains=g)
+    maps = zm.step_maps(arb(a), T, 8, gains=g)
     rng = np.random.default_rng(7)
     x1, x2 = rng.uniform(-0.5, 0.5, 2000), rng.uniform(-80, 80, 2000)
     j = rng.integers(0, 9, 2000)
-    img = iv.linear_image(maps, j, (x1, x1, x2, x2))
+    img = zm.linear_image(maps, j, (x1, x1, x2, x2))
     exact1, exact2 = [], []
     with ctx.workprec(200):
         for p, q, k in zip(x1.tolist(), x2.tolist(), j.tolist()):
@@ -152,11 +153,11 @@ def test_shrunk_enclosures_are_caught():
     assert _outside(lo, hi - 1e-9, exact) == r.size, "a lowered upper bound went unnoticed"
     # the image box of a box is tight at corners: shrinking it by 1e-9 loses them
     a, T = 188.49555921538757, 0.002  # noqa: N806
-    maps = iv.step_maps(arb(a), T, 1)
+    maps = zm.step_maps(arb(a), T, 1)
     x1, x2 = rng.uniform(-40, 40, 500), rng.uniform(-300, 300, 500)
     box = (x1, x1 + 0.5, x2, x2 + 3.0)
     u = np.full(500, 300.0)
-    img = iv.affine_image(maps, np.ones(500, dtype=int), box, (u, u))
+    img = zm.affine_image(maps, np.ones(500, dtype=int), box, (u, u))
     ex = [_exact_image(a, T, p, q, 300.0, 1)[0] for p, q in zip(box[0].tolist(), x2.tolist())]
     assert _outside(img[0], img[1], ex) == 0
     assert _outside(img[0] + 1e-9, img[1], ex) == 500, "a shrunk image box went unnoticed"

@@ -15,6 +15,10 @@ reach     ZonotopeTable, zonotope_steps: N-step null-controllable sets as 2-D zo
 ocp       TwoPhaseOCP, CollocationOCP (CasADi + IPOPT), convergence_study
 poles     PD and linear-zone (eq. 37) loops: poles, damping, margins (python-control)
 memo      memo, clear_memos: the one memo mechanism, keyed on configuration objects
+intervals outward-rounded interval arithmetic on NumPy arrays; log1p, h(r) by bounded series
+lawbox    LawSpec, enclose: the laws enclosed over boxes of states (``prove``)
+zohmaps   step_maps, affine_image, linear_image: the j-step ZOH maps enclosed for a point
+          or an interval of a (``prove``)
 """
 
 # the baselines import laws and register their names with make_law; importing them here

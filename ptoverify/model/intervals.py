@@ -1,4 +1,4 @@
-"""Outward-rounded interval arithmetic on NumPy arrays, and ZOH map enclosures.
+"""Outward-rounded interval arithmetic on NumPy arrays.
 
 An interval is a pair ``(lo, hi)`` of float arrays (or floats) with lo <= hi.
 Every operation returns an interval that contains the exact real result for
@@ -20,16 +20,14 @@ floats outward (:func:`arb_interval`).
 
 Catalogue: :func:`down`, :func:`up`, :func:`add`, :func:`sub`, :func:`mul`,
 :func:`div`, :func:`log1p_point`, :func:`log1p_iv`, :func:`h_point`,
-:func:`h_iv`, :func:`arb_interval`, :func:`a_ball`, :class:`StepMaps`,
-:func:`step_maps`, :func:`affine_image`.
+:func:`h_iv`, :func:`arb_interval`.  The ZOH map enclosures built on them are
+in :mod:`ptoverify.model.zohmaps`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
-from flint import arb, arb_mat, ctx
+from flint import arb, ctx
 
 __all__ = [
     "down",
@@ -43,10 +41,6 @@ __all__ = [
     "h_point",
     "h_iv",
     "arb_interval",
-    "a_ball",
-    "StepMaps",
-    "step_maps",
-    "affine_image",
     "ARB_PREC",
 ]
 
@@ -453,178 +447,3 @@ def arb_interval(x: arb) -> tuple[float, float]:
     while not arb(hi) >= x:
         hi = float(np.nextafter(hi, np.inf))
     return lo, hi
-
-
-def a_ball(a_lo: float, a_hi: float) -> arb:
-    """Return an arb ball containing the closed interval [a_lo, a_hi].
-
-    Parameters
-    ----------
-    a_lo, a_hi : float
-        Bandwidth interval [rad/s], a_lo <= a_hi.
-
-    Returns
-    -------
-    arb
-        Ball containing [a_lo, a_hi].
-
-    Examples
-    --------
-    >>> a_ball(1.0, 2.0).contains(arb(1.5))
-    True
-    """
-    return arb(a_lo).union(arb(a_hi))
-
-
-@dataclass(frozen=True)
-class StepMaps:
-    """Enclosures of the exact j-step ZOH maps, j = 1..K, under a constant input.
-
-    x1_j = x1 + p_j x2 + s1_j u, x2_j = e_j x2 + s2_j u, with e_j = exp(-a j T),
-    p_j = (1 - e_j) / a, s1_j = j T - p_j, s2_j = 1 - e_j; and the j-th power
-    of the closed-loop matrix of a linear law u = -g1 x1 - g2 x2.  Each entry is
-    an interval (lo, hi) of arrays of shape (K + 1,) (index j; index 0 is the
-    identity), valid for every constant a in the ball the maps were built for.
-
-    Attributes
-    ----------
-    p, e, s1, s2 : tuple of ndarray
-        Coefficient intervals [s], [-], [s], [-].
-    lin : tuple of ndarray or None
-        Closed-loop powers: (lo, hi), each of shape (K + 1, 2, 2) [s^0, s, 1/s].
-    """
-
-    p: tuple
-    e: tuple
-    s1: tuple
-    s2: tuple
-    lin: tuple | None
-
-
-def step_maps(a: arb, T: float, K: int, gains: tuple[float, float] | None = None) -> StepMaps:  # noqa: N803
-    """Enclose the j-step ZOH maps for j = 0..K in arb, then as float intervals.
-
-    Parameters
-    ----------
-    a : arb
-        Bandwidth ball [rad/s] (a point or :func:`a_ball`).
-    T : float
-        Sampling period [s].
-    K : int
-        Largest number of steps.
-    gains : tuple of float, optional
-        Linear law gains (g1 [1/s], g2 [-]), u = -g1 x1 - g2 x2.
-
-    Returns
-    -------
-    StepMaps
-        The enclosures.
-
-    Examples
-    --------
-    >>> m = step_maps(arb(100), 0.01, 2)
-    >>> bool(m.e[0][1] <= 0.36787944117144233 <= m.e[1][1] and m.e[1][1] - m.e[0][1] < 1e-16)
-    True
-    """
-    cols = {k: ([], []) for k in ("p", "e", "s1", "s2")}
-    mats = ([], [])
-    with ctx.workprec(ARB_PREC):
-        t = arb(T)
-        ed = (-a * t).exp()
-        if gains is not None:
-            g = -(-a * t).expm1()  # 1 - e^{-aT}
-            A = arb_mat([[1, g / a], [0, 1 - g]])  # noqa: N806
-            B = arb_mat([[t - g / a], [g]])  # noqa: N806
-            K1 = arb_mat([[arb(gains[0]), arb(gains[1])]])  # noqa: N806
-            acl = A - B * K1
-            power = arb_mat([[1, 0], [0, 1]])
-        ej = arb(1)
-        for j in range(K + 1):
-            vals = {"e": ej, "p": (1 - ej) / a, "s2": 1 - ej}
-            vals["s1"] = j * t - vals["p"]
-            for k, v in vals.items():
-                lo, hi = arb_interval(v)
-                cols[k][0].append(lo)
-                cols[k][1].append(hi)
-            if gains is not None:
-                iv = [[arb_interval(power[r, c]) for c in range(2)] for r in range(2)]
-                mats[0].append([[iv[r][c][0] for c in range(2)] for r in range(2)])
-                mats[1].append([[iv[r][c][1] for c in range(2)] for r in range(2)])
-                power = power * acl
-            ej = ej * ed
-    arr = {k: (np.array(v[0]), np.array(v[1])) for k, v in cols.items()}
-    lin = (np.array(mats[0]), np.array(mats[1])) if gains is not None else None
-    return StepMaps(arr["p"], arr["e"], arr["s1"], arr["s2"], lin)
-
-
-def affine_image(maps: StepMaps, j, box, u):
-    """Enclose the j-step image of boxes under a constant input in an interval.
-
-    Parameters
-    ----------
-    maps : StepMaps
-        Coefficient enclosures.
-    j : ndarray of int
-        Number of steps per box (0..K).
-    box : tuple of ndarray
-        (x1lo, x1hi, x2lo, x2hi) [mm], [mm/s].
-    u : tuple of ndarray
-        Input interval (lo, hi) [mm/s], held constant over the j steps.
-
-    Returns
-    -------
-    tuple of ndarray
-        Image box (x1lo, x1hi, x2lo, x2hi).
-
-    Examples
-    --------
-    >>> m = step_maps(arb(100), 0.01, 1)
-    >>> b = affine_image(m, np.array([1]), tuple(np.zeros(1) for _ in range(4)),
-    ...                  (np.ones(1), np.ones(1)))
-    >>> bool(b[0][0] < 0.01 - (1 - np.exp(-1)) / 100 < b[1][0])
-    True
-    """
-    x1 = (box[0], box[1])
-    x2 = (box[2], box[3])
-    p = (maps.p[0][j], maps.p[1][j])
-    e = (maps.e[0][j], maps.e[1][j])
-    s1 = (maps.s1[0][j], maps.s1[1][j])
-    s2 = (maps.s2[0][j], maps.s2[1][j])
-    y1 = add(add(x1, mul(p, x2)), mul(s1, u))
-    y2 = add(mul(e, x2), mul(s2, u))
-    return y1[0], y1[1], y2[0], y2[1]
-
-
-def linear_image(maps: StepMaps, j, box):
-    """Enclose the j-step image of boxes under the closed-loop linear map.
-
-    Parameters
-    ----------
-    maps : StepMaps
-        Enclosures built with ``gains``.
-    j : ndarray of int
-        Steps per box (0..K).
-    box : tuple of ndarray
-        (x1lo, x1hi, x2lo, x2hi) [mm], [mm/s].
-
-    Returns
-    -------
-    tuple of ndarray
-        Image box (x1lo, x1hi, x2lo, x2hi).
-
-    Examples
-    --------
-    >>> m = step_maps(arb(100), 0.01, 1, gains=(0.0, 0.0))
-    >>> b = linear_image(m, np.array([0]), (np.ones(1), np.ones(1), np.ones(1), np.ones(1)))
-    >>> bool(b[0][0] <= 1.0 <= b[1][0])
-    True
-    """
-    lo, hi = maps.lin
-    x1 = (box[0], box[1])
-    x2 = (box[2], box[3])
-    out = []
-    for r in range(2):
-        m1 = (lo[j, r, 0], hi[j, r, 0])
-        m2 = (lo[j, r, 1], hi[j, r, 1])
-        out.append(add(mul(m1, x1), mul(m2, x2)))
-    return out[0][0], out[0][1], out[1][0], out[1][1]

@@ -34,6 +34,9 @@ __all__ = [
     "GATE_UNITS",
     "GateContext",
     "ROBUST_GATES",
+    "ROBUST_STUDY_GATES",
+    "PROOF_INTERVAL_GATE",
+    "proof_interval_verdict",
     "robust_verdicts",
     "run_checks",
     "summarize",
@@ -690,13 +693,67 @@ def run_checks(
     ctx = context if context is not None else GateContext(cfg, max_iter=max_iter)
     out = [fn(ctx) for name, fn in GATES.items() if names is None or name in names]
     wanted = [g for g in ROBUST_GATES if (names is None and robust) or (names and g in names)]
-    if wanted:
+    if set(wanted) & set(ROBUST_STUDY_GATES):
         out += [v for v in robust_verdicts(cfg) if v.name in wanted]
+    if PROOF_INTERVAL_GATE in wanted:
+        out.append(proof_interval_verdict(cfg))
     return out
 
 
+#: Gates judged from the robustness study (``ptoverify robust``) over ``[robustness]``.
+ROBUST_STUDY_GATES = ("robust-no-limit-cycle", "robust-settling")
+#: The interval proof over the ``[robustness]`` box's a_ratio (``ptoverify prove --a-interval``).
+PROOF_INTERVAL_GATE = "proof-reach-a-interval"
 #: Gates over the uncertainty box of ``[robustness]`` (``check --robust``), not run by default.
-ROBUST_GATES = ("robust-no-limit-cycle", "robust-settling")
+ROBUST_GATES = (*ROBUST_STUDY_GATES, PROOF_INTERVAL_GATE)
+
+
+def proof_interval_verdict(cfg: Config) -> Verdict:
+    """Judge the corrected PTO's certified reach for every a in the robustness box (fails closed).
+
+    The proof (:func:`ptoverify.studies.prove.interval_proof`) covers every
+    constant a in ``[robustness] a_ratio`` x the plant's a.  The measured figure
+    is the fraction of the envelope without a certified bound to the target
+    ellipse; 1 when the target is not certified or a simulated state needs more
+    samples than its cell's bound.  A proof that raises is ``unverified``.
+
+    Parameters
+    ----------
+    cfg : Config
+        Nominal configuration with its ``[robustness]`` box.
+
+    Returns
+    -------
+    Verdict
+        ``proof-reach-a-interval`` (limit 0.003, as ``proof-reach``).
+    """
+    name, limit = PROOF_INTERVAL_GATE, 0.003
+    desc = (
+        "Corrected PTO: certified reach of the target ellipse on at least 99.7 % of the "
+        "envelope for every constant a in the [robustness] box's a_ratio (interval proof)."
+    )
+    lo, hi = cfg.robustness.a_ratio
+    try:
+        from ptoverify.studies.prove import interval_proof
+
+        proof = interval_proof(cfg)
+        reach = proof.property("reach")
+        strict = proof.property("no-stride-over-strict")
+        relaxed = proof.property("no-stride-over-relaxed")
+    except Exception as exc:  # noqa: BLE001 - a gate fails closed on any fault
+        why = f"could not be computed: {type(exc).__name__}: {exc}"
+        return Verdict(name, UNVERIFIED, None, limit, why, "<=", "1", desc)
+    sound = proof.target.certified and proof.simulation_over_bound == 0
+    detail = (
+        f"fraction of the envelope without a certified bound to the target ellipse for every "
+        f"a in [{lo:g}, {hi:g}] x a ({reach.status}; {len(proof.balls)} sub-intervals); bound "
+        f"{proof.bound_samples} samples vs simulated worst {proof.simulated_worst_samples} "
+        f"over 9 values of a; {proof.simulation_over_bound} simulated states over their bound; "
+        f"no stride-over: strict {strict.status}, relaxed {relaxed.status}"
+        + ("" if proof.target.certified else f"; {proof.target.reason}")
+    )
+    v = at_most(name, 1.0 - reach.coverage if sound else 1.0, limit, detail, "1")
+    return dataclasses.replace(v, description=desc)
 
 
 def robust_verdicts(cfg: Config) -> list[Verdict]:

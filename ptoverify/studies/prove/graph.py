@@ -24,8 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ptoverify.model.intervals import StepMaps, add, affine_image, linear_image, mul
+from ptoverify.model.intervals import add, mul
 from ptoverify.model.lawbox import LawSpec, enclose, sigma_point
+from ptoverify.model.zohmaps import StepMaps, affine_image, linear_image
 from ptoverify.studies.prove.target import Target, box_in_target
 
 __all__ = ["Grid", "make_grid", "Images", "images", "successors", "longest_path"]

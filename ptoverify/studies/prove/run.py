@@ -1,11 +1,12 @@
 """``ptoverify prove``: proofs over the continuum of initial states, per law.
 
 For each sub-interval of the plant's a (one point, the nominal a, by default)
-:func:`prove_ball` builds the grid, the certified target, the macro-step
-images and the longest-path bounds, and proves no stride-over per cell.  A
-cell's verdict over an a-interval is the conjunction (and its bound the
-maximum) over the sub-intervals, so it holds for every constant a in it.
-:func:`prove_law` gathers the per-cell results into the properties.
+:mod:`.ball` certifies the target, proves no stride-over and builds the
+macro-step images per block of cells (the jobs a cluster runs), then the
+longest-path bounds.  A cell's verdict over an a-interval is the conjunction
+(and its bound the maximum) over the sub-intervals, so it holds for every
+constant a in it.  :func:`prove_law` gathers the per-cell results into the
+properties.
 """
 
 from __future__ import annotations
@@ -18,187 +19,33 @@ import numpy as np
 from flint import arb
 
 from ptoverify.config import Config
-from ptoverify.model.intervals import a_ball, down, step_maps
-from ptoverify.model.lawbox import LawSpec, enclose, law_spec
+from ptoverify.model.intervals import add, div, down, mul
+from ptoverify.model.lawbox import enclose, law_spec
 from ptoverify.model.laws import make_law
 from ptoverify.model.plant import step
-from ptoverify.studies.prove.graph import Grid, images, longest_path, make_grid, successors
-from ptoverify.studies.prove.stride import (
-    Counterexample,
-    StrideResult,
-    find_counterexample,
-    stride_check,
+from ptoverify.studies.prove.ball import (
+    BallResult,
+    Resolution,
+    assemble_ball,
+    ball_target,
+    cell_blocks,
+    law_grid,
+    prove_ball,
+    prove_block,
 )
-from ptoverify.studies.prove.target import Target, box_in_target, certify_decrease, make_target
+from ptoverify.studies.prove.graph import Grid
+from ptoverify.studies.prove.stride import Counterexample, find_counterexample
+from ptoverify.studies.prove.target import Target, make_target
 
-__all__ = ["Resolution", "BallResult", "PropertyResult", "LawProof", "prove_ball", "prove_law"]
-
-
-@dataclass(frozen=True)
-class Resolution:
-    """Grid and macro-step settings.
-
-    Attributes
-    ----------
-    h1 : float
-        Cell width near the origin and the zones [mm].
-    h2 : float
-        Cell height [mm/s].
-    h1_max : float
-        Largest cell width [mm].
-    h_edge : float
-        Cell width at the envelope's edge [mm].
-    steps : int
-        Longest macro-step [samples].
-    """
-
-    h1: float = 0.02
-    h2: float = 5.0
-    h1_max: float = 2.0
-    h_edge: float = 0.05
-    steps: int = 40
-
-
-def fine_extent(spec: LawSpec) -> float:
-    """Half-width of the finely gridded strip [mm]: the zones, the curves, the linear zone.
-
-    Parameters
-    ----------
-    spec : LawSpec
-        The law.
-
-    Returns
-    -------
-    float
-        |x1| below which cells have the fine width, one millimetre beyond the
-        widest of the linear zone, the switching curves within |x2| <= w_max
-        (eqs. 9, 13) and w_max / g1 [mm].
-    """
-    w = spec.w_max
-    level = spec.omega0 if spec.has_zone else w
-    curve = level * (w / level - math.log1p(w / level)) / spec.a
-    extent = max(curve, w / spec.g1 if spec.g1 > 0 else 0.0)
-    if math.isfinite(spec.d):
-        extent = max(extent, spec.d)
-    return extent + 1.0
-
-
-@dataclass(frozen=True)
-class BallResult:
-    """Per-cell results for one sub-interval of a.
-
-    Attributes
-    ----------
-    a_lo, a_hi : float
-        The plant's bandwidth interval [rad/s].
-    target : Target
-        The ellipse (decrease certified for this interval when ``certified``).
-    bound : ndarray
-        Certified samples to the target per cell; inf: unproven.
-    stride : StrideResult
-        No stride-over per cell, in each reading.
-    k : ndarray of int
-        Samples of each cell's macro-step.
-    image : tuple of ndarray
-        Each cell's macro-step image box [mm], [mm/s].
-    u_lo, u_hi : ndarray
-        Input enclosure per cell [mm/s].
-    exits : ndarray of bool
-        The image leaves the grid.
-    """
-
-    a_lo: float
-    a_hi: float
-    target: Target
-    bound: np.ndarray
-    stride: StrideResult
-    k: np.ndarray
-    image: tuple
-    u_lo: np.ndarray
-    u_hi: np.ndarray
-    exits: np.ndarray
-
-
-def law_grid(cfg: Config, spec: LawSpec, res: Resolution, excursion: float) -> Grid:
-    """Return the grid of a proof: the envelope widened by ``excursion`` [mm] along x1.
-
-    Parameters
-    ----------
-    cfg : Config
-        Configuration (position_range [mm], w_max [mm/s]).
-    spec : LawSpec
-        The law.
-    res : Resolution
-        Grid settings.
-    excursion : float
-        Margin allowed beyond the envelope [mm].
-
-    Returns
-    -------
-    Grid
-        The grid.
-    """
-    p = cfg.plant
-    return make_grid(
-        p.position_range + excursion,
-        p.w_max,
-        fine_extent(spec),
-        res.h1,
-        res.h2,
-        res.h1_max,
-        res.h_edge,
-    )
-
-
-def prove_ball(
-    cfg: Config,
-    name: str,
-    a_lo: float,
-    a_hi: float,
-    res: Resolution,
-    excursion: float,
-    target: Target,
-) -> BallResult:
-    """Prove reach and no stride-over on every cell for every a in [a_lo, a_hi].
-
-    Parameters
-    ----------
-    cfg : Config
-        Configuration (the law is designed with its a).
-    name : str
-        Law name.
-    a_lo, a_hi : float
-        The plant's bandwidth interval [rad/s].
-    res : Resolution
-        Grid settings.
-    excursion : float
-        Margin allowed beyond the envelope [mm].
-    target : Target
-        Ellipse (built for the nominal a); its decrease is certified here for the interval.
-
-    Returns
-    -------
-    BallResult
-        Per-cell results.
-    """
-    p = cfg.plant
-    spec = law_spec(name, cfg)
-    ball = arb(a_lo) if a_lo == a_hi else a_ball(a_lo, a_hi)
-    if target.certified and not certify_decrease(target.P, ball, p.sample_time, spec.g1, spec.g2):
-        target = Target(target.P, target.c, False, "decrease not certified for this a-interval")
-    grid = law_grid(cfg, spec, res, excursion)
-    boxes = grid.boxes()
-    gains = (spec.g1, spec.g2) if target.certified else None
-    maps = step_maps(ball, p.sample_time, res.steps, gains=gains)
-    stride = stride_check(spec, cfg, maps, boxes)
-    img = images(spec, maps, target, boxes, p.position_range + excursion, res.steps)
-    starts, succ, exits = successors(grid.e1, grid.e2, img)
-    if target.certified:
-        in_target = box_in_target(target, boxes)
-        bound = longest_path(starts, succ, img.k, in_target, img.to_target, exits)
-    else:
-        bound = np.full(grid.size, np.inf)
-    return BallResult(a_lo, a_hi, target, bound, stride, img.k, img.box, img.u_lo, img.u_hi, exits)
+__all__ = [
+    "Resolution",
+    "BallResult",
+    "PropertyResult",
+    "LawProof",
+    "prove_ball",
+    "prove_law",
+    "min_time_lower",
+]
 
 
 @dataclass(frozen=True)
@@ -427,8 +274,62 @@ def _simulate(cfg, name, target, grid, bound, a_values, n_random, seed=0):
     return worst, over, x1.size
 
 
-def _suboptimality(cfg, grid, bound, radius):
-    """Certified max of bound / N* over proved cells with |x1| >= radius (N* >= |x1| / (w T))."""
+def min_time_lower(box, a_hi: float, w: float) -> np.ndarray:
+    """Certified lower bound of the minimum time t_f* to the origin over boxes [s].
+
+    For x1 > 0: whatever the input |u| <= w, x2(t) >= -w + (x2 + w) exp(-a t),
+    so x1(t) >= x1 - w t + (x2 + w) (1 - exp(-a t)) / a, and with
+    1 - exp(-s) >= s / (1 + s) and a <= a_hi, x1(t) > 0 while
+    w t - x1 - (x2 + w) t / (1 + a_hi t) < 0, i.e. before the positive root of
+    a_hi w t^2 - (a_hi x1 + x2) t - x1 = 0:
+    t_f* >= ((a_hi x1 + x2) + sqrt((a_hi x1 + x2)^2 + 4 a_hi w x1)) / (2 a_hi w)
+    (= x1 / w at x2 = -w).  The root increases in x1 and x2, so its minimum over
+    a box right of x1 = 0 is at the lower-left corner; boxes left of it are
+    mirrored ((x1, x2) -> (-x1, -x2)); boxes that meet x1 = 0 get 0.  Evaluated
+    with outward rounding (np.sqrt is correctly rounded in IEEE 754).
+
+    Parameters
+    ----------
+    box : tuple of ndarray
+        (x1lo, x1hi, x2lo, x2hi) [mm], [mm/s], within |x2| <= w.
+    a_hi : float
+        Largest plant bandwidth covered [rad/s] (the bound holds for every a <= a_hi).
+    w : float
+        Saturation w_max [mm/s].
+
+    Returns
+    -------
+    ndarray
+        Lower bounds of t_f* [s] (0 where the box meets x1 = 0).
+
+    Examples
+    --------
+    >>> t = min_time_lower(tuple(np.array([v]) for v in (6.0, 7.0, -300.0, -290.0)), 100.0, 300.0)
+    >>> bool(0.0199 < t[0] <= 0.02)
+    True
+    """
+    x1lo, x1hi, x2lo, x2hi = (np.asarray(v, dtype=float) for v in box)
+    right, left = x1lo > 0, x1hi < 0
+    z1 = np.where(right, x1lo, np.where(left, -x1hi, 0.0))
+    z2 = np.maximum(np.where(right, x2lo, np.where(left, -x2hi, -w)), -w)
+    av = (a_hi, a_hi)
+    s = add(mul(av, (z1, z1)), (z2, z2))
+    sq = mul(s, s)
+    four_aw = mul((4.0 * a_hi, 4.0 * a_hi), (w, w))  # 4 a_hi is exact
+    disc = add((np.maximum(sq[0], 0.0), sq[1]), mul(four_aw, (z1, z1)))[0]
+    root = down(np.sqrt(np.maximum(disc, 0.0)))
+    num = add(s, (root, root))[0]
+    den = mul((2.0 * a_hi, 2.0 * a_hi), (w, w))[1]
+    t = div((num, num), (den, den))[0]
+    return np.where(right | left, np.maximum(t, 0.0), 0.0)
+
+
+def _suboptimality(cfg, grid, bound, radius, a_hi):
+    """Certified max of bound / N* over proved cells with |x1| >= radius.
+
+    N* T >= t_f* (the sampled input is one continuous input), so N* >=
+    ceil(:func:`min_time_lower` / T), with t_f* bounded for every a <= a_hi.
+    """
     p = cfg.plant
     b = grid.boxes()
     near = np.where((b[0] < 0) & (b[1] > 0), 0.0, np.minimum(np.abs(b[0]), np.abs(b[1])))
@@ -436,9 +337,36 @@ def _suboptimality(cfg, grid, bound, radius):
     use &= np.isfinite(bound)  # over the proved cells
     if not use.any():
         return None
-    wt = float(np.nextafter(p.w_max * p.sample_time, np.inf))  # divided by an upper bound
-    n_star = np.ceil(down(near[use] / wt))  # N* >= t_f*/T >= |x1| / (w T), rounded down
+    t_lo = min_time_lower(tuple(v[use] for v in b), a_hi, p.w_max)
+    n_star = np.ceil(div((t_lo, t_lo), (p.sample_time, p.sample_time))[0])
     return float(np.max(bound[use] / n_star))
+
+
+def _counterexample(spec, cfg, balls, reading, tries: int = 3):
+    """Search the failing leaves of the sub-intervals with the largest gaps for a stride-over.
+
+    Each of the ``tries`` sub-intervals where the reading fails over the largest
+    area is searched with the plant's a at its upper end, middle and lower end.
+    """
+    gaps = [float(getattr(bl.stride, reading + "_gap").sum()) for bl in balls]
+    order = [q for q in np.argsort(gaps)[::-1] if gaps[q] > 0][:tries]
+    first = None
+    for q in order:
+        bl = balls[q]
+        leaves = bl.stride.leaves
+        for a in dict.fromkeys((bl.a_hi, 0.5 * (bl.a_lo + bl.a_hi), bl.a_lo)):
+            cex = find_counterexample(
+                spec,
+                cfg,
+                leaves,
+                np.ones(leaves[0].size, dtype=bool),
+                relaxed=reading == "relaxed",
+                a_plant=a,
+            )
+            if cex is not None and cex.confirmed_by_simulation:
+                return cex
+            first = first or cex
+    return first
 
 
 def prove_law(
@@ -452,6 +380,7 @@ def prove_law(
     n_random: int = 20_000,
     mapper=map,
     excluded_radius: float | None = None,
+    block_cells: int | None = None,
 ) -> LawProof:
     """Prove the properties of one law over the envelope.
 
@@ -472,10 +401,14 @@ def prove_law(
     n_random : int
         Seeded random states simulated besides the cell centres.
     mapper : callable
-        ``map``-like callable running the sub-intervals (in-process or a cluster's).
+        ``map``-like callable running the jobs, one per sub-interval and block of
+        cells (in-process or a cluster's).
     excluded_radius : float, optional
         Neighbourhood |x1| < radius [mm] left out of the suboptimality bound
         (default a tenth of position_range).
+    block_cells : int, optional
+        Cells per job (default all: one job per sub-interval); the result does
+        not depend on it.
 
     Returns
     -------
@@ -497,13 +430,22 @@ def prove_law(
         pass
     else:  # no linear zone (TO): no target
         target = Target(target.P, 0.0, False, "the law has no linear zone: no target ellipse")
-    jobs = [
-        (cfg, name, float(edges[q]), float(edges[q + 1]), res, excursion, target)
-        for q in range(len(edges) - 1)
-    ]
-    balls = tuple(mapper(_run_ball, jobs))
-    t1 = time.perf_counter()
     grid = law_grid(cfg, spec, res, excursion)
+    pieces = [(float(edges[q]), float(edges[q + 1])) for q in range(len(edges) - 1)]
+    targets = [ball_target(cfg, spec, a0, a1, target) for a0, a1 in pieces]
+    blocks = cell_blocks(grid.size, block_cells)
+    jobs = [
+        (cfg, spec, a0, a1, res, excursion, tq, block)
+        for (a0, a1), tq in zip(pieces, targets)
+        for block in blocks
+    ]
+    done = list(mapper(_run_block, jobs))
+    nb = len(blocks)
+    balls = tuple(
+        assemble_ball(cfg, spec, a0, a1, res, excursion, tq, done[q * nb : (q + 1) * nb])
+        for q, ((a0, a1), tq) in enumerate(zip(pieces, targets))
+    )
+    t1 = time.perf_counter()
     bound = np.max(np.stack([bl.bound for bl in balls]), axis=0)
     b, area = _envelope_weights(cfg, grid)
     enc = enclose(spec, b)
@@ -515,10 +457,7 @@ def prove_law(
         gap = np.minimum(sum(getattr(bl.stride, reading + "_gap") for bl in balls), full)
         cex = None
         if not ok[area > 0].all() and math.isfinite(spec.d):
-            leaves = balls[0].stride.leaves
-            cex = find_counterexample(
-                spec, cfg, leaves, np.ones(leaves[0].size, dtype=bool), relaxed=reading == "relaxed"
-            )
+            cex = _counterexample(spec, cfg, balls, reading)
         note = ""
         if cex is not None and not cex.confirmed_by_simulation:  # refuted needs both
             note = f"; a state certified in arb but not confirmed by simulate: {cex.x0}"
@@ -559,7 +498,9 @@ def prove_law(
         simulated_worst_samples=worst,
         simulated_states=n_sim or 0,
         simulation_over_bound=over or 0,
-        certified_max_ratio_nt=_suboptimality(cfg, grid, bound, radius) if tgt.certified else None,
+        certified_max_ratio_nt=(
+            _suboptimality(cfg, grid, bound, radius, hi) if tgt.certified else None
+        ),
         excluded_radius=radius,
         cells=grid.size,
         grid=grid,
@@ -573,6 +514,6 @@ def prove_law(
     )
 
 
-def _run_ball(job) -> BallResult:
-    """Run :func:`prove_ball` on a job tuple (picklable for a cluster)."""
-    return prove_ball(*job)
+def _run_block(job):
+    """Run :func:`~ptoverify.studies.prove.ball.prove_block` on a job tuple (picklable)."""
+    return prove_block(*job)

@@ -25,9 +25,10 @@ import numpy as np
 from flint import arb, ctx
 
 from ptoverify.config import Config
-from ptoverify.model.intervals import ARB_PREC, StepMaps, affine_image
+from ptoverify.model.intervals import ARB_PREC
 from ptoverify.model.lawbox import LawSpec, enclose, sigma_point
 from ptoverify.model.laws import make_law
+from ptoverify.model.zohmaps import StepMaps, affine_image
 from ptoverify.sim.simulate import simulate_batch
 from ptoverify.verdict import tie_band
 
@@ -133,16 +134,33 @@ class StrideResult:
     depth: int
 
 
+def _split(b):
+    """Cut boxes into _SPLIT x _SPLIT children that tile each box exactly."""
+    f = np.arange(_SPLIT) / _SPLIT  # each side cut in _SPLIT: 3 levels at once
+    t1 = np.repeat(f, _SPLIT)[:, None]
+    t2 = np.tile(f, _SPLIT)[:, None]
+    # a child's upper edge is computed exactly as its neighbour's lower edge
+    # (t + 1/8 is exact), and the last one is the box's own edge: no gaps
+    lo1 = b[0] + t1 * (b[1] - b[0])
+    lo2 = b[2] + t2 * (b[3] - b[2])
+    u1, u2 = t1 + 1.0 / _SPLIT, t2 + 1.0 / _SPLIT
+    hi1 = np.where(u1 >= 1.0, b[1], b[0] + u1 * (b[1] - b[0]))
+    hi2 = np.where(u2 >= 1.0, b[3], b[2] + u2 * (b[3] - b[2]))
+    return tuple(v.ravel() for v in (lo1, hi1, lo2, hi2))
+
+
 def stride_check(
-    spec: LawSpec, cfg: Config, maps: StepMaps, boxes, *, depth: int = 24, cap: int = 20_000
+    spec: LawSpec, cfg: Config, maps: StepMaps, boxes, *, depth: int = 24, cap: int = 256
 ) -> StrideResult:
-    """Prove no stride-over per cell, refining failing cells into quarters.
+    """Prove no stride-over per cell, refining failing cells.
 
     A failing box is cut into 8 x 8 children (three halvings of each side, so
     children tile the box exactly: the last child ends at the box's edge); each
-    child is checked again, down to ``depth`` halvings or while fewer than
-    ``cap`` boxes fail.  The verdict of a
-    cell holds where all its leaves pass; the failing leaves' area is its gap.
+    child is checked again, down to ``depth`` halvings, for as long as at most
+    ``cap`` boxes of its cell fail.  Each cell is refined on its own, so the
+    result of a cell does not depend on the other cells checked with it (a
+    cluster may split the cells into blocks).  The verdict of a cell holds where
+    all its leaves pass; the failing leaves' area is its gap.
 
     Parameters
     ----------
@@ -157,46 +175,46 @@ def stride_check(
     depth : int
         Most refinement levels.
     cap : int
-        Most failing boxes carried to the next level.
+        Most failing boxes of one cell carried to the next level.
 
     Returns
     -------
     StrideResult
-        Per-cell verdicts and gaps.
+        Per-cell verdicts and gaps; leaves ordered by cell, then position.
     """
     n = boxes[0].size
     s, r = _check(spec, cfg, maps, boxes)
     owner = np.arange(n)
     cur = boxes
-    fail_s, fail_r = ~s, ~r
-    level = 0
-    while level < depth and (fail_s | fail_r).any() and np.count_nonzero(fail_s | fail_r) <= cap:
-        keep = np.flatnonzero(fail_s | fail_r)
-        b = tuple(v[keep] for v in cur)
-        f = np.arange(_SPLIT) / _SPLIT  # each side cut in _SPLIT: 3 levels at once
-        t1 = np.repeat(f, _SPLIT)[:, None]
-        t2 = np.tile(f, _SPLIT)[:, None]
-        # a child's upper edge is computed exactly as its neighbour's lower edge
-        # (t + 1/8 is exact), and the last one is the box's own edge: no gaps
-        lo1 = b[0] + t1 * (b[1] - b[0])
-        lo2 = b[2] + t2 * (b[3] - b[2])
-        u1, u2 = t1 + 1.0 / _SPLIT, t2 + 1.0 / _SPLIT
-        hi1 = np.where(u1 >= 1.0, b[1], b[0] + u1 * (b[1] - b[0]))
-        hi2 = np.where(u2 >= 1.0, b[3], b[2] + u2 * (b[3] - b[2]))
-        kids = tuple(v.ravel() for v in (lo1, hi1, lo2, hi2))
-        owner = np.tile(owner[keep], _SPLIT * _SPLIT)
-        cur = kids
+    kept = []  # failing leaves no longer refined: (boxes, owner, strict fails, relaxed fails)
+    level = deepest = 0
+    while True:
+        bad = ~s | ~r
+        go = bad & (np.bincount(owner[bad], minlength=n)[owner] <= cap)
+        if level >= depth:
+            go[:] = False
+        stop = bad & ~go
+        kept.append((tuple(v[stop] for v in cur), owner[stop], ~s[stop], ~r[stop]))
+        if not go.any():
+            break
+        cur = _split(tuple(v[go] for v in cur))
+        owner = np.tile(owner[go], _SPLIT * _SPLIT)
         s, r = _check(spec, cfg, maps, cur)
-        fail_s, fail_r = ~s, ~r
         level += 3
-    area = (cur[1] - cur[0]) * (cur[3] - cur[2])
+        deepest = level
+    leaves = tuple(np.concatenate([k[0][q] for k in kept]) for q in range(4))
+    owner = np.concatenate([k[1] for k in kept])
+    fail_s = np.concatenate([k[2] for k in kept])
+    fail_r = np.concatenate([k[3] for k in kept])
+    order = np.lexsort((leaves[2], leaves[0], owner))  # canonical: by cell, then position
+    leaves = tuple(v[order] for v in leaves)
+    owner, fail_s, fail_r = owner[order], fail_s[order], fail_r[order]
+    area = (leaves[1] - leaves[0]) * (leaves[3] - leaves[2])
     gap_s = np.bincount(owner[fail_s], weights=area[fail_s], minlength=n)
     gap_r = np.bincount(owner[fail_r], weights=area[fail_r], minlength=n)
-    bad = fail_s | fail_r
-    leaves = tuple(v[bad] for v in cur)
     strict = np.bincount(owner[fail_s], minlength=n) == 0
     relaxed = np.bincount(owner[fail_r], minlength=n) == 0
-    return StrideResult(strict, relaxed, gap_s, gap_r, leaves, level)
+    return StrideResult(strict, relaxed, gap_s, gap_r, leaves, deepest)
 
 
 @dataclass(frozen=True)
@@ -217,6 +235,8 @@ class Counterexample:
         The next sample lies in |x1| < d (a stride-over only in the strict reading).
     confirmed_by_simulation : bool
         ``simulate``'s one step (floats) shows the same crossing.
+    a_plant : float
+        The plant's bandwidth of the step [rad/s] (the law keeps its design a).
     """
 
     x0: tuple
@@ -226,6 +246,7 @@ class Counterexample:
     sigma1: float
     lands_in_strip: bool
     confirmed_by_simulation: bool
+    a_plant: float = float("nan")
 
     def to_json(self) -> dict:
         """Plain JSON object."""
@@ -240,8 +261,8 @@ def _sigma_arb(a: arb, x1: arb, x2: arb, level: float) -> arb:
     return a * x1 + (lv * h if x2 > 0 else -lv * h if x2 < 0 else 0)
 
 
-def _certify(spec: LawSpec, cfg: Config, x1: float, x2: float):
-    """Certify a stride-over from (x1, x2) in arb; None if it cannot be certified."""
+def _certify(spec: LawSpec, cfg: Config, x1: float, x2: float, a_plant: float):
+    """Certify a stride-over from (x1, x2) in arb, plant's a = a_plant; None if it cannot."""
     p = cfg.plant
     d, w = cfg.pto.d, p.w_max
     tol = tie_band(w, p.a, p.position_range)
@@ -261,9 +282,9 @@ def _certify(spec: LawSpec, cfg: Config, x1: float, x2: float):
             if not ((so > 0) if side < 0 else (so < 0)):
                 return None
         u = side * w
-        e = (-arb(p.a) * arb(p.sample_time)).exp()
+        e = (-arb(a_plant) * arb(p.sample_time)).exp()
         y2 = arb(u) + (arb(x2) - arb(u)) * e
-        y1 = arb(x1) + arb(u) * arb(p.sample_time) + (arb(x2) - arb(u)) * (1 - e) / arb(p.a)
+        y1 = arb(x1) + arb(u) * arb(p.sample_time) + (arb(x2) - arb(u)) * (1 - e) / arb(a_plant)
         if not (y2 > 0 or y2 < 0):
             return None
         s1 = _sigma_arb(a, y1, y2, w)
@@ -278,7 +299,14 @@ def _certify(spec: LawSpec, cfg: Config, x1: float, x2: float):
 
 
 def find_counterexample(
-    spec: LawSpec, cfg: Config, boxes, failing, *, relaxed: bool, limit: int = 400
+    spec: LawSpec,
+    cfg: Config,
+    boxes,
+    failing,
+    *,
+    relaxed: bool,
+    limit: int = 400,
+    a_plant: float | None = None,
 ):
     """Search failing cells for a certified stride-over.
 
@@ -295,25 +323,31 @@ def find_counterexample(
     relaxed : bool
         Search for a crossing that lands outside the strip (relaxed reading).
     limit : int
-        Cells tried at most.
+        Cells tried at most (spread evenly over the failing ones).
+    a_plant : float, optional
+        The plant's bandwidth [rad/s] (default the configuration's); the law
+        keeps the configuration's design.
 
     Returns
     -------
     Counterexample or None
         A state certified in arb and confirmed by one simulated step.
     """
-    idx = np.flatnonzero(failing)[:limit]
+    idx = np.flatnonzero(failing)
+    idx = idx[np.unique(np.linspace(0, idx.size - 1, min(limit, idx.size)).astype(int))]
     law = make_law(spec.name, cfg)
+    a_plant = cfg.plant.a if a_plant is None else a_plant
+    plant = cfg.with_plant(a=a_plant).plant
     for c in idx.tolist():
         for f1, f2 in ((0.5, 0.5), (0.0, 0.0), (1.0, 1.0), (0.0, 1.0), (1.0, 0.0)):
             x1 = float(boxes[0][c] + f1 * (boxes[1][c] - boxes[0][c]))
             x2 = float(boxes[2][c] + f2 * (boxes[3][c] - boxes[2][c]))
-            got = _certify(spec, cfg, x1, x2)
+            got = _certify(spec, cfg, x1, x2, a_plant)
             if got is None or (relaxed and got[4]):
                 continue
             y, u, s0, s1, inside = got
-            b = simulate_batch(law, cfg.plant, [x1], [x2], 1)
+            b = simulate_batch(law, plant, [x1], [x2], 1)
             z1, z2 = float(b.x1[1, 0]), float(b.x2[1, 0])
             sim = bool(b.u[0, 0] == u and abs(z1 - y[0]) < 1e-9 and abs(z2 - y[1]) < 1e-6)
-            return Counterexample((x1, x2), y, u, s0, s1, inside, sim)
+            return Counterexample((x1, x2), y, u, s0, s1, inside, sim, a_plant)
     return None

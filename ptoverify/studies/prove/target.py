@@ -28,6 +28,9 @@ from ptoverify.model.intervals import ARB_PREC, add, mul
 
 __all__ = ["Target", "make_target", "certify_decrease", "box_in_target", "closed_loop_arb"]
 
+#: Sub-balls a ball of a is cut into to certify the decrease (each must certify).
+DECREASE_PIECES = 64
+
 
 @dataclass(frozen=True)
 class Target:
@@ -88,7 +91,7 @@ def _positive_definite(m: arb_mat) -> bool:
 
 
 def certify_decrease(P, a: arb, T: float, g1: float, g2: float) -> bool:  # noqa: N803
-    """Certify P - Acl' P Acl > 0 for every a in the ball.
+    """Certify P - Acl' P Acl > 0 for every a in the ball (checked on sub-balls covering it).
 
     Parameters
     ----------
@@ -112,10 +115,20 @@ def certify_decrease(P, a: arb, T: float, g1: float, g2: float) -> bool:  # noqa
     False
     """
     with ctx.workprec(ARB_PREC):
-        acl = closed_loop_arb(a, T, g1, g2)
         p = arb_mat([[arb(v) for v in row] for row in P])
-        m = p - acl.transpose() * p * acl
-        return _positive_definite(m)
+        if a.rad() == 0:
+            pieces = [a]
+        else:  # sub-balls covering the ball: less wrapping of a through Acl' P Acl
+            lo, hi = a.lower(), a.upper()
+            n = DECREASE_PIECES
+            pieces = [
+                (lo + (hi - lo) * i / n).union(lo + (hi - lo) * (i + 1) / n) for i in range(n)
+            ]
+        for piece in pieces:
+            acl = closed_loop_arb(piece, T, g1, g2)
+            if not _positive_definite(p - acl.transpose() * p * acl):
+                return False
+        return True
 
 
 def make_target(a: arb, a_nominal: float, T: float, g1: float, g2: float, d: float, w: float):  # noqa: N803
