@@ -53,6 +53,8 @@ __all__ = [
     "ALL_LAW_NAMES",
     "PTOSGains",
     "CascadeGains",
+    "ConformLimits",
+    "conform_limits_from_mapping",
 ]
 
 #: The laws the suite implements (:func:`ptoverify.model.laws.make_law`), here so that naming
@@ -211,6 +213,89 @@ class Robustness:
 
 
 @dataclass(frozen=True)
+class ConformLimits:
+    """Pass limits of ``ptoverify conform`` (table ``[conform]``; README "Conformance").
+
+    Attributes
+    ----------
+    settling_margin : float
+        Settling may exceed the reference's worst by this fraction of it [-]
+        (``settling-vs-discrete-limit``: the excess over N*; under a
+        perturbation: the settling samples), in [0, 10].
+    settling_min_samples : int
+        ... and always by at least this many samples [samples], in [0, 1000].
+    count_margin : float
+        Under a perturbation, a count property (states that limit-cycle, stride
+        over or exceed w_max) may exceed the reference's count by this fraction
+        of the initial states [-], in [0, 1].
+    """
+
+    settling_margin: float = 0.5
+    settling_min_samples: int = 2
+    count_margin: float = 0.01
+
+    def settling_limit(self, reference_worst: float) -> float:
+        """Return the settling limit [samples] for the reference's worst [samples].
+
+        Examples
+        --------
+        >>> ConformLimits().settling_limit(38.0)
+        57.0
+        """
+        extra = max(
+            float(self.settling_min_samples), math.ceil(self.settling_margin * reference_worst)
+        )
+        return reference_worst + extra
+
+    def to_mapping(self) -> dict[str, Any]:
+        """Return the limits as a plain dict (the TOML layout)."""
+        return asdict(self)
+
+
+def conform_limits_from_mapping(raw: Any) -> ConformLimits:
+    """Validate the ``[conform]`` table (every key optional; defaults of :class:`ConformLimits`).
+
+    Parameters
+    ----------
+    raw : dict
+        The parsed table.
+
+    Returns
+    -------
+    ConformLimits
+        The limits.
+
+    Raises
+    ------
+    ConfigError
+        On unknown keys, wrong types or out-of-range values (the key is named).
+
+    Examples
+    --------
+    >>> conform_limits_from_mapping({"settling_margin": 1.0}).settling_margin
+    1.0
+    """
+    if not isinstance(raw, dict):
+        raise ConfigError(f"config key 'conform' must be a table [conform], got {raw!r}")
+    base = ConformLimits()
+    for key in raw:
+        if key not in base.to_mapping():
+            raise ConfigError(f"unknown config key 'conform.{key}'")
+    out: dict[str, Any] = {}
+    for key, hi in (("settling_margin", 10.0), ("count_margin", 1.0)):
+        v = _number("conform", key, raw.get(key, getattr(base, key)))
+        if not 0.0 <= v <= hi:
+            raise ConfigError(f"config key 'conform.{key}' must be in [0, {hi:g}], got {v!r}")
+        out[key] = v
+    n = raw.get("settling_min_samples", base.settling_min_samples)
+    if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= 1000:
+        raise ConfigError(
+            f"config key 'conform.settling_min_samples' must be an integer in [0, 1000], got {n!r}"
+        )
+    return ConformLimits(settling_min_samples=int(n), **out)
+
+
+@dataclass(frozen=True)
 class Config:
     """A full configuration: plant, PD gains and PTO settings.
 
@@ -230,6 +315,8 @@ class Config:
         PTOS baseline settings.
     cascade : CascadeGains
         Cascade P baseline gain.
+    conform : ConformLimits
+        Pass limits of ``ptoverify conform``.
     bandwidth_hz : float or None
         The bandwidth as given in Hz, when the file gave it in Hz.
     """
@@ -242,6 +329,7 @@ class Config:
     robustness: Robustness = field(default_factory=Robustness)
     ptos: PTOSGains = field(default_factory=PTOSGains)
     cascade: CascadeGains = field(default_factory=CascadeGains)
+    conform: ConformLimits = field(default_factory=ConformLimits)
 
     def with_plant(self, **changes: float) -> Config:
         """Return a copy with plant fields replaced (``a``, ``w_max``...)."""
@@ -286,6 +374,8 @@ class Config:
             given = {k: v for k, v in asdict(obj).items() if v is not None}
             if obj != type(obj)():
                 out[key] = given
+        if self.conform != ConformLimits():  # only when set (the digest of others is kept)
+            out["conform"] = self.conform.to_mapping()
         return out
 
 
@@ -439,7 +529,7 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
         infinities and out-of-range values; the message names the key.
     """
     for key in data:
-        if key not in {"name", "robustness", "ptos", "cascade", *_SECTIONS}:
+        if key not in {"name", "robustness", "ptos", "cascade", "conform", *_SECTIONS}:
             raise ConfigError(f"unknown config key '{key}'")
     name = data.get("name", "custom")
     if (
@@ -493,6 +583,7 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
         robustness=robustness_from_mapping(data.get("robustness", {}), plant),
         ptos=PTOSGains(**_baseline_table(data, "ptos", plant["sample_time"])),
         cascade=CascadeGains(**_baseline_table(data, "cascade", plant["sample_time"])),
+        conform=conform_limits_from_mapping(data.get("conform", {})),
     )
 
 

@@ -501,14 +501,24 @@ def ties(x1: NDArray, x2: NDArray, cfg: Config) -> NDArray[np.bool_]:
     return near & (np.abs(x1) >= cfg.pto.d)
 
 
-def _reference_chunked(x1, x2, cfg: Config, chunk: int = 1_000_000):
-    """Return u_ref, region codes and the tie mask, computed a million states at a time."""
+def _reference_chunked(x1, x2, cfg: Config, chunk: int = 1_000_000, precision: str = "float64"):
+    """Return u_ref, region codes and the tie mask, computed a million states at a time.
+
+    In ``float32`` mode the reference is evaluated at the state rounded to
+    float32 and the ties include :func:`ptoverify.conform.precision.float32_ties`.
+    """
+    from ptoverify.conform.precision import as_seen, float32_ties
+
     u_ref, reg = np.empty(x1.size), np.empty(x1.size, dtype=np.int8)
     tie = np.empty(x1.size, dtype=bool)
+    om = omega0_ref(cfg) if precision == "float32" else None
     for i in range(0, x1.size, chunk):
         s = slice(i, i + chunk)
-        u_ref[s], reg[s] = reference(cfg)(x1[s], x2[s])
-        tie[s] = ties(x1[s], x2[s], cfg)
+        y1, y2 = as_seen(x1[s], x2[s], precision)
+        u_ref[s], reg[s] = reference(cfg)(y1, y2)
+        tie[s] = ties(y1, y2, cfg)
+        if precision == "float32":
+            tie[s] |= float32_ties(y1, y2, cfg, om)
     return u_ref, reg, tie
 
 
@@ -575,7 +585,13 @@ def largest_gap(x1: NDArray, x2: NDArray, cfg: Config, n: int = 201) -> dict:
 
 
 def agreement(
-    x1: NDArray, x2: NDArray, u: NDArray, cfg: Config, rtol: float = DEFAULT_RTOL
+    x1: NDArray,
+    x2: NDArray,
+    u: NDArray,
+    cfg: Config,
+    rtol: float = DEFAULT_RTOL,
+    *,
+    precision: str = "float64",
 ) -> tuple[dict, list[dict]]:
     """Compare u with the reference PTO law, region by region.
 
@@ -589,11 +605,14 @@ def agreement(
         Configuration.
     rtol : float
         Tolerance relative to w_max.
+    precision : str
+        ``float64``, or ``float32``: the reference at the state rounded to
+        float32, float32 ties excluded (:mod:`ptoverify.conform.precision`).
 
     Returns
     -------
     summary : dict
-        ``points``, ``excluded``, ``tolerance_mm_s``, ``max_abs_du``, ``worst``,
+        ``precision``, ``points``, ``excluded``, ``tolerance_mm_s``, ``max_abs_du``, ``worst``,
         ``regions`` (per reference region: points, excluded, max_abs_du, state,
         u, u_ref, violations).
     failures : list of dict
@@ -601,7 +620,7 @@ def agreement(
     """
     w = cfg.plant.w_max
     tol = rtol * w
-    u_ref, reg, tie = _reference_chunked(x1, x2, cfg)
+    u_ref, reg, tie = _reference_chunked(x1, x2, cfg, precision=precision)
     du = np.abs(u - u_ref)
     judged = ~tie
     bad = judged & (du > tol)
@@ -631,6 +650,7 @@ def agreement(
         regions[code.name] = entry
     worst = int(np.argmax(np.where(judged, du, -1.0)))
     summary = {
+        "precision": precision,
         "points": int(x1.size),
         "excluded": int(tie.sum()),
         "rtol": rtol,

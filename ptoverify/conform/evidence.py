@@ -444,6 +444,8 @@ def conform_with_evidence(
     table: str | Path | None = None,
     rtol: float,
     timeout: float,
+    precision: str = "float64",
+    perturbations: tuple = (),
 ) -> tuple[ConformResult, ConformEvidence]:
     """Run ``conform`` on a ``--law`` or a ``--table`` and keep the report's evidence.
 
@@ -459,6 +461,10 @@ def conform_with_evidence(
         Agreement tolerance relative to w_max.
     timeout : float
         Budget of the isolated law [s] (responses included).
+    precision : str
+        ``float64`` or ``float32`` (:mod:`ptoverify.conform.precision`).
+    perturbations : tuple of Perturbation
+        Closed loops under perturbation (:mod:`ptoverify.conform.perturbed`; ``law`` only).
 
     Returns
     -------
@@ -469,7 +475,7 @@ def conform_with_evidence(
     """
     keep: dict[str, Any] = {}
     if table is not None:
-        result = conform_table(table, cfg, rtol=rtol, keep=keep)
+        result = conform_table(table, cfg, rtol=rtol, keep=keep, precision=precision)
         note = (
             "a --table gives u only at its states, and a closed loop needs u wherever the "
             "trajectory goes: no responses (run --law for them)"
@@ -483,6 +489,8 @@ def conform_with_evidence(
             timeout=timeout,
             keep=keep,
             after=lambda user: user_responses(user, cfg),
+            precision=precision,
+            perturbations=perturbations,
         )
         note, settle_note = "", ""
         if "after" not in keep:
