@@ -1,5 +1,6 @@
 """The firmware example: the PTO law in C99, built by the system compiler, gated by
-``conform --law`` in double precision (conforms) and single precision (does not, and why)."""
+``conform --law`` in double precision (conforms), single precision judged as a float64
+function (does not, and why) and single precision under ``--precision float32`` (conforms)."""
 
 import json
 import shutil
@@ -18,9 +19,9 @@ pytestmark = pytest.mark.skipif(
 )
 
 
-def _conform(capsys, func, tmp_path):
+def _conform(capsys, func, tmp_path, *extra):
     junit = tmp_path / f"{func}.xml"
-    code = main(["conform", "--law", f"{SPEC}:{func}", "--json", "--junit", str(junit)])
+    code = main(["conform", "--law", f"{SPEC}:{func}", "--json", "--junit", str(junit), *extra])
     return code, json.loads(capsys.readouterr().out), junit
 
 
@@ -50,6 +51,24 @@ def test_c_single_build_fails_only_agreement(capsys, tmp_path):
     others = {n: p for n, p in res["properties"].items() if n != "agreement"}
     assert res["properties"]["agreement"]["status"] == "fail"
     assert all(p["status"] == "pass" for p in others.values()), others
+
+
+@pytest.mark.slow
+def test_c_single_build_conforms_as_float32(capsys, tmp_path):
+    """Under --precision float32 the reference is evaluated at the state the float build
+    rounded to, and states within the derived float32 tie band of a boundary are ties: what
+    is left is the float build's own arithmetic, which stays within 1e-6 w_max (no
+    precision loss in log1p or in the omega_c root)."""
+    code, res, _ = _conform(capsys, "pto_single", tmp_path, "--precision", "float32")
+    assert code == 0 and res["conforms"], res["failures"]
+    assert res["precision"] == "float32" and res["agreement"]["precision"] == "float32"
+    a = res["agreement"]
+    assert a["max_abs_du"] <= a["tolerance_mm_s"]
+    # the float build really computes in float: far from the boundaries it differs from the
+    # double reference by more than double round-off (else the mode would prove nothing)
+    assert a["max_abs_du"] > 1e-9 * 300.0
+    # ties are a small fraction of the judged states
+    assert 0 < a["excluded"] < 1e-3 * a["points"]
 
 
 def test_c_source_is_c99_without_allocation_or_state():

@@ -55,8 +55,6 @@ ALLOWED: dict[str, str] = {
     "ptoverify.cli.print_json": "no Parameters section",
     "ptoverify.cli.to_jsonable": "no Parameters section",
     "ptoverify.cli.write_atomic": "no Parameters section",
-    "ptoverify.conform.gate.ConformResult": "parameter 'config' undocumented",
-    "ptoverify.conform.gate.format_result": "no Parameters section",
     "ptoverify.conform.gate.reference_law_scalar": "no Parameters section",
     "ptoverify.sim.metrics.sign_reversals": "parameter 'band' states no unit",
     "ptoverify.model.ocp.CollocationOCP": "parameter 'control' undocumented",

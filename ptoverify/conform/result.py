@@ -117,6 +117,8 @@ class ConformResult:
         None for ``isolation``), ``detail``.
     timings_s : dict
         Wall time per phase [s].
+    config : str
+        Name of the configuration judged against.
     unverified : list of str
         Properties that could not be evaluated (``unverified``).
     law_output : str
@@ -202,18 +204,19 @@ def clip_output(text: str, n: int = 2000) -> str:
     return f"{text[:n]}\n[... {len(text) - 2 * n} characters left out ...]\n{text[-n:]}"
 
 
-def summary_line(r: ConformResult) -> str:
+def summary_line(result: ConformResult) -> str:
     """Return the verdict in one line: precision, perturbations, where the reference fails.
 
     Parameters
     ----------
-    r : ConformResult
+    result : ConformResult
         The result.
 
     Returns
     -------
     str
     """
+    r = result
     why = f": {r.mode_reason}" if r.mode_reason else ""
     line = f"{'CONFORMS' if r.conforms else 'DOES NOT CONFORM'}: {r.target} (mode {r.mode}{why})"
     if r.precision != "float64":
@@ -230,12 +233,12 @@ def summary_line(r: ConformResult) -> str:
     return line
 
 
-def format_result(r: ConformResult) -> str:
+def format_result(result: ConformResult) -> str:
     """Human-readable report: verdict, agreement per region, properties, failures.
 
     Parameters
     ----------
-    r : ConformResult
+    result : ConformResult
         The result.
 
     Returns
@@ -243,6 +246,7 @@ def format_result(r: ConformResult) -> str:
     str
         Lines: :func:`summary_line`, the agreement, each property, each failure.
     """
+    r = result
     lines = [summary_line(r)]
     a = r.agreement
     if "regions" in a:
