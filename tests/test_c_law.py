@@ -67,8 +67,8 @@ def test_c_single_build_conforms_as_float32(capsys, tmp_path):
     # the float build really computes in float: far from the boundaries it differs from the
     # double reference by more than double round-off (else the mode would prove nothing)
     assert a["max_abs_du"] > 1e-9 * 300.0
-    # ties are a small fraction of the judged states
-    assert 0 < a["excluded"] < 1e-3 * a["points"]
+    # ties (float64 curve ties and float32 ties) are a small fraction of the judged states
+    assert 0 < a["excluded"] < 1e-2 * a["points"]
 
 
 def test_c_source_is_c99_without_allocation_or_state():

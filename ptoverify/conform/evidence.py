@@ -62,10 +62,21 @@ __all__ = [
     "user_responses",
     "settling_summary",
     "conform_with_evidence",
+    "reference_delay_cycles",
     "CELLS",
+    "SIGNAL_METRICS",
 ]
 
 CELLS = 121  #: cells per axis of each |u - u_ref| map
+#: The response metrics that mean something for each Section 6 signal: a step's
+#: settling and rise; a ramp's overshoot past its end value (its "settling" from the
+#: record's start measures the ramp, not the law); a sine's phase delay (a sine never
+#: settles).
+SIGNAL_METRICS = {
+    "step": ("overshoot_mm", "rise_time_s", "settling_2pct_s", "settling_0p01mm_s"),
+    "ramp": ("overshoot_mm",),
+    "sine": ("phase_delay_deg",),
+}
 _CHUNK = 1_000_000  #: states per reference evaluation
 
 
@@ -269,7 +280,8 @@ class Response:
     user, reference : SimResult
         The user law's and the reference PTO law's responses (same reference signal).
     user_metrics, reference_metrics : dict
-        ``simulate --json`` metrics, exact between samples ([mm], [s], [deg]).
+        ``simulate --json`` metrics, exact between samples ([mm], [s], [deg]), only
+        those of :data:`SIGNAL_METRICS` for the signal.
     max_abs_dx1_mm : float
         Largest |x1_user - x1_ref| over the samples [mm].
     """
@@ -311,14 +323,53 @@ def user_responses(user, cfg: Config) -> dict[str, Response]:
     out = {}
     for name in SIGNALS:
         ru, rr = simulate(law, cfg.plant, name), simulate(ref, cfg.plant, name)
+        keys = SIGNAL_METRICS.get(name, ())
+        mu = exact_metrics(ru, cfg.plant, ru.reference).json_metrics()
+        mr = exact_metrics(rr, cfg.plant, rr.reference).json_metrics()
         out[name] = Response(
             ru,
             rr,
-            exact_metrics(ru, cfg.plant, ru.reference).json_metrics(),
-            exact_metrics(rr, cfg.plant, rr.reference).json_metrics(),
+            {k: mu.get(k) for k in keys},
+            {k: mr.get(k) for k in keys},
             float(np.max(np.abs(ru.x1 - rr.x1))),
         )
     return out
+
+
+def reference_delay_cycles(cfg: Config, delay: int = 1) -> dict:
+    """How often the reference law itself limit-cycles with a computation delay.
+
+    The reference's closed loop on the vectorized sweep of ``conform``
+    (:func:`ptoverify.studies.properties.initial_grid`, 101 x 101 + 200 states)
+    with ``delay`` samples of delay, measured as the perturbed comparison
+    measures it (:mod:`ptoverify.conform.perturbed`).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+    delay : int
+        Computation delay [samples].
+
+    Returns
+    -------
+    dict
+        ``delay_samples``, ``states`` and ``cycling`` (initial states that
+        oscillate or are not settled at the end), ``unsettled`` (never settled
+        under definition ``settling``).
+    """
+    from ptoverify.conform.closedloop import SETTLING, sweep_sizes
+    from ptoverify.conform.perturbed import Perturbation, reference_loop
+
+    sizes = sweep_sizes("vectorized", None)
+    loop = reference_loop(cfg, Perturbation(delay_samples=delay), sizes)
+    return {
+        "delay_samples": delay,
+        "states": int(loop.cycle.size),
+        "cycling": int(loop.cycle.sum()),
+        "unsettled": int(np.isinf(loop.settle).sum()),
+        "settling": SETTLING,
+    }
 
 
 def _stats(ratio: NDArray) -> dict:
@@ -387,6 +438,8 @@ class ConformEvidence:
         :func:`settling_summary` (None when not computed).
     settling_note : str
         Why there is no settling summary.
+    reference_delay : dict or None
+        :func:`reference_delay_cycles` with a one-sample delay.
     """
 
     maps: list[DuMap]
@@ -397,6 +450,7 @@ class ConformEvidence:
     responses_note: str
     settling: dict | None
     settling_note: str
+    reference_delay: dict | None = None
 
     def to_json(self) -> dict:
         """JSON-able summary (``results.json`` key ``evidence``)."""
@@ -412,6 +466,7 @@ class ConformEvidence:
             "responses_note": self.responses_note,
             "settling": self.settling,
             "settling_note": self.settling_note,
+            "reference_delay": self.reference_delay,
         }
 
 
@@ -512,5 +567,6 @@ def conform_with_evidence(
         note,
         settling,
         settle_note,
+        reference_delay_cycles(cfg, 1),
     )
     return result, evidence

@@ -67,6 +67,8 @@ __all__ = [
     "robust_box",
     "perturbed_runs",
     "perturbed_verdicts",
+    "reference_loop",
+    "LoopMeasures",
 ]
 
 MAX_DELAY = 10  #: largest --delay [samples] (as the [robustness] box)
@@ -368,18 +370,32 @@ class PerturbedRun:
         }
 
 
-@dataclass(frozen=True)
-class _Loop:
-    """Per-state closed-loop measures of one law under one perturbation."""
+@dataclass(frozen=True, eq=False)
+class LoopMeasures:
+    """Per-state closed-loop measures of one law under one perturbation.
 
-    stride: NDArray[np.bool_]  # initial states that stride over at least once
-    cycle: NDArray[np.bool_]  # oscillating or not settled at the end
-    over: int  # samples with |u| > w_max
-    settle: NDArray[np.float64]  # settling samples (inf: never)
-    u_max: float  # largest |u| [mm/s]
+    Attributes
+    ----------
+    stride : ndarray of bool, shape (n,)
+        Initial states that stride over l1/l2 at least once.
+    cycle : ndarray of bool, shape (n,)
+        Initial states that oscillate or are not settled at the end.
+    over : int
+        Samples with |u| > w_max [-].
+    settle : ndarray, shape (n,)
+        Settling samples under ``SETTLING`` [samples] (inf: never).
+    u_max : float
+        Largest |u| [mm/s].
+    """
+
+    stride: NDArray[np.bool_]
+    cycle: NDArray[np.bool_]
+    over: int
+    settle: NDArray[np.float64]
+    u_max: float
 
 
-def _measure(res: BatchResult, cfg: Config, p: Perturbation) -> _Loop:
+def _measure(res: BatchResult, cfg: Config, p: Perturbation) -> LoopMeasures:
     from ptoverify.studies.properties import crossing_masks, oscillating
 
     steps = res.u.shape[0]
@@ -387,7 +403,7 @@ def _measure(res: BatchResult, cfg: Config, p: Perturbation) -> _Loop:
     osc = oscillating(res.x1[-max(20, steps // 4) :], BAND_MM)
     unsettled = np.abs(res.x1[-1]) > BAND_MM
     au = np.abs(res.u)
-    return _Loop(
+    return LoopMeasures(
         stride.any(axis=0),
         osc | unsettled,
         int((au > cfg.plant.w_max).sum()),
@@ -404,8 +420,23 @@ def _states(cfg: Config, sizes: tuple[int, int, int]) -> tuple[NDArray, NDArray,
 
 
 @functools.lru_cache(maxsize=16)
-def _reference_loop(cfg: Config, p: Perturbation, sizes: tuple[int, int, int]) -> _Loop:
-    """Measure the reference under ``p`` on the sweep ``sizes`` (cached)."""
+def reference_loop(cfg: Config, p: Perturbation, sizes: tuple[int, int, int]) -> LoopMeasures:
+    """Measure the reference under ``p`` on the sweep ``sizes`` (cached).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+    p : Perturbation
+        The perturbation.
+    sizes : (n1, n2, rest)
+        The sweep (:func:`ptoverify.studies.properties.initial_grid`).
+
+    Returns
+    -------
+    LoopMeasures
+        Per initial state: strides over, cycles, settling samples; samples over w_max.
+    """
     from ptoverify.sim.simulate import simulate_batch
 
     x1, x2, steps = _states(cfg, sizes)
@@ -413,7 +444,7 @@ def _reference_loop(cfg: Config, p: Perturbation, sizes: tuple[int, int, int]) -
     return _measure(res, cfg, p)
 
 
-def _compare(user: _Loop, ref: _Loop, x1, x2, cfg: Config) -> tuple[Comparison, ...]:
+def _compare(user: LoopMeasures, ref: LoopMeasures, x1, x2, cfg: Config) -> tuple[Comparison, ...]:
     lim = cfg.conform
     n = x1.size
     slack = math.ceil(lim.count_margin * n)
@@ -537,7 +568,7 @@ def perturbed_runs(
     law = as_law(user, cfg)
     runs, fails = [], []
     for p in perturbations:
-        ref = _reference_loop(cfg, p, sizes)
+        ref = reference_loop(cfg, p, sizes)
         try:
             res = simulate_batch(law, cfg.plant, x1, x2, steps, mismatch=p.mismatch())
         except LawFault as fault:
