@@ -1187,6 +1187,14 @@ the range and w_max), or else a state in each of 200 x 200 cells and 100 per reg
 "insufficient coverage" (exit 1). The reference is evaluated at the table's x1, x2, so
 firmware that rounds the state (float32) must write back the state it actually evaluated.
 
+--precision float32 judges firmware that computes in single precision: the reference is
+evaluated at the state rounded to float32 and states within the derived float32 tie band of a
+region boundary are ties (README). --delay N, --quantum MM, --velocity-noise MM_S --seed S,
+--a-ratio R (or --robust: the corners of the [robustness] box) also run the closed loops of
+your law and the reference under that perturbation, from the same states with the same noise:
+each property must be no worse than the reference's by more than the [conform] margins; where
+the reference itself fails (it limit-cycles with a one-sample delay) the output says so.
+
 --report DIR also writes a report for a review (verdict, properties with units, heat maps of
 |u - u_ref| with l1, l2, l1*, l2* and |x1| < d, closed loop, settling / N*T, step/ramp/sine
 responses of a --law next to the reference); DIR is checked before anything runs and written

@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ptoverify.config import Config
-from ptoverify.conform.agreement import omega0_ref, reference, ties
+from ptoverify.conform.agreement import omega0_ref, reference, reference_values
 from ptoverify.conform.gate import ConformResult, as_law, conform_spec, conform_table
 from ptoverify.model.curves import level_curve_x1
 from ptoverify.sim.exact import exact_metrics
@@ -470,18 +470,17 @@ class ConformEvidence:
         }
 
 
-def _maps(states, cfg: Config, bounds: Boundaries, tol: float) -> tuple[list[DuMap], int, int]:
-    """Both maps from the judged states (curve ties excluded, as the agreement does)."""
+def _maps(
+    states, cfg: Config, bounds: Boundaries, tol: float, precision: str = "float64"
+) -> tuple[list[DuMap], int, int]:
+    """Both maps from the judged states (ties excluded, as the agreement does)."""
     if states is None:
         x1 = x2 = du = np.zeros(0)
         excluded = 0
     else:
         x1, x2, u = (np.asarray(s, dtype=float) for s in states)
-        du, tie = np.empty(x1.size), np.empty(x1.size, dtype=bool)
-        for i in range(0, x1.size, _CHUNK):
-            s = slice(i, i + _CHUNK)
-            du[s] = np.abs(u[s] - reference(cfg)(x1[s], x2[s])[0])
-            tie[s] = ties(x1[s], x2[s], cfg)
+        u_ref, _, tie = reference_values(x1, x2, cfg, _CHUNK, precision)
+        du = np.abs(u - u_ref)
         excluded = int(tie.sum())
         x1, x2, du = x1[~tie], x2[~tie], du[~tie]
     R, w = cfg.plant.position_range, cfg.plant.w_max
@@ -556,7 +555,7 @@ def conform_with_evidence(
             settle_note = "not computed" + (f": {prop.detail}" if prop is not None else "")
     bounds = boundaries(cfg)
     tol = rtol * cfg.plant.w_max
-    maps, judged, excluded = _maps(keep.get("states"), cfg, bounds, tol)
+    maps, judged, excluded = _maps(keep.get("states"), cfg, bounds, tol, precision)
     settling = settling_summary(keep["settling"]) if "settling" in keep else None
     evidence = ConformEvidence(
         maps,

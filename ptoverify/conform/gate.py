@@ -49,12 +49,23 @@ Agreement (:mod:`ptoverify.conform.agreement`) where the law is used
 Odd symmetry
     u(-x) = -u(x) to the agreement tolerance on the grid, curve ties included:
     on a mirrored tie the law must pick the mirrored branch.
+Precision (:mod:`ptoverify.conform.precision`)
+    ``float64`` (default) or ``float32``: in float32 the reference is evaluated
+    at the state rounded to float32, and states within the derived float32 tie
+    band of a region boundary are excluded and counted.
+Under perturbation (:mod:`ptoverify.conform.perturbed`, callable only)
+    With a delay, quantum, velocity noise (seeded) or a-ratio, or the corners of
+    the ``[robustness]`` box, the closed loops of the law and the reference run
+    from the same states under the same perturbation and noise; the law may be
+    no worse than the reference by more than the ``[conform]`` margins on each
+    property, and where the reference itself fails, the result says so.
 Closed loop (callable only)
     The sweep of ``check`` (101 x 101 + 200 states vectorized, 21 x 21 + 40
     scalar) with :mod:`ptoverify.studies.properties`' definitions: stride-overs, limit
-    cycles or not settled within 1e-3 mm, |u| <= w_max; settling against the
-    discrete-time limit N* (worst excess <= E_ref + max(2, ceil(E_ref / 2))
-    samples, E_ref the reference's worst; ``unverified`` if N* is unknown).
+    cycles or not settled within 1e-3 mm, |u| <= w_max; settling (definition
+    ``0p001mm``) against the discrete-time limit N* (worst excess <= E_ref +
+    max(2, ceil(E_ref / 2)) samples by default (``[conform]``), E_ref the
+    reference's worst; ``unverified`` if N* is unknown).
 Tables
     Regular files only, parsed in chunks.  States beyond 1000 x the envelope
     are bad input (as ``mintime``).  ``coverage``: the table must hold every
@@ -89,7 +100,6 @@ from ptoverify.conform.agreement import (
     MATCH_TOL,
     N_BAND,
     N_RANDOM,
-    RANDOM_SEED,
     agreement,
     conformance_grid,
     failure,
@@ -106,6 +116,12 @@ from ptoverify.conform.closedloop import (
     closed_loop,
     settling_states,
 )
+from ptoverify.conform.determinism import (
+    N_DETERMINISM,
+    determinism,
+    determinism_states,
+    differs,
+)
 from ptoverify.conform.isolation import MEMORY_LIMIT_BYTES, IsolatedLaw, LawAborted
 from ptoverify.conform.perturbed import (
     PERTURBED_PROPERTIES,
@@ -119,6 +135,7 @@ from ptoverify.conform.result import (
     clip_output,
     format_result,
     input_bound,
+    summary_line,
 )
 from ptoverify.conform.table import MIN_PER_REGION, conform_table
 from ptoverify.conform.userlaw import (
@@ -152,6 +169,7 @@ __all__ = [
     "conform_spec",
     "conform_table",
     "format_result",
+    "summary_line",
     "DEFAULT_RTOL",
     "DEFAULT_TIMEOUT_S",
     "N_RANDOM",
@@ -165,8 +183,6 @@ __all__ = [
     "LATTICE",
 ]
 
-N_DETERMINISM = 2000  #: states of the determinism check
-_CHUNKS = (1, 2, 3, 5, 8, 13, 21, 34)  #: chunk sizes of the determinism check, cycled
 
 #: every property of a callable, in the order they are evaluated
 PROPERTIES = (
@@ -214,76 +230,7 @@ def reference_law_scalar(x1: float, x2: float, cfg: Config) -> float:
     return reference(cfg).scalar(x1, x2)[0]
 
 
-# ------------------------------------------------------------------ determinism
-def _determinism_states(cfg: Config, grid: tuple[NDArray, NDArray]) -> tuple[NDArray, NDArray]:
-    """Probe-like states: grid points on/near curves and edges, and random states."""
-    rng = np.random.default_rng(RANDOM_SEED + 1)
-    g1, g2 = grid
-    tie = ties(g1, g2, cfg)
-    pick = np.concatenate(
-        [
-            rng.choice(np.flatnonzero(tie), min(200, int(tie.sum())), replace=False),
-            rng.choice(g1.size, min(N_DETERMINISM // 2, g1.size), replace=False),
-        ]
-    )
-    n = N_DETERMINISM - pick.size
-    R, w = cfg.plant.position_range, cfg.plant.w_max
-    x1 = np.concatenate([g1[pick], rng.uniform(-R, R, n)])
-    x2 = np.concatenate([g2[pick], rng.uniform(-w, w, n)])
-    return x1, x2
-
-
-def determinism(user, x1: NDArray, x2: NDArray) -> tuple[NDArray, list[dict]]:
-    """Call the law on the same states twice, shuffled and in chunks; all must agree.
-
-    Parameters
-    ----------
-    user : UserLaw or IsolatedLaw
-        The law.
-    x1, x2 : ndarray
-        States [mm], [mm/s].
-
-    Returns
-    -------
-    u : ndarray
-        u of the first pass [mm/s] (kept for the re-check after all other calls).
-    failures : list of dict
-        One ``pure-function`` failure at the first differing state, or none.
-    """
-    first = user(x1, x2)
-    perm = np.random.default_rng(RANDOM_SEED + 2).permutation(x1.size)
-    shuffled = np.empty_like(first)
-    shuffled[perm] = user(x1[perm], x2[perm])
-    chunked, i, k = np.empty_like(first), 0, 0
-    while i < x1.size:
-        j = min(x1.size, i + _CHUNKS[k % len(_CHUNKS)])
-        chunked[i:j] = user(x1[i:j], x2[i:j])
-        i, k = j, k + 1
-    passes = (("a second call", user(x1, x2)), ("a shuffled call", shuffled))
-    passes += (("calls in chunks of " + "/".join(map(str, _CHUNKS)), chunked),)
-    for how, other in passes:
-        fails = _differs(first, other, x1, x2, how)
-        if fails:
-            return first, fails
-    return first, []
-
-
-def _differs(first, other, x1, x2, how: str) -> list[dict]:
-    diff = first != other
-    if not diff.any():
-        return []
-    i = int(np.argmax(diff))
-    return [
-        failure(
-            "pure-function",
-            (x1[i], x2[i]),
-            f"has memory or is not deterministic: u = {float(first[i])!r} mm/s at the first "
-            f"call, {float(other[i])!r} mm/s at {how} ({int(diff.sum())} of {x1.size} "
-            "states differ)",
-        )
-    ]
-
-
+# ------------------------------------------------------------------ properties
 def _odd_symmetry(user, x1: NDArray, x2: NDArray, u: NDArray, cfg: Config, rtol: float):
     """u(-x) = -u(x) on the grid, curve ties included, to the agreement tolerance."""
     tol = rtol * cfg.plant.w_max
@@ -346,7 +293,7 @@ def _judge(user, failures: list[dict], cfg: Config, opt: _Options, keep=None):
     blocked = next((f for f in failures if f["property"] in ("evaluation", "pure-function")), None)
     if blocked is None:
         t = time.perf_counter()
-        d1, d2 = _determinism_states(cfg, grid)
+        d1, d2 = determinism_states(cfg, grid)
         try:
             u_det, f = determinism(user, d1, d2)
         except LawFault as fault:
@@ -428,7 +375,7 @@ def _judge(user, failures: list[dict], cfg: Config, opt: _Options, keep=None):
 
 def _recheck(user, d1, d2, u_det, v: Verdict) -> tuple[Verdict, list[dict]]:
     """Call the law at the determinism states once more, after every other call."""
-    f = _differs(u_det, user(d1, d2), d1, d2, f"the end (after {user.calls} calls)")
+    f = differs(u_det, user(d1, d2), d1, d2, f"the end (after {user.calls} calls)")
     if f:
         return Verdict(v.name, FAIL, 1, 0, f[0]["detail"], "<=", "1"), f
     return v, []
