@@ -255,7 +255,18 @@ def probe_set(
 
 
 def grid_csv(cfg: Config) -> str:
-    """Return the probe set (:func:`probe_set`) as CSV text, columns x1, x2 (exact repr)."""
+    """Return the probe set (:func:`probe_set`) as CSV text, columns x1, x2 (exact repr).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    str
+        Header ``x1,x2`` and one state per line [mm], [mm/s].
+    """
     parts = probe_set(cfg).values()
     x1 = np.concatenate([p[0] for p in parts])
     x2 = np.concatenate([p[1] for p in parts])

@@ -26,13 +26,35 @@ def reference(cfg: Config) -> Law:
 
 
 def tie_band(cfg: Config) -> float:
-    """Return the exclusion band of ``verdict.tie_band`` for ``cfg`` [mm/s]."""
+    """Return the exclusion band of ``verdict.tie_band`` for ``cfg`` [mm/s].
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (w_max [mm/s], a [rad/s], position_range [mm]).
+
+    Returns
+    -------
+    float
+        1e-9 (w_max + a position_range) [mm/s].
+    """
     p = cfg.plant
     return verdict.tie_band(p.w_max, p.a, p.position_range)
 
 
 def omega0_ref(cfg: Config) -> float | None:
-    """omega0 [mm/s] the reference uses, None when it has no switching zone."""
+    """Return omega0 [mm/s] the reference uses, None when it has no switching zone.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    float or None
+        Level of l1*, l2* [mm/s].
+    """
     from ptoverify.model.zones import zone_for_law
 
     z = zone_for_law(cfg, "corrected")
@@ -41,7 +63,23 @@ def omega0_ref(cfg: Config) -> float | None:
 
 
 def failure(prop: str, state, detail: str, **extra) -> dict:
-    """Return a failure entry: property, state [x1, x2], detail (and extra keys)."""
+    """Return a failure entry: property, state [x1, x2], detail (and extra keys).
+
+    Parameters
+    ----------
+    prop : str
+        The property (or ``evaluation``, ``isolation``).
+    state : sequence of 2 floats
+        The first state that shows it, x1 [mm], x2 [mm/s].
+    detail : str
+        What failed.
+    **extra
+        More keys (``sample``, ``at``).
+
+    Returns
+    -------
+    dict
+    """
     return {
         "property": prop,
         "state": [float(state[0]), float(state[1])],
