@@ -292,3 +292,24 @@ def test_float32_reference_at_the_state_as_seen(capsys):
     assert r32.agreement["max_abs_du"] == 0.0
     r64 = conform_callable(rounded, cfg, **FEW)
     assert not r64.conforms and set(r64.failed_properties()) == {"agreement"}
+
+
+@pytest.mark.slow
+def test_assert_conforms_takes_perturbations_and_precision():
+    from ptoverify.conform.testing import assert_conforms
+
+    r = assert_conforms(REF, perturbations=(Perturbation(delay_samples=1),))
+    assert r.precision == "float64" and len(r.perturbed) == 1
+    assert "no-limit-cycle under delay 1 sample" in r.reference_fails
+    # a failing law's message carries the summary line with the perturbation
+    with pytest.raises(AssertionError, match="under delay 1 sample"):
+        assert_conforms(f"{__file__}:_to_law", perturbations=(Perturbation(delay_samples=1),))
+    # float32 says the implementation sees the state rounded to float32: the double
+    # reference (which does not round) then disagrees where rounding crosses |x1| = d
+    with pytest.raises(AssertionError, match="precision float32"):
+        assert_conforms(REF, precision="float32")
+
+
+def _to_law(x1, x2, cfg):
+    """Return the time-optimal bang-bang law's u [mm/s] at x1 [mm], x2 [mm/s] (not the PTO)."""
+    return make_law("to", cfg).vector(np.asarray(x1, float), np.asarray(x2, float))[0]
