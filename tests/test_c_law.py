@@ -81,3 +81,30 @@ def test_c_source_is_c99_without_allocation_or_state():
         r"^(?:static\s+)?(?:const\s+)?(?:double|float|real|int)\s+\w+\s*(?:=|;|\[)", src, re.M
     )
     assert file_scope_vars == [], f"state between calls: {file_scope_vars}"
+
+
+@pytest.mark.slow
+def test_c_single_build_table_conforms_as_float32(tmp_path):
+    """The --table route of the same float build: the emitted probe set evaluated by the
+    float32 C law conforms under --precision float32 and not as a float64 function."""
+    import importlib.util
+
+    from ptoverify.config import paper_config
+    from ptoverify.conform.agreement import grid_csv
+    from ptoverify.conform.table import conform_table
+
+    spec = importlib.util.spec_from_file_location("c_pto_for_test", SPEC)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    cfg = paper_config()
+    rows = grid_csv(cfg).splitlines()[1:]
+    table = tmp_path / "fw.csv"
+    with table.open("w") as fh:
+        fh.write("x1,x2,u\n")
+        for row in rows:
+            x1, x2 = (float(v) for v in row.split(","))
+            fh.write(f"{row},{mod.pto_single(x1, x2, cfg)!r}\n")
+    r32 = conform_table(table, cfg, precision="float32")
+    assert r32.conforms, r32.failures
+    r64 = conform_table(table, cfg)
+    assert not r64.conforms and set(r64.failed_properties()) == {"agreement"}
