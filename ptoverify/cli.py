@@ -1195,6 +1195,14 @@ the range and w_max), or else a state in each of 200 x 200 cells and 100 per reg
 "insufficient coverage" (exit 1). The reference is evaluated at the table's x1, x2, so
 firmware that rounds the state (float32) must write back the state it actually evaluated.
 
+--precision float32 judges firmware that computes in single precision: the reference is
+evaluated at the state rounded to float32 and states within the derived float32 tie band of a
+region boundary are ties (README). --delay N, --quantum MM, --velocity-noise MM_S --seed S,
+--a-ratio R (or --robust: the corners of the [robustness] box) also run the closed loops of
+your law and the reference under that perturbation, from the same states with the same noise:
+each property must be no worse than the reference's by more than the [conform] margins; where
+the reference itself fails (it limit-cycles with a one-sample delay) the output says so.
+
 --report DIR also writes a report for a review (verdict, properties with units, heat maps of
 |u - u_ref| with l1, l2, l1*, l2* and |x1| < d, closed loop, settling / N*T, step/ramp/sine
 responses of a --law next to the reference); DIR is checked before anything runs and written
@@ -1256,8 +1264,56 @@ def _add_conform(sub) -> None:
         "figures/): verdict, properties, map of |u - u_ref| with the region boundaries, "
         "closed loop, step/ramp/sine responses; checked before computing, written atomically",
     )
+    p.add_argument(
+        "--precision",
+        default="float64",
+        metavar="P",
+        help="what the implementation computes in: float64 (default) or float32 (the reference "
+        "is evaluated at the state rounded to float32; float32 ties at region boundaries excluded)",
+    )
+    for flag, kind, metavar, text in (
+        ("--delay", int, "N", "also compare closed loops with a computation delay [samples]"),
+        ("--quantum", finite_float, "MM", "... with an encoder quantum [mm]"),
+        (
+            "--velocity-noise",
+            finite_float,
+            "MM_S",
+            "... with velocity noise sd [mm/s] (needs --seed)",
+        ),
+        ("--seed", int, "S", "seed of the velocity noise (one sequence, shared by both laws)"),
+        ("--a-ratio", finite_float, "R", "... with a true bandwidth a_true / a_design"),
+    ):
+        p.add_argument(flag, type=kind, metavar=metavar, default=None, help=text)
+    p.add_argument(
+        "--robust",
+        action="store_true",
+        help="compare closed loops at the corners of the configuration's [robustness] box",
+    )
     _add_junit(p)
     p.set_defaults(handler=_cmd_conform)
+
+
+def _conform_perturbations(args: argparse.Namespace, cfg) -> tuple:
+    """Return the perturbations of ``conform`` (validated; InputError on bad options)."""
+    from ptoverify.conform.perturbed import perturbation, robust_box
+
+    one = perturbation(
+        cfg,
+        delay=args.delay,
+        quantum=args.quantum,
+        velocity_noise=args.velocity_noise,
+        seed=args.seed,
+        a_ratio=args.a_ratio,
+    )
+    if args.robust and one is not None:
+        raise InputError(
+            "--robust runs the [robustness] box: give it without --delay, --quantum, "
+            "--velocity-noise, --seed and --a-ratio"
+        )
+    found = robust_box(cfg) if args.robust else (() if one is None else (one,))
+    if found and not args.law:
+        raise InputError("closed loops under perturbation need --law (a table has no closed loop)")
+    return found
 
 
 def _cmd_conform(args: argparse.Namespace) -> int:
@@ -1268,6 +1324,12 @@ def _cmd_conform(args: argparse.Namespace) -> int:
     if not 0 < rtol < 1:
         raise InputError(f"--tolerance must be in (0, 1), got {rtol:g}")
     _check_junit(args)
+    from ptoverify.conform.precision import check_precision
+
+    precision = check_precision(args.precision)
+    perturbations = _conform_perturbations(args, cfg)
+    if args.emit_grid and (perturbations or precision != "float64"):
+        raise InputError("--emit-grid writes the probe set only: no --precision or perturbation")
     target = None
     if args.report is not None:
         from ptoverify.report.conform_report import check_report_target
@@ -1294,12 +1356,25 @@ def _cmd_conform(args: argparse.Namespace) -> int:
         from ptoverify.conform.evidence import conform_with_evidence
 
         result, evidence = conform_with_evidence(
-            cfg, law=args.law, table=args.table, rtol=rtol, timeout=args.timeout
+            cfg,
+            law=args.law,
+            table=args.table,
+            rtol=rtol,
+            timeout=args.timeout,
+            precision=precision,
+            perturbations=perturbations,
         )
     elif args.table:
-        result = conform.conform_table(args.table, cfg, rtol=rtol)
+        result = conform.conform_table(args.table, cfg, rtol=rtol, precision=precision)
     else:  # the law runs in a child process; what it prints goes to stderr afterwards
-        result = conform.conform_spec(args.law, cfg, rtol=rtol, timeout=args.timeout)
+        result = conform.conform_spec(
+            args.law,
+            cfg,
+            rtol=rtol,
+            timeout=args.timeout,
+            precision=precision,
+            perturbations=perturbations,
+        )
     if args.law and result.law_output:
         print(result.law_output, end="", file=sys.stderr)
     if args.junit:

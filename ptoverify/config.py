@@ -36,6 +36,7 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from ptoverify.conform_limits import ConformLimits, conform_limits_from_mapping
 from ptoverify.errors import ConfigError
 
 __all__ = [
@@ -53,6 +54,8 @@ __all__ = [
     "ALL_LAW_NAMES",
     "PTOSGains",
     "CascadeGains",
+    "ConformLimits",
+    "conform_limits_from_mapping",
 ]
 
 #: The laws the suite implements (:func:`ptoverify.model.laws.make_law`), here so that naming
@@ -230,6 +233,8 @@ class Config:
         PTOS baseline settings.
     cascade : CascadeGains
         Cascade P baseline gain.
+    conform : ConformLimits
+        Pass limits of ``ptoverify conform``.
     bandwidth_hz : float or None
         The bandwidth as given in Hz, when the file gave it in Hz.
     """
@@ -242,6 +247,7 @@ class Config:
     robustness: Robustness = field(default_factory=Robustness)
     ptos: PTOSGains = field(default_factory=PTOSGains)
     cascade: CascadeGains = field(default_factory=CascadeGains)
+    conform: ConformLimits = field(default_factory=ConformLimits)
 
     def with_plant(self, **changes: float) -> Config:
         """Return a copy with plant fields replaced (``a``, ``w_max``...)."""
@@ -286,6 +292,8 @@ class Config:
             given = {k: v for k, v in asdict(obj).items() if v is not None}
             if obj != type(obj)():
                 out[key] = given
+        if self.conform != ConformLimits():  # only when set (the digest of others is kept)
+            out["conform"] = self.conform.to_mapping()
         return out
 
 
@@ -439,7 +447,7 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
         infinities and out-of-range values; the message names the key.
     """
     for key in data:
-        if key not in {"name", "robustness", "ptos", "cascade", *_SECTIONS}:
+        if key not in {"name", "robustness", "ptos", "cascade", "conform", *_SECTIONS}:
             raise ConfigError(f"unknown config key '{key}'")
     name = data.get("name", "custom")
     if (
@@ -493,6 +501,7 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
         robustness=robustness_from_mapping(data.get("robustness", {}), plant),
         ptos=PTOSGains(**_baseline_table(data, "ptos", plant["sample_time"])),
         cascade=CascadeGains(**_baseline_table(data, "cascade", plant["sample_time"])),
+        conform=conform_limits_from_mapping(data.get("conform", {})),
     )
 
 

@@ -1,5 +1,6 @@
 """The firmware example: the PTO law in C99, built by the system compiler, gated by
-``conform --law`` in double precision (conforms) and single precision (does not, and why)."""
+``conform --law`` in double precision (conforms), single precision judged as a float64
+function (does not, and why) and single precision under ``--precision float32`` (conforms)."""
 
 import json
 import shutil
@@ -18,9 +19,9 @@ pytestmark = pytest.mark.skipif(
 )
 
 
-def _conform(capsys, func, tmp_path):
+def _conform(capsys, func, tmp_path, *extra):
     junit = tmp_path / f"{func}.xml"
-    code = main(["conform", "--law", f"{SPEC}:{func}", "--json", "--junit", str(junit)])
+    code = main(["conform", "--law", f"{SPEC}:{func}", "--json", "--junit", str(junit), *extra])
     return code, json.loads(capsys.readouterr().out), junit
 
 
@@ -52,6 +53,24 @@ def test_c_single_build_fails_only_agreement(capsys, tmp_path):
     assert all(p["status"] == "pass" for p in others.values()), others
 
 
+@pytest.mark.slow
+def test_c_single_build_conforms_as_float32(capsys, tmp_path):
+    """Under --precision float32 the reference is evaluated at the state the float build
+    rounded to, and states within the derived float32 tie band of a boundary are ties: what
+    is left is the float build's own arithmetic, which stays within 1e-6 w_max (no
+    precision loss in log1p or in the omega_c root)."""
+    code, res, _ = _conform(capsys, "pto_single", tmp_path, "--precision", "float32")
+    assert code == 0 and res["conforms"], res["failures"]
+    assert res["precision"] == "float32" and res["agreement"]["precision"] == "float32"
+    a = res["agreement"]
+    assert a["max_abs_du"] <= a["tolerance_mm_s"]
+    # the float build really computes in float: far from the boundaries it differs from the
+    # double reference by more than double round-off (else the mode would prove nothing)
+    assert a["max_abs_du"] > 1e-9 * 300.0
+    # ties (float64 curve ties and float32 ties) are a small fraction of the judged states
+    assert 0 < a["excluded"] < 1e-2 * a["points"]
+
+
 def test_c_source_is_c99_without_allocation_or_state():
     import re
 
@@ -62,3 +81,30 @@ def test_c_source_is_c99_without_allocation_or_state():
         r"^(?:static\s+)?(?:const\s+)?(?:double|float|real|int)\s+\w+\s*(?:=|;|\[)", src, re.M
     )
     assert file_scope_vars == [], f"state between calls: {file_scope_vars}"
+
+
+@pytest.mark.slow
+def test_c_single_build_table_conforms_as_float32(tmp_path):
+    """The --table route of the same float build: the emitted probe set evaluated by the
+    float32 C law conforms under --precision float32 and not as a float64 function."""
+    import importlib.util
+
+    from ptoverify.config import paper_config
+    from ptoverify.conform.agreement import grid_csv
+    from ptoverify.conform.table import conform_table
+
+    spec = importlib.util.spec_from_file_location("c_pto_for_test", SPEC)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    cfg = paper_config()
+    rows = grid_csv(cfg).splitlines()[1:]
+    table = tmp_path / "fw.csv"
+    with table.open("w") as fh:
+        fh.write("x1,x2,u\n")
+        for row in rows:
+            x1, x2 = (float(v) for v in row.split(","))
+            fh.write(f"{row},{mod.pto_single(x1, x2, cfg)!r}\n")
+    r32 = conform_table(table, cfg, precision="float32")
+    assert r32.conforms, r32.failures
+    r64 = conform_table(table, cfg)
+    assert not r64.conforms and set(r64.failed_properties()) == {"agreement"}

@@ -12,7 +12,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from ptoverify.cli import main
-from ptoverify.conform.evidence import du_map
+from ptoverify.conform.evidence import SIGNAL_METRICS, du_map
 from ptoverify.conform.gate import reference_law
 from ptoverify.report.conform_report import state
 from ptoverify.sim.runs import run_simulation
@@ -41,9 +41,9 @@ DIMENSIONLESS = {
 }
 
 #: columns that name a row (a property, region, law or metric), not a figure
-LABELS = {"property", "region", "law", "item"}
+LABELS = {"property", "region", "law", "item", "why", "perturbation"}
 #: rows of the summary table that hold names, not figures
-TEXT_ROWS = {"law", "evaluated as", "configuration"}
+TEXT_ROWS = {"law", "evaluated as", "configuration", "precision", "perturbation"}
 
 
 def run(capsys, *argv):
@@ -263,7 +263,9 @@ def check_responses(res: dict, cfg, *, agree_mm: float) -> None:
     assert set(resp) == {"step", "ramp", "sine"}
     for name, r in resp.items():
         metrics, _ = run_simulation(cfg, "pto", name).metrics()
-        assert r["reference"] == metrics, name
+        # only the metrics that mean something for the signal (no ramp or sine settling)
+        assert set(r["reference"]) == set(SIGNAL_METRICS[name]) <= set(metrics), name
+        assert r["reference"] == {k: metrics[k] for k in SIGNAL_METRICS[name]}, name
         assert r["max_abs_dx1_mm"] <= agree_mm, (name, r["max_abs_dx1_mm"])
     assert {f"figures/response_{n}.png" for n in resp} <= set(res["meta"]["figures"])
 
@@ -279,7 +281,9 @@ def test_example_law_report(capsys, tmp_path, paper_cfg):
     res = check_complete(out)
     assert res["conform"]["conforms"] is True and res["conform"]["mode"] == "scalar"
     html = (out / "index.html").read_text()
-    assert "<h1>Conformance of" in html and ": CONFORMS</h1>" in html
+    assert "<h1>Conformance of" in html and ": CONFORMS (float64; perturbation: none)</h1>" in html
+    assert "settling" not in json.dumps(res["evidence"]["responses"]["ramp"]["user"])
+    assert "settling" not in json.dumps(res["evidence"]["responses"]["sine"]["user"])
     check_map_is_the_agreement(res)
     check_responses(res, paper_cfg, agree_mm=1e-9)
     s = res["evidence"]["settling"]
@@ -353,3 +357,45 @@ def test_law_that_raises_gets_a_report_without_map(capsys, tmp_path):
     assert "No map of |u - u_ref|: no state was judged" in md
     assert "figures/du_map.png" not in res["meta"]["figures"]
     assert f"First failing property: evaluation at {state(first['state'])}" in md
+
+
+@pytest.mark.slow
+def test_report_under_delay_shows_precision_perturbation_and_warnings(capsys, tmp_path):
+    out = tmp_path / "delay"
+    code, stdout, _ = run(
+        capsys,
+        "conform",
+        "--law",
+        "ptoverify.conform.gate:reference_law",
+        "--delay",
+        "1",
+        "--precision",
+        "float32",
+        "--report",
+        str(out),
+    )
+    res = check_complete(out)
+    first = stdout.splitlines()[0]
+    assert "precision float32" in first and "under delay 1 sample" in first
+    assert "the reference itself fails" in first
+    md = (out / "report.md").read_text()
+    assert md.splitlines()[0].endswith("(float32; perturbation: delay 1 sample)")
+    rd = res["evidence"]["reference_delay"]
+    assert rd["delay_samples"] == 1 and 0 < rd["cycling"] <= rd["states"]
+    assert f"from {rd['cycling']} of {rd['states']} initial states" in md
+    assert "WARNING: under the perturbations judged, the reference law itself fails" in md
+    runs = res["conform"]["perturbation"]["runs"]
+    assert len(runs) == 1 and "no-limit-cycle" in runs[0]["reference_fails"]
+    assert "## Closed loop under perturbation" in md and "## Pass limits and why" in md
+    # the limits shown are the configuration's [conform] values
+    assert "E_ref + max(2, ceil(0.5 x E_ref))" in md
+    assert code == (0 if res["conform"]["conforms"] else 1)
+
+
+def test_report_with_a_wrong_function_name_lists_the_callables(capsys, tmp_path):
+    out = tmp_path / "r"
+    code, _, err = run(
+        capsys, "conform", "--law", f"{ROOT / 'examples' / 'my_pto.py'}:ptoo", "--report", str(out)
+    )
+    assert code == 2 and "(callables defined there: pto)" in err
+    assert len(err.strip().splitlines()) == 1 and not out.exists()

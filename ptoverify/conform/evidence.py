@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ptoverify.config import Config
-from ptoverify.conform.agreement import omega0_ref, reference, ties
+from ptoverify.conform.agreement import omega0_ref, reference, reference_values
 from ptoverify.conform.gate import ConformResult, as_law, conform_spec, conform_table
 from ptoverify.model.curves import level_curve_x1
 from ptoverify.sim.exact import exact_metrics
@@ -62,10 +62,21 @@ __all__ = [
     "user_responses",
     "settling_summary",
     "conform_with_evidence",
+    "reference_delay_cycles",
     "CELLS",
+    "SIGNAL_METRICS",
 ]
 
 CELLS = 121  #: cells per axis of each |u - u_ref| map
+#: The response metrics that mean something for each Section 6 signal: a step's
+#: settling and rise; a ramp's overshoot past its end value (its "settling" from the
+#: record's start measures the ramp, not the law); a sine's phase delay (a sine never
+#: settles).
+SIGNAL_METRICS = {
+    "step": ("overshoot_mm", "rise_time_s", "settling_2pct_s", "settling_0p01mm_s"),
+    "ramp": ("overshoot_mm",),
+    "sine": ("phase_delay_deg",),
+}
 _CHUNK = 1_000_000  #: states per reference evaluation
 
 
@@ -269,7 +280,8 @@ class Response:
     user, reference : SimResult
         The user law's and the reference PTO law's responses (same reference signal).
     user_metrics, reference_metrics : dict
-        ``simulate --json`` metrics, exact between samples ([mm], [s], [deg]).
+        ``simulate --json`` metrics, exact between samples ([mm], [s], [deg]), only
+        those of :data:`SIGNAL_METRICS` for the signal.
     max_abs_dx1_mm : float
         Largest |x1_user - x1_ref| over the samples [mm].
     """
@@ -311,14 +323,53 @@ def user_responses(user, cfg: Config) -> dict[str, Response]:
     out = {}
     for name in SIGNALS:
         ru, rr = simulate(law, cfg.plant, name), simulate(ref, cfg.plant, name)
+        keys = SIGNAL_METRICS.get(name, ())
+        mu = exact_metrics(ru, cfg.plant, ru.reference).json_metrics()
+        mr = exact_metrics(rr, cfg.plant, rr.reference).json_metrics()
         out[name] = Response(
             ru,
             rr,
-            exact_metrics(ru, cfg.plant, ru.reference).json_metrics(),
-            exact_metrics(rr, cfg.plant, rr.reference).json_metrics(),
+            {k: mu.get(k) for k in keys},
+            {k: mr.get(k) for k in keys},
             float(np.max(np.abs(ru.x1 - rr.x1))),
         )
     return out
+
+
+def reference_delay_cycles(cfg: Config, delay: int = 1) -> dict:
+    """How often the reference law itself limit-cycles with a computation delay.
+
+    The reference's closed loop on the vectorized sweep of ``conform``
+    (:func:`ptoverify.studies.properties.initial_grid`, 101 x 101 + 200 states)
+    with ``delay`` samples of delay, measured as the perturbed comparison
+    measures it (:mod:`ptoverify.conform.perturbed`).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration.
+    delay : int
+        Computation delay [samples].
+
+    Returns
+    -------
+    dict
+        ``delay_samples``, ``states`` and ``cycling`` (initial states that
+        oscillate or are not settled at the end), ``unsettled`` (never settled
+        under definition ``settling``).
+    """
+    from ptoverify.conform.closedloop import SETTLING, sweep_sizes
+    from ptoverify.conform.perturbed import Perturbation, reference_loop
+
+    sizes = sweep_sizes("vectorized", None)
+    loop = reference_loop(cfg, Perturbation(delay_samples=delay), sizes)
+    return {
+        "delay_samples": delay,
+        "states": int(loop.cycle.size),
+        "cycling": int(loop.cycle.sum()),
+        "unsettled": int(np.isinf(loop.settle).sum()),
+        "settling": SETTLING,
+    }
 
 
 def _stats(ratio: NDArray) -> dict:
@@ -387,6 +438,8 @@ class ConformEvidence:
         :func:`settling_summary` (None when not computed).
     settling_note : str
         Why there is no settling summary.
+    reference_delay : dict or None
+        :func:`reference_delay_cycles` with a one-sample delay.
     """
 
     maps: list[DuMap]
@@ -397,6 +450,7 @@ class ConformEvidence:
     responses_note: str
     settling: dict | None
     settling_note: str
+    reference_delay: dict | None = None
 
     def to_json(self) -> dict:
         """JSON-able summary (``results.json`` key ``evidence``)."""
@@ -412,21 +466,21 @@ class ConformEvidence:
             "responses_note": self.responses_note,
             "settling": self.settling,
             "settling_note": self.settling_note,
+            "reference_delay": self.reference_delay,
         }
 
 
-def _maps(states, cfg: Config, bounds: Boundaries, tol: float) -> tuple[list[DuMap], int, int]:
-    """Both maps from the judged states (curve ties excluded, as the agreement does)."""
+def _maps(
+    states, cfg: Config, bounds: Boundaries, tol: float, precision: str = "float64"
+) -> tuple[list[DuMap], int, int]:
+    """Both maps from the judged states (ties excluded, as the agreement does)."""
     if states is None:
         x1 = x2 = du = np.zeros(0)
         excluded = 0
     else:
         x1, x2, u = (np.asarray(s, dtype=float) for s in states)
-        du, tie = np.empty(x1.size), np.empty(x1.size, dtype=bool)
-        for i in range(0, x1.size, _CHUNK):
-            s = slice(i, i + _CHUNK)
-            du[s] = np.abs(u[s] - reference(cfg)(x1[s], x2[s])[0])
-            tie[s] = ties(x1[s], x2[s], cfg)
+        u_ref, _, tie = reference_values(x1, x2, cfg, _CHUNK, precision)
+        du = np.abs(u - u_ref)
         excluded = int(tie.sum())
         x1, x2, du = x1[~tie], x2[~tie], du[~tie]
     R, w = cfg.plant.position_range, cfg.plant.w_max
@@ -444,6 +498,8 @@ def conform_with_evidence(
     table: str | Path | None = None,
     rtol: float,
     timeout: float,
+    precision: str = "float64",
+    perturbations: tuple = (),
 ) -> tuple[ConformResult, ConformEvidence]:
     """Run ``conform`` on a ``--law`` or a ``--table`` and keep the report's evidence.
 
@@ -459,6 +515,10 @@ def conform_with_evidence(
         Agreement tolerance relative to w_max.
     timeout : float
         Budget of the isolated law [s] (responses included).
+    precision : str
+        ``float64`` or ``float32`` (:mod:`ptoverify.conform.precision`).
+    perturbations : tuple of Perturbation
+        Closed loops under perturbation (:mod:`ptoverify.conform.perturbed`; ``law`` only).
 
     Returns
     -------
@@ -469,7 +529,7 @@ def conform_with_evidence(
     """
     keep: dict[str, Any] = {}
     if table is not None:
-        result = conform_table(table, cfg, rtol=rtol, keep=keep)
+        result = conform_table(table, cfg, rtol=rtol, keep=keep, precision=precision)
         note = (
             "a --table gives u only at its states, and a closed loop needs u wherever the "
             "trajectory goes: no responses (run --law for them)"
@@ -483,6 +543,8 @@ def conform_with_evidence(
             timeout=timeout,
             keep=keep,
             after=lambda user: user_responses(user, cfg),
+            precision=precision,
+            perturbations=perturbations,
         )
         note, settle_note = "", ""
         if "after" not in keep:
@@ -493,7 +555,7 @@ def conform_with_evidence(
             settle_note = "not computed" + (f": {prop.detail}" if prop is not None else "")
     bounds = boundaries(cfg)
     tol = rtol * cfg.plant.w_max
-    maps, judged, excluded = _maps(keep.get("states"), cfg, bounds, tol)
+    maps, judged, excluded = _maps(keep.get("states"), cfg, bounds, tol, precision)
     settling = settling_summary(keep["settling"]) if "settling" in keep else None
     evidence = ConformEvidence(
         maps,
@@ -504,5 +566,6 @@ def conform_with_evidence(
         note,
         settling,
         settle_note,
+        reference_delay_cycles(cfg, 1),
     )
     return result, evidence

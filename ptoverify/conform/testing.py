@@ -89,6 +89,8 @@ def assert_conforms(
     rtol: float | None = None,
     timeout: float = DEFAULT_TIMEOUT_S,
     memory_limit: int | None = MEMORY_LIMIT_BYTES,
+    precision: str = "float64",
+    perturbations: tuple = (),
 ):
     """Assert that a PTO implementation conforms to the reference law.
 
@@ -106,6 +108,11 @@ def assert_conforms(
         Budget for everything the law does [s] (as ``conform --timeout``).
     memory_limit : int or None
         Address-space limit of the law's process [bytes].
+    precision : str
+        ``float64`` or ``float32``, as ``conform --precision``.
+    perturbations : tuple of Perturbation
+        Closed loops to compare with the reference's, as ``conform --delay`` etc.
+        (:mod:`ptoverify.conform.perturbation`).
 
     Returns
     -------
@@ -134,12 +141,21 @@ def assert_conforms(
     spec = law_spec(law)
     target = spec if isinstance(law, str) else getattr(law, "__qualname__", spec)
     kwargs = {} if rtol is None else {"rtol": rtol}
-    result = conform.conform_spec(spec, cfg, timeout=timeout, memory_limit=memory_limit, **kwargs)
+    result = conform.conform_spec(
+        spec,
+        cfg,
+        timeout=timeout,
+        memory_limit=memory_limit,
+        precision=precision,
+        perturbations=tuple(perturbations),
+        **kwargs,
+    )
     verdicts, states = conform_verdicts(result)
     bad = [v for v in verdicts if not v.passed and not (result.conforms and v.status == NOT_RUN)]
     if result.conforms and not bad:
         return result
     lines = [f"{target} does not conform to the reference PTO law (config {cfg.name}):"]
+    lines.append(f"  {conform.summary_line(result)}")
     for v in bad:
         lines.append(f"  {v.name}: {failure_message(v, states.get(v.name))} -- {v.detail}")
     for f in result.failures:

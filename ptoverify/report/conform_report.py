@@ -8,11 +8,16 @@ and ``figures/*.png``.  It is validated before anything is computed
 with one rename (:mod:`ptoverify.outdir`), so it is never half-written.
 
 What it shows, in order: the verdict with the first failing property and
-state; every property with measured / limit / unit and its first failing
-state; the agreement per reference region; the map of |u - u_ref| with the
-region boundaries (:mod:`ptoverify.conform.evidence`); the closed-loop
-properties and settling / (N* T); the step, ramp and sine responses next to
-the reference (a ``--table`` has none, and the report says so); every failure.
+state, the precision and perturbations judged, and a warning when the
+reference law itself limit-cycles with a one-sample delay; every property with
+measured / limit / unit and its first failing state; the pass limits and why
+(configurable under ``[conform]``); the agreement per reference region; the
+map of |u - u_ref| with the region boundaries
+(:mod:`ptoverify.conform.evidence`); the closed-loop properties and settling /
+(N* T) (settling definition named); the closed loops under perturbation next
+to the reference's; the step, ramp and sine responses next to the reference,
+with the metrics that mean something for each signal (a ``--table`` has none,
+and the report says so); every failure.
 
 Numbers carry their unit and 4 significant digits; states that reproduce a
 failure carry 10 (a state 5e-8 mm from |x1| = d must be told apart from d).
@@ -31,6 +36,14 @@ from ptoverify.config import Config
 from ptoverify.conform.evidence import ConformEvidence
 from ptoverify.conform.gate import ConformResult
 from ptoverify.errors import InputError
+from ptoverify.report.conform_conditions import (
+    limits,
+    perturbation_text,
+    perturbed,
+    precision_text,
+    quantity,
+    state,
+)
 from ptoverify.report.render import Block, Section, render_html, render_markdown
 
 __all__ = ["check_report_target", "write_conform_report", "build_sections", "quantity", "state"]
@@ -45,58 +58,6 @@ _METRICS = (
     ("settling_0p01mm_s", "settling (0.01 mm band)", "s"),
     ("phase_delay_deg", "phase delay", "deg"),
 )
-
-
-def quantity(v: Any, unit: str = "", digits: int = 4) -> str:
-    """Format a number with its unit at readable precision; ``n/a`` when undefined.
-
-    Parameters
-    ----------
-    v : float, int or None
-        The value.
-    unit : str
-        Its unit (empty: dimensionless, printed bare).
-    digits : int
-        Significant digits.
-
-    Returns
-    -------
-    str
-
-    Examples
-    --------
-    >>> quantity(0.000123456, "mm/s"), quantity(None, "s"), quantity(12, "samples")
-    ('0.0001235 mm/s', 'n/a', '12 samples')
-    """
-    if v is None or isinstance(v, bool):
-        return "n/a"
-    v = float(v)
-    if not math.isfinite(v):
-        return "never" if v == math.inf and unit in ("samples", "s") else "n/a"
-    text = f"{v:.{digits}g}"
-    return f"{text} {unit}" if unit else text
-
-
-def state(s: Any) -> str:
-    """Format a state [mm, mm/s] with 10 significant digits (enough to reproduce it).
-
-    Parameters
-    ----------
-    s : sequence of 2 floats or None
-        The state x1 [mm], x2 [mm/s].
-
-    Returns
-    -------
-    str
-
-    Examples
-    --------
-    >>> state([0.50000005, -115.0]), state(None)
-    ('x1 = 0.50000005 mm, x2 = -115 mm/s', 'n/a')
-    """
-    if s is None:
-        return "n/a"
-    return f"x1 = {float(s[0]):.10g} mm, x2 = {float(s[1]):.10g} mm/s"
 
 
 def check_report_target(out: str | Path, cfg: Config) -> Path:
@@ -157,6 +118,27 @@ def _verdict(r: ConformResult, ev: ConformEvidence, cfg: Config) -> list[Block]:
         ]
         head = f"DOES NOT CONFORM: {r.target} fails {', '.join(failing)}."
     blocks = [_p(head)]
+    fails = r.reference_fails
+    if fails:
+        blocks.append(
+            _p(
+                f"WARNING: under the perturbations judged, the reference law itself fails "
+                f"{'; '.join(fails)}. Your law was judged relative to it (no worse by more "
+                "than the margins below), so conforming there means no worse than a "
+                "reference that fails, not that the loop is sound."
+            )
+        )
+    rd = ev.reference_delay
+    if rd is not None and rd["cycling"]:
+        blocks.append(
+            _p(
+                f"WARNING: the reference PTO law itself limit-cycles or does not settle with a "
+                f"{rd['delay_samples']}-sample computation delay from {rd['cycling']} of "
+                f"{rd['states']} initial states (the closed-loop sweep of this gate). "
+                "Conformance to it does not make a law delay-tolerant: compensate the delay, "
+                f"and run conform --delay {rd['delay_samples']} to compare under it."
+            )
+        )
     if r.failures:
         f = r.failures[0]
         where = "" if f["state"] is None else f" at {state(f['state'])}"
@@ -164,6 +146,8 @@ def _verdict(r: ConformResult, ev: ConformEvidence, cfg: Config) -> list[Block]:
     rows = [
         ["law", r.target],
         ["evaluated as", f"{r.mode} ({r.mode_reason})" if r.mode_reason else r.mode],
+        ["precision", precision_text(r.precision)],
+        ["perturbation", perturbation_text(r)],
         ["configuration", cfg.name],
         [
             "plant",
@@ -331,7 +315,8 @@ def _closed_loop(r: ConformResult, ev: ConformEvidence) -> list[Block]:
         return blocks
     blocks.append(
         _p(
-            f"Settling time t_s (|x1| <= {quantity(s['band_mm'], 'mm')} for good) divided by "
+            f"Settling time t_s (definition {s.get('definition', '0p001mm')}: |x1| <= "
+            f"{quantity(s['band_mm'], 'mm')} for good, read on the samples) divided by "
             f"the discrete-time limit N* T (T = {quantity(s['sample_time_s'], 's')}), over the "
             f"{s['states']} initial states of the settling sweep with N* >= 1 "
             "(dimensionless; 1 is the fastest any sampled controller can be)."
@@ -367,7 +352,10 @@ def _responses(ev: ConformEvidence, figures: dict[str, str]) -> list[Block]:
             "The Section 6 references (5 mm step; ramp to 30 mm at 200 mm/s; 5 mm, 5 Hz "
             "sine; reference velocity fed forward), simulated with your law called through "
             "the same isolated process as the conformance, next to the reference PTO law. "
-            "Metrics are exact between samples."
+            "Metrics are exact between samples, and only those that mean something for the "
+            "signal: settling and rise for the step, the overshoot past the end value for "
+            "the ramp (its settling from the start would measure the ramp), the phase delay "
+            "for the sine (a sine does not settle)."
         )
     ]
     for name, resp in ev.responses.items():
@@ -422,9 +410,11 @@ def build_sections(
     return [
         ("verdict", "Verdict", _verdict(r, ev, cfg)),
         ("properties", "Properties", _properties(r)),
+        ("limits", "Pass limits and why", limits(r, cfg)),
         ("agreement", "Agreement per region", _agreement(r)),
         ("map", "Where your law differs: |u - u_ref|", _map(r, ev, figures)),
         ("closed-loop", "Closed loop and settling / N*T", _closed_loop(r, ev)),
+        ("perturbed", "Closed loop under perturbation", perturbed(r)),
         ("responses", "Step, ramp and sine responses", _responses(ev, figures)),
         ("failures", "Failures", _failures(r)),
     ]
@@ -485,7 +475,11 @@ def write_conform_report(
         figures = {k: f"figures/{p.name}" for k, p in written.items()}
         sections = build_sections(r, ev, cfg, figures)
         verdict = "CONFORMS" if r.conforms else "DOES NOT CONFORM"
-        title = f"Conformance of {r.target}: {verdict}"
+        title = (
+            f"Conformance of {r.target}: {verdict} ({r.precision}; perturbation: "
+            + ("; ".join(p.text() for p in r.perturbations) or "none")
+            + ")"
+        )
         (tmp / "index.html").write_text(render_html(sections, title), encoding="utf-8")
         (tmp / "report.md").write_text(render_markdown(sections, title), encoding="utf-8")
         results = {
