@@ -320,3 +320,20 @@ def test_mirrored_state_has_the_same_properties(law_name):
     for k in a:
         assert np.array_equal(a[k], b[k], equal_nan=True), k
     assert np.nanmax(a["settling_ratio_nt"]) > 1.0
+
+
+def test_grid_worst_keeps_a_cell_that_never_settles():
+    """A cell whose worst state never settles (inf) is the worst start, not left out: the
+    report's 'grid worst' then says unbounded, as the map's own figure does."""
+    from ptoverify.studies.robust.results import MapCell, PropertyMax
+    from ptoverify.studies.robust.search import grid_worst, merge_found
+
+    def cell(ratio, a):
+        pm = PropertyMax(0.0, (1.0, 0.0))
+        return MapCell(a, 1.0, 1, pm, pm, pm, PropertyMax(ratio, (a, 2.0)), 0, 0, 0)
+
+    cells = [cell(8.3, 0.9), cell(math.inf, 1.1), cell(math.nan, 1.2)]
+    starts = grid_worst(cells, "settling_ratio_nt")
+    assert [s.value for s in starts] == [math.inf, 8.3], "inf first, NaN left out"
+    worst = merge_found(paper_config(), {"settling_ratio_nt": starts}, [])["settling_ratio_nt"]
+    assert worst.grid_unbounded and worst.unbounded and worst.state == (1.1, 2.0)

@@ -112,10 +112,11 @@ def grid_worst(cells: Sequence[MapCell], prop: str, k: int = 4) -> list[Start]:
     Returns
     -------
     list of Start
-        Each cell's worst state of ``prop`` and its perturbation, worst first
-        (cells with a non-finite worst left out).
+        Each cell's worst state of ``prop`` and its perturbation, worst first;
+        an unbounded worst (inf: a state that never settles) comes first, a cell
+        without a value (NaN) is left out.
     """
-    scored = [c for c in cells if math.isfinite(c.prop(prop).max)]
+    scored = [c for c in cells if not math.isnan(c.prop(prop).max) and c.prop(prop).max > -math.inf]
     scored.sort(key=lambda c: -c.prop(prop).max)
     return [
         Start(
