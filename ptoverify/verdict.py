@@ -100,8 +100,13 @@ class Verdict:
         return self.status == PASS
 
     def to_json(self) -> dict[str, Any]:
-        """Return a JSON-able dict; non-finite numbers become None."""
+        """Return a JSON-able dict; non-finite numbers become None.
+
+        ``measured_unbounded`` says whether a None ``measured`` stands for +inf (a
+        trajectory that never settles, say) rather than a value not computed.
+        """
         d = asdict(self)
+        d["measured_unbounded"] = self.measured is not None and self.measured == math.inf
         for key in ("measured", "limit"):
             v = d[key]
             d[key] = None if v is None or not math.isfinite(v) else float(v)

@@ -273,7 +273,9 @@ def summary(res: dict[str, Any]) -> list[Block]:
             "perturbed plant" if c["name"].startswith("robust-") else "nominal plant",
             c["description"],
             c["status"],
-            qty(c["measured"], _GATE_UNITS.get(c["unit"], c["unit"])),
+            "unbounded"
+            if c["measured_unbounded"]
+            else qty(c["measured"], _GATE_UNITS.get(c["unit"], c["unit"])),
             c["comparison"],
             qty(c["limit"], _GATE_UNITS.get(c["unit"], c["unit"])),
         ]

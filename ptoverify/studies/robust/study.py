@@ -220,6 +220,17 @@ def describe_case(case: WorstCase) -> str:
     )
 
 
+#: What the robustness gates check, in a sentence (the report's gate table).
+LIMIT_CYCLE_DESCRIPTION = (
+    "No limit cycle from any state anywhere in the [robustness] box (true a, drive limit, "
+    "computation delay, encoder quantum), by grid and seeded search"
+)
+SETTLING_DESCRIPTION = (
+    "Every state settles (box-0p01mm, on the samples) within the limit times N* T of the true "
+    "plant, anywhere in the [robustness] box, by grid and seeded search"
+)
+
+
 def robust_gates(result: RobustResult, law: str = GATE_LAW) -> list[Verdict]:
     """Judge the box: ``robust-no-limit-cycle`` and ``robust-settling`` for ``law``.
 
@@ -255,6 +266,7 @@ def robust_gates(result: RobustResult, law: str = GATE_LAW) -> list[Verdict]:
                 f"{law}: the worst-case search did not evaluate the limit-cycle amplitude",
                 "<=",
                 "mm",
+                LIMIT_CYCLE_DESCRIPTION,
             )
         )
     else:
@@ -268,6 +280,7 @@ def robust_gates(result: RobustResult, law: str = GATE_LAW) -> list[Verdict]:
                 f"differential evolution){where}",
                 "<=",
                 "mm",
+                LIMIT_CYCLE_DESCRIPTION,
             )
         )
     st = worst.get("settling_ratio_nt")
@@ -283,6 +296,7 @@ def robust_gates(result: RobustResult, law: str = GATE_LAW) -> list[Verdict]:
                 f"{law}: the worst-case search did not evaluate settling / N*T",
                 "<=",
                 "1",
+                SETTLING_DESCRIPTION,
             )
         )
     else:
@@ -298,6 +312,7 @@ def robust_gates(result: RobustResult, law: str = GATE_LAW) -> list[Verdict]:
                 f"limit from [robustness] settling_ratio_limit",
                 "<=",
                 "1",
+                SETTLING_DESCRIPTION,
             )
         )
     return out
