@@ -300,3 +300,16 @@ def test_smallest_d_depends_on_the_plant_only():
     clear_caches()
     other = dataclasses.replace(PAPER, pto=PTOSettings(d=3.7, k1=10.0, k2=0.1))
     assert smallest_d(other) == base
+
+
+def test_corrected_zone_names_y_star_and_z_star_as_the_paper():
+    """Corrected zone: z* = -x~20 / omega0 (eq. 26's ratio, where l1* meets x1 = d) and
+    y* = -x~20 / w_max (eq. 22's); they differ unless omega0 = w_max."""
+    cfg = paper_config()
+    z = corrected_zone(cfg)
+    w, a, d = cfg.plant.w_max, cfg.plant.a, cfg.pto.d
+    assert_allclose(z.z_star, -z.x20_tilde / z.omega0, rtol=1e-12, err_msg="z* [-]")
+    assert_allclose(z.y_star, -z.x20_tilde / w, rtol=1e-15, err_msg="y* [-]")
+    assert z.y_star < z.z_star
+    # l1* passes through (d, x~20): its level curve at x2 = x~20 is at x1 = d
+    assert_allclose(level_curve_x1(z.x20_tilde, a, z.omega0), d, rtol=1e-9, err_msg="x1 [mm]")

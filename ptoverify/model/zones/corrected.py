@@ -236,9 +236,9 @@ def _corrected_zone(cfg: Config, reading: str, scan: int, verify: bool) -> PTOZo
         omega0=omega0,
         x20_tilde=x20,
         b0=a * d / omega0,
-        y_star=y if math.isfinite(x20) else _NAN,
+        y_star=-x20 / w if math.isfinite(x20) else _NAN,  # eq. (22)'s y* = -x~20 / w_max
         k=k,
-        z_star=y if math.isfinite(x20) else _NAN,
+        z_star=y if math.isfinite(x20) else _NAN,  # eq. (26)'s z* = -x~20 / omega0
         valid=valid,
         degenerate=degenerate,
         reason="; ".join(parts),

@@ -25,7 +25,8 @@ class PTOZone:
         when l1* never reaches x1 = d inside the envelope.
     b0, y_star, k, z_star : float
         Intermediate numbers of eqs. (21)-(26) [-] (corrected: b0 = a d / omega0,
-        y* = z* = -x20_tilde / omega0, k from eq. 25).
+        the argument of h whose root z* = -x20_tilde / omega0 puts l1* through
+        x1 = d; y* = -x20_tilde / w_max as in eq. 22; k from eq. 25).
     valid : bool
         0 < omega0 < w_max, the zone acts outside the linear zone, and the
         principle (module docstring) holds for ``reading``.

@@ -120,8 +120,9 @@ def poles(res: dict[str, Any]) -> list[Block]:
                 lp["continuous_poles"],
                 lp["continuous_zeta"],
                 lp["sampled_moduli"],
-                lp["gain_margin"],
+                qty(lp["gain_margin_db"], "dB"),
                 lp["phase_margin_deg"],
+                lp["delay_margin_samples"],
                 lp["pole_mismatch"],
                 lp["stable_sampled"],
                 lp["lyapunov_conditions"],
@@ -137,8 +138,9 @@ def poles(res: dict[str, Any]) -> list[Block]:
                 "continuous poles (re, im) [rad/s]",
                 "damping [-]",
                 "sampled |z| [-]",
-                "gain margin [-]",
+                "gain margin",
                 "phase margin [deg]",
+                "delay margin [samples]",
                 "|python-control - numpy| [-]",
                 "sampled stable",
                 "Section 5 conditions",
@@ -158,6 +160,8 @@ def poles(res: dict[str, Any]) -> list[Block]:
 
 def _unit_from_name(name: str, v: Any) -> str:
     """Show a value with the unit its key names (``_mm``, ``_s``, ``_deg``...)."""
+    if name.startswith(("k1", "kp")) and isinstance(v, (int, float)):
+        return qty(v, "1/s")  # a position gain: velocity per position
     for suffix, unit in (
         ("_mm_s", "mm/s"),
         ("_mm", "mm"),
