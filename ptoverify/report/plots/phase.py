@@ -169,12 +169,16 @@ def plot_zones(zone: PTOZone, cfg: Config, ax=None) -> dict:
         )
         ax.fill_betweenx(pos, level_curve_x1(pos, a, om), level_curve_x1(pos, a, w), **fill)
     else:
-        drawn["no zone"] = ax.text(
-            0.02,
-            0.04,
+        drawn["no zone"] = ax.text(  # top right, clear of the legends (lower left, best)
+            0.98,
+            0.97,
             f"{variant}: omega0 = {zone.omega0:.4g} mm/s, no switching zone",
             transform=ax.transAxes,
             fontsize=7,
+            ha="right",
+            va="top",
+            bbox={"facecolor": "white", "edgecolor": "0.5", "alpha": 0.9},
+            zorder=5,
         )
     lim = _zone_xlim(cfg, zone.omega0)
     ax.set_xlim(-lim, lim)

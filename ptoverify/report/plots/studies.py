@@ -19,7 +19,14 @@ import numpy as np
 from matplotlib.colors import ListedColormap
 from numpy.typing import NDArray
 
-from ptoverify.report.plots.common import folder, new_axes, new_figure, save_figure, write_png
+from ptoverify.report.plots.common import (
+    STYLE,
+    folder,
+    new_axes,
+    new_figure,
+    save_figure,
+    write_png,
+)
 
 if TYPE_CHECKING:  # data types for annotations only: no solver, no sweep
     from ptoverify.model.ocp import ConvergenceStudy
@@ -113,7 +120,13 @@ def plot_sweep(
     if math.isfinite(wr[0]):
         (drawn["worst"],) = ax.plot(*wr, "r*", ms=10, label=f"worst ratio {worst:.2f}")
     if colorbar:
-        drawn["colorbar"] = ax.figure.colorbar(drawn["mesh"], ax=ax, label=_sweep_label(which))
+        clipped = bool(finite.size) and float(finite.max()) > vmax
+        drawn["colorbar"] = ax.figure.colorbar(
+            drawn["mesh"],
+            ax=ax,
+            label=_sweep_label(which, vmax if clipped else None),
+            extend="max" if clipped else "neither",
+        )
     ax.set_xlabel("initial position x1 [mm]")
     ax.set_ylabel("initial velocity x2 [mm/s]")
     ax.set_title(
@@ -131,8 +144,10 @@ def _floor_of(ratios: NDArray[np.float64]) -> float:
     return min(1.0, float(ratios.min())) if ratios.size else 0.9
 
 
-def _sweep_label(which: str) -> str:
-    return f"settling time / {'t_f*' if which == 'tf' else 'N* T'} [-]"
+def _sweep_label(which: str, clip: float | None = None) -> str:
+    """Colour-bar label; says where the scale clips (the arrow's colour is every larger value)."""
+    text = f"settling time / {'t_f*' if which == 'tf' else 'N* T'} [-]"
+    return text if clip is None else f"{text}; clipped at {clip:.3g} (99th percentile)"
 
 
 def _cells(ax, x1: NDArray[np.float64], x2: NDArray[np.float64]) -> Callable:
@@ -190,7 +205,13 @@ def save_sweep(res: SweepResult, outdir: str | Path) -> list[Path]:
         for ax, law in zip(panels, laws, strict=True):
             scale = {"vmin": _floor_of(finite), "vmax": vmax}
             mesh = plot_sweep(res, law, which, ax, **scale, colorbar=False)["mesh"]
-        fig.colorbar(mesh, ax=panels, label=_sweep_label(which))
+        clipped = bool(finite.size) and float(finite.max()) > vmax
+        fig.colorbar(
+            mesh,
+            ax=panels,
+            label=_sweep_label(which, vmax if clipped else None),
+            extend="max" if clipped else "neither",
+        )
         files.append(write_png(fig, outdir / f"sweep_ratio_{which}.png"))
     return files
 
@@ -295,6 +316,15 @@ def save_robust(maps: Mapping, outdir: str | Path) -> list[Path]:
     return files
 
 
+def _law_name(law: str) -> str:
+    """Return a law's name for a legend (the response figures' labels; else the id)."""
+    return (
+        STYLE[law]["label"]
+        if law in STYLE
+        else {"ptos": "PTOS", "cascade-p": "cascade P"}.get(law, law)
+    )
+
+
 def plot_pareto(tuning: Mapping, ax=None) -> dict:
     """Settling-vs-overshoot Pareto fronts of PD and PTO on the step, with the floor.
 
@@ -316,9 +346,16 @@ def plot_pareto(tuning: Mapping, ax=None) -> dict:
     """
     ax = new_axes(ax)
     drawn: dict = {}
-    colors = {"pd": "tab:orange", "pto": "tab:green"}
-    for law, front in tuning["fronts"].items():
-        col = colors.get(law, "tab:blue")
+    colors = {
+        "pd": "tab:orange",
+        "pto": "tab:green",
+        "ptos": "tab:purple",
+        "cascade-p": "tab:brown",
+    }
+    offscale: list[tuple[float, float, str, str]] = []  # (overshoot, ms, colour, what)
+    ys: list[float] = []
+    for k, (law, front) in enumerate(tuning["fronts"].items()):
+        col, name = colors.get(law, "tab:blue"), _law_name(law)
         pts = sorted(
             (c["overshoot_mm"], 1e3 * c["settling_2pct_s"])
             for c in front
@@ -326,31 +363,55 @@ def plot_pareto(tuning: Mapping, ax=None) -> dict:
         )
         if pts:
             x, y = np.array(pts).T
-            (drawn[f"{law} front"],) = ax.step(x, y, where="post", color=col, marker=".", ms=3)
+            ys += list(y)
+            # the first front wide and pale, later ones narrower on top: equal fronts stay visible
+            (drawn[f"{name}: front"],) = ax.step(
+                x, y, where="post", color=col, lw=max(3.5 - 1.2 * k, 1.0), alpha=0.75,
+                marker=".", ms=3, zorder=2 + k,
+            )  # fmt: skip
         bests = [b[law] for b in tuning["best"].values() if law in b]
-        drawn[f"{law} best per bound"] = ax.scatter(
+        ys += [1e3 * b["settling_2pct_s"] for b in bests]
+        drawn[f"{name}: best per bound"] = ax.scatter(
             [b["overshoot_mm"] for b in bests],
             [1e3 * b["settling_2pct_s"] for b in bests],
             color=col,
             marker="*",
             s=140,
-            zorder=3,
+            edgecolor="k",
+            lw=0.4,
+            zorder=6,
         )
         p = tuning["paper"].get(law, {})
         if p.get("settling_2pct_s") is not None:
-            drawn[f"{law} paper gains"] = ax.scatter(
-                [p["overshoot_mm"]], [1e3 * p["settling_2pct_s"]], color=col, marker="s", zorder=3
+            px, py = p["overshoot_mm"], 1e3 * p["settling_2pct_s"]
+            drawn[f"{name}: paper's gains"] = ax.scatter(
+                [px], [py], color=col, marker="s", zorder=6
             )
+            offscale.append((px, py, col, f"{name}, paper's gains: {py:.1f} ms"))
     fl = tuning["floor"]
     drawn["t_f* (exact arrival)"] = ax.axhline(1e3 * fl["tf_s"], color="k", ls="--", lw=1)
     drawn["N* T (sampled arrival)"] = ax.axhline(1e3 * fl["nt_s"], color="k", ls=":", lw=1)
     drawn["least 2 % band entry"] = ax.axhline(1e3 * fl["band_entry_s"], color="0.5", lw=1)
     for name, bound in tuning["bounds_mm"].items():
-        drawn[f"bound: {name}"] = ax.axvline(bound, color="0.6", lw=0.8, ls="-.")
+        law = name.removesuffix("-paper")
+        what = f"{_law_name(law)}'s at the paper's gains" if law != name else name
+        drawn[f"overshoot bound: {what}"] = ax.axvline(bound, color="0.6", lw=0.8, ls="-.")
+    # zoom on the fronts and the floor; a point above is marked at the top edge
+    floor = 1e3 * min(fl["tf_s"], fl["nt_s"], fl["band_entry_s"])
+    top = 1e3 * fl["nt_s"]
+    if ys:  # the fronts' bulk; a few slow candidates may run off the top
+        top = max(top, float(np.percentile(ys, 90)))
+    top *= 1.08
+    ax.set_ylim(0.97 * floor, top)
+    for px, py, col, what in offscale:
+        if py > top:
+            ax.annotate(
+                what, (px, top), xytext=(4, -14), textcoords="offset points", fontsize=7,
+                color=col, arrowprops={"arrowstyle": "-|>", "color": col}, annotation_clip=False,
+            )  # fmt: skip
     ax.set_xlabel("overshoot, between samples [mm]")
     ax.set_ylabel("2 % settling time of the step [ms]")
-    ax.set_ylim(bottom=0)
-    ax.legend(list(drawn.values()), list(drawn), fontsize=7)
+    ax.legend(list(drawn.values()), list(drawn), fontsize=6, loc="upper right")
     ax.grid(alpha=0.3)
     return drawn
 
@@ -395,14 +456,23 @@ def plot_convergence(study: ConvergenceStudy, ax=None) -> dict:
     ax = new_axes(ax, (6.0, 4.0))
     drawn: dict = {}
     n = study.intervals.astype(float)
-    for (x1, x2), err in zip(study.states, study.rel_error, strict=True):
+    markers = "osD^v<>"
+    for k, ((x1, x2), err) in enumerate(zip(study.states, study.rel_error, strict=True)):
         label = f"x0 = ({x1:g} mm, {x2:g} mm/s)"
-        (drawn[label],) = ax.loglog(n, err, "o-", ms=3, label=label)
+        (drawn[label],) = ax.loglog(
+            n, err, marker=markers[k % len(markers)], ms=7 - k, lw=1.2, alpha=0.8, label=label
+        )
     ref = np.nanmax(study.rel_error[:, 0]) * (n / n[0]) ** -2.0
     (drawn["slope -2"],) = ax.loglog(n, ref, "k--", lw=0.8, label="slope -2")
     ax.set_xlabel("collocation intervals N [-]")
     ax.set_ylabel("|t_f - t_f*| / t_f* [-]")
-    ax.set_title(f"Radau collocation, observed order {study.order:.2f}")
+    with np.errstate(invalid="ignore"):
+        rises = bool(np.any(np.diff(study.rel_error, axis=1) > 0))
+    ax.set_title(
+        f"Radau collocation: log-log slope {study.order:.2f} over all N"
+        + (" (the error is not monotone in N)" if rises else ""),
+        fontsize=9,
+    )
     ax.grid(True, which="both", lw=0.3)
     ax.legend(fontsize=7)
     return drawn
