@@ -164,8 +164,11 @@ def _to_mathml(text: str) -> str:
             parts.append(mathml(parse(piece), printer="presentation"))
         except Exception:  # noqa: BLE001 - prose, not a formula: rendered as text
             return ""
-    sep = '<mo>;</mo><mspace width="1em"/>'
-    return "<mrow>" + sep.join(parts) + "</mrow>"
+    if len(parts) == 1:
+        return "<mrow>" + parts[0] + "</mrow>"
+    # one row per part: a chain of equations stacks instead of running off the page
+    rows = "".join(f"<mtr><mtd>{p}</mtd></mtr>" for p in parts)
+    return f'<mtable columnalign="left">{rows}</mtable>'
 
 
 def as_tuple(expr: Any) -> tuple[sp.Expr, ...]:

@@ -963,7 +963,7 @@ def write_report(
             "traces": res["_traces"],
             "generated": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         }
-        title = f"Verification of the paper's PTO law: configuration '{cfg.name}'"
+        title = f'Verification of "{PAPER_TITLE}" (configuration {cfg.name!r})'
         intro = downloads_intro(res["_traces"])
         sections = build_sections(
             results_view(public), figures, res["_records"], res.get("_rendered")

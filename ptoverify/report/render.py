@@ -214,7 +214,7 @@ def findings(items: list[tuple[str, str, str]], figure: str = "", caption: str =
         f"({html.escape(t)})</a></li>"
         for i, (s, a, t) in enumerate(items, 1)
     )
-    md = "\n".join(f"{i}. {s} ({t}: section {a})" for i, (s, a, t) in enumerate(items, 1))
+    md = "\n".join(f"{i}. {s} ([{t}](#{a}))" for i, (s, a, t) in enumerate(items, 1))
     fig = ""
     if figure:
         fig = (
@@ -246,6 +246,10 @@ def image(figures: dict[str, str], key: str, caption: str) -> list[Block]:
     return [Block("img", text=caption, html=figures[key])] if key in figures else []
 
 
+#: A Markdown link to an anchor of this page: ``](#anchor)``.
+_SECTION_LINK = re.compile(r"\]\(#([A-Za-z0-9_-]+)\)")
+
+
 def link(anchor: str, text: str) -> Block:
     """Return a paragraph linking to a section of the same page.
 
@@ -263,7 +267,7 @@ def link(anchor: str, text: str) -> Block:
     """
     return Block(
         "raw",
-        text=f"{text} (section {anchor})",
+        text=f"[{text}](#{anchor})",  # the Markdown renderer points #anchor at the heading
         html=f'<p><a href="#{html.escape(anchor)}">{html.escape(text)}</a></p>',
     )
 
@@ -464,11 +468,17 @@ def render_markdown(sections: list[Section], title: str, intro: str = "") -> str
     lines += ["Contents:", ""]
     lines += [f"- [{heading}](#{md_slug(heading)})" for _a, heading, _b in sections]
     lines.append("")
+    # a link to a section's anchor goes to its heading's slug (what a code host makes)
+    slugs = {a: md_slug(heading) for a, heading, _b in sections}
+
+    def to_heading(m: re.Match) -> str:
+        return f"](#{slugs.get(m.group(1), m.group(1))})"
+
     for anchor, heading, blocks in sections:
         lines += [f"## {heading}", ""]
         for b in blocks:
             if b.kind in ("p", "raw"):
-                lines += [_md_code(b.text, anchor), ""]
+                lines += [_SECTION_LINK.sub(to_heading, _md_code(b.text, anchor)), ""]
             elif b.kind == "img":
                 lines += [f"![{b.text}]({b.html})", "", f"*{b.text}*", ""]
             else:

@@ -294,7 +294,9 @@ def summary(res: dict[str, Any]) -> list[Block]:
         blocks.append(
             Block(
                 "raw",
-                text="Errata: " + ", ".join(f"eq. ({r['id']})" for r in err) + " (section errata)",
+                text="Errata: "
+                + ", ".join(f"eq. ({r['id']})" for r in err)
+                + " ([errata](#errata))",
                 html="<p>Errata: "
                 + ", ".join(
                     f'<a href="#erratum-{html.escape(r["id"])}">eq. ({html.escape(r["id"])})</a>'
