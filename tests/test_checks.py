@@ -1,7 +1,8 @@
 import json
 
 from ptoverify.cli import main
-from ptoverify.studies.checks import FAIL, GATES, PASS, UNVERIFIED, run_checks, summarize
+from ptoverify.studies.checks import GATES, run_checks, summarize
+from ptoverify.verdict import FAIL, PASS, UNVERIFIED
 
 
 def test_core_gates_pass_on_paper(paper_cfg):

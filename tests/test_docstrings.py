@@ -42,7 +42,7 @@ UNIT = re.compile(r"\[[^\]]+\]")
 ALLOWED: dict[str, str] = {
     "ptoverify.conform.agreement.input_bound": "no Parameters section",
     "ptoverify.conform.agreement.ties": "no Parameters section",
-    "ptoverify.studies.checks.summarize": "no Parameters section",
+    "ptoverify.studies.checks.run.summarize": "no Parameters section",
     "ptoverify.studies.claims.types.Reading": "parameter 'a' states no unit",
     "ptoverify.studies.claims.types.numeric_verdict": "no Parameters section",
     "ptoverify.cli.finite_float": "no Parameters section",
