@@ -462,15 +462,21 @@ def _cmd_robust(args: argparse.Namespace) -> int:
 def _add_tune(sub) -> None:
     p = sub.add_parser(
         "tune",
-        help="tune PD (kp, kd) or PTO (d, k1, k2) for a fair comparison",
+        help="tune PD (kp, kd), PTO (d, k1, k2), PTOS (alpha, k) or cascade P (kp) fairly",
         description="Search a law's gains (differential evolution, fixed seed; the PTO's "
         "omega0 from the corrected construction for each d) for the best response under an "
         "overshoot bound (between samples), a stable sampled linear loop and no limit cycle "
         "(PTO: nor stride-over) on the gate grid. Prints the gains as a TOML configuration.",
         epilog="example:\n  ptoverify tune --law pd --signal step --max-overshoot 0\n"
-        "  ptoverify tune --law pto --json > tuned.json",
+        "  ptoverify tune --law pto --json > tuned.json\n"
+        "  ptoverify tune --law ptos --max-overshoot 0",
     )
-    p.add_argument("--law", choices=("pd", "pto"), required=True, help="law to tune")
+    p.add_argument(
+        "--law",
+        choices=("pd", "pto", "ptos", "cascade-p"),
+        required=True,
+        help="law to tune (ptos, cascade-p: the baselines, same constraints)",
+    )
     p.add_argument(
         "--signal", choices=("step", "ramp", "sine"), default="step", help="response (step)"
     )

@@ -293,10 +293,10 @@ TUNE_EFFORT = {"maxiter": 10, "popsize": 8, "d_grid": 5, "d_refine": 2, "polish"
 def tuned_law_config(cfg: Config, name: str, max_overshoot: float) -> Config | None:
     """Return the configuration of ``name`` tuned on the step (None: infeasible).
 
-    PD and PTO by :func:`ptoverify.studies.tune.tune`, PTOS and cascade P by
-    :func:`ptoverify.studies.ptos_claim.tune_baseline`, each minimizing the 2 %
-    settling of the Section 6 step under the same overshoot bound, a stable sampled
-    linear loop and no limit cycle; effort :data:`TUNE_EFFORT`.  TO and the printed
+    Every law with gains (PD, PTO, PTOS, cascade P) by
+    :func:`ptoverify.studies.tune.tune`, each minimizing the 2 % settling of the
+    Section 6 step under the same overshoot bound, a stable sampled linear loop and
+    no limit cycle; effort :data:`TUNE_EFFORT`.  TO and the printed
     PTO have nothing to tune: ``cfg``.
 
     Parameters
@@ -313,21 +313,16 @@ def tuned_law_config(cfg: Config, name: str, max_overshoot: float) -> Config | N
     Config or None
         The tuned configuration.
     """
-    from ptoverify.studies.ptos_claim import tune_baseline
-    from ptoverify.studies.tune import tune
+    from ptoverify.studies.tune import BOUNDS, tune
 
-    e = TUNE_EFFORT
-    if name in ("pd", "pto"):
-        try:
-            return tune(
-                cfg, name, "step", max_overshoot=max_overshoot, find_runner_up=False, **e
-            ).config
-        except InputError:  # tune's answer when no gains meet the constraints
-            return None
-    if name in ("ptos", "cascade-p"):
-        t = tune_baseline(cfg, name, max_overshoot, maxiter=e["maxiter"], popsize=e["popsize"])
-        return t.config if t.feasible else None
-    return cfg
+    if name not in BOUNDS:
+        return cfg
+    try:
+        return tune(
+            cfg, name, "step", max_overshoot=max_overshoot, find_runner_up=False, **TUNE_EFFORT
+        ).config
+    except InputError:  # tune's answer when no gains meet the constraints
+        return None
 
 
 def _law_at(
