@@ -726,13 +726,20 @@ def tuning_results(cfg: Config) -> dict[str, Any]:
     Returns
     -------
     dict
-        The keys of :func:`ptoverify.studies.claims.fair_comparison` less its wall time.
+        The keys of :func:`ptoverify.studies.claims.fair_comparison` less its wall
+        time, and ``versus``: the corrected PTO against fair-tuned PD, PTOS and the
+        cascade P loop under both readings of a
+        (:meth:`ptoverify.studies.versus.Versus.to_json`, less its wall time).
     """
     from ptoverify.studies.claims import fair_comparison
     from ptoverify.studies.tune import TuneBudget
+    from ptoverify.studies.versus import versus
 
-    res = fair_comparison(cfg, TuneBudget(**TUNE_SETTINGS))
+    budget = TuneBudget(**TUNE_SETTINGS)
+    res = fair_comparison(cfg, budget)
     res.pop("seconds", None)
+    res["versus"] = versus(cfg, budget).to_json()  # PD and PTO at a = 2 pi f: cached above
+    res["versus"].pop("seconds", None)
     return res
 
 

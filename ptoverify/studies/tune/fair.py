@@ -140,10 +140,13 @@ def _law_tunings(
     return out
 
 
-def _fair_tunings(cfg: Config, budget: TuneBudget, laws: tuple[str, ...]) -> FairTunings:
+def _fair_tunings(
+    cfg: Config, budget: TuneBudget, laws: tuple[str, ...], names: tuple[str, ...]
+) -> FairTunings:
     t0 = time.perf_counter()
     paper = _paper(cfg)
-    bounds = {"pto-paper": paper["pto"]["overshoot_mm"], "pd-paper": paper["pd"]["overshoot_mm"]}
+    every = {"pto-paper": paper["pto"]["overshoot_mm"], "pd-paper": paper["pd"]["overshoot_mm"]}
+    bounds = {name: every[name] for name in names}
     values = tuple(dict.fromkeys(bounds.values()))
     results, infeasible = {}, {}
     for law in laws:
@@ -160,7 +163,10 @@ def _fair_tunings(cfg: Config, budget: TuneBudget, laws: tuple[str, ...]) -> Fai
 
 
 def fair_tunings(
-    cfg: Config, budget: TuneBudget | None = None, laws: tuple[str, ...] = ("pd", "pto")
+    cfg: Config,
+    budget: TuneBudget | None = None,
+    laws: tuple[str, ...] = ("pd", "pto"),
+    bounds: tuple[str, ...] = tuple(FAIR_BOUNDS),
 ) -> FairTunings:
     """Tune each law on the step under each shared overshoot bound (memoized).
 
@@ -186,10 +192,20 @@ def fair_tunings(
         PD and PTO by default; the baselines ``ptos`` and ``cascade-p`` under the
         same bounds, constraints and search.  Each law's tunings are cached
         alone, so adding a law does not re-tune the others.
+    bounds : tuple of str
+        Names of the bounds (:data:`FAIR_BOUNDS`) to tune under; default both.
 
     Returns
     -------
     FairTunings
         Bounds, paper-gain metrics and the tuned results.
+
+    Raises
+    ------
+    InputError
+        An unknown bound name.
     """
-    return _fair_tunings(cfg, budget or TuneBudget(), tuple(laws))
+    unknown = [b for b in bounds if b not in FAIR_BOUNDS]
+    if unknown or not bounds:
+        raise InputError(f"fair tunings: bounds must be among {', '.join(FAIR_BOUNDS)}")
+    return _fair_tunings(cfg, budget or TuneBudget(), tuple(laws), tuple(dict.fromkeys(bounds)))

@@ -564,7 +564,7 @@ def tune_checked(
         raise InputError(
             f"tune: no {law} gains in the search range meet the constraints ("
             + ("" if max_overshoot is None else f"overshoot <= {max_overshoot:g} mm, ")
-            + "stable, no limit cycle)"
+            + "stable, settles within the record, no limit cycle)"
         )
     runner_up = None
     if find_runner_up:
