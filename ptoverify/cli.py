@@ -1120,7 +1120,7 @@ def _add_report(sub) -> None:
         metavar="STAGES",
         default="",
         help="comma-separated expensive stages to leave out for a quick report: robust, "
-        "tuning (their sections then say so)",
+        "tuning, charts (their sections then say so)",
     )
     p.add_argument(
         "--jobs",

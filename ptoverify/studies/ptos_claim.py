@@ -294,6 +294,6 @@ def fair_configs(
     if bound not in FAIR_BOUNDS:
         raise InputError(f"bound must be one of {', '.join(FAIR_BOUNDS)}, got {bound!r}")
     tunable = tuple(law for law in laws if law in BOUNDS)
-    fair = fair_tunings(cfg, budget or TuneBudget(), tunable)
+    fair = fair_tunings(cfg, budget or TuneBudget(), tunable, (bound,))
     # a law with no feasible tuning keeps its configured gains
     return {law: fair.config(law, bound) if (law, bound) in fair.results else cfg for law in laws}

@@ -94,15 +94,35 @@ def _paper(cfg: Config) -> dict[str, dict[str, float]]:
     return {law: response_metrics(cfg, law, "step") for law in ("pd", "pto")}
 
 
-@lru_cache(maxsize=32)
+#: Tunings done, by (configuration, budget, law, bound value): a TuneResult, or the
+#: reason none meets the constraints.  Emptied when it holds :data:`_MEMO_SIZE`.
+_MEMO: dict[tuple, TuneResult | str] = {}
+_MEMO_SIZE = 64
+
+
 def _law_tunings(
     cfg: Config, budget: TuneBudget, law: str, values: tuple[float, ...]
 ) -> dict[float, TuneResult | str]:
     """One law tuned under each bound value, side by side on one shared screen.
 
     A value under which no gains meet the constraints maps to the reason (tune's
-    InputError message).
+    InputError message).  Each (law, value) is memoized alone: only the values
+    not tuned yet run (together), so every tuning is what :func:`tune` gives alone.
     """
+    todo = tuple(v for v in values if (cfg, budget, law, v) not in _MEMO)
+    if todo:
+        if len(_MEMO) >= _MEMO_SIZE:
+            _MEMO.clear()
+        _MEMO.update(
+            {(cfg, budget, law, v): r for v, r in _run_law(cfg, budget, law, todo).items()}
+        )
+    return {v: _MEMO[(cfg, budget, law, v)] for v in values}
+
+
+def _run_law(
+    cfg: Config, budget: TuneBudget, law: str, values: tuple[float, ...]
+) -> dict[float, TuneResult | str]:
+    """Tune one law under each value side by side (see :func:`_law_tunings`)."""
     effort = {
         "seed": budget.seed,
         "maxiter": budget.maxiter,
