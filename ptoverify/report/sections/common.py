@@ -18,6 +18,8 @@ LAW_WORDS = {
     "pd": "PD",
     "pto": "PTO (corrected)",
     "pto-printed": "PTO as printed",
+    "ptos": "PTOS",
+    "cascade-p": "cascade P",
 }
 
 
