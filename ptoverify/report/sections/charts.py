@@ -73,9 +73,7 @@ def _design_blocks(d: Any, figures: dict[str, str]) -> list[Block]:
     ts, fs = list(d["sample_times_s"]), list(d["bandwidths_hz"])
     lead = []
     for law, f in sm["fastest"].items():
-        by = (
-            f"; the runner-up needs up to {fmt(f['by_max'])} times its ratio" if f["by_max"] else ""
-        )
+        by = f", ahead by up to x{fmt(f['by_max'])}" if f["by_max"] else ""
         lead.append(f"{SHORT.get(law, law)} in {f['cells']} of {sm['cells']} cells{by}")
 
     def where(cells: Any) -> str:
@@ -84,7 +82,8 @@ def _design_blocks(d: Any, figures: dict[str, str]) -> list[Block]:
     text = (
         "Which law is fastest where (least median settling / (N* T) over a "
         f"{d['grid']} x {d['grid']} grid of the envelope, each law at the configured gains, "
-        f"a = 2 pi f): {', '.join(lead) if lead else 'no law settles anywhere'}. "
+        "a = 2 pi f; 'ahead by x': the runner-up's median ratio over the fastest's): "
+        f"{'; '.join(lead) if lead else 'no law settles anywhere'}. "
         f"The PTO's corrected zone is unusable in {sm['pto_zone_unusable']} cells "
         f"({where(sm['pto_zone_unusable_cells'])}) and degenerate (inside the linear zone) in "
         f"{sm['pto_zone_degenerate']} ({where(sm['pto_zone_degenerate_cells'])}); its linear "
