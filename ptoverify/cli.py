@@ -462,7 +462,7 @@ def _cmd_robust(args: argparse.Namespace) -> int:
 def _add_tune(sub) -> None:
     p = sub.add_parser(
         "tune",
-        help="tune PD (kp, kd), PTO (d, k1, k2), PTOS (alpha, k) or cascade P (kp) fairly",
+        help="tune the gains of PD, PTO, PTOS or cascade P fairly",
         description="Search a law's gains (differential evolution, fixed seed; the PTO's "
         "omega0 from the corrected construction for each d) for the best response under an "
         "overshoot bound (between samples), a stable sampled linear loop and no limit cycle "
