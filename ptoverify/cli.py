@@ -399,9 +399,10 @@ def _add_robust(sub) -> None:
     p.add_argument(
         "--law",
         action="append",
-        choices=("to", "pd", "pto", "pto-printed"),
+        choices=("to", "pd", "pto", "pto-printed", "ptos", "cascade-p"),
         default=None,
-        help="study only this law (repeatable; default all four)",
+        help="study only this law (repeatable; default the paper's four: to, pd, pto, "
+        "pto-printed; the baselines ptos, cascade-p on request)",
     )
     p.add_argument(
         "--generations",

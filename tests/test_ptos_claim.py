@@ -13,32 +13,30 @@ from conftest import zoh_reference
 
 from ptoverify.config import paper_config
 from ptoverify.errors import InputError
+from ptoverify.model.baselines import linear_loop_gains
 from ptoverify.model.laws import make_law
-from ptoverify.studies.ptos_claim import (
-    baseline_linear_gains,
-    ptos_claim,
-    reading_config,
-)
+from ptoverify.studies.ptos_claim import ptos_claim, reading_config
 
 CFG = paper_config()
 
 
 def _stable(cfg, law) -> bool:
     Ad, Bd = zoh_reference(cfg.plant.a, cfg.plant.sample_time)
-    K = np.array([baseline_linear_gains(cfg, law)])
+    K = np.array([linear_loop_gains(law, cfg)])
     return float(np.abs(np.linalg.eigvals(Ad - Bd @ K)).max()) < 1.0
 
 
 def test_linear_gains_are_those_of_the_laws():
     """The linear loop's gains equal the laws' own slopes near the origin (unclipped)."""
+    assert linear_loop_gains("to", CFG) is None
     for law in ("pd", "pto", "ptos", "cascade-p"):
-        k1, k2 = baseline_linear_gains(CFG, law)
+        k1, k2 = linear_loop_gains(law, CFG)
         fn = make_law(law, CFG)
         x1, x2 = np.array([1e-4, 0.0]), np.array([0.0, 1e-3])
         u, _ = fn(x1, x2)
         assert u[0] == pytest.approx(-k1 * 1e-4, rel=1e-12)
         assert u[1] == pytest.approx(-k2 * 1e-3, rel=1e-12, abs=1e-18)
-    assert _stable(CFG, "pd")
+    assert _stable(CFG, "pd") and _stable(CFG, "cascade-p")
 
 
 def test_fair_configs_come_from_fair_tunings():

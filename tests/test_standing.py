@@ -20,7 +20,10 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.fixture(scope="module")
 def base():
-    return json.loads((ROOT / "reports" / "paper" / "results.json").read_text())
+    data = json.loads((ROOT / "reports" / "paper" / "results.json").read_text())
+    # a committed report from before the charts stage reads as one that skipped it
+    data.setdefault("charts", None)
+    return data
 
 
 def _rows(data):

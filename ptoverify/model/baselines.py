@@ -82,6 +82,7 @@ __all__ = [
     "cascade_gain",
     "cascade_law",
     "cascade_state_gains",
+    "linear_loop_gains",
 ]
 
 
@@ -309,6 +310,42 @@ def cascade_law(cfg: Config, *, kp: float | None = None) -> Law:
     kp = cascade_gain(cfg) if kp is None else float(kp)
     law = pd_law(replace(cfg, pd=PDGains(kp=kp, kd=0.0)))
     return replace(law, name="cascade-p", note=f"cascade P u = sat(-{kp:.6g} x1)")
+
+
+def linear_loop_gains(law: str, cfg: Config) -> tuple[float, float] | None:
+    """Return the gains (k_x1 [1/s], k_x2 [-]) of a law's linear loop u = -k_x1 x1 - k_x2 x2.
+
+    The one place a law's linear loop is read off its configuration: PD (kp, kd),
+    the PTO's linear zone (k1, k2; printed or corrected), PTOS's linear region
+    (:meth:`PTOSDesign.linear_gains`), the cascade P loop (kp, 0); None for TO
+    (no linear loop) and unknown names.
+
+    Parameters
+    ----------
+    law : str
+        Law name.
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    tuple of float or None
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> linear_loop_gains("pd", paper_config()), linear_loop_gains("to", paper_config())
+    ((356.0, 1.15), None)
+    """
+    if law == "pd":
+        return cfg.pd.kp, cfg.pd.kd
+    if law in ("pto", "pto-printed"):
+        return cfg.pto.k1, cfg.pto.k2
+    if law == "ptos":
+        return ptos_design(cfg).linear_gains()
+    if law == "cascade-p":
+        return cascade_gain(cfg), 0.0
+    return None
 
 
 register_law("ptos", ptos_law, ptos_state_gains)

@@ -28,13 +28,12 @@ from typing import Any
 
 from ptoverify.config import Config
 from ptoverify.errors import InputError
-from ptoverify.model.baselines import cascade_gain, ptos_design
+from ptoverify.model.baselines import ptos_design
 from ptoverify.model.laws import make_law
 from ptoverify.studies.properties import law_properties
 from ptoverify.studies.tune import response_metrics
 
 __all__ = [
-    "baseline_linear_gains",
     "PTOSMeasure",
     "PTOSClaim",
     "ptos_claim",
@@ -45,38 +44,6 @@ __all__ = [
 
 #: Readings of the printed bandwidth: a = 2 pi f, or a = f taken as rad/s.
 READINGS = ("2pi", "hz")
-
-
-def baseline_linear_gains(cfg: Config, law: str) -> tuple[float, float]:
-    """Gains (k_x1 [1/s], k_x2 [-]) of a law's linear loop u = -k_x1 x1 - k_x2 x2.
-
-    Parameters
-    ----------
-    cfg : Config
-        Configuration.
-    law : str
-        ``pd``, ``pto``, ``pto-printed``, ``ptos`` or ``cascade-p``.
-
-    Returns
-    -------
-    tuple of float
-        The linear loop's gains.
-
-    Examples
-    --------
-    >>> from ptoverify.config import paper_config
-    >>> baseline_linear_gains(paper_config(), "pd")
-    (356.0, 1.15)
-    """
-    if law == "pd":
-        return cfg.pd.kp, cfg.pd.kd
-    if law in ("pto", "pto-printed"):
-        return cfg.pto.k1, cfg.pto.k2
-    if law == "ptos":
-        return ptos_design(cfg).linear_gains()
-    if law == "cascade-p":
-        return cascade_gain(cfg), 0.0
-    raise InputError(f"law {law!r} has no linear loop")
 
 
 @dataclass(frozen=True)

@@ -147,8 +147,8 @@ def tuned_config(cfg: Config, law: str, gains: dict[str, float]) -> Config:
 def linear_gains(cfg: Config, law: str, gains: dict[str, float]) -> tuple[float, float]:
     """Return the gains (k_x1 [1/s], k_x2 [-]) of the law's linear loop u = -k_x1 x1 - k_x2 x2.
 
-    PD: (kp, kd); PTO: (k1, k2); PTOS: its linear region's gains
-    (:meth:`ptoverify.model.baselines.PTOSDesign.linear_gains`); cascade P: (kp, 0).
+    :func:`ptoverify.model.baselines.linear_loop_gains` of the configuration
+    holding ``gains`` (:func:`tuned_config`).
 
     Parameters
     ----------
@@ -164,15 +164,9 @@ def linear_gains(cfg: Config, law: str, gains: dict[str, float]) -> tuple[float,
     tuple of float
         Position gain [1/s] and velocity gain [-].
     """
-    if law == "pd":
-        return gains["kp"], gains["kd"]
-    if law == "ptos":
-        from ptoverify.model.baselines import ptos_design
+    from ptoverify.model.baselines import linear_loop_gains
 
-        return ptos_design(cfg, alpha=gains["alpha"], k=gains["k"]).linear_gains()
-    if law == "cascade-p":
-        return gains["kp"], 0.0
-    return gains["k1"], gains["k2"]
+    return linear_loop_gains(law, tuned_config(cfg, law, gains))
 
 
 def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:
