@@ -169,9 +169,12 @@ def _poles(cfg: Config) -> dict[str, Any]:
 
 
 def _properties(cfg: Config) -> dict[str, Any]:
+    from ptoverify.config import BASELINE_NAMES, LAW_NAMES
     from ptoverify.studies.properties import all_properties
 
-    return {k: v.to_json() for k, v in all_properties(cfg).items()}
+    # the baselines beside the paper's laws (informational: the gates judge the paper's)
+    laws = LAW_NAMES + BASELINE_NAMES
+    return {k: v.to_json() for k, v in all_properties(cfg, laws).items()}
 
 
 def _environment(cfg: Config) -> dict[str, Any]:
