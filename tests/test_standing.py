@@ -143,7 +143,15 @@ def _versus(T, diffs_by_reading, infeasible=()):
     readings = []
     for rd, diffs in diffs_by_reading.items():
         pto_t = 0.02
-        laws = [{"law": "pto", "settling_s": pto_t, "ratio_nt": pto_t / 0.026, "infeasible": ""}]
+        laws = [
+            {
+                "law": "pto",
+                "settling_s": pto_t,
+                "ratio_nt": pto_t / 0.026,
+                "ratio_tf": pto_t / 0.024,
+                "infeasible": "",
+            }
+        ]
         minus = {}
         for law, d in diffs.items():
             bad = (rd, law) in infeasible
@@ -153,6 +161,7 @@ def _versus(T, diffs_by_reading, infeasible=()):
                     "law": law,
                     "settling_s": t,
                     "ratio_nt": None if bad else t / 0.026,
+                    "ratio_tf": None if bad else t / 0.024,
                     "infeasible": "tune: no gains" if bad else "",
                 }
             )
@@ -211,6 +220,7 @@ def test_versus_row_names_each_reading_and_infeasible_tunings(base):
     assert "no cascade P gains meet the constraints" in hz
     evidence = _rows(data)[VERSUS_QUESTION][2]
     assert "cascade P no tuning" in evidence and "settling definition 2pct" in evidence
+    assert "PTO 20 ms (0.7692 N*T, 0.8333 t_f*)" in evidence  # 20 / 26, 20 / 24
 
 
 def test_versus_row_says_when_tuning_was_skipped(base):

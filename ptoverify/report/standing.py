@@ -383,7 +383,7 @@ def versus_row(res: Mapping) -> list[str]:
             + (
                 "no tuning"
                 if x["infeasible"]
-                else f"{_ms(x['settling_s'])} ({fmt(x['ratio_nt'])} N*T)"
+                else f"{_ms(x['settling_s'])} ({fmt(x['ratio_nt'])} N*T, {fmt(x['ratio_tf'])} t_f*)"
             )
             for x in r["laws"]
         )
