@@ -169,6 +169,7 @@ def _versus(T, diffs_by_reading, infeasible=()):
         readings.append(
             {
                 "reading": rd,
+                "a": 188.5,
                 "sample_time": T,
                 "bound_mm": 0.0,
                 "nt_s": 0.026,
@@ -221,6 +222,20 @@ def test_versus_row_names_each_reading_and_infeasible_tunings(base):
     evidence = _rows(data)[VERSUS_QUESTION][2]
     assert "cascade P no tuning" in evidence and "settling definition 2pct" in evidence
     assert "PTO 20 ms (0.7692 N*T, 0.8333 t_f*)" in evidence  # 20 / 26, 20 / 24
+
+
+def test_versus_row_with_one_reading_names_the_configured_a(base):
+    """A configuration given in rad/s has one reading: the row names its a, not a reading."""
+    from ptoverify.report.standing import VERSUS_QUESTION
+
+    data = copy.deepcopy(base)
+    T = data["environment"]["config"]["plant"]["sample_time"]
+    data["tuning"]["versus"] = _versus(T, {"2pi": {"pd": -3 * T}})
+    data["tuning"]["versus"]["readings"][0]["a"] = 123.0
+    answer = _rows(data)[VERSUS_QUESTION][1]
+    assert answer.startswith("a = 123 rad/s (the configuration's): beats PD")
+    data["tuning"]["versus"] = _versus(T, {"2pi": {"pd": -3 * T}, "hz": {"pd": 3 * T}})
+    assert _rows(data)[VERSUS_QUESTION][1].startswith("a = 2 pi f")
 
 
 def test_versus_row_says_when_tuning_was_skipped(base):

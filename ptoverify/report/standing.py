@@ -376,7 +376,11 @@ def versus_row(res: Mapping) -> list[str]:
             versus_verdict(d, laws[name], pto, r["sample_time"])
             for name, d in r["pto_minus"].items()
         ]
-        words = reading_words("a", {"2pi": "2pi*f", "hz": "f"}.get(r["reading"], r["reading"]))
+        words = (
+            reading_words("a", {"2pi": "2pi*f", "hz": "f"}.get(r["reading"], r["reading"]))
+            if len(v["readings"]) > 1
+            else f"a = {qty(r['a'], 'rad/s')} (the configuration's)"
+        )
         answers.append(f"{words}: {', '.join(verdicts)}")
         times = ", ".join(
             f"{LAW_WORDS.get(x['law'], x['law'])} "
