@@ -372,9 +372,10 @@ def versus_row(res: Mapping) -> list[str]:
     for r in v["readings"]:
         laws = {x["law"]: x for x in r["laws"]}
         pto = laws["pto"]
-        verdicts = [
-            versus_verdict(d, laws[name], pto, r["sample_time"])
-            for name, d in r["pto_minus"].items()
+        verdicts = [  # in the laws' order (results.json sorts the keys of pto_minus)
+            versus_verdict(r["pto_minus"][x["law"]], x, pto, r["sample_time"])
+            for x in r["laws"]
+            if x["law"] != "pto"
         ]
         words = (
             reading_words("a", {"2pi": "2pi*f", "hz": "f"}.get(r["reading"], r["reading"]))
