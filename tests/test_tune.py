@@ -528,3 +528,10 @@ def test_infeasible_tuning_is_recorded_not_raised():
     ft = fair_tunings(slow, TuneBudget(maxiter=2, popsize=4), ("cascade-p",))
     assert not ft.results and set(ft.infeasible) == {("cascade-p", b) for b in ft.bounds}
     assert all("no cascade-p gains" in v for v in ft.infeasible.values())
+
+
+def test_fair_tunings_name_their_bounds():
+    with pytest.raises(InputError, match="bounds must be among"):
+        fair_tunings(CFG, SMALL, ("pd",), ("nope",))
+    with pytest.raises(InputError, match="bounds must be among"):
+        fair_tunings(CFG, SMALL, ("pd",), ())
