@@ -39,9 +39,9 @@ poles       PD and linear-zone (eq. 37) loops: poles, damping, margins (python-c
 Closed loop and metrics
 simulate    Reference (step/ramp/sine, custom), simulate (tracking: feedforward, none, error;
             results carry their reference), Mismatch, simulate_batch (true plant, delay,
-            quantization, noise), simulate_segments (several laws and mismatches, one run)
+            quantization, noise), simulate_parts (several laws and mismatches, one run)
 lockstep    run_together: searches side by side, their batches merged (threads);
-            simulate_asks: asks simulated in few simulate_segments runs (robust, tune)
+            simulate_asks: asks simulated in few simulate_parts runs (robust, tune)
 exact       metrics between samples on the exact ZOH flow: overshoot, settling (last exit),
             rise time, linear-zone entry, sine phase; exact and sample-grid values side by side
 metrics     summarize (exact metrics with their grid twins), oscillation_amplitude,

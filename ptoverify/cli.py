@@ -428,9 +428,9 @@ def _cmd_robust(args: argparse.Namespace) -> int:
 
     cfg = _config(args)
     if args.dask is not None:
-        from ptoverify.studies.cluster import check_dask_address
+        from ptoverify.studies.cluster import ensure_reachable
 
-        check_dask_address(args.dask)  # bad input at once, before any computation
+        ensure_reachable(args.dask)  # bad input or no scheduler: at once, before any work
     if not 3 <= args.grid <= 101:
         raise InputError(f"--grid must be in [3, 101], got {args.grid}")
     if not 0 <= args.generations <= 500:
@@ -821,6 +821,10 @@ def _cmd_design(args: argparse.Namespace) -> int:
     cfg = _config(args)
     if args.dask and args.jobs > 1:
         raise InputError("--dask and --jobs are exclusive")
+    if args.dask is not None:
+        from ptoverify.studies.cluster import ensure_reachable
+
+        ensure_reachable(args.dask)  # bad input or no scheduler: at once, before any work
     runner = dask_design_runner(args.dask) if args.dask else None
     if args.jobs > 1:
         runner = process_runner(args.jobs)
@@ -1015,6 +1019,10 @@ def _cmd_prove(args: argparse.Namespace) -> int:
     if not math.isfinite(args.excursion):
         raise InputError("--excursion must be a finite number of mm")
     a_int = parse_a_interval(args.a_interval, cfg.plant.a) if args.a_interval else None
+    if args.dask is not None:
+        from ptoverify.studies.cluster import ensure_reachable
+
+        ensure_reachable(args.dask)  # bad input or no scheduler: at once, before any work
     laws = tuple(dict.fromkeys(args.law)) if args.law else ("pto", "pto-printed", "pd", "to")
     target = tmp = None
     if args.out is not None:

@@ -108,10 +108,12 @@ def test_connect_is_time_boxed(garbage):
 
 
 @pytest.mark.slow
-def test_cli_against_a_silent_listener_is_exit_1_within_the_promise():
+@pytest.mark.parametrize("command", [["robust", "--quiet"], ["design"], ["prove"]], ids=str)
+def test_cli_against_a_silent_listener_is_exit_1_within_the_promise(command):
+    """Every command that takes --dask reaches the scheduler before any work."""
     listener = Listener()
     try:
-        code, out, err, took = cli("robust", "--dask", listener.address, "--json", "--quiet")
+        code, out, err, took = cli(*command, "--dask", listener.address, "--json")
     finally:
         listener.close()
     assert code == 1 and out == "" and "cannot reach the Dask scheduler" in err, err

@@ -24,6 +24,7 @@ import ptoverify.model.ocp as ocp_mod
 import ptoverify.model.plant as plant_mod
 import ptoverify.model.poles as poles_mod
 import ptoverify.model.zones as zones_mod
+import ptoverify.model.zones.margins as zone_margins
 import ptoverify.studies.claims as claims_mod
 import ptoverify.studies.robust as robust_mod
 import ptoverify.studies.robust.maps as robust_maps_mod
@@ -205,9 +206,9 @@ def _(monkeypatch, cfg):
 @perturbation("zone-corrected-valid", baseline=False)
 def _(monkeypatch, cfg):
     """A construction that believes every omega0 meets the principle: the grid check objects."""
-    real = zones_mod.principle_margin
+    real = zone_margins.principle_margin
     monkeypatch.setattr(
-        zones_mod, "principle_margin", lambda *a, **k: np.asarray(real(*a, **k)) + 1e3
+        zone_margins, "principle_margin", lambda *a, **k: np.asarray(real(*a, **k)) + 1e3
     )
     return cfg
 

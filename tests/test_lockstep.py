@@ -1,6 +1,6 @@
 """Batched simulation of the robustness study against the simple per-case simulation.
 
-``simulate_segments`` (several laws and mismatches in one run), ``simulate_asks``
+``simulate_parts`` (several laws and mismatches in one run), ``simulate_asks``
 (asks in runs) and ``run_together`` (searches side by side) must give each case exactly what
 the case simulated alone gives: ``simulate_batch`` with its own mismatch, and
 that in turn the independent scalar loop (``plant.flow`` per sample, a delay
@@ -18,7 +18,7 @@ from ptoverify.config import paper_config
 from ptoverify.model.laws import Region, make_law
 from ptoverify.model.plant import flow
 from ptoverify.sim.lockstep import Ask, run_together, simulate_asks
-from ptoverify.sim.simulate import Mismatch, simulate_batch, simulate_segments
+from ptoverify.sim.simulate import BatchResult, Mismatch, simulate_batch, simulate_parts
 from ptoverify.studies.robust import (
     RobustSettings,
     grid_worst,
@@ -62,8 +62,19 @@ def _random_case(rng, n):
     )
 
 
+def simulate_segments(segments, plant, steps):
+    """The parts of :func:`simulate_parts` side by side (columns in segment order)."""
+    parts = simulate_parts(segments, plant, steps)
+    return BatchResult(
+        *(
+            np.concatenate([getattr(p, f) for p in parts], axis=1)
+            for f in ("x1", "x2", "u", "region")
+        )
+    )
+
+
 def _assert_segments_run_alone(segments, steps):
-    """simulate_segments gives each segment exactly its own simulate_batch run."""
+    """simulate_parts gives each segment exactly its own simulate_batch run."""
     both = simulate_segments(segments, P, steps)
     at = 0
     for law, x1, x2, m in segments:

@@ -345,16 +345,3 @@ def test_saved_png_is_the_figure_drawn(tmp_path):
     with Image.open(path) as img:
         assert img.info["dpi"] == pytest.approx((plots.DPI, plots.DPI), abs=0.01)
         assert_array_equal(np.asarray(img.convert("RGBA")), drawn)
-
-
-@pytest.mark.slow
-def test_save_all_writes_figures_2_to_14(tmp_path):
-    from ptoverify.report.collect import figure_inputs
-
-    files = plots.save_all(figure_inputs(paper_config()), tmp_path)
-    nums = {int(f.name[3:5]) for f in files if f.name.startswith("fig")}
-    assert nums == set(range(2, 15)), f"figures written: {sorted(nums)}"
-    assert "zone_geometry.png" in {f.name for f in files}
-    for f in files:
-        assert f.exists() and f.stat().st_size > 10_000, f"{f.name} is too small"
-        assert f.stat().st_size < 400_000, f"{f.name} is too large for a report"

@@ -56,9 +56,18 @@ def test_report_folder_complete_and_reproducible(two_reports):
         assert (one / f).stat().st_size > 1000, f
     figs = sorted((one / "figures").glob("*.png"))
     assert len(figs) >= 20 and all(f.stat().st_size > 5000 for f in figs)
+    # the paper's figures 2 to 14 and the zone's geometry, each a readable size
+    nums = {int(f.name[3:5]) for f in figs if f.name.startswith("fig")}
+    assert nums == set(range(2, 15)), f"figures written: {sorted(nums)}"
+    assert "zone_geometry.png" in {f.name for f in figs}
+    paper = [f for f in figs if f.name.startswith("fig") or f.name == "zone_geometry.png"]
+    assert all(10_000 < f.stat().st_size < 400_000 for f in paper), "a figure's size"
     a, b = _without_meta(one), _without_meta(two)
     assert _shared(a) == _shared(b), "two runs differ beyond the timestamp"
     assert b["skipped"] == sorted(SKIPPABLE) and b["robust"] is None and b["tuning"] is None
+    # the full sweep: 200 x 200 states of the envelope, every law (run here, not twice)
+    assert a["sweep"]["grid"] == [200, 200]
+    assert set(a["sweep"]["laws"]) == {"to", "pd", "pto", "pto-printed"}
     data = a
     for key in (
         "derivations",
@@ -425,7 +434,7 @@ def _alive(pid: int) -> bool:
 @pytest.mark.parametrize("sig, code", [("SIGTERM", 143), ("SIGINT", 130)])
 def test_report_pool_interrupted_cleans_up(tmp_path, sig, code):
     """SIGTERM to the command, or Ctrl-C to its process group, while the pool's workers
-    draw figures: one line, exit 143 / 130 within seconds, no folder left, no worker left
+    compute their stages: one line, exit 143 / 130 within seconds, no folder left, no worker left
     running."""
     import signal
     import sys
@@ -445,12 +454,14 @@ def test_report_pool_interrupted_cleans_up(tmp_path, sig, code):
     workers: set[int] = set()
     try:
         deadline = time.monotonic() + 300
-        while not any(tmp_path.glob(".out.tmp-*/figures/*.png")):
+        # the pool's two workers (and the resource tracker) are at work on their stages
+        while not (any(tmp_path.glob(".out.tmp-*")) and len(_descendants(proc.pid)) >= 2):
             assert proc.poll() is None, proc.communicate()
-            assert time.monotonic() < deadline, "the workers never drew a figure"
+            assert time.monotonic() < deadline, "the pool never started"
             time.sleep(0.05)
+        time.sleep(1.0)  # inside their stages' work, not at start-up
         workers = _descendants(proc.pid)
-        assert len(workers) >= 2, workers  # the two workers (and the resource tracker)
+        assert len(workers) >= 2, workers
         if sig == "SIGTERM":
             proc.send_signal(signal.SIGTERM)
         else:

@@ -288,10 +288,10 @@ def test_single_trajectory_is_the_batch_on_one_state(paper_cfg):
 
 
 def test_segments_merged_per_law_equal_each_segment_alone():
-    """simulate_segments runs segments of one law as one batch: bit for bit each alone."""
+    """simulate_parts runs segments of one law as one batch: bit for bit each alone."""
     from ptoverify.config import paper_config
     from ptoverify.model.laws import make_law
-    from ptoverify.sim.simulate import Mismatch, simulate_batch, simulate_segments
+    from ptoverify.sim.simulate import Mismatch, simulate_batch, simulate_parts
 
     cfg = paper_config()
     rng = np.random.default_rng(7)
@@ -311,13 +311,9 @@ def test_segments_merged_per_law_equal_each_segment_alone():
             seed=k,
         )
         segments.append((law, x1, x2, None if k == 0 else m))
-    both = simulate_segments(segments, cfg.plant, 150)
-    start = 0
-    for law, x1, x2, m in segments:
+    parts = simulate_parts(segments, cfg.plant, 150)
+    assert len(parts) == len(segments)
+    for (law, x1, x2, m), part in zip(segments, parts, strict=True):
         one = simulate_batch(law, cfg.plant, x1, x2, 150, mismatch=m)
-        sl = slice(start, start + x1.size)
         for f in ("x1", "x2", "u", "region"):
-            np.testing.assert_array_equal(
-                getattr(both, f)[:, sl], getattr(one, f), err_msg=f"segment {f}"
-            )
-        start += x1.size
+            np.testing.assert_array_equal(getattr(part, f), getattr(one, f), err_msg=f"segment {f}")

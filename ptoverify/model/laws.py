@@ -66,7 +66,7 @@ class LawFamily:
 
     A batch that drives states with several laws of one family evaluates them
     in one call, each state with its law's parameters
-    (:func:`ptoverify.sim.simulate.simulate_segments`).  A member's own
+    (:func:`ptoverify.sim.simulate.simulate_parts`).  A member's own
     ``vector`` is this function with its ``params``, so each state's input and
     region are those of its own law by construction.
 

@@ -26,7 +26,6 @@ from ptoverify.config import Config
 
 __all__ = [
     "PENALTY_LAWS",
-    "PENALTY_DEFINITION",
     "CHART_SAMPLE_TIMES",
     "CHART_BANDWIDTHS_HZ",
     "CHART_LAWS",
@@ -41,8 +40,6 @@ __all__ = [
 
 #: The laws of the penalty curves.
 PENALTY_LAWS = ("to", "pd", "pto", "ptos", "cascade-p")
-#: The penalty's settling definition by name (:data:`ptoverify.sim.settling.DEFINITIONS`).
-PENALTY_DEFINITION = "box-0p01mm"
 #: The coarse chart's sample times [s]: ``design``'s defaults less 0.25 ms, which the
 #: configuration check rejects at 5 Hz (a T < 0.01).
 CHART_SAMPLE_TIMES = (0.0005, 0.001, 0.002, 0.004, 0.008)
@@ -70,14 +67,16 @@ def penalty_results(
     -------
     dict
         :meth:`ptoverify.studies.penalty.PenaltyResult.to_json` less ``seconds``,
-        plus ``definition`` (the settling definition's name), ``count`` (move
+        plus ``definition_description`` (the named settling definition's
+        description, :data:`ptoverify.sim.settling.DEFINITIONS`), ``count`` (move
         sizes) and per law ``never_settled`` (sizes it never settles from).
     """
+    from ptoverify.sim.settling import definition
     from ptoverify.studies.penalty import penalty_curves
 
     res = penalty_curves(cfg, PENALTY_LAWS, configs=configs, setting=setting).to_json()
     res.pop("seconds", None)
-    res["definition"] = PENALTY_DEFINITION
+    res["definition_description"] = definition(res["settling_definition"]).description
     res["count"] = len(res["sizes_mm"])
     for c in res["laws"].values():
         c["never_settled"] = sum(t is None for t in c["settling_s"])

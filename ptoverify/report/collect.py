@@ -43,7 +43,8 @@ import platform
 import subprocess
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -659,6 +660,30 @@ def _worker_setup() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+@contextmanager
+def _sigint_ignored_at_spawn() -> Iterator[None]:
+    """Ignore SIGINT while the pool spawns its workers, so that they start ignoring it.
+
+    A worker installs :func:`_worker_setup` only after its interpreter has started
+    and unpickled its task; a Ctrl-C before then would print a KeyboardInterrupt
+    traceback from the worker.  An ignored signal stays ignored across ``exec``,
+    and Python leaves an inherited SIG_IGN of SIGINT in place, so a worker spawned
+    here never sees Ctrl-C.  The parent ignores it only while it submits (the
+    workers are started by ``submit``); off the main thread nothing is changed.
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def _run_in_pool(
     names: list[str],
     cfg: Config,
@@ -692,7 +717,8 @@ def _run_in_pool(
         return
     with pool:
         try:
-            futures = {pool.submit(_run_stage, name, cfg, figdir): name for name in names}
+            with _sigint_ignored_at_spawn():
+                futures = {pool.submit(_run_stage, name, cfg, figdir): name for name in names}
             for future in as_completed(futures):
                 name = futures[future]
                 try:
@@ -716,12 +742,16 @@ def _robust(cfg: Config) -> tuple[dict[str, Any], list]:
     from dataclasses import asdict
 
     from ptoverify.studies.robust import RobustSettings, robust_gates, run_robust
+    from ptoverify.studies.robust.drive import drive_sweeps
+    from ptoverify.studies.robust.maps import SETTLING
 
     settings = RobustSettings(**ROBUST_SETTINGS)
     result = run_robust(cfg, settings)
     res = result.to_json()
     res.pop("timings_s", None)
     res["settings"] = asdict(settings)
+    res["settling"] = SETTLING
+    res["drive"] = drive_sweeps(cfg).to_json()
     return res, robust_gates(result)
 
 

@@ -27,7 +27,6 @@ __all__ = [
     "paragraph",
     "qty",
     "image",
-    "figure_beside",
     "findings",
     "code",
     "link",
@@ -226,24 +225,6 @@ def findings(items: list[tuple[str, str, str]], figure: str = "", caption: str =
     return Block(
         "raw", text=md, html=f'<div class="headline"><ol class="findings">{lis}</ol>{fig}</div>'
     )
-
-
-def figure_beside(blocks: list[Block]) -> Block:
-    """Return figures side by side (a row of small multiples; one per line in Markdown).
-
-    Parameters
-    ----------
-    blocks : list of Block
-        ``img`` blocks.
-
-    Returns
-    -------
-    Block
-        A raw block.
-    """
-    inner = "".join(_html_block(b) for b in blocks)
-    md = "\n\n".join(f"![{b.text}]({b.html})" for b in blocks)
-    return Block("raw", text=md, html=f'<div class="row">{inner}</div>')
 
 
 def image(figures: dict[str, str], key: str, caption: str) -> list[Block]:

@@ -3,7 +3,7 @@
 Catalogue
 ---------
 reference  Reference (step/ramp/sine), SIGNALS, reference
-simulate   simulate, Mismatch, simulate_batch (the one loop), simulate_segments
+simulate   simulate, Mismatch, simulate_batch (the one loop), simulate_parts
 lockstep   run_together (searches side by side, batches merged), simulate_asks
 flow       Signal, Trajectory and the monotone pieces of the exact ZOH flow
 settling   SettlingDefinition, DEFINITIONS, settling_time, overshoot (named definitions)

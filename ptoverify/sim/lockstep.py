@@ -13,7 +13,7 @@ per item), so the outcome is that of running the jobs one after the other, and a
 deterministic; only the number of batches drops.
 
 :func:`simulate_asks` is the batch function of simulation studies: the asks of one
-call are simulated by :func:`ptoverify.sim.simulate.simulate_segments` (the asks of
+call are simulated by :func:`ptoverify.sim.simulate.simulate_parts` (the asks of
 one law, and of the laws of one :class:`~ptoverify.model.laws.LawFamily`, share one
 evaluation per sample), in runs of at most ``round_states`` states, and each ask's
 trajectories are measured at once (so a round keeps measured values, not
@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 
 from ptoverify.config import Plant
 from ptoverify.model.laws import Law
-from ptoverify.sim.simulate import BatchResult, Mismatch, simulate_segments
+from ptoverify.sim.simulate import BatchResult, Mismatch, simulate_parts
 
 __all__ = ["Ask", "run_together", "simulate_asks", "ROUND_STATES"]
 
@@ -240,20 +240,13 @@ def simulate_asks(
             order.setdefault(id(asks[k].law), len(order))
         run.sort(key=lambda k: (order[_family(asks[k].law)], order[id(asks[k].law)]))
         t = time.perf_counter()
-        batch = simulate_segments(
+        parts = simulate_parts(
             [(asks[k].law, asks[k].x1, asks[k].x2, asks[k].mismatch) for k in run], plant, steps
         )
         start = 0
-        for k in run:
-            sl = slice(start, start + asks[k].size)
+        for k, part in zip(run, parts, strict=True):
             start += asks[k].size
-            b = BatchResult(
-                batch.x1[:, sl],
-                batch.x2[:, sl],
-                batch.u[:, sl],
-                batch.region[:, sl],
-                asks[k].mismatch,
-            )
+            b = BatchResult(part.x1, part.x2, part.u, part.region, asks[k].mismatch)
             out[k] = measure(k, b)
         if seconds is not None:
             elapsed = time.perf_counter() - t

@@ -45,6 +45,7 @@ __all__ = [
     "definition",
     "Settling",
     "settling_time",
+    "grid_settling",
     "Overshoot",
     "overshoot",
     "definitions_table",
@@ -277,16 +278,61 @@ def settling_time(
         exact[sl] = np.where(ended, np.nan, last)
     hold_ok = t_end - exact >= d.hold_s - 1e-9 * T
     exact = np.where(hold_ok, exact - float(t[0]), np.nan)
-    # the sample grid: first sample from which every later sample is in the box
+    grid = grid_settling(trajectory, reference, d)
+    eps = float(np.finfo(float).eps)
+    return Settling(d, exact, grid, 4.0 * eps * T + 4.0 * eps * abs(t_end))
+
+
+def grid_settling(
+    trajectory: Trajectory, reference: object, definition_: str | SettlingDefinition
+) -> NDArray[np.float64]:
+    """Settling time under a named definition, read on the samples only.
+
+    The first sample from which every later sample lies in the definition's box,
+    measured from the record's start; NaN where the record ends outside or the
+    settled tail is shorter than the hold time.  It is the ``grid`` twin that
+    :func:`settling_time` returns beside the exact time, for studies that judge
+    on the samples alone (``robust``: the same definition, without the cost of
+    the exact last exit).
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        One trajectory or a batch (``u`` is not read); the velocity band is
+        that of ``trajectory.a`` [rad/s].
+    reference : Signal, Reference-like, tuple or None
+        The reference r(t); None for regulation to the origin.
+    definition_ : str or SettlingDefinition
+        A name of :data:`DEFINITIONS` or a definition.
+
+    Returns
+    -------
+    ndarray, shape (k,)
+        Settling times on the sample grid [s].
+
+    Examples
+    --------
+    >>> t = np.arange(4) * 0.1
+    >>> tr = Trajectory.from_samples(t, [1.0, 0.5, 0.0, 0.0], [0, 0, 0, 0], [0, 0, 0], 10.0)
+    >>> grid_settling(tr, None, "0p01mm").tolist()  # in the band from the third sample on
+    [0.2]
+    """
+    d = definition(definition_)
+    sig = Signal("step", 0.0) if reference is None else as_signal(reference)
+    b1, b2 = d.position_band(abs(sig.amplitude)), d.velocity_band(trajectory.a)
+    t = trajectory.t
+    X1 = trajectory.x1[:, None] if trajectory.x1.ndim == 1 else trajectory.x1
+    X2 = trajectory.x2[:, None] if trajectory.x2.ndim == 1 else trajectory.x2
+    T = float(np.max(np.diff(t)))
+    t_end = float(t[-1])
     out = np.abs(sig.r(t)[:, None] - X1) > b1
     if math.isfinite(b2):
         out |= np.abs(sig.r_dot(t)[:, None] - X2) > b2
     rev = out[::-1]
     kg = np.where(rev.any(axis=0), t.size - rev.argmax(axis=0), 0)
     tg = t[np.minimum(kg, t.size - 1)]
-    grid = np.where((kg < t.size) & (t_end - tg >= d.hold_s - 1e-9 * T), tg - float(t[0]), np.nan)
-    eps = float(np.finfo(float).eps)
-    return Settling(d, exact, grid, 4.0 * eps * T + 4.0 * eps * abs(t_end))
+    ok = (kg < t.size) & (t_end - tg >= d.hold_s - 1e-9 * T)
+    return np.where(ok, tg - float(t[0]), np.nan)
 
 
 def _last_exit(tr: Trajectory, sig: Signal, band: float, order: int, T: float):  # noqa: N803

@@ -49,7 +49,7 @@ __all__ = [
     "BatchResult",
     "Mismatch",
     "simulate_batch",
-    "simulate_segments",
+    "simulate_parts",
 ]
 
 
@@ -301,7 +301,7 @@ def simulate_batch(
     """Simulate the sampled loop to the origin from many initial states at once.
 
     This is the suite's one simulator: :func:`simulate` (one state tracking a
-    reference) and :func:`simulate_segments` (several laws and mismatches) run
+    reference) and :func:`simulate_parts` (several laws and mismatches) run
     the same loop.
 
     Parameters
@@ -399,15 +399,19 @@ def _loop(
 
 
 Segment = tuple[Law, ArrayLike, ArrayLike, Mismatch | None]
-"""One group of :func:`simulate_segments`: (law, x1 [mm], x2 [mm/s], mismatch)."""
+"""One group of :func:`simulate_parts`: (law, x1 [mm], x2 [mm/s], mismatch)."""
 
 
-def simulate_segments(
+def simulate_parts(
     segments: list[Segment],
     plant: Plant,
     steps: int,
-) -> BatchResult:
-    """Run :func:`simulate_batch` for each segment and join the trajectories.
+) -> list[BatchResult]:
+    """Run :func:`simulate_batch` for each segment; one result per segment.
+
+    The segments of one law and one noise-free measurement model run as one batch
+    (each state's trajectory does not depend on the batch it runs in); each result
+    is a view of that batch's arrays, so nothing is copied.
 
     Parameters
     ----------
@@ -421,24 +425,11 @@ def simulate_segments(
 
     Returns
     -------
-    BatchResult
-        The trajectories of all states, segment after segment (``mismatch`` None).
-
-    Examples
-    --------
-    >>> from ptoverify.config import paper_config
-    >>> from ptoverify.model.laws import pd_law, to_law
-    >>> cfg = paper_config()
-    >>> m = Mismatch(a_ratio=0.9, delay_samples=1)
-    >>> both = simulate_segments([(pd_law(cfg), [5.0], [0.0], None),
-    ...                           (to_law(cfg), [5.0], [0.0], m)], cfg.plant, 100)
-    >>> one = simulate_batch(to_law(cfg), cfg.plant, [5.0], [0.0], 100, mismatch=m)
-    >>> bool((both.x1[:, 1] == one.x1[:, 0]).all())
-    True
+    list of BatchResult
+        The trajectories of each segment, in order (``mismatch`` None).
     """
     if not segments:
-        empty = np.empty((steps + 1, 0))
-        return BatchResult(empty, empty.copy(), np.empty((steps, 0)), np.empty((steps, 0), np.int8))
+        return []
     # segments of one law and one noise-free measurement model run as one batch, their
     # a ratio, drive limit and delay per state (a state's trajectory does not depend on
     # the batch it runs in); a noisy segment keeps its own call (its own noise stream)
@@ -479,9 +470,4 @@ def simulate_segments(
             sl = slice(start, start + x.shape[0])
             parts[i] = BatchResult(run.x1[:, sl], run.x2[:, sl], run.u[:, sl], run.region[:, sl])
             start += x.shape[0]
-    return BatchResult(
-        *(
-            np.concatenate([getattr(parts[i], f) for i in range(len(segments))], axis=1)
-            for f in ("x1", "x2", "u", "region")
-        )
-    )
+    return [parts[i] for i in range(len(segments))]

@@ -6,7 +6,7 @@ log-spaced sizes s from 0.01 mm to the position range.  For each law:
 * **settling** (the suite's 0.01 mm definition, as ``ptoverify sweep``): the
   last exit of the exact trajectory between samples from the box
   |x1| <= 0.01 mm, |x2| <= a 0.01 mm/s, with a settled tail of at least 0.05 s
-  (:func:`ptoverify.sim.exact.settling_times_batch`); NaN where the law never
+  (:func:`ptoverify.sim.settling.settling_time` under ``box-0p01mm``); NaN where the law never
   settles (the sampled TO law limit-cycles, so it never does);
 * **arrival**: the first sample time k T at which the position has reached or
   passed the target (x1_k s <= 0, or |x1_k| <= 0.01 mm): reaching, not staying,
@@ -34,16 +34,17 @@ from ptoverify.config import ALL_LAW_NAMES, Config
 from ptoverify.errors import InputError
 from ptoverify.model.laws import make_law
 from ptoverify.model.mintime import discrete_min_steps_batch, min_time
-from ptoverify.sim.exact import TIGHT_BAND, settling_times_batch
+from ptoverify.sim.exact import TIGHT_BAND
+from ptoverify.sim.flow import Trajectory
+from ptoverify.sim.settling import DEFINITIONS, settling_time
 from ptoverify.sim.simulate import simulate_batch
 
 __all__ = ["PenaltyCurve", "PenaltyResult", "penalty_curves", "move_sizes", "SETTLING_DEFINITION"]
 
-SETTLING_DEFINITION = (
-    "last exit of the exact trajectory from |x1| <= 0.01 mm, |x2| <= a * 0.01 mm/s, "
-    "held at least 0.05 s (ptoverify sweep's settling)"
-)
-HOLD_S = 0.05  #: shortest settled tail [s] (the sweep's)
+#: The settling definition of the curves, by name (:data:`ptoverify.sim.settling.DEFINITIONS`):
+#: the sweep's box, |x1| <= 0.01 mm and |x2| <= a 0.01 mm/s held 0.05 s.
+SETTLING_DEFINITION = "box-0p01mm"
+HOLD_S = DEFINITIONS[SETTLING_DEFINITION].hold_s  #: shortest settled tail [s]
 HORIZON_FACTOR = 4.0  #: horizon in units of the largest t_f* (the sweep's), plus the hold
 
 
@@ -248,7 +249,8 @@ def penalty_curves(
     for name in laws:
         law = make_law(name, (configs or {}).get(name, cfg))
         b = simulate_batch(law, plant, s, zero, steps)
-        st = settling_times_batch(b.x1, b.x2, b.u, a, T, TIGHT_BAND, a * TIGHT_BAND, HOLD_S)
+        t = np.arange(b.x1.shape[0]) * T
+        st = settling_time(Trajectory(t, b.x1, b.x2, b.u, a), None, SETTLING_DEFINITION)
         reached = (b.x1 * s <= 0.0) | (np.abs(b.x1) <= TIGHT_BAND)
         arrival = np.where(reached.any(axis=0), reached.argmax(axis=0) * T, np.nan)
         with np.errstate(invalid="ignore", divide="ignore"):

@@ -37,7 +37,6 @@ not settled
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -48,6 +47,7 @@ import numpy as np
 from ptoverify.config import Config
 from ptoverify.model.curves import level_side, switching_function
 from ptoverify.model.laws import Law, Region, make_law
+from ptoverify.model.memo import memo
 from ptoverify.sim.flow import Trajectory
 from ptoverify.sim.settling import (
     DEFINITIONS,
@@ -554,7 +554,7 @@ def all_properties(
     return {name: law_properties(make_law(name, cfg), cfg, **kwargs) for name in laws}
 
 
-@functools.lru_cache(maxsize=16)
+@memo(maxsize=16)
 def named_properties(cfg: Config, law: str) -> LawProperties:
     """Properties of the law called ``law`` on the default grid, once per configuration.
 

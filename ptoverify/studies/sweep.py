@@ -70,7 +70,6 @@ __all__ = [
     "LawSweep",
     "SweepResult",
     "run_sweep",
-    "settle_steps",
     "settling_times",
     "sweep_definition",
     "grid_states",
@@ -350,32 +349,6 @@ def mirror_pairs(x1: NDArray, x2: NDArray) -> tuple[NDArray[np.intp], NDArray[np
     first = np.minimum(np.arange(n), np.array(mirror, dtype=np.intp))
     reps, where = np.unique(first, return_inverse=True)
     return reps.astype(np.intp), where.astype(np.intp)
-
-
-def settle_steps(
-    x1: NDArray, x2: NDArray, band: float, velocity_band: float, hold_steps: int
-) -> NDArray[np.int64]:
-    """First sample from which every later state lies in the band.
-
-    Parameters
-    ----------
-    x1, x2 : ndarray, shape (steps + 1, n)
-        Trajectories [mm], [mm/s].
-    band, velocity_band : float
-        Half-widths [mm], [mm/s].
-    hold_steps : int
-        Shortest settled tail [samples].
-
-    Returns
-    -------
-    ndarray of int, shape (n,)
-        Settling sample; -1 where the tail settled for fewer than ``hold_steps``.
-    """
-    out = (np.abs(x1) > band) | (np.abs(x2) > velocity_band)
-    last = out.shape[0] - 1
-    rev = out[::-1]
-    k = np.where(rev.any(axis=0), last - rev.argmax(axis=0) + 1, 0)
-    return np.where(last - k >= hold_steps, k, -1)
 
 
 #: States simulated at once by default (about 20 MB of trajectories at 384 samples).

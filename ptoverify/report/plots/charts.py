@@ -62,7 +62,7 @@ def plot_penalty(penalty: Mapping, axes) -> dict:
         right.semilogx(s, _col(c["ratio_nt"]), color=colour, lw=1.3, label=label)
     right.axhline(1.0, color="k", ls=":", lw=1.0)
     left.set_xlabel("move size [mm]")
-    left.set_ylabel(f"settling time ({penalty['definition']}) [ms]")
+    left.set_ylabel(f"settling time ({penalty['settling_definition']}) [ms]")
     right.set_xlabel("move size [mm]")
     right.set_ylabel("settling / (N* T) [-]")
     left.set_title(f"gains: {penalty['setting']}", fontsize=9)

@@ -156,7 +156,8 @@ def charts(res: Any, figures: dict[str, str]) -> list[Block]:
             text="How much slower than the limit is each law, for a given move? Point-to-point "
             f"moves from rest, {p['count']} sizes log-spaced from "
             f"{qty(p['sizes_mm'][0], 'mm')} to {qty(p['sizes_mm'][-1], 'mm')}; settling "
-            f"definition {p['definition']} ({p['settling_definition']}), beside the continuous "
+            f"definition {p['settling_definition']} ({p['definition_description']}), beside the "
+            "continuous "
             "minimum time t_f* and the sampled limit N* T.",
         ),
         *_penalty_blocks(p, figures, "penalty_moves", "tables/penalty_moves.csv"),

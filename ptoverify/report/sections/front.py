@@ -18,7 +18,6 @@ from ptoverify.report.standing import ratio_interval
 from .common import (
     _GATE_UNITS,
     _claim_qty,
-    _display_unit,
     _downstream_ids,
     _ms,
     measured_quantity,
@@ -199,12 +198,6 @@ def c31_paper(res: dict[str, Any]) -> float | None:
     """
     c = next((c for c in res["claims"] if c["id"] == "step-pd-31-percent"), None)
     return None if c is None else c["paper_value"]
-
-
-def _claim_value_sentence(c: dict[str, Any]) -> str:
-    unit, scale = _display_unit(c["unit"])
-    paper = f", paper {qty(c['paper_value'] * scale, unit)}" if c["paper_value"] is not None else ""
-    return f"{c['id']} measures {qty(c['measured'] * scale, unit)}{paper}"
 
 
 def _finding_robust(res: Any) -> tuple[str, str, str] | None:

@@ -5,10 +5,10 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import replace
-from functools import lru_cache
 from typing import TYPE_CHECKING
 
 from ptoverify.config import Config
+from ptoverify.model.memo import memo
 from ptoverify.sim import metrics as mt
 from ptoverify.studies.tune import (
     FairTunings,
@@ -114,7 +114,7 @@ def _evaluate(
     )
 
 
-@lru_cache(maxsize=8)
+@memo(maxsize=8)
 def _evaluate_all(
     cfg: Config, claims: tuple[_Claim, ...], tuned: bool = False, budget: TuneBudget | None = None
 ) -> tuple[ClaimResult, ...]:

@@ -5,13 +5,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ptoverify.config import Config
 from ptoverify.model.laws import Law, make_law
+from ptoverify.model.memo import memo
 from ptoverify.sim import metrics as mt
 from ptoverify.sim.exact import Compared, ExactMetrics, exact_metrics
 from ptoverify.sim.simulate import SimResult, simulate
@@ -34,17 +34,17 @@ def _cfg_for(cfg: Config, reading: Reading) -> Config:
     return cfg.with_plant(a=cfg.bandwidth_hz) if reading.a == "f" else cfg
 
 
-@lru_cache(maxsize=64)
+@memo(maxsize=64)
 def _law(name: str, cfg: Config) -> Law:
     return make_law(name, cfg)
 
 
-@lru_cache(maxsize=256)
+@memo(maxsize=256)
 def _sim(cfg: Config, law: str, signal: str, tracking: str) -> SimResult:
     return simulate(_law(law, cfg), cfg.plant, signal, tracking=_SIM_TRACKING[tracking])
 
 
-@lru_cache(maxsize=512)
+@memo(maxsize=512)
 def _metrics(cfg: Config, law: str, signal: str, tracking: str, frac: float) -> ExactMetrics:
     res = _sim(cfg, law, signal, tracking)
     return exact_metrics(res, cfg.plant, res.reference, step_fraction=frac)

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict
-from functools import lru_cache
 from typing import Any
 
 import numpy as np
 
 from ptoverify.config import Config
+from ptoverify.model.memo import memo
 from ptoverify.model.mintime import discrete_min_steps_batch, min_time
 from ptoverify.sim import metrics as mt
 from ptoverify.sim.metrics import STEP_FRACTION
@@ -30,7 +30,7 @@ from .measure import _sim
 from .sentences import TUNED_CLAIMS
 
 
-@lru_cache(maxsize=8)
+@memo(maxsize=8)
 def _response_metrics(cfg: Config) -> dict[str, dict[str, dict[str, float]]]:
     out: dict[str, dict[str, dict[str, float]]] = {}
     for law in ("to", "pd", "pto", "pto-printed"):

@@ -5,10 +5,10 @@ from __future__ import annotations
 import functools
 import time
 from dataclasses import dataclass, field
-from functools import lru_cache
 
 from ptoverify.config import Config
 from ptoverify.errors import InputError
+from ptoverify.model.memo import memo
 from ptoverify.sim.lockstep import run_together
 from ptoverify.studies.tune.measure import response_metrics
 from ptoverify.studies.tune.screen import StepScreen
@@ -88,41 +88,23 @@ class FairTunings:
         return self.results[(law, bound)].config
 
 
-@lru_cache(maxsize=8)
+@memo(maxsize=8)
 def _paper(cfg: Config) -> dict[str, dict[str, float]]:
     """Return the step's metrics at the paper's gains of PD and PTO (the bounds' source)."""
     return {law: response_metrics(cfg, law, "step") for law in ("pd", "pto")}
 
 
-#: Tunings done, by (configuration, budget, law, bound value): a TuneResult, or the
-#: reason none meets the constraints.  Emptied when it holds :data:`_MEMO_SIZE`.
-_MEMO: dict[tuple, TuneResult | str] = {}
-_MEMO_SIZE = 64
-
-
+@memo(maxsize=32)
 def _law_tunings(
     cfg: Config, budget: TuneBudget, law: str, values: tuple[float, ...]
 ) -> dict[float, TuneResult | str]:
     """One law tuned under each bound value, side by side on one shared screen.
 
     A value under which no gains meet the constraints maps to the reason (tune's
-    InputError message).  Each (law, value) is memoized alone: only the values
-    not tuned yet run (together), so every tuning is what :func:`tune` gives alone.
+    InputError message).  Memoized per law: :func:`_fair_tunings` always asks
+    for every bound's value, so a law is tuned once per configuration and budget
+    whichever bounds a caller names.
     """
-    todo = tuple(v for v in values if (cfg, budget, law, v) not in _MEMO)
-    if todo:
-        if len(_MEMO) >= _MEMO_SIZE:
-            _MEMO.clear()
-        _MEMO.update(
-            {(cfg, budget, law, v): r for v, r in _run_law(cfg, budget, law, todo).items()}
-        )
-    return {v: _MEMO[(cfg, budget, law, v)] for v in values}
-
-
-def _run_law(
-    cfg: Config, budget: TuneBudget, law: str, values: tuple[float, ...]
-) -> dict[float, TuneResult | str]:
-    """Tune one law under each value side by side (see :func:`_law_tunings`)."""
     effort = {
         "seed": budget.seed,
         "maxiter": budget.maxiter,
@@ -167,7 +149,7 @@ def _fair_tunings(
     paper = _paper(cfg)
     every = {"pto-paper": paper["pto"]["overshoot_mm"], "pd-paper": paper["pd"]["overshoot_mm"]}
     bounds = {name: every[name] for name in names}
-    values = tuple(dict.fromkeys(bounds.values()))
+    values = tuple(dict.fromkeys(every.values()))  # every bound: one memo entry per law
     results, infeasible = {}, {}
     for law in laws:
         by_value = _law_tunings(cfg, budget, law, values)

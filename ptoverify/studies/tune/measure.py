@@ -11,7 +11,6 @@ import dataclasses
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -19,6 +18,7 @@ import numpy as np
 from ptoverify.config import CascadeGains, Config, PDGains, PTOSettings, PTOSGains
 from ptoverify.errors import InputError
 from ptoverify.model.laws import make_law, with_state_gains
+from ptoverify.model.memo import memo
 from ptoverify.model.mintime import discrete_min_steps_batch, min_time
 from ptoverify.model.poles import spectral_radii
 from ptoverify.sim.exact import (
@@ -214,7 +214,7 @@ def _settling_overshoot(cfg: Config, law: str, signal: str) -> dict[str, float]:
 WORST_GRID = (20, 20)
 
 
-@lru_cache(maxsize=16)
+@memo(maxsize=16)
 def _envelope(plant, n1: int, n2: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, int]:
     """States, N* T [s], horizon and hold [samples] of the grid; once per plant and grid."""
     s = SweepSettings()

@@ -13,17 +13,13 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from ptoverify.config import Config
 from ptoverify.errors import InputError
 from ptoverify.model.laws import Law, with_state_gains
 from ptoverify.model.poles import spectral_radii
-from ptoverify.sim.exact import (
-    STEP_FRACTION,
-    TIGHT_BAND,
-    settling_times_batch,
-)
+from ptoverify.sim.flow import Trajectory
+from ptoverify.sim.settling import overshoot, settling_time
 from ptoverify.sim.simulate import reference, simulate_batch
 from ptoverify.studies.tune.measure import (
     BOUNDS,
@@ -35,27 +31,6 @@ from ptoverify.studies.tune.measure import (
 )
 
 __all__ = []
-
-
-def _overshoot_batch(t, X1, X2, U, a: float, target: float) -> NDArray[np.float64]:
-    """Overshoot between samples of many records at once (:func:`ptoverify.sim.exact.overshoot`).
-
-    The same closed form per sample interval, x1 extremal at s* = ln(1 - x2k/u)/a
-    when 0 < s* < T_k, on arrays of shape (steps + 1, n); the screen of
-    :func:`_step_screen` (what ``tune`` reports is measured by ``exact`` itself).
-    """
-    h = np.diff(t)[:, None]
-    x1, x2 = X1[:-1], X2[:-1]
-    sgn = np.where(target >= X1[0], 1.0, -1.0)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        s = np.log1p(-x2 / U) / a
-    inner = np.isfinite(s) & (s > 0) & (s < h)
-    s = np.where(inner, s, 0.0)
-    y1 = x1 + U * s + (x2 - U) * -np.expm1(-a * s) / a
-    between = (sgn * (np.where(inner, y1, x1) - target)).max(axis=0)
-    at = (sgn * (X1 - target)).max(axis=0)
-    best = np.maximum(between, at)
-    return np.where(best > 0, best, 0.0)
 
 
 @dataclass(frozen=True)
@@ -90,8 +65,8 @@ class StepScreen:
     (:func:`ptoverify.model.laws.with_state_gains`; each PTO candidate acts with the zone
     of its own d), in absolute coordinates with the law fed x1 - r as
     :func:`ptoverify.sim.simulate.simulate` does.  Overshoot and settling are read
-    between samples (:func:`_overshoot_batch`,
-    :func:`ptoverify.sim.exact.settling_times_batch`); the 0.01 mm settling only with
+    between samples (:func:`ptoverify.sim.settling.overshoot`, and
+    :func:`ptoverify.sim.settling.settling_time` under ``2pct`` and ``0p01mm``); the latter only with
     ``tight``.  These agree with :func:`evaluate` (the scalar simulation and
     :mod:`ptoverify.sim.exact`, the path of ``simulate --json``) to round-off, not bit
     for bit: :func:`tune` re-measures on that path every candidate it reports.
@@ -159,12 +134,11 @@ class StepScreen:
         X1, X2, U = res.x1, res.x2, res.u
         finite = np.isfinite(X1).all(axis=0) & np.isfinite(X2).all(axis=0)
         with np.errstate(invalid="ignore", over="ignore"):
-            ov = _overshoot_batch(np.arange(steps + 1) * T, X1, X2, U, a, r)
-            e1 = X1 - r
-            band2 = STEP_FRACTION * abs(r)
-            st2 = settling_times_batch(e1, X2, U, a, T, band2, math.inf).time
+            tr = Trajectory(np.arange(steps + 1) * T, X1, X2, U, a)
+            ov = overshoot(tr, r).value
+            st2 = settling_time(tr, ("step", r), "2pct").time
             st01 = (
-                settling_times_batch(e1, X2, U, a, T, TIGHT_BAND, math.inf).time
+                settling_time(tr, ("step", r), "0p01mm").time
                 if self.tight
                 else np.full(len(live), nan)
             )
