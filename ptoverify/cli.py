@@ -399,9 +399,10 @@ def _add_robust(sub) -> None:
     p.add_argument(
         "--law",
         action="append",
-        choices=("to", "pd", "pto", "pto-printed"),
+        choices=("to", "pd", "pto", "pto-printed", "ptos", "cascade-p"),
         default=None,
-        help="study only this law (repeatable; default all four)",
+        help="study only this law (repeatable; default the paper's four: to, pd, pto, "
+        "pto-printed; the baselines ptos, cascade-p on request)",
     )
     p.add_argument(
         "--generations",
@@ -462,15 +463,21 @@ def _cmd_robust(args: argparse.Namespace) -> int:
 def _add_tune(sub) -> None:
     p = sub.add_parser(
         "tune",
-        help="tune PD (kp, kd) or PTO (d, k1, k2) for a fair comparison",
+        help="tune the gains of PD, PTO, PTOS or cascade P fairly",
         description="Search a law's gains (differential evolution, fixed seed; the PTO's "
         "omega0 from the corrected construction for each d) for the best response under an "
         "overshoot bound (between samples), a stable sampled linear loop and no limit cycle "
         "(PTO: nor stride-over) on the gate grid. Prints the gains as a TOML configuration.",
         epilog="example:\n  ptoverify tune --law pd --signal step --max-overshoot 0\n"
-        "  ptoverify tune --law pto --json > tuned.json",
+        "  ptoverify tune --law pto --json > tuned.json\n"
+        "  ptoverify tune --law ptos --max-overshoot 0",
     )
-    p.add_argument("--law", choices=("pd", "pto"), required=True, help="law to tune")
+    p.add_argument(
+        "--law",
+        choices=("pd", "pto", "ptos", "cascade-p"),
+        required=True,
+        help="law to tune (ptos, cascade-p: the baselines, same constraints)",
+    )
     p.add_argument(
         "--signal", choices=("step", "ramp", "sine"), default="step", help="response (step)"
     )
@@ -1122,7 +1129,7 @@ def _add_report(sub) -> None:
         metavar="STAGES",
         default="",
         help="comma-separated expensive stages to leave out for a quick report: robust, "
-        "tuning (their sections then say so)",
+        "tuning, charts (their sections then say so)",
     )
     p.add_argument(
         "--jobs",

@@ -132,14 +132,13 @@ def test_cli_json_and_out(tmp_path, capsys):
 def test_tuned_point_uses_the_tuning():
     """--tuned: the law's gains are the tuning's (recomputed here), measured as configured ones."""
     from ptoverify.studies.design import TUNE_EFFORT
-    from ptoverify.studies.ptos_claim import tune_baseline
+    from ptoverify.studies.tune import tune
 
     pt = design_point(CFG, 0.002, 30.0, laws=("cascade-p", "to"), grid=4, tuned_overshoot=0.0)
     r = pt.law("cascade-p")
     c = point_config(CFG, 0.002, 30.0, "2pi")
-    t = tune_baseline(c, "cascade-p", 0.0, maxiter=TUNE_EFFORT["maxiter"],
-                      popsize=TUNE_EFFORT["popsize"])  # fmt: skip
-    assert r.gains_from == "tuned" and r.k_x1 == t.gains()[0]
+    t = tune(c, "cascade-p", "step", max_overshoot=0.0, find_runner_up=False, **TUNE_EFFORT)
+    assert r.gains_from == "tuned" and r.k_x1 == t.best.gains["kp"]
     assert pt.law("to").gains_from == "configured"
     assert pt.pto_beats == () and pt.pto_loses_to == ()  # no PTO asked
     with pytest.raises(InputError, match="--tuned"):

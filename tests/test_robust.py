@@ -337,3 +337,35 @@ def test_grid_worst_keeps_a_cell_that_never_settles():
     assert [s.value for s in starts] == [math.inf, 8.3], "inf first, NaN left out"
     worst = merge_found(paper_config(), {"settling_ratio_nt": starts}, [])["settling_ratio_nt"]
     assert worst.grid_unbounded and worst.unbounded and worst.state == (1.1, 2.0)
+
+
+@pytest.mark.parametrize("law_name", ["ptos", "cascade-p"])
+def test_baseline_linear_margins_against_the_laws_own_slopes(law_name):
+    """The baselines' margins: the loop's gains read off the law itself (its slopes at the
+    origin, unclipped), SciPy's ZOH plant; with and without the one-sample delay."""
+    from scipy.signal import cont2discrete
+
+    fn = make_law(law_name, CFG)
+    h = 1e-6
+    u, _ = fn(np.array([h, 0.0]), np.array([0.0, h]))
+    K = np.array([[-u[0] / h, -u[1] / h]])
+    p = CFG.plant
+
+    def radius(r, delay):
+        a = p.a * r
+        A, B = np.array([[0.0, 1.0], [0.0, -a]]), np.array([[0.0], [a]])
+        Ad, Bd, *_ = cont2discrete((A, B, np.eye(2), np.zeros((2, 1))), p.sample_time, method="zoh")
+        M = Ad - Bd @ K if delay == 0 else np.block([[Ad, Bd], [-K, np.zeros((1, 1))]])
+        return np.abs(np.linalg.eigvals(M)).max()
+
+    for delay in (0, 1):
+        m = linear_loop_margin(law_name, CFG, delay_samples=delay)
+        if m.interval is None:
+            assert radius(1.0, delay) >= 1.0 - 1e-9
+            continue
+        for end in m.interval:
+            if end is not None:
+                assert abs(radius(end, delay) - 1.0) < 1e-6, (delay, end)
+        lo, hi = m.interval
+        for r in np.geomspace(lo or 0.1, hi or 10.0, 25)[1:-1]:
+            assert radius(r, delay) < 1.0

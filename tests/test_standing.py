@@ -20,7 +20,10 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.fixture(scope="module")
 def base():
-    return json.loads((ROOT / "reports" / "paper" / "results.json").read_text())
+    data = json.loads((ROOT / "reports" / "paper" / "results.json").read_text())
+    # a committed report from before the charts stage reads as one that skipped it
+    data.setdefault("charts", None)
+    return data
 
 
 def _rows(data):
@@ -128,3 +131,116 @@ def test_errata_finding_counts_only_changed_equations(base):
     first["inherits"] = ["17: unchanged for the map", "18: changes", "20-27: change"]
     text = front._finding_errata(results_view(data))[0]
     assert "changes 2 downstream equation groups (18; 20-27)" in text
+
+
+# ---------------------------------------------------------------- the baselines' row
+def _versus(T, diffs_by_reading, infeasible=()):
+    """A ``tuning.versus`` block: the PTO's settling minus each law's, per reading.
+
+    Settling times are built from the differences (PTO at 20 ms); ``infeasible``
+    names (reading, law) pairs whose tuning found no gains.
+    """
+    readings = []
+    for rd, diffs in diffs_by_reading.items():
+        pto_t = 0.02
+        laws = [
+            {
+                "law": "pto",
+                "settling_s": pto_t,
+                "ratio_nt": pto_t / 0.026,
+                "ratio_tf": pto_t / 0.024,
+                "infeasible": "",
+            }
+        ]
+        minus = {}
+        for law, d in diffs.items():
+            bad = (rd, law) in infeasible
+            t = None if bad else pto_t - d
+            laws.append(
+                {
+                    "law": law,
+                    "settling_s": t,
+                    "ratio_nt": None if bad else t / 0.026,
+                    "ratio_tf": None if bad else t / 0.024,
+                    "infeasible": "tune: no gains" if bad else "",
+                }
+            )
+            minus[law] = None if bad else d
+        readings.append(
+            {
+                "reading": rd,
+                "a": 188.5,
+                "sample_time": T,
+                "bound_mm": 0.0,
+                "nt_s": 0.026,
+                "tf_s": 0.024,
+                "laws": laws,
+                "pto_minus": minus,
+            }
+        )
+    return {"settling": "2pct", "settling_description": "2 % band", "readings": readings}
+
+
+def test_versus_row_flips_with_each_difference(base):
+    from ptoverify.report.standing import VERSUS_QUESTION
+
+    data = copy.deepcopy(base)
+    T = data["environment"]["config"]["plant"]["sample_time"]
+    laws = ("pd", "ptos", "cascade-p")
+    data["tuning"]["versus"] = _versus(T, {"2pi": dict.fromkeys(laws, -3 * T)})
+    row = _rows(data)[VERSUS_QUESTION]
+    assert "beats PD by" in row[1] and "beats PTOS by" in row[1] and "beats cascade P" in row[1]
+    assert "loses" not in adoption(results_view(data))
+    # the PTO slower than PTOS by 3 samples: that verdict, and only it, flips
+    data["tuning"]["versus"] = _versus(
+        T, {"2pi": {"pd": -3 * T, "ptos": 3 * T, "cascade-p": -3 * T}}
+    )
+    row = _rows(data)[VERSUS_QUESTION]
+    assert "loses to PTOS by" in row[1] and "beats PD by" in row[1]
+    assert "loses to PTOS" in adoption(results_view(data))
+    assert adoption(results_view(data)).startswith("Adopt only with care")
+    # within one sample: a tie
+    data["tuning"]["versus"] = _versus(T, {"2pi": dict.fromkeys(laws, 0.5 * T)})
+    assert _rows(data)[VERSUS_QUESTION][1].count("ties") == 3
+
+
+def test_versus_row_names_each_reading_and_infeasible_tunings(base):
+    from ptoverify.report.standing import VERSUS_QUESTION
+
+    data = copy.deepcopy(base)
+    T = data["environment"]["config"]["plant"]["sample_time"]
+    data["tuning"]["versus"] = _versus(
+        T,
+        {"2pi": {"pd": 2 * T, "cascade-p": -9 * T}, "hz": {"pd": -2 * T, "cascade-p": 0.0}},
+        infeasible={("hz", "cascade-p")},
+    )
+    answer = _rows(data)[VERSUS_QUESTION][1]
+    two_pi, hz = answer.split("; ")
+    assert two_pi.startswith("a = 2 pi f") and "loses to PD" in two_pi
+    assert hz.startswith("a = f") and "beats PD" in hz
+    assert "no cascade P gains meet the constraints" in hz
+    evidence = _rows(data)[VERSUS_QUESTION][2]
+    assert "cascade P no tuning" in evidence and "settling definition 2pct" in evidence
+    assert "PTO 20 ms (0.7692 N*T, 0.8333 t_f*)" in evidence  # 20 / 26, 20 / 24
+
+
+def test_versus_row_with_one_reading_names_the_configured_a(base):
+    """A configuration given in rad/s has one reading: the row names its a, not a reading."""
+    from ptoverify.report.standing import VERSUS_QUESTION
+
+    data = copy.deepcopy(base)
+    T = data["environment"]["config"]["plant"]["sample_time"]
+    data["tuning"]["versus"] = _versus(T, {"2pi": {"pd": -3 * T}})
+    data["tuning"]["versus"]["readings"][0]["a"] = 123.0
+    answer = _rows(data)[VERSUS_QUESTION][1]
+    assert answer.startswith("a = 123 rad/s (the configuration's): beats PD")
+    data["tuning"]["versus"] = _versus(T, {"2pi": {"pd": -3 * T}, "hz": {"pd": 3 * T}})
+    assert _rows(data)[VERSUS_QUESTION][1].startswith("a = 2 pi f")
+
+
+def test_versus_row_says_when_tuning_was_skipped(base):
+    from ptoverify.report.standing import VERSUS_QUESTION
+
+    data = copy.deepcopy(base)
+    data["tuning"] = None
+    assert _rows(data)[VERSUS_QUESTION][1].startswith("not compared")

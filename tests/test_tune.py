@@ -321,7 +321,10 @@ def test_limit_cycle_band_is_the_gate_default():
     assert inspect.signature(law_properties).parameters["band"].default == LIMIT_CYCLE_BAND
 
 
-@pytest.mark.parametrize("law, d", [("pd", None), ("pto", 0.3), ("pto", 1.0), ("pto", 2.3)])
+@pytest.mark.parametrize(
+    "law, d",
+    [("pd", None), ("pto", 0.3), ("pto", 1.0), ("pto", 2.3), ("ptos", None), ("cascade-p", None)],
+)
 def test_screen_agrees_with_the_simulate_json_path(law, d):
     from ptoverify.studies.tune import measure as tune_mod
     from ptoverify.studies.tune import screen as screen_mod
@@ -329,6 +332,10 @@ def test_screen_agrees_with_the_simulate_json_path(law, d):
     rng = np.random.default_rng(9)
     if law == "pd":
         batch = [{"kp": 10 ** rng.uniform(1, 3.45), "kd": rng.uniform(0, 4)} for _ in range(60)]
+    elif law == "ptos":
+        batch = [{"alpha": rng.uniform(0.05, 1), "k": 10 ** rng.uniform(1, 3.3)} for _ in range(60)]
+    elif law == "cascade-p":
+        batch = [{"kp": 10 ** rng.uniform(0, 3)} for _ in range(60)]
     else:
         batch = [
             {"d": d, "k1": 10 ** rng.uniform(1, 3.45), "k2": rng.uniform(0, 10)} for _ in range(60)
@@ -436,3 +443,95 @@ def test_batched_worst_ratios_are_worst_ratio_nt():
         gs = [{k: float(v) for k, v in g.items()} for g in gs]
         want = [worst_ratio_nt(tuned_config(CFG, law, g), law, n1=4, n2=4) for g in gs]
         assert worst_ratios(CFG, law, gs, 4, 4) == want
+
+
+# ---------------------------------------------------------------- the baselines
+def _slope_gains(cfg, law):
+    """The law's linear-loop gains read off the law itself (unclipped, near the origin)."""
+    fn = make_law(law, cfg)
+    h1, h2 = 1e-6, 1e-6
+    u, _ = fn(np.array([h1, 0.0]), np.array([0.0, h2]))
+    return -u[0] / h1, -u[1] / h2
+
+
+@pytest.mark.slow
+def test_cascade_tune_matches_brute_force_grid():
+    """One gain: a fine grid of kp is the reference; the tuning does at least as well."""
+    bound = 0.0
+    kps = np.geomspace(*BOUNDS["cascade-p"]["kp"], 200)
+    best = math.inf
+    for kp in kps:
+        c = dataclasses.replace(SLOW, cascade=dataclasses.replace(SLOW.cascade, kp=float(kp)))
+        if _spectral_radius(c.plant.a, c.plant.T, kp, 0.0) >= 1.0:
+            continue
+        m = exact_metrics(simulate(make_law("cascade-p", c), c.plant, "step"), c.plant).exact()
+        if m["overshoot_mm"] <= bound and math.isfinite(m["settling_2pct_s"]):
+            best = min(best, m["settling_2pct_s"])
+    r = tune(SLOW, "cascade-p", "step", max_overshoot=bound, maxiter=20)
+    assert math.isfinite(best)
+    assert r.best.objective <= best * (1 + 1e-9), (r.best.gains, best)
+
+
+@pytest.mark.parametrize("law", ["ptos", "cascade-p"])
+def test_baseline_tuning_reproduced_by_simulate(capsys, tmp_path, law):
+    """`tune --law <baseline>`: its TOML, simulated by `simulate`, gives its numbers."""
+    bound = 0.02
+    out = _cli(
+        capsys, "tune", "--law", law, "--max-overshoot", str(bound), "--maxiter", "4", "--json"
+    )
+    res = json.loads(out)
+    path = tmp_path / "tuned.toml"
+    path.write_text(res["config_toml"])
+    cfg = load_config(path)
+    sim = json.loads(
+        _cli(capsys, "simulate", "--config", str(path), "--law", law, "--signal", "step", "--json")
+    )
+    m = sim["metrics"]
+    assert m["settling_2pct_s"] == res["best"]["settling_2pct_s"]
+    assert m["overshoot_mm"] == res["best"]["overshoot_mm"] <= bound
+    # the constraints, re-checked independently: the loop's slope gains on scipy's ZOH
+    # plant, and the gates' limit-cycle count
+    assert _spectral_radius(cfg.plant.a, cfg.plant.T, *_slope_gains(cfg, law)) < 1.0
+    assert law_properties(make_law(law, cfg), cfg, n1=41, n2=41, rest=40).limit_cycles == 0
+    # the other laws' gains are the configuration's
+    assert (cfg.pd, cfg.pto) == (CFG.pd, CFG.pto)
+
+
+@pytest.mark.slow
+def test_fair_tunings_of_the_baselines_are_tune_alone():
+    """The baselines in fair_tunings: the same search and bounds as ``tune`` run alone."""
+    ft = fair_tunings(CFG, SMALL, ("ptos", "cascade-p"))
+    assert set(ft.results) | set(ft.infeasible) == {
+        (law, b) for law in ("ptos", "cascade-p") for b in ft.bounds
+    }
+    for (law, name), r in ft.results.items():
+        alone = tune(
+            CFG,
+            law,
+            "step",
+            max_overshoot=ft.bounds[name],
+            seed=SMALL.seed,
+            maxiter=SMALL.maxiter,
+            popsize=SMALL.popsize,
+            polish=SMALL.polish,
+            find_runner_up=False,
+        )
+        assert r.best == alone.best, (law, name)
+        assert r.best.overshoot_mm <= ft.bounds[name]
+
+
+def test_infeasible_tuning_is_recorded_not_raised():
+    """No gains can settle: the 5 mm step needs 0.5 s at w_max = 10 mm/s, its record is 0.2 s."""
+    slow = SLOW.with_plant(w_max=10.0)
+    with pytest.raises(InputError, match="no cascade-p gains"):
+        tune(slow, "cascade-p", "step", max_overshoot=0.0, maxiter=2, popsize=4)
+    ft = fair_tunings(slow, TuneBudget(maxiter=2, popsize=4), ("cascade-p",))
+    assert not ft.results and set(ft.infeasible) == {("cascade-p", b) for b in ft.bounds}
+    assert all("no cascade-p gains" in v for v in ft.infeasible.values())
+
+
+def test_fair_tunings_name_their_bounds():
+    with pytest.raises(InputError, match="bounds must be among"):
+        fair_tunings(CFG, SMALL, ("pd",), ("nope",))
+    with pytest.raises(InputError, match="bounds must be among"):
+        fair_tunings(CFG, SMALL, ("pd",), ())

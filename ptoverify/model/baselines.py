@@ -59,13 +59,31 @@ PTOS's proximate region, like the PTO's switching zone).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import partial
 
 import numpy as np
 
 from ptoverify.config import Config, PDGains
-from ptoverify.model.laws import Law, Region, pd_law, register_law, saturate_linear
+from ptoverify.errors import InputError
+from ptoverify.model.laws import (
+    Law,
+    Region,
+    _state_gains_law,
+    pd_law,
+    register_law,
+    saturate_linear,
+)
 
-__all__ = ["PTOSDesign", "ptos_design", "ptos_law", "cascade_gain", "cascade_law"]
+__all__ = [
+    "PTOSDesign",
+    "ptos_design",
+    "ptos_law",
+    "ptos_state_gains",
+    "cascade_gain",
+    "cascade_law",
+    "cascade_state_gains",
+    "linear_loop_gains",
+]
 
 
 @dataclass(frozen=True)
@@ -166,26 +184,79 @@ def ptos_law(cfg: Config, *, alpha: float | None = None, k: float | None = None)
     (-300.0, 6)
     """
     p = ptos_design(cfg, alpha=alpha, k=k)
-    w = cfg.plant.w_max
-    y_l, slope, offset, gain, kv = p.y_l, p.slope, p.offset, p.gain, p.kv
-    root = 2.0 * p.alpha * p.A
+    block = partial(_ptos_input, a=cfg.plant.a, w=cfg.plant.w_max)
 
     def vector(x1, x2):
-        ax = np.abs(x1)
-        lin = ax <= y_l
-        with np.errstate(invalid="ignore"):
-            prof = np.where(lin, slope * ax, np.sqrt(root * ax) - offset)  # f(|x1|) >= 0
-        u, region = saturate_linear(-gain * np.copysign(prof, x1) - kv * x2, w)
-        branch = ~lin & (region == Region.LINEAR)
-        if branch.any():
-            region[branch] = np.where(u[branch] > 0, Region.ZONE_P, Region.ZONE_N)
-        return u, region
+        return block(x1, x2, p.alpha, p.k)
 
     note = (
         f"PTOS alpha = {p.alpha:g}, k = {p.k:.6g} 1/s, A = a w_max = {p.A:.6g} mm/s^2, "
-        f"linear region |x1| <= {y_l:.6g} mm"
+        f"linear region |x1| <= {p.y_l:.6g} mm"
     )
-    return Law("ptos", vector, None, w, note, odd=True)  # scalar: the vector path on one state
+    # scalar: the vector path on one state
+    return Law("ptos", vector, None, cfg.plant.w_max, note, odd=True)
+
+
+def _ptos_input(x1, x2, alpha, k, *, a: float, w: float):
+    """PTOS input and region (module docstring); alpha [-], k [1/s] floats or one per state.
+
+    The numbers of :func:`ptos_design` (k1, y_l, slope, offset, gain, kv) with the
+    same arithmetic, so a per-state entry equals the law built from its gains bit
+    for bit.
+    """
+    A = a * w  # noqa: N806 - Workman's symbol
+    k1 = alpha * k * k / 2.0
+    y_l, slope, offset, gain, kv = A / k1, k1 / k, A / k, k / a, k / a - 1.0
+    ax = np.abs(x1)
+    lin = ax <= y_l
+    with np.errstate(invalid="ignore"):
+        prof = np.where(lin, slope * ax, np.sqrt(2.0 * alpha * A * ax) - offset)  # f(|x1|) >= 0
+    u, region = saturate_linear(-gain * np.copysign(prof, x1) - kv * x2, w)
+    branch = ~lin & (region == Region.LINEAR)
+    if branch.any():
+        region[branch] = np.where(u[branch] > 0, Region.ZONE_P, Region.ZONE_N)
+    return u, region
+
+
+def ptos_state_gains(cfg: Config, gains: dict) -> Law:
+    """Return PTOS with (alpha, k) one per state (:func:`~ptoverify.model.laws.with_state_gains`).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (a [rad/s], w_max [mm/s]).
+    gains : dict
+        ``alpha`` [-] and ``k`` [1/s], arrays of one shape.
+
+    Returns
+    -------
+    Law
+        For states of the gains' shape; state i acts as ``ptos_law`` with gains i.
+    """
+    g = (np.asarray(gains["alpha"], dtype=float), np.asarray(gains["k"], dtype=float))
+    if g[0].shape != g[1].shape:
+        raise InputError("per-state gains: alpha and k need one shape")
+    block = partial(_ptos_input, a=cfg.plant.a, w=cfg.plant.w_max)
+    return _state_gains_law("ptos", block, g, cfg.plant.w_max)
+
+
+def cascade_state_gains(cfg: Config, gains: dict) -> Law:
+    """Return the cascade P loop with kp one per state (:func:`~ptoverify.model.laws.with_state_gains`).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (w_max [mm/s]).
+    gains : dict
+        ``kp`` [1/s], an array.
+
+    Returns
+    -------
+    Law
+        For states of the gains' shape: the PD law's per-state path with kd = 0.
+    """
+    kp = np.asarray(gains["kp"], dtype=float)
+    return replace(pd_law(cfg, gains=(kp, np.zeros_like(kp))), name="cascade-p")
 
 
 def cascade_gain(cfg: Config) -> float:
@@ -241,5 +312,41 @@ def cascade_law(cfg: Config, *, kp: float | None = None) -> Law:
     return replace(law, name="cascade-p", note=f"cascade P u = sat(-{kp:.6g} x1)")
 
 
-register_law("ptos", ptos_law)
-register_law("cascade-p", cascade_law)
+def linear_loop_gains(law: str, cfg: Config) -> tuple[float, float] | None:
+    """Return the gains (k_x1 [1/s], k_x2 [-]) of a law's linear loop u = -k_x1 x1 - k_x2 x2.
+
+    The one place a law's linear loop is read off its configuration: PD (kp, kd),
+    the PTO's linear zone (k1, k2; printed or corrected), PTOS's linear region
+    (:meth:`PTOSDesign.linear_gains`), the cascade P loop (kp, 0); None for TO
+    (no linear loop) and unknown names.
+
+    Parameters
+    ----------
+    law : str
+        Law name.
+    cfg : Config
+        Configuration.
+
+    Returns
+    -------
+    tuple of float or None
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> linear_loop_gains("pd", paper_config()), linear_loop_gains("to", paper_config())
+    ((356.0, 1.15), None)
+    """
+    if law == "pd":
+        return cfg.pd.kp, cfg.pd.kd
+    if law in ("pto", "pto-printed"):
+        return cfg.pto.k1, cfg.pto.k2
+    if law == "ptos":
+        return ptos_design(cfg).linear_gains()
+    if law == "cascade-p":
+        return cascade_gain(cfg), 0.0
+    return None
+
+
+register_law("ptos", ptos_law, ptos_state_gains)
+register_law("cascade-p", cascade_law, cascade_state_gains)

@@ -510,7 +510,9 @@ def with_state_gains(name: str, cfg: Config, gains: dict[str, ArrayLike]) -> Law
     Parameters
     ----------
     name : str
-        ``pd`` (gains ``kp`` [1/s], ``kd`` [-]) or ``pto`` (``k1`` [1/s], ``k2`` [-]).
+        ``pd`` (gains ``kp`` [1/s], ``kd`` [-]), ``pto`` (``k1`` [1/s], ``k2`` [-]),
+        or a baseline registered with its per-state factory (:func:`register_law`:
+        ``ptos`` with ``alpha`` [-], ``k`` [1/s]; ``cascade-p`` with ``kp`` [1/s]).
     cfg : Config
         Configuration (plant; for the PTO its d [mm]).
     gains : dict
@@ -528,9 +530,12 @@ def with_state_gains(name: str, cfg: Config, gains: dict[str, ArrayLike]) -> Law
     >>> law(np.array([0.1, 0.1]), np.zeros(2))[0].tolist()
     [-10.0, -20.0]
     """
+    if name in _STATE_FACTORIES:  # a baseline (registered with its per-state factory)
+        return _STATE_FACTORIES[name](cfg, gains)
     keys = {"pd": ("kp", "kd"), "pto": ("k1", "k2")}
     if name not in keys:
-        raise InputError(f"per-state gains: law '{name}' has none (choose from pd, pto)")
+        choices = ", ".join(["pd", "pto", *_STATE_FACTORIES])
+        raise InputError(f"per-state gains: law '{name}' has none (choose from {choices})")
     g1, g2 = (np.asarray(gains[k], dtype=float) for k in keys[name])
     if g1.shape != g2.shape:
         raise InputError("per-state gains: both gains need one shape")
@@ -555,7 +560,15 @@ _FACTORIES: dict[str, Callable[[Config], Law]] = {
 }
 
 
-def register_law(name: str, factory: Callable[[Config], Law]) -> None:
+#: Per-state factories of the baselines (:func:`with_state_gains`), by law name.
+_STATE_FACTORIES: dict[str, Callable[[Config, dict[str, ArrayLike]], Law]] = {}
+
+
+def register_law(
+    name: str,
+    factory: Callable[[Config], Law],
+    state_gains: Callable[[Config, dict[str, ArrayLike]], Law] | None = None,
+) -> None:
     """Let :func:`make_law` build a law defined in another module of this layer.
 
     The baselines (:mod:`ptoverify.model.baselines`, which import this module)
@@ -567,10 +580,16 @@ def register_law(name: str, factory: Callable[[Config], Law]) -> None:
         One of :data:`ptoverify.config.BASELINE_NAMES`.
     factory : callable
         ``factory(cfg) -> Law``.
+    state_gains : callable, optional
+        ``state_gains(cfg, gains) -> Law`` with gains one per state, for
+        :func:`with_state_gains` (bit for bit the law ``factory`` builds from a
+        configuration holding one state's gains).
     """
     if name not in BASELINE_NAMES:
         raise ValueError(f"register_law: {name!r} is not a baseline name")
     _FACTORIES[name] = factory
+    if state_gains is not None:
+        _STATE_FACTORIES[name] = state_gains
 
 
 def make_law(name: str, cfg: Config) -> Law:

@@ -69,7 +69,7 @@ __all__ = [
 ]
 
 #: Stages ``--skip`` can leave out (the expensive ones).
-SKIPPABLE = ("robust", "tuning")
+SKIPPABLE = ("robust", "tuning", "charts")
 
 #: Sizes of the report's robustness study: overrides of
 #: :class:`ptoverify.studies.robust.RobustSettings`.  Empty: the report runs the same study as
@@ -170,9 +170,12 @@ def _poles(cfg: Config) -> dict[str, Any]:
 
 
 def _properties(cfg: Config) -> dict[str, Any]:
+    from ptoverify.config import BASELINE_NAMES, LAW_NAMES
     from ptoverify.studies.properties import all_properties
 
-    return {k: v.to_json() for k, v in all_properties(cfg).items()}
+    # the baselines beside the paper's laws (informational: the gates judge the paper's)
+    laws = LAW_NAMES + BASELINE_NAMES
+    return {k: v.to_json() for k, v in all_properties(cfg, laws).items()}
 
 
 def _environment(cfg: Config) -> dict[str, Any]:
@@ -417,10 +420,21 @@ def _stage_proofs(cfg: Config, figdir: Path | None) -> dict[str, Any]:
 def _stage_tuning(cfg: Config, figdir: Path | None) -> dict[str, Any]:
     """Run the fair tuning comparison and draw its Pareto fronts."""
     res = tuning_results(cfg)
-    return {
-        "tuning": res,
-        "_files": [] if figdir is None else _plots().save_tuning(res, figdir),
-    }
+    files = []
+    if figdir is not None:
+        files = _plots().save_tuning(res, figdir)
+        from ptoverify.report.charts import tables_dir, write_penalty_csv
+
+        files += _plots().save_penalty(res["penalty"], figdir, "penalty_moves_tuned")
+        write_penalty_csv(res["penalty"], tables_dir(figdir) / "penalty_moves_tuned.csv")
+    return {"tuning": res, "_files": files}
+
+
+def _stage_charts(cfg: Config, figdir: Path | None) -> dict[str, Any]:
+    """Penalty against move size (configured gains) and the coarse design chart."""
+    from ptoverify.report.charts import charts_stage
+
+    return charts_stage(cfg, figdir, _plots)
 
 
 def _stage_figures(cfg: Config, figdir: Path | None) -> dict[str, Any]:
@@ -498,12 +512,13 @@ _STAGE_FUNCTIONS: dict[str, Callable[[Config, Path | None], dict[str, Any]]] = {
     "derivations": _stage_derivations,
     "closed loop, claims and gates": _stage_core,
     "tuning": _stage_tuning,
+    "penalty and design chart": _stage_charts,
     "ground truth": _stage_ground_truth,
     "paper figures": _stage_figures,
     "proofs": _stage_proofs,
     "poles": _stage_poles,
 }
-_SKIP_STAGE = {"robust": "robustness", "tuning": "tuning"}
+_SKIP_STAGE = {"robust": "robustness", "tuning": "tuning", "charts": "penalty and design chart"}
 
 
 def _run_stage(name: str, cfg: Config, figdir: Path | None) -> tuple[dict[str, Any], float]:
@@ -602,7 +617,7 @@ def collect(
     else:
         _run_in_pool(names, cfg, figdir, jobs, finished)
 
-    out: dict[str, Any] = {"derivations": None, "robust": None, "tuning": None}
+    out: dict[str, Any] = {"derivations": None, "robust": None, "tuning": None, "charts": None}
     files: list[Path] = []
     traces: list[str] = []
     checks = []
@@ -756,13 +771,23 @@ def tuning_results(cfg: Config) -> dict[str, Any]:
     Returns
     -------
     dict
-        The keys of :func:`ptoverify.studies.claims.fair_comparison` less its wall time.
+        The keys of :func:`ptoverify.studies.claims.fair_comparison` less its wall
+        time, and ``versus``: the corrected PTO against fair-tuned PD, PTOS and the
+        cascade P loop under both readings of a
+        (:meth:`ptoverify.studies.versus.Versus.to_json`, less its wall time).
     """
     from ptoverify.studies.claims import fair_comparison
     from ptoverify.studies.tune import TuneBudget
+    from ptoverify.studies.versus import versus
 
-    res = fair_comparison(cfg, TuneBudget(**TUNE_SETTINGS))
+    budget = TuneBudget(**TUNE_SETTINGS)
+    res = fair_comparison(cfg, budget)
     res.pop("seconds", None)
+    res["versus"] = versus(cfg, budget).to_json()  # PD and PTO at a = 2 pi f: cached above
+    res["versus"].pop("seconds", None)
+    from ptoverify.report.charts import tuned_penalty
+
+    res["penalty"] = tuned_penalty(cfg, budget)
     return res
 
 
@@ -897,6 +922,7 @@ def build_sections(
         ("proofs", "Proved over the continuum", rs.proofs(res, figures)),
         ("robustness", "Robustness under model mismatch", rs.robustness(res, figures)),
         ("tuning", "Can any tuning reproduce the paper?", rs.tuning(res, figures)),
+        ("charts", "Penalty by move size, and the design space", rs.charts(res, figures)),
         ("environment", "Environment", rs.environment(res)),
     ]
     return [(a, t if i < 2 else f"{i - 1}. {t}", b) for i, (a, t, b) in enumerate(parts)]

@@ -39,6 +39,7 @@ TOP_LEVEL = (
     "robust",
     "proofs",
     "tuning",
+    "charts",
     "skipped",
     "environment",
 )

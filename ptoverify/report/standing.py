@@ -9,13 +9,15 @@ never typed in: every number they show is a field of ``results.json``.
 - :func:`engineer_rows`: adopt or not, and under which conditions: which zone, the
   settling time against PD at the paper's gains under both readings of a and at the
   best tuning, delay and bandwidth tolerance, the closed-loop properties, and the
-  baselines a drive already runs where the results hold them.
+  corrected PTO against fair-tuned PD, PTOS and the cascade P loop under both
+  readings of a (:func:`versus_row`).
 
 Catalogue
 ---------
 claim_standing  holds / fails / depends, with what it depends on
 reviewer_rows   the reviewer's table rows
 engineer_rows   the drive engineer's table rows (question, answer, evidence)
+versus_row      the PTO against fair-tuned PD, PTOS and cascade P, per reading of a
 adoption        the one-sentence recommendation
 """
 
@@ -26,7 +28,17 @@ from typing import Any
 
 from ptoverify.report.render import fmt, qty
 
-__all__ = ["claim_standing", "reviewer_rows", "engineer_rows", "adoption", "READING_WORDS"]
+__all__ = [
+    "claim_standing",
+    "reviewer_rows",
+    "engineer_rows",
+    "adoption",
+    "versus_row",
+    "versus_verdict",
+    "READING_WORDS",
+    "LAW_WORDS",
+    "VERSUS_QUESTION",
+]
 
 #: How each reading dimension of a claim reads in words.
 READING_WORDS: dict[str, dict[Any, str]] = {
@@ -297,15 +309,95 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
                 "(sampled: see the proofs for the continuum where they ran)",
             ]
         )
-    base = [law for law in ("ptos", "cascade-p") if law in res["responses"]]
-    rows.append(
-        [
-            "Better than PTOS or the cascade P loop?",
-            "see the baselines" if base else "not compared: these laws are not in this report",
-            ", ".join(base) if base else "the suite does not run them in this report",
-        ]
-    )
+    rows.append(versus_row(res))
     return rows
+
+
+#: How the compared laws are named in the verdict table.
+LAW_WORDS = {"pto": "PTO", "pd": "PD", "ptos": "PTOS", "cascade-p": "cascade P"}
+#: The question of the baselines' row.
+VERSUS_QUESTION = "Faster than fair-tuned PD, PTOS and the cascade P loop (step)?"
+
+
+def versus_verdict(diff: float | None, other: Mapping, pto: Mapping, sample: float) -> str:
+    """Return the PTO's verdict against one fair-tuned law: beats, ties, loses, or no verdict.
+
+    Parameters
+    ----------
+    diff : float or None
+        The PTO's settling minus the other law's [s] (None: one has no tuning).
+    other, pto : Mapping
+        The two tuned laws (``law``, ``infeasible``) of ``tuning.versus``.
+    sample : float
+        T [s]: a difference within one sample is a tie.
+
+    Returns
+    -------
+    str
+        E.g. ``beats PTOS by 1.264 ms``.
+    """
+    name = LAW_WORDS.get(other["law"], other["law"])
+    if pto["infeasible"]:
+        return f"no verdict against {name} (no PTO gains meet the constraints)"
+    if other["infeasible"] or diff is None:
+        return f"no {name} gains meet the constraints"
+    if abs(diff) <= sample:
+        return f"ties {name} (within one sample, {_ms(abs(diff))} apart)"
+    return f"{'beats' if diff < 0 else 'loses to'} {name} by {_ms(abs(diff))}"
+
+
+def versus_row(res: Mapping) -> list[str]:
+    """Return the row saying whether the corrected PTO beats fair-tuned PD, PTOS, cascade P.
+
+    Read off ``tuning.versus`` (:func:`ptoverify.studies.versus.versus`): under each
+    reading of a, every law tuned by ``tune`` under the same overshoot bound; the
+    verdict per law and reading, with the settling times in ms under the named
+    definition, and each over N* T.
+
+    Parameters
+    ----------
+    res : Mapping
+        The results (:class:`ptoverify.report.results.Results`).
+
+    Returns
+    -------
+    list of str
+        ``[question, answer, evidence]``.
+    """
+    t = res["tuning"]
+    if t is None or "versus" not in t:
+        return [VERSUS_QUESTION, "not compared: the tuning was skipped", "no tuned results"]
+    v = t["versus"]
+    answers, evidence = [], []
+    for r in v["readings"]:
+        laws = {x["law"]: x for x in r["laws"]}
+        pto = laws["pto"]
+        verdicts = [  # in the laws' order (results.json sorts the keys of pto_minus)
+            versus_verdict(r["pto_minus"][x["law"]], x, pto, r["sample_time"])
+            for x in r["laws"]
+            if x["law"] != "pto"
+        ]
+        words = (
+            reading_words("a", {"2pi": "2pi*f", "hz": "f"}.get(r["reading"], r["reading"]))
+            if len(v["readings"]) > 1
+            else f"a = {qty(r['a'], 'rad/s')} (the configuration's)"
+        )
+        answers.append(f"{words}: {', '.join(verdicts)}")
+        times = ", ".join(
+            f"{LAW_WORDS.get(x['law'], x['law'])} "
+            + (
+                "no tuning"
+                if x["infeasible"]
+                else f"{_ms(x['settling_s'])} ({fmt(x['ratio_nt'])} N*T, {fmt(x['ratio_tf'])} t_f*)"
+            )
+            for x in r["laws"]
+        )
+        evidence.append(
+            f"{words}, overshoot <= {qty(r['bound_mm'], 'mm')}: {times}; "
+            f"N*T = {_ms(r['nt_s'])}, t_f* = {_ms(r['tf_s'])}"
+        )
+    evidence.append(f"settling definition {v['settling']}: {v['settling_description']}")
+    return [VERSUS_QUESTION, "; ".join(answers), "; ".join(evidence)]
 
 
 def _proved_stride(res: Mapping) -> str:
@@ -379,6 +471,9 @@ def adoption(res: Mapping) -> str:
         parts.append(f"at this design point the tuned PTO {tuned.replace('PD', 'a tuned PD')}")
     elif paper:
         parts.append(f"at the paper's gains the PTO {paper}")
+    versus = rows.get(VERSUS_QUESTION, "")
+    if "loses" in versus:
+        parts.append(f"against fair-tuned laws it {versus}")
     delay = rows.get("Tolerates a one-sample computation delay?")
     if delay and delay != "yes":
         parts.append("it needs delay compensation")

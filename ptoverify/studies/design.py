@@ -12,8 +12,8 @@ so a bad T or bandwidth is an InputError naming the key).  Per law:
   and the fraction of states that settle;
 * the robustness margin of its linear loop in a_true / a_design, without and
   with a one-sample delay (:func:`ptoverify.studies.robust.linear_loop_margin`,
-  the linear loop as a PD of the law's gains,
-  :func:`ptoverify.studies.ptos_claim.baseline_linear_gains`), and the
+  the law's linear loop,
+  :func:`ptoverify.model.baselines.linear_loop_gains`), and the
   spectral radius of the delayed loop at the design a;
 
 and for the PTO its corrected zone (:func:`ptoverify.model.zones.zone_for_law`):
@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -39,14 +39,14 @@ from ptoverify.config import (
     DESIGN_LAWS,
     DESIGN_SAMPLE_TIMES,
     Config,
-    PDGains,
     config_from_mapping,
 )
 from ptoverify.errors import InputError
+from ptoverify.model.baselines import linear_loop_gains
 from ptoverify.model.laws import make_law
 from ptoverify.model.mintime import discrete_min_steps_batch, min_time
 from ptoverify.model.zones import zone_for_law
-from ptoverify.studies.ptos_claim import READINGS, baseline_linear_gains
+from ptoverify.studies.ptos_claim import READINGS
 from ptoverify.studies.robust import linear_loop_margin, linear_loop_radii
 from ptoverify.studies.sweep import SweepSettings, grid_states, settling_times
 
@@ -275,10 +275,9 @@ def point_config(cfg: Config, sample_time: float, bandwidth_hz: float, reading: 
     return config_from_mapping({**m, "plant": plant})
 
 
-def _margin(law: str, cfg: Config, gains: tuple[float, float], delay: int) -> tuple[float, float]:
+def _margin(law: str, cfg: Config, delay: int) -> tuple[float, float]:
     """(lo, hi) of the linear loop's stable a_true / a_design interval."""
-    pd = replace(cfg, pd=PDGains(kp=gains[0], kd=gains[1]))
-    got = linear_loop_margin("pd", pd, delay_samples=delay).interval
+    got = linear_loop_margin(law, cfg, delay_samples=delay).interval
     if got is None:
         return math.nan, math.nan
     lo, hi = got
@@ -293,10 +292,10 @@ TUNE_EFFORT = {"maxiter": 10, "popsize": 8, "d_grid": 5, "d_refine": 2, "polish"
 def tuned_law_config(cfg: Config, name: str, max_overshoot: float) -> Config | None:
     """Return the configuration of ``name`` tuned on the step (None: infeasible).
 
-    PD and PTO by :func:`ptoverify.studies.tune.tune`, PTOS and cascade P by
-    :func:`ptoverify.studies.ptos_claim.tune_baseline`, each minimizing the 2 %
-    settling of the Section 6 step under the same overshoot bound, a stable sampled
-    linear loop and no limit cycle; effort :data:`TUNE_EFFORT`.  TO and the printed
+    Every law with gains (PD, PTO, PTOS, cascade P) by
+    :func:`ptoverify.studies.tune.tune`, each minimizing the 2 % settling of the
+    Section 6 step under the same overshoot bound, a stable sampled linear loop and
+    no limit cycle; effort :data:`TUNE_EFFORT`.  TO and the printed
     PTO have nothing to tune: ``cfg``.
 
     Parameters
@@ -313,21 +312,16 @@ def tuned_law_config(cfg: Config, name: str, max_overshoot: float) -> Config | N
     Config or None
         The tuned configuration.
     """
-    from ptoverify.studies.ptos_claim import tune_baseline
-    from ptoverify.studies.tune import tune
+    from ptoverify.studies.tune import BOUNDS, tune
 
-    e = TUNE_EFFORT
-    if name in ("pd", "pto"):
-        try:
-            return tune(
-                cfg, name, "step", max_overshoot=max_overshoot, find_runner_up=False, **e
-            ).config
-        except InputError:  # tune's answer when no gains meet the constraints
-            return None
-    if name in ("ptos", "cascade-p"):
-        t = tune_baseline(cfg, name, max_overshoot, maxiter=e["maxiter"], popsize=e["popsize"])
-        return t.config if t.feasible else None
-    return cfg
+    if name not in BOUNDS:
+        return cfg
+    try:
+        return tune(
+            cfg, name, "step", max_overshoot=max_overshoot, find_runner_up=False, **TUNE_EFFORT
+        ).config
+    except InputError:  # tune's answer when no gains meet the constraints
+        return None
 
 
 def _law_at(
@@ -354,10 +348,9 @@ def _law_at(
     if name == "to":
         gains, m0, m1, rad = (math.nan, math.nan), (math.nan,) * 2, (math.nan,) * 2, math.nan
     else:
-        gains = baseline_linear_gains(cfg, name)
-        m0, m1 = _margin(name, cfg, gains, 0), _margin(name, cfg, gains, 1)
-        pd = replace(cfg, pd=PDGains(kp=gains[0], kd=gains[1]))
-        rad = float(linear_loop_radii("pd", pd, [1.0], delay_samples=1)[0])
+        gains = linear_loop_gains(name, cfg)
+        m0, m1 = _margin(name, cfg, 0), _margin(name, cfg, 1)
+        rad = float(linear_loop_radii(name, cfg, [1.0], delay_samples=1)[0])
     frac = float(np.count_nonzero(settled)) / max(1, ratio.size)
     return LawAtPoint(name, law.note, *gains, median, worst, frac, *m0, *m1, rad, gains_from)
 

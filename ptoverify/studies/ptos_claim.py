@@ -1,13 +1,10 @@
 """The baselines tuned fairly, and the paper's claim that PTOS "cannot be directly used".
 
-:func:`tune_baseline` tunes PTOS (alpha, k) or the cascade P loop (kp) under
-the constraints ``ptoverify tune`` applies to PD and PTO: the 2 % settling time
-of the Section 6 step is minimized (``scipy.optimize.differential_evolution``,
-fixed seed) subject to the step's overshoot between samples <= a bound and a
-stable sampled linear loop (spectral radius < 1,
-:func:`ptoverify.model.poles.spectral_radii`); the best candidates, in order,
-are then checked for limit cycles on the gates' grid
-(:func:`ptoverify.studies.properties.law_properties`) until one passes.
+PTOS (alpha, k) and the cascade P loop (kp) are tuned by ``ptoverify tune``
+itself (:func:`ptoverify.studies.tune.fair_tunings`: the search, constraints and
+bounds that tune PD and PTO): the 2 % settling time of the Section 6 step is
+minimized subject to the step's overshoot between samples <= a bound, a stable
+sampled linear loop and no limit cycle on the gates' grid.
 
 The claim (Section 1: "the PTOS and its various improvements on the double
 integrator system cannot be directly used") is tested under each reading of a
@@ -27,22 +24,16 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, replace
+from typing import Any
 
-import numpy as np
-from scipy.optimize import differential_evolution
-
-from ptoverify.config import CascadeGains, Config, PTOSGains
+from ptoverify.config import Config
 from ptoverify.errors import InputError
-from ptoverify.model.baselines import cascade_gain, ptos_design
+from ptoverify.model.baselines import ptos_design
 from ptoverify.model.laws import make_law
-from ptoverify.model.poles import spectral_radii
 from ptoverify.studies.properties import law_properties
 from ptoverify.studies.tune import response_metrics
 
 __all__ = [
-    "BaselineTuning",
-    "tune_baseline",
-    "baseline_linear_gains",
     "PTOSMeasure",
     "PTOSClaim",
     "ptos_claim",
@@ -51,183 +42,8 @@ __all__ = [
     "fair_configs",
 ]
 
-#: Search ranges: PTOS alpha [-] and log10(k / a); cascade log10(kp / a).
-SEARCH = {
-    "ptos": ((0.05, 1.0), (math.log10(0.25), math.log10(20.0))),
-    "ptos-ideal": ((0.05, 1.0),),  # k = a: the profile is the velocity command itself
-    "cascade-p": ((-2.0, 0.7),),
-}
 #: Readings of the printed bandwidth: a = 2 pi f, or a = f taken as rad/s.
 READINGS = ("2pi", "hz")
-
-
-def baseline_linear_gains(cfg: Config, law: str) -> tuple[float, float]:
-    """Gains (k_x1 [1/s], k_x2 [-]) of a law's linear loop u = -k_x1 x1 - k_x2 x2.
-
-    Parameters
-    ----------
-    cfg : Config
-        Configuration.
-    law : str
-        ``pd``, ``pto``, ``pto-printed``, ``ptos`` or ``cascade-p``.
-
-    Returns
-    -------
-    tuple of float
-        The linear loop's gains.
-
-    Examples
-    --------
-    >>> from ptoverify.config import paper_config
-    >>> baseline_linear_gains(paper_config(), "pd")
-    (356.0, 1.15)
-    """
-    if law == "pd":
-        return cfg.pd.kp, cfg.pd.kd
-    if law in ("pto", "pto-printed"):
-        return cfg.pto.k1, cfg.pto.k2
-    if law == "ptos":
-        return ptos_design(cfg).linear_gains()
-    if law == "cascade-p":
-        return cascade_gain(cfg), 0.0
-    raise InputError(f"law {law!r} has no linear loop")
-
-
-def _with_params(cfg: Config, law: str, x: np.ndarray) -> Config:
-    """Return the configuration of one search point (in SEARCH coordinates)."""
-    a = cfg.plant.a
-    if law == "ptos":
-        return replace(cfg, ptos=PTOSGains(alpha=float(x[0]), k=float(a * 10.0 ** x[1])))
-    if law == "ptos-ideal":
-        return replace(cfg, ptos=PTOSGains(alpha=float(x[0]), k=None))
-    return replace(cfg, cascade=CascadeGains(kp=float(a * 10.0 ** x[0])))
-
-
-@dataclass(frozen=True)
-class BaselineTuning:
-    """Best gains of a baseline under the fair constraints.
-
-    Attributes
-    ----------
-    law : str
-        ``ptos`` or ``cascade-p`` (the law built from ``config``).
-    config : Config
-        The configuration holding the best gains (``ptos`` or ``cascade``).
-    max_overshoot_mm : float
-        The overshoot bound [mm].
-    settling_2pct_s, settling_0p01mm_s : float
-        Step settling times at the best gains [s] (NaN: none feasible).
-    overshoot_mm : float
-        Step overshoot at the best gains [mm].
-    feasible : bool
-        Whether a candidate met every constraint.
-    evaluations : int
-        Candidates evaluated.
-    seconds : float
-        Wall time [s].
-    """
-
-    law: str
-    config: Config
-    max_overshoot_mm: float
-    settling_2pct_s: float
-    settling_0p01mm_s: float
-    overshoot_mm: float
-    feasible: bool
-    evaluations: int
-    seconds: float
-
-    def gains(self) -> tuple[float, ...]:
-        """Return (alpha [-], k [1/s]) for PTOS, (kp [1/s],) for cascade P."""
-        if self.law == "ptos":
-            return ptos_design(self.config).alpha, ptos_design(self.config).k
-        return (cascade_gain(self.config),)
-
-
-def tune_baseline(
-    cfg: Config,
-    law: str,
-    max_overshoot: float,
-    *,
-    seed: int = 0,
-    maxiter: int = 20,
-    popsize: int = 8,
-    grid: tuple[int, int, int] = (41, 41, 40),
-) -> BaselineTuning:
-    """Tune a baseline's gains on the step (module docstring).
-
-    Parameters
-    ----------
-    cfg : Config
-        Configuration (plant).
-    law : str
-        ``ptos`` (alpha and k), ``ptos-ideal`` (alpha; k = a: the velocity loop
-        treated as ideal, u the profile itself) or ``cascade-p`` (kp).
-    max_overshoot : float
-        Overshoot bound of the step [mm].
-    seed : int
-        Seed of differential evolution.
-    maxiter, popsize : int
-        Differential-evolution generations and population factor.
-    grid : tuple of int
-        (n1, n2, rest) of the limit-cycle check's grid.
-
-    Returns
-    -------
-    BaselineTuning
-        The best feasible candidate (``feasible`` False if none).
-
-    Examples
-    --------
-    >>> from ptoverify.config import paper_config
-    >>> t = tune_baseline(paper_config(), "cascade-p", 0.0, maxiter=3, popsize=4)
-    >>> t.feasible and t.overshoot_mm <= 0.0
-    True
-    """
-    if law not in SEARCH:
-        raise InputError(f"tune_baseline: law must be one of {', '.join(SEARCH)}, got {law!r}")
-    t0 = time.perf_counter()
-    search, law = law, "ptos" if law == "ptos-ideal" else law
-    p = cfg.plant
-    seen: dict[tuple, tuple[float, dict]] = {}
-
-    def cost(x: np.ndarray) -> float:
-        key = tuple(float(v) for v in x)
-        if key not in seen:
-            c = _with_params(cfg, search, x)
-            gains = baseline_linear_gains(c, law)
-            if spectral_radii(p.a, p.sample_time, *gains)[0] >= 1.0:
-                seen[key] = (math.inf, {})
-            else:
-                m = response_metrics(c, law, "step")
-                ok = m["overshoot_mm"] <= max_overshoot and math.isfinite(m["settling_2pct_s"])
-                seen[key] = (m["settling_2pct_s"] if ok else math.inf, m)
-        return seen[key][0]
-
-    differential_evolution(
-        cost, SEARCH[search], seed=seed, maxiter=maxiter, popsize=popsize, tol=0.0, polish=False
-    )
-    order = sorted((v, k) for k, (v, _) in seen.items() if math.isfinite(v))
-    for _, key in order[:20]:
-        c = _with_params(cfg, search, np.array(key))
-        props = law_properties(make_law(law, c), c, n1=grid[0], n2=grid[1], rest=grid[2])
-        if props.limit_cycles == 0 and props.not_settled == 0:
-            m = seen[key][1]
-            return BaselineTuning(
-                law,
-                c,
-                max_overshoot,
-                m["settling_2pct_s"],
-                m["settling_0p01mm_s"],
-                m["overshoot_mm"],
-                True,
-                len(seen),
-                time.perf_counter() - t0,
-            )
-    nan = math.nan
-    return BaselineTuning(
-        law, cfg, max_overshoot, nan, nan, nan, False, len(seen), time.perf_counter() - t0
-    )
 
 
 @dataclass(frozen=True)
@@ -241,8 +57,8 @@ class PTOSMeasure:
     a : float
         Bandwidth [rad/s].
     setting : str
-        ``configured``, or ``tuned <search> <bound name>`` (search ``ptos-ideal``:
-        alpha with k = a; ``ptos``: alpha and k).
+        ``configured``, or ``tuned <bound name>`` (alpha and k tuned by
+        :func:`ptoverify.studies.tune.fair_tunings`).
     alpha, k, y_l : float
         Discount [-], velocity-loop gain [1/s], linear-region half-width [mm].
     bound_mm : float
@@ -382,7 +198,7 @@ def ptos_claim(
     cfg : Config
         Configuration (its bandwidth in Hz gives the two readings).
     maxiter, popsize : int
-        Effort of each tuning (:func:`tune_baseline`).
+        Effort of each tuning (:class:`ptoverify.studies.tune.TuneBudget`).
     grid : tuple of int
         (n1, n2, rest) of the properties' grid (default: the gates' grid).
 
@@ -391,24 +207,21 @@ def ptos_claim(
     PTOSClaim
         Measures and verdicts.
     """
+    from ptoverify.studies.tune import TuneBudget, fair_tunings
+
     t0 = time.perf_counter()
     measures, verdicts = [], []
+    budget = TuneBudget(maxiter=maxiter, popsize=popsize)
     for reading in READINGS:
         c = reading_config(cfg, reading)
-        paper = {law: response_metrics(c, law, "step") for law in ("pto", "pd")}
-        bounds = {
-            "pto-paper": paper["pto"]["overshoot_mm"],
-            "pd-paper": paper["pd"]["overshoot_mm"],
-        }
-        pto_ts = paper["pto"]["settling_2pct_s"]
+        ft = fair_tunings(c, budget, ("ptos",))
+        bounds = ft.bounds
+        pto_ts = ft.paper["pto"]["settling_2pct_s"]
         rows = [_measure(c, reading, "configured", bounds["pto-paper"], pto_ts, grid)]
         for name, b in bounds.items():
-            for search in ("ptos-ideal", "ptos"):
-                t = tune_baseline(c, search, b, maxiter=maxiter, popsize=popsize)
-                if t.feasible:
-                    rows.append(
-                        _measure(t.config, reading, f"tuned {search} {name}", b, pto_ts, grid)
-                    )
+            if ("ptos", name) in ft.results:
+                t = ft.results[("ptos", name)]
+                rows.append(_measure(t.config, reading, f"tuned {name}", b, pto_ts, grid))
         measures += rows
         verdicts.append(
             (reading, "not reproduced" if any(r.usable for r in rows) else "reproduced")
@@ -417,12 +230,12 @@ def ptos_claim(
 
 
 def fair_configs(
-    cfg: Config, laws: tuple[str, ...], bound: str = "pto-paper", *, maxiter: int = 20
+    cfg: Config, laws: tuple[str, ...], bound: str = "pto-paper", *, budget: Any = None
 ) -> dict[str, Config]:
     """Each law's best tuning on the step under one shared overshoot bound.
 
-    PD and PTO from :func:`ptoverify.studies.tune.fair_tunings`, PTOS and the
-    cascade P loop from :func:`tune_baseline`, under the bound named ``bound``
+    Every law with gains from :func:`ptoverify.studies.tune.fair_tunings` (one
+    search for all), under the bound named ``bound``
     (:data:`ptoverify.studies.tune.FAIR_BOUNDS`: the PTO's or the PD's overshoot at
     the paper's gains).  TO and the printed PTO have no gains: their
     configuration is ``cfg``.
@@ -435,26 +248,19 @@ def fair_configs(
         Law names.
     bound : str
         ``pto-paper`` or ``pd-paper``.
-    maxiter : int
-        Generations of the baselines' searches.
+    budget : TuneBudget, optional
+        Search effort (:class:`ptoverify.studies.tune.TuneBudget`; default its defaults).
 
     Returns
     -------
     dict
         Law name -> the configuration holding its tuned gains.
     """
-    from ptoverify.studies.tune import FAIR_BOUNDS, fair_tunings
+    from ptoverify.studies.tune import BOUNDS, FAIR_BOUNDS, TuneBudget, fair_tunings
 
     if bound not in FAIR_BOUNDS:
         raise InputError(f"bound must be one of {', '.join(FAIR_BOUNDS)}, got {bound!r}")
-    fair = fair_tunings(cfg)
-    out = {}
-    for law in laws:
-        if law in ("pd", "pto"):
-            out[law] = fair.config(law, bound)
-        elif law in ("ptos", "cascade-p"):
-            t = tune_baseline(cfg, law, fair.bounds[bound], maxiter=maxiter)
-            out[law] = t.config if t.feasible else cfg
-        else:
-            out[law] = cfg
-    return out
+    tunable = tuple(law for law in laws if law in BOUNDS)
+    fair = fair_tunings(cfg, budget or TuneBudget(), tunable, (bound,))
+    # a law with no feasible tuning keeps its configured gains
+    return {law: fair.config(law, bound) if (law, bound) in fair.results else cfg for law in laws}

@@ -20,9 +20,17 @@ paper        plot_response (Figs. 7-13), plot_state_trajectories (Fig. 14), Figu
              save_all (Figs. 2-14 and the zone geometry as PNGs)
 studies      plot_sweep, save_sweep; plot_robust_map, save_robust; plot_pareto,
              save_tuning; plot_convergence, plot_switch_profiles, save_ground_truth
+charts       plot_penalty, plot_design, save_charts, save_penalty (move-size penalty,
+             coarse design chart)
 conformance  plot_du_map, plot_conform_response, save_conform_figures (conform --report)
 """
 
+from ptoverify.report.plots.charts import (
+    plot_design,
+    plot_penalty,
+    save_charts,
+    save_penalty,
+)
 from ptoverify.report.plots.common import (
     DPI,
     REGION_STYLE,
@@ -105,4 +113,8 @@ __all__ = [
     "plot_conform_response",
     "save_conform_figures",
     "save_proof_map",
+    "plot_penalty",
+    "plot_design",
+    "save_charts",
+    "save_penalty",
 ]

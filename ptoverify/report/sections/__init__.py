@@ -8,6 +8,7 @@ values are in ``results.json``).  Nothing here computes: the derivation and
 errata sections get the records the collect step made.
 """
 
+from .charts import charts
 from .common import CAPTIONS, LAW_WORDS, figure, measured_quantity, verdict
 from .equations import (
     SYMBOL_UNITS,
@@ -28,6 +29,7 @@ __all__ = [
     "LAW_WORDS",
     "SYMBOL_UNITS",
     "c31_paper",
+    "charts",
     "claims",
     "derivations",
     "environment",

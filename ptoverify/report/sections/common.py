@@ -18,6 +18,8 @@ LAW_WORDS = {
     "pd": "PD",
     "pto": "PTO (corrected)",
     "pto-printed": "PTO as printed",
+    "ptos": "PTOS",
+    "cascade-p": "cascade P",
 }
 
 
@@ -86,6 +88,15 @@ CAPTIONS: dict[str, str] = {
     "of the envelope, corrected PTO (interval arithmetic; red: unproven).",
     "proof_bound_pd": "Certified number of samples to reach the target ellipse from each cell "
     "of the envelope, PD (interval arithmetic; red: unproven).",
+    "penalty_moves": "Settling time of point-to-point moves from rest against the move size, "
+    "per law at the configured gains, beside t_f* and N* T (left), and its ratio to N* T "
+    "(right); a law that never settles from a size has no point there.",
+    "penalty_moves_tuned": "The same penalty curves with each law at its best tuning under the "
+    "shared overshoot bound: settling time against move size (left) and its ratio to N* T "
+    "(right).",
+    "design_chart": "The coarse design chart: at each sample time and bandwidth, the law with "
+    "the least median settling / (N* T) and the runner-up's ratio over it; Z marks an unusable "
+    "or degenerate PTO zone, D a PTO linear zone unstable with one sample of delay.",
     "tuning_pareto": "Settling against overshoot on the step: the Pareto fronts of PD and PTO "
     "over every candidate evaluated, the best tunings (stars), the paper's gains (squares) and "
     "the floor.",

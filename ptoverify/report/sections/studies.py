@@ -215,7 +215,19 @@ def properties(res: dict[str, Any]) -> list[Block]:
     rows = [
         [_law(law), *[p[k] for k, _ in _PROPERTY_COLUMNS]] for law, p in res["properties"].items()
     ]
-    return [table(["law", *[h for _, h in _PROPERTY_COLUMNS]], rows)]
+    blocks = [table(["law", *[h for _, h in _PROPERTY_COLUMNS]], rows)]
+    base = [_law(law) for law in ("ptos", "cascade-p") if law in res["properties"]]
+    if base:
+        blocks.insert(
+            0,
+            Block(
+                "p",
+                text=f"The baselines ({', '.join(base)}) are measured as the paper's laws are, "
+                "for information: the gates judge the paper's laws only. Stride-overs and "
+                "crossings refer to the PTO's curves l1, l2 and its linear zone.",
+            ),
+        )
+    return blocks
 
 
 def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:

@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ptoverify.config import Config
 from ptoverify.errors import InputError
+from ptoverify.model.baselines import linear_loop_gains
 from ptoverify.model.laws import Law
 from ptoverify.model.plant import zoh_matrices
 from ptoverify.sim.lockstep import Ask
@@ -43,14 +44,6 @@ __all__ = [
 
 MARGIN_RANGE = (0.1, 10.0)  #: a_true / a_design searched for margins [-]
 MARGIN_RTOL = 1e-12  #: relative accuracy of the linear margin endpoints (the contract asks 1e-6)
-
-
-def _linear_gains(law: str, cfg: Config) -> tuple[float, float] | None:
-    if law == "pd":
-        return cfg.pd.kp, cfg.pd.kd
-    if law in ("pto", "pto-printed"):
-        return cfg.pto.k1, cfg.pto.k2
-    return None
 
 
 EDGE_CHUNK = 64  #: scan points of :func:`_edge` tested per stacked eigenvalue call
@@ -115,7 +108,7 @@ def linear_loop_radii(
     >>> (linear_loop_radii("pd", paper_config(), [1.0, 10.0]) < 1.0).tolist()
     [True, False]
     """
-    gains = _linear_gains(law, cfg)
+    gains = linear_loop_gains(law, cfg)
     if gains is None or delay_samples not in (0, 1):
         raise InputError(
             f"linear_loop_radii: no linear loop for {law!r} with delay {delay_samples}"
@@ -171,7 +164,7 @@ def linear_loop_margin(law: str, cfg: Config, *, delay_samples: int = 0) -> Marg
     """
     if delay_samples not in (0, 1):
         raise InputError(f"linear_loop_margin: delay_samples must be 0 or 1, got {delay_samples}")
-    if _linear_gains(law, cfg) is None:
+    if linear_loop_gains(law, cfg) is None:
         return Margin(None, "no linear loop")
 
     def stable(ratios: NDArray) -> NDArray[np.bool_]:

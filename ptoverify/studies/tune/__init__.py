@@ -1,4 +1,6 @@
-"""Fair comparisons: tune PD (kp, kd) and PTO (d, k1, k2) before judging the paper.
+"""Fair comparisons: every law's gains tuned under one set of constraints.
+
+PD (kp, kd), PTO (d, k1, k2) and the baselines PTOS (alpha, k) and cascade P (kp).
 
 measure   one set of gains: Candidate, tuned_config, response_metrics (the
           ``simulate --json`` path), evaluate, worst_ratio_nt, grid_counts
@@ -6,7 +8,8 @@ screen    many gain sets' step responses in one simulation (the search's screen)
 search    tune: SciPy's differential evolution (searches side by side through
           ptoverify.sim.lockstep.run_together), a compass polish, the checks;
           TuneResult, pareto_front
-fair      fair_tunings: both laws tuned under shared overshoot bounds (FairTunings)
+fair      fair_tunings: the laws tuned under shared overshoot bounds (FairTunings;
+          memoized per law and bound, infeasible tunings recorded with the reason)
 """
 
 from ptoverify.studies.tune.fair import FAIR_BOUNDS, FairTunings, TuneBudget, fair_tunings

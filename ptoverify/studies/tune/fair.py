@@ -1,12 +1,13 @@
-"""The fair comparison: PD and PTO tuned on the step under shared overshoot bounds."""
+"""The fair comparison: PD, PTO (and the baselines) tuned on the step under shared bounds."""
 
 from __future__ import annotations
 
 import functools
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ptoverify.config import Config
+from ptoverify.errors import InputError
 from ptoverify.model.memo import memo
 from ptoverify.sim.lockstep import run_together
 from ptoverify.studies.tune.measure import response_metrics
@@ -64,11 +65,15 @@ class FairTunings:
         ``pd``, ``pto`` -> response metrics of the step at the paper's gains
         (:func:`response_metrics`).
     results : dict
-        (law, bound name) -> :class:`TuneResult` (settling_2pct objective).
+        (law, bound name) -> :class:`TuneResult` (settling_2pct objective), for
+        each tuning that found gains meeting the constraints.
     budget : TuneBudget
         The search effort used.
     seconds : float
         Wall time of the tunings [s].
+    infeasible : dict
+        (law, bound name) -> why no gains in the search range meet the
+        constraints (those tunings are not in ``results``).
     """
 
     bounds: dict[str, float]
@@ -76,6 +81,7 @@ class FairTunings:
     results: dict[tuple[str, str], TuneResult]
     budget: TuneBudget
     seconds: float
+    infeasible: dict[tuple[str, str], str] = field(default_factory=dict)
 
     def config(self, law: str, bound: str) -> Config:
         """Return the configuration of ``law`` tuned under the bound named ``bound``."""
@@ -83,11 +89,22 @@ class FairTunings:
 
 
 @memo(maxsize=8)
-def _fair_tunings(cfg: Config, budget: TuneBudget) -> FairTunings:
-    t0 = time.perf_counter()
-    paper = {law: response_metrics(cfg, law, "step") for law in ("pd", "pto")}
-    bounds = {"pto-paper": paper["pto"]["overshoot_mm"], "pd-paper": paper["pd"]["overshoot_mm"]}
-    by_value: dict[tuple[str, float], TuneResult] = {}
+def _paper(cfg: Config) -> dict[str, dict[str, float]]:
+    """Return the step's metrics at the paper's gains of PD and PTO (the bounds' source)."""
+    return {law: response_metrics(cfg, law, "step") for law in ("pd", "pto")}
+
+
+@memo(maxsize=32)
+def _law_tunings(
+    cfg: Config, budget: TuneBudget, law: str, values: tuple[float, ...]
+) -> dict[float, TuneResult | str]:
+    """One law tuned under each bound value, side by side on one shared screen.
+
+    A value under which no gains meet the constraints maps to the reason (tune's
+    InputError message).  Memoized per law: :func:`_fair_tunings` always asks
+    for every bound's value, so a law is tuned once per configuration and budget
+    whichever bounds a caller names.
+    """
     effort = {
         "seed": budget.seed,
         "maxiter": budget.maxiter,
@@ -96,19 +113,16 @@ def _fair_tunings(cfg: Config, budget: TuneBudget) -> FairTunings:
         "d_refine": budget.d_refine,
         "polish": budget.polish,
     }
-    for law in ("pd", "pto"):
-        # the law's tunings (one per distinct bound) side by side, on one shared screen:
-        # each is what tune() gives alone, in fewer simulations
-        values = list(dict.fromkeys(bounds.values()))
-        for v in values:
-            check_arguments(
-                law, "step", "settling_2pct", v, **{k: effort[k] for k in effort if k != "seed"}
-            )
+    for v in values:
+        check_arguments(
+            law, "step", "settling_2pct", v, **{k: effort[k] for k in effort if k != "seed"}
+        )
+    out: dict[float, TuneResult | str] = {}
+    shared: dict = {}
 
-        shared: dict = {}
-
-        def job(ev, law=law, v=0.0, shared=shared):
-            by_value[(law, v)] = tune_checked(
+    def job(ev, v=0.0):
+        try:
+            out[v] = tune_checked(
                 cfg,
                 law,
                 "step",
@@ -120,16 +134,43 @@ def _fair_tunings(cfg: Config, budget: TuneBudget) -> FairTunings:
                 remeasured=shared,
                 **effort,
             )
+        except InputError as exc:  # no gains meet the constraints: the reason
+            out[v] = str(exc)
 
-        run_together(StepScreen(cfg, law, False), [functools.partial(job, v=v) for v in values])
-    results = {
-        (law, name): by_value[(law, b)] for name, b in bounds.items() for law in ("pd", "pto")
-    }
-    return FairTunings(bounds, paper, results, budget, time.perf_counter() - t0)
+    # each is what tune() gives alone, in fewer simulations
+    run_together(StepScreen(cfg, law, False), [functools.partial(job, v=v) for v in values])
+    return out
 
 
-def fair_tunings(cfg: Config, budget: TuneBudget | None = None) -> FairTunings:
-    """Tune PD and PTO on the step under each shared overshoot bound (memoized).
+def _fair_tunings(
+    cfg: Config, budget: TuneBudget, laws: tuple[str, ...], names: tuple[str, ...]
+) -> FairTunings:
+    t0 = time.perf_counter()
+    paper = _paper(cfg)
+    every = {"pto-paper": paper["pto"]["overshoot_mm"], "pd-paper": paper["pd"]["overshoot_mm"]}
+    bounds = {name: every[name] for name in names}
+    values = tuple(dict.fromkeys(every.values()))  # every bound: one memo entry per law
+    results, infeasible = {}, {}
+    for law in laws:
+        by_value = _law_tunings(cfg, budget, law, values)
+        for name, b in bounds.items():
+            r = by_value[b]
+            if isinstance(r, str):
+                infeasible[(law, name)] = r
+            else:
+                results[(law, name)] = r
+    return FairTunings(
+        bounds, paper, results, budget, time.perf_counter() - t0, infeasible=infeasible
+    )
+
+
+def fair_tunings(
+    cfg: Config,
+    budget: TuneBudget | None = None,
+    laws: tuple[str, ...] = ("pd", "pto"),
+    bounds: tuple[str, ...] = tuple(FAIR_BOUNDS),
+) -> FairTunings:
+    """Tune each law on the step under each shared overshoot bound (memoized).
 
     The bounds (:data:`FAIR_BOUNDS`) are the overshoots, between samples, of the
     PTO and of the PD at the paper's gains: under the first, "the same overshoot"
@@ -148,10 +189,25 @@ def fair_tunings(cfg: Config, budget: TuneBudget | None = None) -> FairTunings:
         Configuration (plant and the paper's gains).
     budget : TuneBudget, optional
         Search effort; default :class:`TuneBudget`.
+    laws : tuple of str
+        The laws tuned (keys of :data:`~ptoverify.studies.tune.measure.BOUNDS`):
+        PD and PTO by default; the baselines ``ptos`` and ``cascade-p`` under the
+        same bounds, constraints and search.  Each law's tunings are cached
+        alone, so adding a law does not re-tune the others.
+    bounds : tuple of str
+        Names of the bounds (:data:`FAIR_BOUNDS`) to tune under; default both.
 
     Returns
     -------
     FairTunings
         Bounds, paper-gain metrics and the tuned results.
+
+    Raises
+    ------
+    InputError
+        An unknown bound name.
     """
-    return _fair_tunings(cfg, budget or TuneBudget())
+    unknown = [b for b in bounds if b not in FAIR_BOUNDS]
+    if unknown or not bounds:
+        raise InputError(f"fair tunings: bounds must be among {', '.join(FAIR_BOUNDS)}")
+    return _fair_tunings(cfg, budget or TuneBudget(), tuple(laws), tuple(dict.fromkeys(bounds)))

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from ptoverify.config import Config, PDGains, PTOSettings
+from ptoverify.config import CascadeGains, Config, PDGains, PTOSettings, PTOSGains
 from ptoverify.errors import InputError
 from ptoverify.model.laws import make_law, with_state_gains
 from ptoverify.model.memo import memo
@@ -34,11 +34,19 @@ from ptoverify.studies.properties import (
 from ptoverify.studies.sweep import SweepSettings, grid_states, settling_times
 
 OBJECTIVES = ("settling_2pct", "settling_0p01mm", "worst_ratio_nt")
-#: Search ranges: gains [1/s] and [-], d [mm]; kp and k1 are searched in log10.
+#: Search ranges: gains [1/s] and [-], d [mm]; kp, k1 and k are searched in log10.
+#: The baselines (:mod:`ptoverify.model.baselines`): PTOS's discount alpha [-] and
+#: velocity-loop gain k [1/s] (its linear-region gains and kv = k / a - 1 follow
+#: from them, Workman's continuity), the cascade P loop's kp [1/s].  Their ranges
+#: hold the plants of ``design``'s default chart (a from 5 to 630 rad/s).
 BOUNDS: dict[str, dict[str, tuple[float, float]]] = {
     "pd": {"kp": (10.0, 3000.0), "kd": (0.0, 4.0)},
     "pto": {"d": (0.2, 5.0), "k1": (10.0, 3000.0), "k2": (0.0, 10.0)},
+    "ptos": {"alpha": (0.05, 1.0), "k": (1.0, 10000.0)},
+    "cascade-p": {"kp": (0.3, 3000.0)},
 }
+#: The searched gains kept in log10 (search coordinates, normalized units).
+LOG_GAINS = frozenset({"kp", "k1", "k", "d"})
 PENALTY = 1e3  #: objective of an infeasible candidate [s or -]; above any feasible value
 #: Most candidates re-measured on the simulate --json path while looking for the best.
 MAX_REMEASURED = 200
@@ -49,6 +57,7 @@ __all__ = [
     "PENALTY",
     "WORST_GRID",
     "LIMIT_CYCLE_BAND",
+    "LOG_GAINS",
     "Candidate",
     "tuned_config",
     "response_metrics",
@@ -65,7 +74,8 @@ class Candidate:
     Attributes
     ----------
     gains : dict
-        ``kp``, ``kd`` (PD) or ``d``, ``k1``, ``k2`` (PTO) [1/s], [-], [mm].
+        ``kp``, ``kd`` (PD) or ``d``, ``k1``, ``k2`` (PTO) [1/s], [-], [mm];
+        ``alpha``, ``k`` (PTOS) [-], [1/s]; ``kp`` (cascade P) [1/s].
     objective : float
         The objective's value ([s] for settling, [-] for worst_ratio_nt); inf if infeasible.
     settling_2pct_s, settling_0p01mm_s : float
@@ -102,16 +112,17 @@ class Candidate:
 
 
 def tuned_config(cfg: Config, law: str, gains: dict[str, float]) -> Config:
-    """Return ``cfg`` with the law's gains replaced (the PD or the PTO section).
+    """Return ``cfg`` with the law's gains replaced (its section: pd, pto, ptos, cascade).
 
     Parameters
     ----------
     cfg : Config
         Base configuration.
     law : str
-        ``pd`` or ``pto``.
+        A key of :data:`BOUNDS`.
     gains : dict
-        ``kp``, ``kd`` [1/s], [-] or ``d`` [mm], ``k1`` [1/s], ``k2`` [-].
+        ``kp``, ``kd`` [1/s], [-] (PD), ``d`` [mm], ``k1`` [1/s], ``k2`` [-] (PTO),
+        ``alpha`` [-], ``k`` [1/s] (PTOS) or ``kp`` [1/s] (cascade P).
 
     Returns
     -------
@@ -126,25 +137,36 @@ def tuned_config(cfg: Config, law: str, gains: dict[str, float]) -> Config:
     """
     if law == "pd":
         return dataclasses.replace(cfg, pd=PDGains(kp=gains["kp"], kd=gains["kd"]))
+    if law == "ptos":
+        return dataclasses.replace(cfg, ptos=PTOSGains(alpha=gains["alpha"], k=gains["k"]))
+    if law == "cascade-p":
+        return dataclasses.replace(cfg, cascade=CascadeGains(kp=gains["kp"]))
     return dataclasses.replace(cfg, pto=PTOSettings(d=gains["d"], k1=gains["k1"], k2=gains["k2"]))
 
 
-def linear_gains(law: str, gains: dict[str, float]) -> tuple[float, float]:
-    """Return the gains of the law's linear loop: (kp, kd) or (k1, k2).
+def linear_gains(cfg: Config, law: str, gains: dict[str, float]) -> tuple[float, float]:
+    """Return the gains (k_x1 [1/s], k_x2 [-]) of the law's linear loop u = -k_x1 x1 - k_x2 x2.
+
+    :func:`ptoverify.model.baselines.linear_loop_gains` of the configuration
+    holding ``gains`` (:func:`tuned_config`).
 
     Parameters
     ----------
+    cfg : Config
+        Base configuration (the plant's a for PTOS).
     law : str
-        ``pd`` or ``pto``.
+        A key of :data:`BOUNDS`.
     gains : dict
-        ``kp``, ``kd`` [1/s], [-] or ``d`` [mm], ``k1`` [1/s], ``k2`` [-].
+        The law's gains (see :func:`tuned_config`).
 
     Returns
     -------
     tuple of float
         Position gain [1/s] and velocity gain [-].
     """
-    return (gains["kp"], gains["kd"]) if law == "pd" else (gains["k1"], gains["k2"])
+    from ptoverify.model.baselines import linear_loop_gains
+
+    return linear_loop_gains(law, tuned_config(cfg, law, gains))
 
 
 def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:
@@ -290,7 +312,7 @@ def worst_ratios(
     x1, x2, nt, steps, hold = _envelope(p, n1, n2)
     ok = np.isfinite(nt)
     m = x1.size
-    keys = ("kp", "kd") if law == "pd" else ("d", "k1", "k2")
+    keys = tuple(BOUNDS[law])
     band = SweepSettings().band
     per = max(1, 4096 // m)  # gain sets per simulation (sweep.settling_times' chunk)
     out = []
@@ -370,7 +392,7 @@ def evaluate(
     tcfg = tuned_config(cfg, law, gains)
     p = cfg.plant
     nan = math.nan
-    if spectral_radii(p.a, p.sample_time, *linear_gains(law, gains))[0] >= 1.0:
+    if spectral_radii(p.a, p.sample_time, *linear_gains(cfg, law, gains))[0] >= 1.0:
         return Candidate(
             gains, math.inf, nan, nan, nan, False, reason="sampled linear loop unstable"
         )

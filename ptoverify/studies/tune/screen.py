@@ -22,6 +22,7 @@ from ptoverify.sim.flow import Trajectory
 from ptoverify.sim.settling import overshoot, settling_time
 from ptoverify.sim.simulate import reference, simulate_batch
 from ptoverify.studies.tune.measure import (
+    BOUNDS,
     Candidate,
     gains_key,
     linear_gains,
@@ -76,7 +77,7 @@ class StepScreen:
     cfg : Config
         Base configuration (plant; the law's other settings).
     law : str
-        ``pd`` or ``pto``.
+        A key of :data:`ptoverify.studies.tune.measure.BOUNDS` (pd, pto, ptos, cascade-p).
     tight : bool
         Also measure the 0.01 mm settling time.
     """
@@ -95,7 +96,8 @@ class StepScreen:
         cfg, law = self.cfg, self.law
         p = cfg.plant
         a, T, nan = p.a, p.sample_time, math.nan
-        g = np.array([linear_gains(law, gains) for gains in batch], dtype=float).reshape(-1, 2)
+        g = np.array([linear_gains(cfg, law, gains) for gains in batch], dtype=float)
+        g = g.reshape(-1, 2)
         rho = spectral_radii(a, T, g[:, 0], g[:, 1])
         out: list[ScreenedResponse | None] = [None] * len(batch)
         omega0: dict[float | None, float | None] = {}  # the PTO's zone level per d
@@ -123,10 +125,7 @@ class StepScreen:
         ref = reference("step")
         r = ref.amplitude
         steps = int(round(ref.duration / T))  # as simulate()
-        keys = ("kp", "kd") if law == "pd" else ("k1", "k2")
-        per_state = dict(zip(keys, g[live].T, strict=True))
-        if law == "pto":
-            per_state["d"] = np.array([batch[i]["d"] for i in live])
+        per_state = {k: np.array([batch[i][k] for i in live]) for k in BOUNDS[law]}
         base = with_state_gains(law, cfg, per_state)
         # the law sees x1 - r, as simulate() feeds it for a step (r' = 0)
         shifted = Law(base.name, lambda x1, x2: base.vector(x1 - r, x2), base.scalar, base.w_max)
@@ -170,7 +169,7 @@ def screened_candidate(
     cfg : Config
         Base configuration.
     law : str
-        ``pd`` or ``pto``.
+        A key of :data:`ptoverify.studies.tune.measure.BOUNDS` (pd, pto, ptos, cascade-p).
     gains : dict
         The gains (see :func:`ptoverify.studies.tune.measure.tuned_config`).
     raw : ScreenedResponse

@@ -61,6 +61,7 @@ from ptoverify.sim.lockstep import run_together
 from ptoverify.sim.simulate import reference
 from ptoverify.studies.tune.measure import (
     BOUNDS,
+    LOG_GAINS,
     MAX_REMEASURED,
     OBJECTIVES,
     PENALTY,
@@ -148,8 +149,10 @@ class TuneResult:
         m = self.config.to_mapping()
         lines = [f'name = "{m["name"]}"', "", "[plant]"]
         lines += [f"{k} = {v!r}" for k, v in m["plant"].items()]
-        for sect in ("pd", "pto"):
-            lines += ["", f"[{sect}]"] + [f"{k} = {v!r}" for k, v in m[sect].items()]
+        for sect in ("pd", "pto", "ptos", "cascade"):
+            if sect in m:
+                items = [(k, v) for k, v in m[sect].items() if v is not None]
+                lines += ["", f"[{sect}]"] + [f"{k} = {v!r}" for k, v in items]
         return "\n".join(lines) + "\n"
 
     def to_json(self) -> dict[str, Any]:
@@ -173,7 +176,7 @@ def _unit(law: str, gains: dict[str, float]) -> np.ndarray:
     out = []
     for k, (lo, hi) in BOUNDS[law].items():
         v = gains[k]
-        if k in ("kp", "k1", "d"):
+        if k in LOG_GAINS:
             out.append((math.log(v) - math.log(lo)) / (math.log(hi) - math.log(lo)))
         else:
             out.append((v - lo) / (hi - lo))
@@ -181,13 +184,13 @@ def _unit(law: str, gains: dict[str, float]) -> np.ndarray:
 
 
 class _Space:
-    """The search coordinates of ``keys`` (log10 for kp, k1), other gains ``fixed``.
+    """The search coordinates of ``keys`` (log10 for :data:`LOG_GAINS`), other gains ``fixed``.
 
     ``f`` evaluates a batch of points (one column each) through ``batch_fn`` and
     returns their objectives (:data:`PENALTY` where infeasible).
     """
 
-    LOG = frozenset({"kp", "k1"})
+    LOG = LOG_GAINS
 
     def __init__(self, batch_fn, keys: tuple[str, ...], law: str, fixed: dict[str, float]):
         self.batch_fn, self.keys, self.fixed = batch_fn, keys, fixed
@@ -314,7 +317,10 @@ def tune(
     cfg : Config
         Base configuration (plant; the other law's gains are kept).
     law : str
-        ``pd`` or ``pto``.
+        ``pd``, ``pto``, or a baseline: ``ptos`` (alpha, k) or ``cascade-p`` (kp)
+        (:data:`~ptoverify.studies.tune.measure.BOUNDS`), tuned under the same
+        constraints (the PTO alone is also checked for stride-overs: the
+        others have no switching curve to stride over).
     signal : str
         ``step``, ``ramp`` or ``sine``.
     max_overshoot : float, optional
@@ -390,7 +396,7 @@ def check_arguments(
         An argument out of range, naming it.
     """
     if law not in BOUNDS:
-        raise InputError(f"tune: unknown law '{law}' (choose from pd, pto)")
+        raise InputError(f"tune: unknown law '{law}' (choose from {', '.join(BOUNDS)})")
     if objective not in OBJECTIVES:
         raise InputError(
             f"tune: unknown objective '{objective}' (choose from {', '.join(OBJECTIVES)})"
@@ -504,8 +510,8 @@ def tune_checked(
             )
         return measured[k]
 
-    keys = ("kp", "kd") if law == "pd" else ("k1", "k2")
-    if law == "pd":
+    keys = tuple(k for k in BOUNDS[law] if k != "d")
+    if law != "pto":
         _de(_Space(batch_fn, keys, law, {}), seed, maxiter, popsize)
     else:
         lo, hi = BOUNDS["pto"]["d"]
@@ -558,7 +564,7 @@ def tune_checked(
         raise InputError(
             f"tune: no {law} gains in the search range meet the constraints ("
             + ("" if max_overshoot is None else f"overshoot <= {max_overshoot:g} mm, ")
-            + "stable, no limit cycle)"
+            + "stable, settles within the record, no limit cycle)"
         )
     runner_up = None
     if find_runner_up:
