@@ -61,7 +61,7 @@ ALLOWED: dict[str, str] = {
     "ptoverify.report.collect.Block": "no Parameters section",
     "ptoverify.report.collect.render_html": "no Parameters section",
     "ptoverify.report.collect.render_markdown": "no Parameters section",
-    "ptoverify.report.collect.stderr_progress": "no Parameters section",
+    "ptoverify.report.collect.write.stderr_progress": "no Parameters section",
     "ptoverify.report.sections.studies.claims": "no Parameters section",
     "ptoverify.report.sections.equations.derivations": "no Parameters section",
     "ptoverify.report.sections.guarantees.environment": "no Parameters section",

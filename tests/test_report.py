@@ -158,7 +158,7 @@ def test_unwritable_out_is_a_clean_error(tmp_path, capsys):
 
 def test_failed_run_leaves_nothing(tmp_path, monkeypatch):
     """An error in the middle of the run (here: a bad figure folder) leaves no folder."""
-    import ptoverify.report.collect as rep
+    import ptoverify.report.collect.write as rep
 
     def boom(*args, **kwargs):
         raise RuntimeError("interrupted")
@@ -397,7 +397,7 @@ def test_jobs_below_one_is_an_input_error(tmp_path, capsys):
 
 def test_pool_stage_error_keeps_its_type_and_names_the_stage():
     """A stage that raises in a worker process raises here, same type, with its stage."""
-    from ptoverify.report.collect import _run_in_pool
+    from ptoverify.report.collect.pool import _run_in_pool
 
     with pytest.raises(KeyError) as info:
         _run_in_pool(["no such stage"], paper_config(), None, 1, lambda *a: None)
