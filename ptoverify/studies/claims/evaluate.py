@@ -156,6 +156,7 @@ def evaluate_claims(
     Examples
     --------
     >>> from ptoverify.config import paper_config
+    >>> from ptoverify.studies.claims import VERDICTS
     >>> res = evaluate_claims(paper_config())
     >>> all(r.verdict in VERDICTS for r in res)
     True
