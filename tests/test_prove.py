@@ -21,6 +21,7 @@ from ptoverify.config import paper_config
 from ptoverify.model.laws import make_law
 from ptoverify.sim.simulate import simulate_batch
 from ptoverify.studies.prove import nominal_proof, parse_a_interval
+from ptoverify.studies.prove.ball import Resolution
 from ptoverify.studies.prove.certificate import certificate_arrays, check_certificate
 from ptoverify.studies.prove.run import prove_law
 
@@ -135,8 +136,13 @@ def test_excursion_proves_reach_everywhere():
     assert proof.property("reach").coverage == 1.0
 
 
+#: A coarse grid for the tests of refutations and of equal results across process layouts
+#: (about 2,000 cells instead of 45,000): what they check does not need the fine grid.
+COARSE = Resolution(h1=0.2, h2=20.0, h1_max=5.0, h_edge=0.5, steps=40)
+
+
 def test_to_strict_stride_over_is_refuted_with_a_certified_counterexample():
-    proof = prove_law(paper_config(), "to", n_random=0)
+    proof = prove_law(paper_config(), "to", n_random=0, res=COARSE)
     p = proof.property("no-stride-over-strict")
     assert p.status == "refuted"
     cex = p.counterexample
@@ -251,7 +257,7 @@ def test_dask_local_equals_in_process():
 
     cfg = paper_config()
     a = cfg.plant.a
-    kw = dict(laws=("pd",), a_interval=(0.99 * a, 1.01 * a), pieces=2, n_random=100)
+    kw = dict(laws=("pd",), a_interval=(0.99 * a, 1.01 * a), pieces=2, n_random=100, res=COARSE)
     here = run_prove(cfg, **kw)
     there = run_prove(cfg, dask="local", **kw)
     np.testing.assert_array_equal(here.proofs[0].bound, there.proofs[0].bound)

@@ -20,6 +20,7 @@ from ptoverify.model.laws import make_law
 from ptoverify.sim.simulate import simulate_batch
 from ptoverify.studies.checks import PROOF_INTERVAL_GATE, run_checks
 from ptoverify.studies.prove import default_pieces, interval_proof
+from ptoverify.studies.prove.ball import Resolution
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED, tie_band
 
 T = 0.002
@@ -207,9 +208,10 @@ def test_cell_blocks_give_the_whole_grid_result_exactly():
     from ptoverify.studies.prove.run import prove_law
 
     cfg = paper_config()
-    kw = dict(a_interval=(A0, 1.03 * A0), pieces=2, n_random=0)
+    coarse = Resolution(h1=0.2, h2=20.0, h1_max=5.0, h_edge=0.5, steps=40)  # ~2,000 cells
+    kw = dict(a_interval=(A0, 1.03 * A0), pieces=2, n_random=0, res=coarse)
     whole = prove_law(cfg, "pto", **kw)
-    split = prove_law(cfg, "pto", block_cells=7_001, **kw)
+    split = prove_law(cfg, "pto", block_cells=701, **kw)
     _same(whole, split)
     assert whole.property("no-stride-over-strict").status == "refuted"  # leaves were compared
 
@@ -220,9 +222,10 @@ def test_dask_cell_blocks_equal_in_process():
     from ptoverify.studies.prove import run_prove
 
     cfg = paper_config()
-    kw = dict(laws=("pd",), a_interval=(0.99 * A0, 1.01 * A0), pieces=2, n_random=100)
+    coarse = Resolution(h1=0.2, h2=20.0, h1_max=5.0, h_edge=0.5, steps=40)  # ~2,000 cells
+    kw = dict(laws=("pd",), a_interval=(0.99 * A0, 1.01 * A0), pieces=2, n_random=100, res=coarse)
     here = run_prove(cfg, **kw)
-    there = run_prove(cfg, dask="local", block_cells=10_000, **kw)
+    there = run_prove(cfg, dask="local", block_cells=700, **kw)
     _same(here.proofs[0], there.proofs[0])
     assert there.backend == "dask:local"
 
