@@ -85,7 +85,7 @@ def test_delay_row_and_gate_finding_follow_the_delay_margin(base):
     data = copy.deepcopy(base)
     m = data["robust"]["margins"]["pto"]
     m["linear_loop_a_ratio_stable_delay1"] = None
-    q = "Tolerates a one-sample computation delay?"
+    q = "Tolerates a one-sample computation delay (paper's gains)?"
     assert _rows(data)[q][1].startswith("no")
     gates = front._finding_gates(results_view(data))[0]
     assert "with one sample of computation delay the PTO's linear zone is unstable" in gates
@@ -244,3 +244,17 @@ def test_versus_row_says_when_tuning_was_skipped(base):
     data = copy.deepcopy(base)
     data["tuning"] = None
     assert _rows(data)[VERSUS_QUESTION][1].startswith("not compared")
+
+
+def test_tuned_delay_row_follows_the_tuned_loops_margins(base):
+    data = copy.deepcopy(base)
+    q = "Do the tuned gains tolerate a one-sample computation delay?"
+    laws = data["tuning"]["versus"]["readings"][0]["laws"]
+    for x in laws:
+        x["delay_margin_samples"] = 2
+    assert _rows(data)[q][1].startswith("yes")
+    laws[0]["delay_margin_samples"] = 0
+    answer = _rows(data)[q][1]
+    assert answer.startswith("no: ") and "PTO" in answer
+    laws[0]["delay_margin_samples"] = -1
+    assert "unstable even without delay" in _rows(data)[q][2]

@@ -35,6 +35,7 @@ __all__ = [
     "adoption",
     "versus_row",
     "versus_verdict",
+    "tuned_delay_row",
     "READING_WORDS",
     "LAW_WORDS",
     "VERSUS_QUESTION",
@@ -266,7 +267,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
         d1 = m["linear_loop_a_ratio_stable_delay1"]
         rows.append(
             [
-                "Tolerates a one-sample computation delay?",
+                "Tolerates a one-sample computation delay (paper's gains)?",
                 "yes" if d1 is not None else "no: needs delay compensation or lower gains",
                 "PTO linear zone with one sample of delay: "
                 + (
@@ -310,7 +311,54 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             ]
         )
     rows.append(versus_row(res))
+    delay = tuned_delay_row(res)
+    if delay:
+        rows.append(delay)
     return rows
+
+
+def tuned_delay_row(res: Mapping) -> list[str] | None:
+    """Return the row on the tuned gains under computation delay (None: tuning skipped).
+
+    Each law's linear loop at its fair tuning (``tuning.versus``, first reading of a),
+    with the whole samples of computation delay it tolerates
+    (:func:`ptoverify.model.poles.delay_margin_samples`).
+
+    Parameters
+    ----------
+    res : Mapping
+        The results (:class:`ptoverify.report.results.Results`).
+
+    Returns
+    -------
+    list of str or None
+        ``[question, answer, evidence]``.
+    """
+    t = res["tuning"]
+    if t is None or "versus" not in t:
+        return None
+    r = t["versus"]["readings"][0]
+    tuned = [x for x in r["laws"] if not x["infeasible"]]
+    if not tuned:
+        return None
+
+    def words(n: int) -> str:
+        return "unstable even without delay" if n < 0 else f"{n} sample{'s' if n != 1 else ''}"
+
+    short = [x for x in tuned if x["delay_margin_samples"] < 1]
+    answer = (
+        "yes: every tuned loop tolerates at least one sample"
+        if not short
+        else "no: "
+        + ", ".join(LAW_WORDS.get(x["law"], x["law"]) for x in short)
+        + " at its best tuning is unstable with one sample of delay (tune with the delay in "
+        "the loop, or compensate it)"
+    )
+    evidence = "; ".join(
+        f"{LAW_WORDS.get(x['law'], x['law'])}: tolerates {words(x['delay_margin_samples'])}"
+        for x in tuned
+    )
+    return ["Do the tuned gains tolerate a one-sample computation delay?", answer, evidence]
 
 
 #: How the compared laws are named in the verdict table.
@@ -474,7 +522,7 @@ def adoption(res: Mapping) -> str:
     versus = rows.get(VERSUS_QUESTION, "")
     if "loses" in versus:
         parts.append(f"against fair-tuned laws it {versus}")
-    delay = rows.get("Tolerates a one-sample computation delay?")
+    delay = rows.get("Tolerates a one-sample computation delay (paper's gains)?")
     if delay and delay != "yes":
         parts.append("it needs delay compensation")
     skipped = [s for s in ("tuning", "robust") if res[s] is None]

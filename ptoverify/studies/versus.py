@@ -27,7 +27,9 @@ from typing import Any
 import numpy as np
 
 from ptoverify.config import Config
+from ptoverify.model.baselines import linear_loop_gains
 from ptoverify.model.mintime import discrete_min_steps_batch, min_time
+from ptoverify.model.poles import delay_margin_samples
 from ptoverify.sim.settling import definition
 from ptoverify.sim.simulate import reference
 from ptoverify.studies.ptos_claim import READINGS, reading_config
@@ -64,6 +66,10 @@ class TunedLaw:
         settling_s / t_f* [-].
     infeasible : str
         Why no gains meet the constraints ("" when tuned).
+    delay_margin_samples : int or None
+        Whole samples of computation delay the tuned linear loop tolerates
+        (:func:`ptoverify.model.poles.delay_margin_samples`; -1: unstable without
+        delay) [samples]; None: infeasible.
     """
 
     law: str
@@ -73,6 +79,7 @@ class TunedLaw:
     ratio_nt: float | None
     ratio_tf: float | None
     infeasible: str = ""
+    delay_margin_samples: int | None = None
 
 
 @dataclass(frozen=True)
@@ -206,6 +213,8 @@ def versus(cfg: Config, budget: TuneBudget | None = None) -> Versus:
                 laws.append(TunedLaw(law, {}, None, None, None, None, ft.infeasible[(law, BOUND)]))
                 continue
             ts = r.best.settling_2pct_s
+            gains = linear_loop_gains(law, r.config)  # every law compared has a linear loop
+            margin = delay_margin_samples(c.plant.a, c.plant.sample_time, *gains)
             laws.append(
                 TunedLaw(
                     law,
@@ -214,6 +223,7 @@ def versus(cfg: Config, budget: TuneBudget | None = None) -> Versus:
                     r.best.overshoot_mm,
                     _ratio(ts, nt),
                     _ratio(ts, tf),
+                    delay_margin_samples=margin,
                 )
             )
         pto = laws[0].settling_s
