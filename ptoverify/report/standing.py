@@ -351,7 +351,8 @@ def tuned_delay_row(res: Mapping) -> list[str] | None:
         if not short
         else "no: "
         + ", ".join(LAW_WORDS.get(x["law"], x["law"]) for x in short)
-        + " at its best tuning is unstable with one sample of delay (tune with the delay in "
+        + (" is" if len(short) == 1 else " are each")
+        + " unstable at the best tuning with one sample of delay (tune with the delay in "
         "the loop, or compensate it)"
     )
     evidence = "; ".join(
