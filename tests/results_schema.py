@@ -17,7 +17,7 @@ import sys
 from typing import Any
 
 #: Stages ``report --skip`` can leave out (their key is then null).
-OPTIONAL_STAGES = ("robust", "tuning")
+OPTIONAL_STAGES = ("robust", "tuning", "charts")
 SCALAR = {bool: "boolean", int: "number", float: "number", str: "string"}
 
 

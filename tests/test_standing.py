@@ -150,6 +150,7 @@ def _versus(T, diffs_by_reading, infeasible=()):
                 "ratio_nt": pto_t / 0.026,
                 "ratio_tf": pto_t / 0.024,
                 "infeasible": "",
+                "delay_margin_samples": 0,
             }
         ]
         minus = {}
@@ -163,6 +164,7 @@ def _versus(T, diffs_by_reading, infeasible=()):
                     "ratio_nt": None if bad else t / 0.026,
                     "ratio_tf": None if bad else t / 0.024,
                     "infeasible": "tune: no gains" if bad else "",
+                    "delay_margin_samples": None if bad else 1,
                 }
             )
             minus[law] = None if bad else d
