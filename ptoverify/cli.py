@@ -87,6 +87,17 @@ def positive_int(text: str) -> int:
     return value
 
 
+def seed_int(text: str) -> int:
+    """Parse a seed: an integer in [0, 2^32), the range of ``robustness.seed``."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if not 0 <= value < 2**32:
+        raise argparse.ArgumentTypeError(f"must be in [0, 2^32): {text!r}")
+    return value
+
+
 def to_jsonable(obj: Any) -> Any:
     """Convert numpy scalars/arrays and non-finite floats to JSON-safe values (NaN -> None)."""
     import numpy as np
@@ -248,7 +259,7 @@ def _add_simulate(sub) -> None:
         ("--delay", int, "N", "computation delay [samples] (with --x0; default 0)"),
         ("--quantum", finite_float, "MM", "encoder resolution [mm] (with --x0; default 0)"),
         ("--velocity-noise", finite_float, "MM_S", "velocity noise sd [mm/s] (with --x0)"),
-        ("--seed", int, "N", "noise seed (with --x0; default 0)"),
+        ("--seed", seed_int, "N", "noise seed (with --x0; default 0)"),
     ):
         p.add_argument(flag, type=kind, metavar=metavar, default=None, help=text)
     p.add_argument("--csv", metavar="FILE", default=None, help="write the time series as CSV")
@@ -488,7 +499,7 @@ def _add_tune(sub) -> None:
         help="what to minimize (default settling_2pct); worst_ratio_nt: the worst settling / "
         "N*T over a 20 x 20 grid of the envelope",
     )
-    p.add_argument("--seed", type=int, default=0, help="search seed (default 0)")
+    p.add_argument("--seed", type=seed_int, default=0, help="search seed (default 0)")
     p.add_argument(
         "--maxiter",
         type=int,

@@ -35,6 +35,11 @@ def test_mintime_json(capsys):
         ["nosuchcommand"],
         [],
         ["mintime", "1", "0", "--config", "/nonexistent/file.toml"],
+        # a seed outside [0, 2^32) (robustness.seed's range): -1 with noise was an internal error
+        ["simulate", "--x0", "1", "0", "--velocity-noise", "1", "--seed", "-1"],
+        ["simulate", "--x0", "1", "0", "--seed", str(2**80)],
+        ["tune", "--law", "pd", "--seed", "-1"],
+        ["tune", "--law", "pd", "--seed", str(2**32)],
     ],
 )
 def test_bad_input_exit_2_one_line(capsys, argv):
