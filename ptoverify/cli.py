@@ -1006,6 +1006,8 @@ def _cmd_prove(args: argparse.Namespace) -> int:
     from ptoverify.studies.prove.certificate import certificate_arrays, check_certificate
 
     cfg = _config(args)
+    if args.full and args.check is None:
+        raise InputError("--full needs --check CERT (it steps a certificate's cells in arb)")
     if args.check is not None:
         try:
             with np.load(args.check, allow_pickle=False) as f:
@@ -1022,7 +1024,7 @@ def _cmd_prove(args: argparse.Namespace) -> int:
         return 0 if res.ok else 1
     if not math.isfinite(args.excursion):
         raise InputError("--excursion must be a finite number of mm")
-    a_int = parse_a_interval(args.a_interval, cfg.plant.a) if args.a_interval else None
+    a_int = parse_a_interval(args.a_interval, cfg.plant.a) if args.a_interval is not None else None
     if args.dask is not None:
         from ptoverify.studies.cluster import ensure_reachable
 

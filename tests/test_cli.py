@@ -40,6 +40,9 @@ def test_mintime_json(capsys):
         ["simulate", "--x0", "1", "0", "--seed", str(2**80)],
         ["tune", "--law", "pd", "--seed", "-1"],
         ["tune", "--law", "pd", "--seed", str(2**32)],
+        # prove options that were silently ignored (exit 0 after a full proof)
+        ["prove", "--full"],
+        ["prove", "--a-interval", ""],
     ],
 )
 def test_bad_input_exit_2_one_line(capsys, argv):
