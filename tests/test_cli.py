@@ -43,6 +43,9 @@ def test_mintime_json(capsys):
         # prove options that were silently ignored (exit 0 after a full proof)
         ["prove", "--full"],
         ["prove", "--a-interval", ""],
+        # an empty --emit-grid fell through to --law None: an internal error
+        ["conform", "--emit-grid", ""],
+        ["conform", "--table", " "],
     ],
 )
 def test_bad_input_exit_2_one_line(capsys, argv):
