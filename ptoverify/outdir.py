@@ -48,6 +48,7 @@ import os
 import re
 import shutil
 import signal
+import stat
 import tempfile
 import threading
 import time
@@ -503,9 +504,22 @@ def write_atomic(path: str | Path, text: str) -> None:
     Raises
     ------
     InputError
-        The file cannot be written (:func:`os_error`; nothing is left behind).
+        The file cannot be written (:func:`os_error`; nothing is left behind), or
+        the name is a device, FIFO or socket: the rename would replace it (as root,
+        ``--csv /dev/full`` replaced the device node with a regular file).
     """
     path = Path(path)
+    try:
+        mode = path.lstat().st_mode
+    except FileNotFoundError:
+        mode = None
+    except OSError as exc:
+        raise os_error(exc, path) from None
+    if mode is not None and not (stat.S_ISREG(mode) or stat.S_ISLNK(mode) or stat.S_ISDIR(mode)):
+        raise InputError(
+            f"cannot write '{path}': it exists and is not a regular file "
+            "(a device, FIFO or socket is never replaced); name a file"
+        )
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name[:200]}.", dir=path.parent or ".")
     except OSError as exc:

@@ -248,3 +248,24 @@ def test_report_default_folder_refuses_another_configuration(tmp_path, monkeypat
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "different configuration" in err[0] and "--out" in err[0]
     assert (committed / "result.txt").read_text() == "committed"
+
+
+def test_write_atomic_never_replaces_a_device_or_fifo(tmp_path, capsys):
+    """The rename of an atomic write replaced /dev/full (run as root) with a regular file."""
+    from ptoverify.cli import main
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    targets = [fifo] + [Path(p) for p in ("/dev/null", "/dev/full") if Path(p).exists()]
+    for target in targets:
+        before = target.lstat()
+        assert main(["simulate", "--law", "pd", "--duration", "0.01", "--csv", str(target)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.count("\n") == 0 and "not a regular file" in err and str(target) in err
+        after = target.lstat()
+        assert (after.st_mode, after.st_ino, after.st_rdev) == (
+            before.st_mode,
+            before.st_ino,
+            before.st_rdev,
+        )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo"]  # no temporary file left
