@@ -598,12 +598,17 @@ def guarded_std_streams() -> Iterator[tuple[GuardedStream, GuardedStream]]:
     """Guard ``sys.stdout`` and ``sys.stderr`` (:class:`GuardedStream`) inside the block.
 
     Flush ``sys.stdout`` inside the block to see a failed write there; what
-    is still buffered at its end is flushed without raising.
+    is still buffered at its end is flushed without raising.  A stream that was
+    closed before the run started (``ptoverify ... >&-``: Python sets it to None)
+    is treated as a closed pipe: its output is discarded and the run keeps its
+    own exit code.
     """
     import sys
 
     old = sys.stdout, sys.stderr
-    out, err = GuardedStream(old[0], "stdout"), GuardedStream(old[1], "stderr")
+    sinks = [open(os.devnull, "w") if s is None else None for s in old]  # noqa: SIM115
+    out = GuardedStream(sinks[0] or old[0], "stdout")
+    err = GuardedStream(sinks[1] or old[1], "stderr")
     sys.stdout, sys.stderr = out, err
     try:
         yield out, err
@@ -614,3 +619,6 @@ def guarded_std_streams() -> Iterator[tuple[GuardedStream, GuardedStream]]:
                 stream.flush()
             except InputError:
                 pass  # reported inside the block when it mattered
+        for sink in sinks:
+            if sink is not None:
+                sink.close()

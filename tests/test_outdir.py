@@ -269,3 +269,18 @@ def test_write_atomic_never_replaces_a_device_or_fifo(tmp_path, capsys):
             before.st_rdev,
         )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo"]  # no temporary file left
+
+
+@pytest.mark.parametrize(
+    "shell, code",
+    [
+        ('"$0" -m ptoverify mintime 1 0 --json >&-', 0),  # stdout closed: was an internal error
+        ('"$0" -m ptoverify zone --config /nonexistent.toml 2>&-', 2),  # stderr closed: was 1
+        ('"$0" -m ptoverify mintime nan 0 >&- 2>&-', 2),
+    ],
+)
+def test_a_stream_closed_before_the_run_keeps_the_exit_code(shell, code):
+    """``>&-`` leaves sys.stdout/stderr None: the output is discarded, the verdict kept."""
+    done = subprocess.run(["bash", "-c", shell, sys.executable], capture_output=True, timeout=60)
+    assert done.returncode == code
+    assert b"Traceback" not in done.stderr and b"internal error" not in done.stderr

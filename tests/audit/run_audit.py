@@ -31,6 +31,7 @@ import json
 import os
 import shutil
 import signal
+import stat
 import subprocess
 import sys
 import tempfile
@@ -1374,6 +1375,9 @@ def run_case(case: Case, base: Path) -> dict:
         for rel in case.absent:
             if (work / rel).exists():
                 problems.append(f"{rel} written by a run that ended {code}")
+    for dev in ("/dev/null", "/dev/full"):  # an output rename must never replace a device
+        if os.path.exists(dev) and not stat.S_ISCHR(os.lstat(dev).st_mode):
+            problems.append(f"{dev} is no longer a device")
     if case.check:
         extra = case.check(work, out_s, err_s)
         if extra:
