@@ -1235,9 +1235,10 @@ def _fill(fs: Path) -> Callable[[Path], None]:
     def setup(_work: Path) -> None:
         for p in fs.iterdir():
             shutil.rmtree(p) if p.is_dir() else p.unlink()
-        with open(fs / "filler", "wb") as f:  # leave ~8 KiB free
+        with open(fs / "filler", "wb", buffering=0) as f:  # fill it to the last byte
             try:
-                f.write(b"\0" * (248 << 10))
+                while True:
+                    f.write(b"\0" * 512)
             except OSError:
                 pass
 
@@ -1305,6 +1306,7 @@ def run_case(case: Case, base: Path) -> dict:
         stderr=subprocess.PIPE,
         stdin=subprocess.PIPE if case.stdin is not None else subprocess.DEVNULL,
         start_new_session=True,
+        preexec_fn=_default_signals,
     )
     hung = False
     if case.signal_after:
@@ -1392,6 +1394,11 @@ def run_case(case: Case, base: Path) -> dict:
         "defect": bool(problems),
         "stderr": err_s.strip()[-300:],
     }
+
+
+def _default_signals() -> None:
+    """SIGINT as a terminal user has it (a shell's ``&`` job inherits it ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def _line_with(text: str, word: str) -> str:
