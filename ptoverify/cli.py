@@ -1009,10 +1009,12 @@ def _cmd_prove(args: argparse.Namespace) -> int:
     if args.full and args.check is None:
         raise InputError("--full needs --check CERT (it steps a certificate's cells in arb)")
     if args.check is not None:
+        import zipfile
+
         try:
             with np.load(args.check, allow_pickle=False) as f:
                 data = {k: f[k] for k in f.files}
-        except (OSError, ValueError) as exc:
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:  # not an .npz
             raise InputError(f"--check: cannot read {args.check}: {exc}") from None
         res = check_certificate(data, cfg, full=args.full)
         if args.json:
