@@ -87,7 +87,7 @@ def positive_int(text: str) -> int:
     return value
 
 
-def seed_int(text: str) -> int:
+def _seed_int(text: str) -> int:
     """Parse a seed: an integer in [0, 2^32), the range of ``robustness.seed``."""
     try:
         value = int(text)
@@ -259,7 +259,7 @@ def _add_simulate(sub) -> None:
         ("--delay", int, "N", "computation delay [samples] (with --x0; default 0)"),
         ("--quantum", finite_float, "MM", "encoder resolution [mm] (with --x0; default 0)"),
         ("--velocity-noise", finite_float, "MM_S", "velocity noise sd [mm/s] (with --x0)"),
-        ("--seed", seed_int, "N", "noise seed (with --x0; default 0)"),
+        ("--seed", _seed_int, "N", "noise seed (with --x0; default 0)"),
     ):
         p.add_argument(flag, type=kind, metavar=metavar, default=None, help=text)
     p.add_argument("--csv", metavar="FILE", default=None, help="write the time series as CSV")
@@ -499,7 +499,7 @@ def _add_tune(sub) -> None:
         help="what to minimize (default settling_2pct); worst_ratio_nt: the worst settling / "
         "N*T over a 20 x 20 grid of the envelope",
     )
-    p.add_argument("--seed", type=seed_int, default=0, help="search seed (default 0)")
+    p.add_argument("--seed", type=_seed_int, default=0, help="search seed (default 0)")
     p.add_argument(
         "--maxiter",
         type=int,
