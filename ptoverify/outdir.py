@@ -321,6 +321,8 @@ def make_temp(target: Path) -> Path:
     """Create the temporary folder for ``target`` (in its nearest existing ancestor).
 
     Stale temporaries of dead runs are removed first (:func:`remove_stale`).
+    A folder that cannot be created or marked (ENOSPC) is removed and raises
+    :func:`os_error` (exit 2).
     """
     remove_stale(target)
     anchor = _existing_ancestor(target)
@@ -330,7 +332,11 @@ def make_temp(target: Path) -> Path:
         )
     except OSError as exc:
         raise os_error(exc, target) from None
-    (tmp / MARKER).write_text(json.dumps({"ptoverify": "staging", "pid": os.getpid()}) + "\n")
+    try:
+        (tmp / MARKER).write_text(json.dumps({"ptoverify": "staging", "pid": os.getpid()}) + "\n")
+    except OSError as exc:  # a full disk: the folder fits, its marker does not
+        discard(tmp)
+        raise os_error(exc, target) from None
     return tmp
 
 

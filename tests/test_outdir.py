@@ -284,3 +284,23 @@ def test_a_stream_closed_before_the_run_keeps_the_exit_code(shell, code):
     done = subprocess.run(["bash", "-c", shell, sys.executable], capture_output=True, timeout=60)
     assert done.returncode == code
     assert b"Traceback" not in done.stderr and b"internal error" not in done.stderr
+
+
+def test_make_temp_on_a_full_disk_leaves_nothing(tmp_path, monkeypatch):
+    """On a full disk the temporary folder fits but its marker does not: it was left behind."""
+    import errno
+
+    from ptoverify import outdir
+    from ptoverify.errors import InputError
+
+    real = Path.write_text
+
+    def full(self, *args, **kwargs):
+        if self.name == outdir.MARKER:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "write_text", full)
+    with pytest.raises(InputError, match="ENOSPC"):
+        outdir.make_temp(tmp_path / "out")
+    assert list(tmp_path.iterdir()) == []
