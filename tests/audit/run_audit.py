@@ -381,7 +381,7 @@ EXTREME_COMMANDS: dict[str, list[str]] = {
     "robust": [
         "robust",
         "--grid",
-        "2",
+        "3",
         "--generations",
         "0",
         "--population",
@@ -1203,7 +1203,24 @@ def build_cases(tmpfs: Path | None) -> list[Case]:  # noqa: C901 - a flat list o
         ("conform-law-sigkill", ["conform", "--law", "law.py:pto"], signal.SIGKILL, (-9,)),
         ("robust-sigint", ["robust", "--quiet"], signal.SIGINT, (130,)),
         ("prove-sigterm-out", ["prove", "--out", "pr"], signal.SIGTERM, (143,)),
-        ("design-sigterm-out", ["design", "--out", "de"], signal.SIGTERM, (143,)),
+        (
+            "design-sigterm-out",
+            [
+                "design",
+                "--sample-times",
+                "0.001",
+                "0.002",
+                "--bandwidths",
+                "30",
+                "60",
+                "--grid",
+                "40",
+                "--out",
+                "de",
+            ],
+            signal.SIGTERM,
+            (143,),
+        ),
     ):
         slow = law_file("import time\n    time.sleep(300)")
         add(
