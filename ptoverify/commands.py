@@ -19,7 +19,7 @@ import numpy as np
 from ptoverify.config import Config
 from ptoverify.errors import InputError
 from ptoverify.model.laws import make_law
-from ptoverify.sim.runs import MAX_DURATION_S
+from ptoverify.sim.runs import MAX_DURATION_S, check_samples
 
 __all__ = [
     "run_regulation",
@@ -148,6 +148,8 @@ def run_regulation(
                 f"--duration must be in [{p.sample_time:g}, {MAX_DURATION_S:g}] s, got {duration:g}"
             )
         steps = int(round(duration / p.sample_time))
+    what = "the default horizon" if duration is None else f"--duration {duration:g} s"
+    check_samples(steps * p.sample_time, p.sample_time, what)
     m = Mismatch(
         a_ratio=a_ratio,
         w_max_ratio=w_max_ratio,

@@ -48,6 +48,7 @@ import os
 import re
 import shutil
 import signal
+import stat
 import tempfile
 import threading
 import time
@@ -320,6 +321,8 @@ def make_temp(target: Path) -> Path:
     """Create the temporary folder for ``target`` (in its nearest existing ancestor).
 
     Stale temporaries of dead runs are removed first (:func:`remove_stale`).
+    A folder that cannot be created or marked (ENOSPC) is removed and raises
+    :func:`os_error` (exit 2).
     """
     remove_stale(target)
     anchor = _existing_ancestor(target)
@@ -329,7 +332,11 @@ def make_temp(target: Path) -> Path:
         )
     except OSError as exc:
         raise os_error(exc, target) from None
-    (tmp / MARKER).write_text(json.dumps({"ptoverify": "staging", "pid": os.getpid()}) + "\n")
+    try:
+        (tmp / MARKER).write_text(json.dumps({"ptoverify": "staging", "pid": os.getpid()}) + "\n")
+    except OSError as exc:  # a full disk: the folder fits, its marker does not
+        discard(tmp)
+        raise os_error(exc, target) from None
     return tmp
 
 
@@ -503,9 +510,22 @@ def write_atomic(path: str | Path, text: str) -> None:
     Raises
     ------
     InputError
-        The file cannot be written (:func:`os_error`; nothing is left behind).
+        The file cannot be written (:func:`os_error`; nothing is left behind), or
+        the name is a device, FIFO or socket: the rename would replace it (as root,
+        ``--csv /dev/full`` replaced the device node with a regular file).
     """
     path = Path(path)
+    try:
+        mode = path.lstat().st_mode
+    except FileNotFoundError:
+        mode = None
+    except OSError as exc:
+        raise os_error(exc, path) from None
+    if mode is not None and not (stat.S_ISREG(mode) or stat.S_ISLNK(mode) or stat.S_ISDIR(mode)):
+        raise InputError(
+            f"cannot write '{path}': it exists and is not a regular file "
+            "(a device, FIFO or socket is never replaced); name a file"
+        )
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name[:200]}.", dir=path.parent or ".")
     except OSError as exc:
@@ -584,12 +604,17 @@ def guarded_std_streams() -> Iterator[tuple[GuardedStream, GuardedStream]]:
     """Guard ``sys.stdout`` and ``sys.stderr`` (:class:`GuardedStream`) inside the block.
 
     Flush ``sys.stdout`` inside the block to see a failed write there; what
-    is still buffered at its end is flushed without raising.
+    is still buffered at its end is flushed without raising.  A stream that was
+    closed before the run started (``ptoverify ... >&-``: Python sets it to None)
+    is treated as a closed pipe: its output is discarded and the run keeps its
+    own exit code.
     """
     import sys
 
     old = sys.stdout, sys.stderr
-    out, err = GuardedStream(old[0], "stdout"), GuardedStream(old[1], "stderr")
+    sinks = [open(os.devnull, "w") if s is None else None for s in old]  # noqa: SIM115
+    out = GuardedStream(sinks[0] or old[0], "stdout")
+    err = GuardedStream(sinks[1] or old[1], "stderr")
     sys.stdout, sys.stderr = out, err
     try:
         yield out, err
@@ -600,3 +625,6 @@ def guarded_std_streams() -> Iterator[tuple[GuardedStream, GuardedStream]]:
                 stream.flush()
             except InputError:
                 pass  # reported inside the block when it mattered
+        for sink in sinks:
+            if sink is not None:
+                sink.close()

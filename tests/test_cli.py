@@ -35,6 +35,17 @@ def test_mintime_json(capsys):
         ["nosuchcommand"],
         [],
         ["mintime", "1", "0", "--config", "/nonexistent/file.toml"],
+        # a seed outside [0, 2^32) (robustness.seed's range): -1 with noise was an internal error
+        ["simulate", "--x0", "1", "0", "--velocity-noise", "1", "--seed", "-1"],
+        ["simulate", "--x0", "1", "0", "--seed", str(2**80)],
+        ["tune", "--law", "pd", "--seed", "-1"],
+        ["tune", "--law", "pd", "--seed", str(2**32)],
+        # prove options that were silently ignored (exit 0 after a full proof)
+        ["prove", "--full"],
+        ["prove", "--a-interval", ""],
+        # an empty --emit-grid fell through to --law None: an internal error
+        ["conform", "--emit-grid", ""],
+        ["conform", "--table", " "],
     ],
 )
 def test_bad_input_exit_2_one_line(capsys, argv):

@@ -248,3 +248,59 @@ def test_report_default_folder_refuses_another_configuration(tmp_path, monkeypat
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "different configuration" in err[0] and "--out" in err[0]
     assert (committed / "result.txt").read_text() == "committed"
+
+
+def test_write_atomic_never_replaces_a_device_or_fifo(tmp_path, capsys):
+    """The rename of an atomic write replaced /dev/full (run as root) with a regular file."""
+    from ptoverify.cli import main
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    targets = [fifo] + [Path(p) for p in ("/dev/null", "/dev/full") if Path(p).exists()]
+    for target in targets:
+        before = target.lstat()
+        assert main(["simulate", "--law", "pd", "--duration", "0.01", "--csv", str(target)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.count("\n") == 0 and "not a regular file" in err and str(target) in err
+        after = target.lstat()
+        assert (after.st_mode, after.st_ino, after.st_rdev) == (
+            before.st_mode,
+            before.st_ino,
+            before.st_rdev,
+        )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo"]  # no temporary file left
+
+
+@pytest.mark.parametrize(
+    "shell, code",
+    [
+        ('"$0" -m ptoverify mintime 1 0 --json >&-', 0),  # stdout closed: was an internal error
+        ('"$0" -m ptoverify zone --config /nonexistent.toml 2>&-', 2),  # stderr closed: was 1
+        ('"$0" -m ptoverify mintime nan 0 >&- 2>&-', 2),
+    ],
+)
+def test_a_stream_closed_before_the_run_keeps_the_exit_code(shell, code):
+    """``>&-`` leaves sys.stdout/stderr None: the output is discarded, the verdict kept."""
+    done = subprocess.run(["bash", "-c", shell, sys.executable], capture_output=True, timeout=60)
+    assert done.returncode == code
+    assert b"Traceback" not in done.stderr and b"internal error" not in done.stderr
+
+
+def test_make_temp_on_a_full_disk_leaves_nothing(tmp_path, monkeypatch):
+    """On a full disk the temporary folder fits but its marker does not: it was left behind."""
+    import errno
+
+    from ptoverify import outdir
+    from ptoverify.errors import InputError
+
+    real = Path.write_text
+
+    def full(self, *args, **kwargs):
+        if self.name == outdir.MARKER:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "write_text", full)
+    with pytest.raises(InputError, match="ENOSPC"):
+        outdir.make_temp(tmp_path / "out")
+    assert list(tmp_path.iterdir()) == []

@@ -278,3 +278,13 @@ def test_omega0_one_percent_larger_does_not_prove(monkeypatch):
     monkeypatch.setattr(prove_run, "law_spec", spec)
     proof = prove_law(paper_config(), "pto", n_random=0)
     assert proof.property("no-stride-over-strict").status != "proved"
+
+
+@pytest.mark.parametrize("content", [b"", b"PK\x03\x04" + b"\x00" * 40, b"not a zip"])
+def test_cli_check_of_a_file_that_is_no_npz_is_bad_input(tmp_path, capsys, content):
+    """A truncated or empty certificate was an internal error (BadZipFile, EOFError)."""
+    cert = tmp_path / "cert.npz"
+    cert.write_bytes(content)
+    assert main(["prove", "--check", str(cert)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith("ptoverify: error: --check: cannot read")

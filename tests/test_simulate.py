@@ -317,3 +317,40 @@ def test_segments_merged_per_law_equal_each_segment_alone():
         one = simulate_batch(law, cfg.plant, x1, x2, 150, mismatch=m)
         for f in ("x1", "x2", "u", "region"):
             np.testing.assert_array_equal(getattr(part, f), getattr(one, f), err_msg=f"segment {f}")
+
+
+FINE_SAMPLED = """name = "fine"
+[plant]
+a = 100000.0
+w_max = 300.0
+sample_time = 1e-7
+position_range = 0.06
+[pd]
+kp = 356.0
+kd = 1.15
+[pto]
+d = 0.005
+k1 = 323.0
+k2 = 3.6
+"""
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [
+        [],  # the step's default 0.2 s: 2e6 samples
+        ["--duration", "100", "--step", "0.01"],
+        ["--x0", "0.01", "0", "--duration", "100"],
+    ],
+)
+def test_simulation_longer_than_the_sample_limit_is_bad_input(tmp_path, capsys, extra):
+    """A configuration the loader accepts (T = 1e-7 s) never makes simulate run unbounded."""
+    from ptoverify.sim.runs import MAX_SAMPLES
+
+    path = tmp_path / "fine.toml"
+    path.write_text(FINE_SAMPLED)
+    assert main(["simulate", "--config", str(path), *extra]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "samples" in err and f"{MAX_SAMPLES:,}" in err
+    # within the limit it runs: the same plant for 1e-3 s (1e4 samples)
+    assert main(["simulate", "--config", str(path), "--step", "0.01", "--duration", "1e-3"]) == 0

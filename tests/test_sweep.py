@@ -316,3 +316,29 @@ def test_mirror_pairs_spread_values_to_mirrors_and_refuse_unpaired_states():
     assert np.array_equal(np.hypot(x1, x2)[reps][where], np.hypot(x1, x2))
     assert np.array_equal(np.abs(x1[reps][where]), np.abs(x1))
     assert mirror_pairs(np.array([1.0, 2.0]), np.array([0.0, 0.0])) is None
+
+
+def test_horizon_over_the_limit_is_bad_input_at_once(tmp_path, capsys):
+    """T = 1e-7 s (accepted by the loader) makes the 0.05 s hold 5e5 samples: exit 2, no run."""
+    import dataclasses
+    import time
+
+    from ptoverify.studies.sweep import MAX_HORIZON_STEPS
+
+    path = tmp_path / "fine.toml"
+    path.write_text(
+        'name = "fine"\n[plant]\na = 100000.0\nw_max = 300.0\nsample_time = 1e-7\n'
+        "position_range = 0.06\n[pd]\nkp = 356.0\nkd = 1.15\n[pto]\nd = 0.005\nk1 = 323.0\n"
+        "k2 = 3.6\n"
+    )
+    start = time.monotonic()
+    assert main(["sweep", "--grid", "4", "--config", str(path), "--out", str(tmp_path / "o")]) == 2
+    assert time.monotonic() - start < 10
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and f"{MAX_HORIZON_STEPS:,}" in err and "hold" in err
+    assert not (tmp_path / "o").exists()
+    # the same limit, just inside it: the paper's plant sampled 4 x finer runs
+    cfg = paper_config()
+    fine = dataclasses.replace(cfg, plant=dataclasses.replace(cfg.plant, sample_time=5e-4))
+    res = run_sweep(fine, SweepSettings(n1=2, n2=2, laws=("pd",)))
+    assert 0 < res.steps <= MAX_HORIZON_STEPS

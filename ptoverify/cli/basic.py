@@ -16,6 +16,7 @@ from .common import (
     _add_junit,
     _check_junit,
     _config,
+    _seed_int,
     finite_float,
     positive_int,
     print_json,
@@ -153,7 +154,7 @@ def _add_simulate(sub) -> None:
         ("--delay", int, "N", "computation delay [samples] (with --x0; default 0)"),
         ("--quantum", finite_float, "MM", "encoder resolution [mm] (with --x0; default 0)"),
         ("--velocity-noise", finite_float, "MM_S", "velocity noise sd [mm/s] (with --x0)"),
-        ("--seed", int, "N", "noise seed (with --x0; default 0)"),
+        ("--seed", _seed_int, "N", "noise seed (with --x0; default 0)"),
     ):
         p.add_argument(flag, type=kind, metavar=metavar, default=None, help=text)
     p.add_argument("--csv", metavar="FILE", default=None, help="write the time series as CSV")

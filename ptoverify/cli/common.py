@@ -79,6 +79,17 @@ def positive_int(text: str) -> int:
     return value
 
 
+def _seed_int(text: str) -> int:
+    """Parse a seed: an integer in [0, 2^32), the range of ``robustness.seed``."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text.strip()!r}") from None
+    if not 0 <= value < 2**32:
+        raise argparse.ArgumentTypeError(f"must be in [0, 2^32): {text.strip()!r}")
+    return value
+
+
 def to_jsonable(obj: Any) -> Any:
     """Convert numpy scalars/arrays and non-finite floats to JSON-safe values (NaN -> None)."""
     import numpy as np

@@ -229,6 +229,13 @@ def _conform_perturbations(args: argparse.Namespace, cfg) -> tuple:
 def _cmd_conform(args: argparse.Namespace) -> int:
     from ptoverify.conform import gate as conform
 
+    for flag, value in (
+        ("--law", args.law),
+        ("--table", args.table),
+        ("--emit-grid", args.emit_grid),
+    ):
+        if value is not None and value.strip() == "":
+            raise InputError(f"{flag} is empty")
     cfg = _config(args)
     rtol = conform.DEFAULT_RTOL if args.tolerance is None else args.tolerance
     if not 0 < rtol < 1:

@@ -14,7 +14,7 @@ from ptoverify.outdir import (
     publish,
 )
 
-from .common import _config, finite_float, positive_int, print_json, to_jsonable
+from .common import _config, _seed_int, finite_float, positive_int, print_json, to_jsonable
 
 
 # ---------------------------------------------------------------- robust
@@ -139,7 +139,7 @@ def _add_tune(sub) -> None:
         help="what to minimize (default settling_2pct); worst_ratio_nt: the worst settling / "
         "N*T over a 20 x 20 grid of the envelope",
     )
-    p.add_argument("--seed", type=int, default=0, help="search seed (default 0)")
+    p.add_argument("--seed", type=_seed_int, default=0, help="search seed (default 0)")
     p.add_argument(
         "--maxiter",
         type=int,
@@ -531,11 +531,15 @@ def _cmd_prove(args: argparse.Namespace) -> int:
     from ptoverify.studies.prove.certificate import certificate_arrays, check_certificate
 
     cfg = _config(args)
+    if args.full and args.check is None:
+        raise InputError("--full needs --check CERT (it steps a certificate's cells in arb)")
     if args.check is not None:
+        import zipfile
+
         try:
             with np.load(args.check, allow_pickle=False) as f:
                 data = {k: f[k] for k in f.files}
-        except (OSError, ValueError) as exc:
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:  # not an .npz
             raise InputError(f"--check: cannot read {args.check}: {exc}") from None
         res = check_certificate(data, cfg, full=args.full)
         if args.json:
@@ -547,7 +551,7 @@ def _cmd_prove(args: argparse.Namespace) -> int:
         return 0 if res.ok else 1
     if not math.isfinite(args.excursion):
         raise InputError("--excursion must be a finite number of mm")
-    a_int = parse_a_interval(args.a_interval, cfg.plant.a) if args.a_interval else None
+    a_int = parse_a_interval(args.a_interval, cfg.plant.a) if args.a_interval is not None else None
     if args.dask is not None:
         from ptoverify.studies.cluster import ensure_reachable
 

@@ -19,11 +19,47 @@ from ptoverify.model.laws import make_law
 from ptoverify.sim.exact import exact_metrics
 from ptoverify.sim.simulate import SimResult, reference, simulate
 
-__all__ = ["SimulationRun", "run_simulation", "MAX_DURATION_S"]
+__all__ = ["SimulationRun", "run_simulation", "check_samples", "MAX_DURATION_S", "MAX_SAMPLES"]
 
 
 #: Longest simulated time accepted from a user [s].
 MAX_DURATION_S = 100.0
+
+#: Most samples one user-requested simulation may take (about 15 s of one core; the
+#: paper's 100 s at T = 2 ms is 50,000).  A fine sample time with a long default
+#: duration (0.2 s at T = 1e-7 s is 2e6 samples) would otherwise run without bound.
+MAX_SAMPLES = 100_000
+
+
+def check_samples(duration: float, sample_time: float, what: str) -> int:
+    """Return the number of samples of ``duration``; reject more than ``MAX_SAMPLES``.
+
+    Parameters
+    ----------
+    duration : float
+        Simulated time [s].
+    sample_time : float
+        Sample time T [s].
+    what : str
+        How the duration was chosen, named in the error (e.g. ``"--duration 3"``).
+
+    Returns
+    -------
+    int
+        ``round(duration / sample_time)`` samples.
+
+    Raises
+    ------
+    InputError
+        More than ``MAX_SAMPLES`` samples.
+    """
+    samples = duration / sample_time
+    if samples > MAX_SAMPLES:
+        raise InputError(
+            f"{what} is {samples:.3g} samples of T = {sample_time:g} s, more than the limit "
+            f"of {MAX_SAMPLES:,}: give a shorter --duration (at most {MAX_SAMPLES * sample_time:g} s)"
+        )
+    return int(round(samples))
 
 
 @dataclass(frozen=True, eq=False)
@@ -132,7 +168,8 @@ def run_simulation(
     Raises
     ------
     InputError
-        A duration outside (0, ``MAX_DURATION_S``] s or shorter than one sample.
+        A duration outside (0, ``MAX_DURATION_S``] s, shorter than one sample or longer
+        than ``MAX_SAMPLES`` samples.
 
     Examples
     --------
@@ -157,6 +194,12 @@ def run_simulation(
         amplitude=amplitude,
         frequency=frequency,
     )
+    what = (
+        f"--duration {duration:g} s"
+        if duration is not None
+        else f"the {signal}'s default duration {ref.duration:g} s"
+    )
+    check_samples(ref.duration if duration is None else duration, cfg.plant.sample_time, what)
     fn = make_law(law, cfg)
     res = simulate(fn, cfg.plant, ref, duration=duration, feedforward=feedforward)
     return SimulationRun(res, fn.note, cfg.plant)

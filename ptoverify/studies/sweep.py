@@ -354,6 +354,11 @@ def mirror_pairs(x1: NDArray, x2: NDArray) -> tuple[NDArray[np.intp], NDArray[np
 #: States simulated at once by default (about 20 MB of trajectories at 384 samples).
 CHUNK = 2048
 
+#: Most samples per trajectory (horizon) a sweep may simulate: 80 x the paper's (about
+#: 620).  The hold is fixed in seconds (0.05 s), so a fine sample time (T = 1e-7 s: 5e5
+#: samples of hold) would otherwise run without bound.
+MAX_HORIZON_STEPS = 50_000
+
 
 def settling_times(
     law,
@@ -536,6 +541,11 @@ def run_sweep(
     SweepResult
         Per-law settling times, ratios and statistics.
 
+    Raises
+    ------
+    InputError
+        A grid under 2 x 2, or a horizon over ``MAX_HORIZON_STEPS`` samples.
+
     Examples
     --------
     >>> from ptoverify.config import paper_config
@@ -555,6 +565,12 @@ def run_sweep(
     t_f = min_time(X1, X2, plant).t_f
     hold_steps = math.ceil(s.hold / T - 1e-9)
     steps = math.ceil(s.horizon_factor * float(t_f.max()) / T) + hold_steps
+    if steps > MAX_HORIZON_STEPS:
+        raise InputError(
+            f"the sweep's horizon is {steps:,} samples ({s.horizon_factor:g} x the largest t_f* "
+            f"+ the {s.hold:g} s hold, at T = {T:g} s), more than the limit of "
+            f"{MAX_HORIZON_STEPS:,}: use a longer sample_time"
+        )
     timings["min_time"] = time.perf_counter() - t0
     report("discrete limit N*", 0.0)
     t1 = time.perf_counter()
