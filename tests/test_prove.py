@@ -185,6 +185,31 @@ def test_certificate_checks_and_tampering_is_caught(pd_proof):
     assert not check_certificate(dict(data, image=img), cfg, samples=40).ok, "shrunk images"
 
 
+@pytest.mark.parametrize(
+    "change",
+    ["law xyz", "law pto", "params", "T", "no P", "no certified", "e1 str", "bound short"],
+)
+def test_a_forged_certificate_is_inconsistent_never_consistent(pd_proof, change):
+    """Another law's name or parameters, a missing array, a wrong dtype or shape: exit 1
+    ("inconsistent"), never "consistent" and never an internal error (audit R5)."""
+    cfg = paper_config()
+    data = dict(certificate_arrays(pd_proof, cfg))
+    if change.startswith("law "):
+        data["law"] = np.array(change.split()[1])
+    elif change == "params":
+        data["law_params"] = data["law_params"] * 1.01
+    elif change == "T":
+        data["T"] = np.array(0.001)
+    elif change.startswith("no "):
+        del data[change.split()[1]]
+    elif change == "e1 str":
+        data["e1"] = data["e1"].astype(str)
+    else:
+        data["bound"] = data["bound"][:10]
+    res = check_certificate(data, cfg, samples=5)
+    assert not res.ok and res.problems
+
+
 def test_cli_prove_json_keys_and_check(tmp_path, capsys):
     out = tmp_path / "proof"
     assert main(["prove", "--law", "pd", "--json", "--out", str(out)]) == 0

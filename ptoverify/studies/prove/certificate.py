@@ -26,6 +26,7 @@ import numpy as np
 from flint import arb, arb_mat, ctx
 
 from ptoverify.config import Config
+from ptoverify.errors import InputError
 
 __all__ = ["certificate_arrays", "CertificateCheck", "check_certificate"]
 
@@ -304,6 +305,78 @@ def _run(params, a: arb, T: arb, x1: arb, x2: arb, k: int):  # noqa: N803
     return x1, x2
 
 
+#: Each array of a certificate: NumPy dtype kinds allowed, and its number of dimensions.
+_LAYOUT = {
+    "law": ("U", 0),
+    "T": ("f", 0),
+    "e1": ("f", 1),
+    "e2": ("f", 1),
+    "bound": ("f", 1),
+    "a_lo": ("f", 1),
+    "a_hi": ("f", 1),
+    "ball_bound": ("f", 2),
+    "k": ("iu", 2),
+    "image": ("f", 3),
+    "u_lo": ("f", 1),
+    "u_hi": ("f", 1),
+    "P": ("f", 2),
+    "c": ("f", 0),
+    "certified": ("b", 0),
+    "law_params": ("f", 1),
+}
+
+
+def _structure_ok(data, cfg: Config, problems: list[str]) -> bool:
+    """Check keys, dtypes, shapes, and that the law and its parameters are the configuration's.
+
+    A certificate is only as good as the law it speaks of: one whose ``law`` is not a
+    law of the suite, or whose parameters differ from those the configuration gives
+    that law, is inconsistent, whatever its bounds say.
+    """
+    from ptoverify.model.lawbox import law_spec
+
+    for key, (kinds, ndim) in _LAYOUT.items():
+        if key not in data:
+            problems.append(f"array '{key}' missing")
+        elif np.asarray(data[key]).dtype.kind not in kinds or np.ndim(data[key]) != ndim:
+            v = np.asarray(data[key])
+            problems.append(f"array '{key}' has dtype {v.dtype} and {v.ndim} dimensions")
+    if problems:
+        return False
+    n = (data["e1"].size - 1) * (data["e2"].size - 1)
+    m = data["a_lo"].size
+    shapes = {
+        "bound": (n,),
+        "u_lo": (n,),
+        "u_hi": (n,),
+        "a_hi": (m,),
+        "ball_bound": (m, n),
+        "k": (m, n),
+        "image": (m, 4, n),
+        "P": (2, 2),
+        "law_params": (6,),
+    }
+    for key, shape in shapes.items():
+        if data[key].shape != shape:
+            problems.append(f"array '{key}' has shape {data[key].shape}, expected {shape}")
+    if problems:
+        return False
+    name = str(data["law"])
+    try:
+        want = _params(law_spec(name, cfg))
+    except (KeyError, ValueError, InputError):
+        problems.append(f"law '{name}' is not a law this configuration can prove")
+        return False
+    if not np.array_equal(data["law_params"], np.array(want, dtype=float), equal_nan=True):
+        problems.append(
+            f"the parameters of law '{name}' differ from this configuration's "
+            f"({data['law_params'].tolist()} vs {want})"
+        )
+    if float(data["T"]) != cfg.plant.sample_time:
+        problems.append(f"T = {float(data['T'])} s, the configuration's is {cfg.plant.sample_time}")
+    return not problems
+
+
 def check_certificate(
     data, cfg: Config, *, full: bool = False, samples: int = 200, seed: int = 0
 ) -> CertificateCheck:
@@ -328,6 +401,8 @@ def check_certificate(
         The outcome.
     """
     problems: list[str] = []
+    if not _structure_ok(data, cfg, problems):
+        return CertificateCheck(False, tuple(problems), 0, 0)
     if bool(data["certified"]):
         _target_ok(data, problems)
     checked = _bounds_ok(data, problems)
