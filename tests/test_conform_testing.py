@@ -103,3 +103,24 @@ def test_law_spec_names_module_level_functions_and_refuses_closures():
     for bad in (closure, lambda x1, x2, cfg: 0.0, 3):
         with pytest.raises(InputError, match="module-level function"):
             law_spec(bad)
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"timeout": float("inf")},
+        {"timeout": float("nan")},
+        {"timeout": 0},
+        {"rtol": -1.0},
+        {"rtol": float("nan")},
+        {"memory_limit": -1},
+    ],
+    ids=str,
+)
+def test_bad_limits_are_bad_input_before_the_law_runs(kwargs):
+    """An unbounded timeout could hang the user's run; a bad limit is an error at once (R3)."""
+    from ptoverify.conform.testing import assert_conforms
+    from ptoverify.errors import InputError
+
+    with pytest.raises(InputError, match="assert_conforms: "):
+        assert_conforms("examples/my_pto.py:pto", **kwargs)

@@ -135,8 +135,21 @@ def assert_conforms(
     """
     from ptoverify.conform import gate as conform
     from ptoverify.conform.junit import conform_verdicts, failure_message
+    from ptoverify.errors import InputError
     from ptoverify.verdict import NOT_RUN
 
+    # the limits of `conform --timeout/--tolerance` (an unbounded timeout could hang the run)
+    if not (isinstance(timeout, (int, float)) and 0 < timeout <= 86400):
+        raise InputError(f"assert_conforms: timeout must be in (0, 86400] s, got {timeout!r}")
+    if rtol is not None and not (isinstance(rtol, (int, float)) and 0 < rtol < 1):
+        raise InputError(f"assert_conforms: rtol must be in (0, 1), got {rtol!r}")
+    if memory_limit is not None and not (
+        isinstance(memory_limit, int) and not isinstance(memory_limit, bool) and memory_limit > 0
+    ):
+        raise InputError(
+            f"assert_conforms: memory_limit must be a positive number of bytes or None, "
+            f"got {memory_limit!r}"
+        )
     cfg = config if isinstance(config, Config) else load_config(config)
     spec = law_spec(law)
     target = spec if isinstance(law, str) else getattr(law, "__qualname__", spec)
