@@ -68,7 +68,7 @@ ALL_LAW_NAMES: tuple[str, ...] = LAW_NAMES + BASELINE_NAMES
 #: Defaults of ``ptoverify design`` (:mod:`ptoverify.studies.design`): laws, T [s], bandwidth [Hz].
 DESIGN_LAWS: tuple[str, ...] = ("pd", "pto", "ptos", "cascade-p")
 DESIGN_SAMPLE_TIMES: tuple[float, ...] = (0.00025, 0.0005, 0.001, 0.002, 0.004, 0.008)
-DESIGN_BANDWIDTHS_HZ: tuple[float, ...] = (5.0, 10.0, 30.0, 60.0, 100.0)
+DESIGN_BANDWIDTHS_HZ: tuple[float, ...] = (8.0, 15.0, 30.0, 60.0, 100.0)  # a T >= 0.01 at 0.25 ms
 DESIGN_GRID = 10  #: envelope states per axis of a design point (even: the origin is off the grid)
 
 

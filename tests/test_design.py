@@ -151,3 +151,21 @@ def test_process_pool_equals_in_process():
     here = design_chart(CFG, [0.002], [30.0, 60.0], **args)
     there = design_chart(CFG, [0.002], [30.0, 60.0], runner=process_runner(2), **args)
     assert here.to_json(timings=False)["points"] == there.to_json(timings=False)["points"]
+
+
+def test_default_axes_are_within_the_configuration_limits():
+    """`ptoverify design` with no axis options builds every default point (audit R6)."""
+    from ptoverify.config import DESIGN_BANDWIDTHS_HZ, DESIGN_SAMPLE_TIMES, paper_config
+    from ptoverify.studies.design import point_config
+
+    for T in DESIGN_SAMPLE_TIMES:
+        for f in DESIGN_BANDWIDTHS_HZ:
+            assert point_config(paper_config(), T, f, "2pi").plant.sample_time == T
+
+
+def test_a_point_outside_the_limits_is_named(capsys):
+    from ptoverify.cli import main
+
+    code = main(["design", "--sample-times", "0.00025", "--bandwidths", "5"])
+    err = capsys.readouterr().err
+    assert code == 2 and "design point T = 0.25 ms, bandwidth 5" in err and err.count("\n") == 1

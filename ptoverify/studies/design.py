@@ -506,7 +506,13 @@ def design_chart(
         raise InputError(f"--grid must be in [2, 100], got {grid}")
     for T in ts:  # validate every point before any runs  # noqa: N806
         for f in bw:
-            point_config(cfg, T, f, reading)
+            try:
+                point_config(cfg, T, f, reading)
+            except InputError as exc:
+                raise InputError(
+                    f"design point T = {1e3 * T:g} ms, bandwidth {f:g} "
+                    f"({'Hz, a = 2 pi f' if reading == '2pi' else 'rad/s'}): {exc}"
+                ) from None
     if tuned_overshoot is not None and not (
         math.isfinite(tuned_overshoot) and tuned_overshoot >= 0
     ):
