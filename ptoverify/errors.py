@@ -26,3 +26,7 @@ class SolverError(PtoverifyError, RuntimeError):
 
 class ClusterError(PtoverifyError, RuntimeError):
     """A compute cluster (a Dask scheduler) could not be reached (exit code 1, not bad input)."""
+
+
+class InfeasibleError(SolverError):
+    """A search found nothing that meets its constraints: a result (exit 1), not bad input."""

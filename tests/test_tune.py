@@ -12,7 +12,7 @@ from scipy.signal import cont2discrete
 
 from ptoverify import cli
 from ptoverify.config import config_from_mapping, load_config, paper_config
-from ptoverify.errors import InputError
+from ptoverify.errors import InfeasibleError, InputError
 from ptoverify.model.laws import make_law
 from ptoverify.model.mintime import discrete_min_steps, min_time
 from ptoverify.sim.exact import exact_metrics
@@ -523,7 +523,7 @@ def test_fair_tunings_of_the_baselines_are_tune_alone():
 def test_infeasible_tuning_is_recorded_not_raised():
     """No gains can settle: the 5 mm step needs 0.5 s at w_max = 10 mm/s, its record is 0.2 s."""
     slow = SLOW.with_plant(w_max=10.0)
-    with pytest.raises(InputError, match="no cascade-p gains"):
+    with pytest.raises(InfeasibleError, match="no cascade-p gains"):
         tune(slow, "cascade-p", "step", max_overshoot=0.0, maxiter=2, popsize=4)
     ft = fair_tunings(slow, TuneBudget(maxiter=2, popsize=4), ("cascade-p",))
     assert not ft.results and set(ft.infeasible) == {("cascade-p", b) for b in ft.bounds}

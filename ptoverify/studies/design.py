@@ -41,7 +41,7 @@ from ptoverify.config import (
     Config,
     config_from_mapping,
 )
-from ptoverify.errors import InputError
+from ptoverify.errors import InfeasibleError, InputError
 from ptoverify.model.baselines import linear_loop_gains
 from ptoverify.model.laws import make_law
 from ptoverify.model.mintime import discrete_min_steps_batch, min_time
@@ -320,7 +320,7 @@ def tuned_law_config(cfg: Config, name: str, max_overshoot: float) -> Config | N
         return tune(
             cfg, name, "step", max_overshoot=max_overshoot, find_runner_up=False, **TUNE_EFFORT
         ).config
-    except InputError:  # tune's answer when no gains meet the constraints
+    except InfeasibleError:  # tune's answer when no gains meet the constraints
         return None
 
 

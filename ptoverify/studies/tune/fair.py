@@ -7,7 +7,7 @@ import time
 from dataclasses import dataclass, field
 
 from ptoverify.config import Config
-from ptoverify.errors import InputError
+from ptoverify.errors import InfeasibleError, InputError
 from ptoverify.model.memo import memo
 from ptoverify.sim.lockstep import run_together
 from ptoverify.studies.tune.measure import response_metrics
@@ -134,7 +134,7 @@ def _law_tunings(
                 remeasured=shared,
                 **effort,
             )
-        except InputError as exc:  # no gains meet the constraints: the reason
+        except InfeasibleError as exc:  # no gains meet the constraints: the reason
             out[v] = str(exc)
 
     # each is what tune() gives alone, in fewer simulations

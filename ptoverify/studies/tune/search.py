@@ -56,7 +56,7 @@ import numpy as np
 from scipy.optimize import differential_evolution
 
 from ptoverify.config import Config
-from ptoverify.errors import InputError
+from ptoverify.errors import InfeasibleError, InputError
 from ptoverify.sim.lockstep import run_together
 from ptoverify.sim.simulate import reference
 from ptoverify.studies.tune.measure import (
@@ -561,7 +561,7 @@ def tune_checked(
         if checked >= 25:
             break
     if best is None:
-        raise InputError(
+        raise InfeasibleError(
             f"tune: no {law} gains in the search range meet the constraints ("
             + ("" if max_overshoot is None else f"overshoot <= {max_overshoot:g} mm, ")
             + "stable, settles within the record, no limit cycle)"
