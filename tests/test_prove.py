@@ -313,3 +313,21 @@ def test_cli_check_of_a_file_that_is_no_npz_is_bad_input(tmp_path, capsys, conte
     assert main(["prove", "--check", str(cert)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and err.startswith("ptoverify: error: --check: cannot read")
+
+
+@pytest.mark.parametrize(
+    "change, words",
+    [({"d": 50.0}, "fills the envelope"), ({"position_range": 1.0}, "proof cells")],
+)
+def test_a_configuration_the_grid_cannot_serve_is_bad_input(change, words):
+    """Accepted configurations with no proof grid: one line naming the key (audit R4: an
+    internal error in the cell graph before)."""
+    from ptoverify.errors import InputError
+
+    cfg = paper_config()
+    if "d" in change:
+        cfg = replace(cfg, pto=replace(cfg.pto, d=change["d"]))
+    else:
+        cfg = cfg.with_plant(position_range=change["position_range"])
+    with pytest.raises(InputError, match=words):
+        prove_law(cfg, "pto", n_random=0)

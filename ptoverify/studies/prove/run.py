@@ -19,6 +19,7 @@ import numpy as np
 from flint import arb
 
 from ptoverify.config import Config
+from ptoverify.errors import InputError
 from ptoverify.model.intervals import add, div, down, mul
 from ptoverify.model.lawbox import enclose, law_spec
 from ptoverify.model.laws import make_law
@@ -369,6 +370,41 @@ def _counterexample(spec, cfg, balls, reading, tries: int = 3):
     return first
 
 
+#: Fewest cells of the finest width across the envelope's half-width for a proof grid.
+MIN_CELLS_ACROSS = 100
+
+
+def check_provable(cfg: Config, res: Resolution) -> None:
+    """Reject up front a configuration the proof grid cannot serve (one line, exit 2).
+
+    The grid's cell sizes are absolute (``res``, in mm and mm/s); an envelope narrower
+    than :data:`MIN_CELLS_ACROSS` of the finest cells, or a linear zone as wide as the
+    envelope, leaves no grid to prove on.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (position_range [mm], d [mm]).
+    res : Resolution
+        Grid settings (h1 [mm]).
+
+    Raises
+    ------
+    InputError
+        Naming the key and the limit.
+    """
+    r, d = cfg.plant.position_range, cfg.pto.d
+    if r < MIN_CELLS_ACROSS * res.h1:
+        raise InputError(
+            f"prove: plant.position_range = {r:g} mm is under {MIN_CELLS_ACROSS} proof cells "
+            f"of {res.h1:g} mm (at least {MIN_CELLS_ACROSS * res.h1:g} mm)"
+        )
+    if d >= r:
+        raise InputError(
+            f"prove: pto.d = {d:g} mm fills the envelope |x1| <= {r:g} mm (d must be smaller)"
+        )
+
+
 def prove_law(
     cfg: Config,
     name: str,
@@ -418,6 +454,7 @@ def prove_law(
     t0 = time.perf_counter()
     p = cfg.plant
     res = res or Resolution()
+    check_provable(cfg, res)
     spec = law_spec(name, cfg)
     lo, hi = a_interval or (p.a, p.a)
     if hi > lo:
