@@ -331,3 +331,20 @@ def test_a_configuration_the_grid_cannot_serve_is_bad_input(change, words):
         cfg = cfg.with_plant(position_range=change["position_range"])
     with pytest.raises(InputError, match=words):
         prove_law(cfg, "pto", n_random=0)
+
+
+def test_suboptimality_map_bounds_the_exact_ratio_at_cell_corners(pd_proof):
+    """The certified map (bound / N* lower bound per cell) is at least bound / exact N* at
+    each corner of 300 seeded cells, and its maximum is the reported certified ratio."""
+    from ptoverify.model.mintime import discrete_min_steps_batch
+
+    cfg = paper_config()
+    ratio = pd_proof.ratio_nt
+    assert pd_proof.certified_max_ratio_nt == pytest.approx(float(np.nanmax(ratio)), rel=0)
+    cells = np.flatnonzero(np.isfinite(ratio))
+    pick = np.random.default_rng(3).choice(cells, 300, replace=False)
+    x1lo, x1hi, x2lo, x2hi = (v[pick] for v in pd_proof.grid.boxes())
+    for x1, x2 in ((x1lo, x2lo), (x1lo, x2hi), (x1hi, x2lo), (x1hi, x2hi)):
+        n_star = discrete_min_steps_batch(x1, x2, cfg.plant).steps
+        exact = pd_proof.bound[pick] / n_star
+        assert np.all(ratio[pick] >= exact * (1 - 1e-12)), "the certified ratio is below the exact"

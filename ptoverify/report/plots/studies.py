@@ -563,10 +563,20 @@ def save_proof_map(proof: Any, path: str | Path) -> Path:
     Path
         The file written.
     """
-    fig = new_figure((7.5, 4.8))
-    ax = fig.add_subplot()
+    ratio = proof.ratio_nt
+    two = ratio is not None and bool(np.isfinite(ratio).any())
+    fig = new_figure((13.0, 4.8) if two else (7.5, 4.8))
+    ax = fig.add_subplot(1, 2, 1) if two else fig.add_subplot()
     e1, e2 = proof.grid.e1, proof.grid.e2
     n1, n2 = proof.grid.shape
+    if two:  # the certified suboptimality map: bound / N* per cell
+        rx = fig.add_subplot(1, 2, 2)
+        rz = np.ma.masked_invalid(np.asarray(ratio, dtype=float).reshape(n2, n1))
+        rm = rx.pcolormesh(e1, e2, rz, cmap="magma", shading="flat")
+        fig.colorbar(rm, ax=rx, label="certified samples to the target / N* [-]")
+        rx.set_xlabel("x1 [mm]")
+        rx.set_ylabel("x2 [mm/s]")
+        rx.set_title("certified suboptimality (blank: unproven or near the origin)", fontsize=9)
     bound = np.asarray(proof.bound, dtype=float).reshape(n2, n1)
     z = np.ma.masked_invalid(bound)
     mesh = ax.pcolormesh(e1, e2, z, cmap="viridis", shading="flat")

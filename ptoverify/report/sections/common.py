@@ -85,9 +85,11 @@ CAPTIONS: dict[str, str] = {
     "robust_settling_nt": "Worst settling / (N* T) over the states, per law and delay (never: "
     "some state never settles).",
     "proof_bound_pto": "Certified number of samples to reach the target ellipse from each cell "
-    "of the envelope, corrected PTO (interval arithmetic; red: unproven).",
+    "of the envelope, corrected PTO (interval arithmetic; red: unproven), and beside it the "
+    "certified suboptimality: that bound over N* per cell.",
     "proof_bound_pd": "Certified number of samples to reach the target ellipse from each cell "
-    "of the envelope, PD (interval arithmetic; red: unproven).",
+    "of the envelope, PD (interval arithmetic; red: unproven), and beside it the certified "
+    "suboptimality: that bound over N* per cell.",
     "penalty_moves": "Settling time of point-to-point moves from rest against the move size, "
     "per law at the configured gains, beside t_f* and N* T (left), and its ratio to N* T "
     "(right); a law that never settles from a size has no point there.",

@@ -122,6 +122,9 @@ class LawProof:
         Per-cell certified bound (max over sub-intervals) [samples]; inf: unproven.
     balls : tuple of BallResult
         Per sub-interval results.
+    ratio_nt : ndarray or None
+        Per-cell certified (samples to the target) / N* [-]; NaN where unproven or
+        within ``excluded_radius`` (the certified suboptimality map).
     timings_s : dict
         Wall time per stage [s].
     """
@@ -140,6 +143,7 @@ class LawProof:
     grid: Grid
     bound: np.ndarray
     balls: tuple
+    ratio_nt: np.ndarray | None = None
     timings_s: dict = field(default_factory=dict)
 
     def property(self, name: str) -> PropertyResult:
@@ -325,8 +329,8 @@ def min_time_lower(box, a_hi: float, w: float) -> np.ndarray:
     return np.where(right | left, np.maximum(t, 0.0), 0.0)
 
 
-def _suboptimality(cfg, grid, bound, radius, a_hi):
-    """Certified max of bound / N* over proved cells with |x1| >= radius.
+def _ratio_per_cell(cfg, grid, bound, radius, a_hi) -> np.ndarray:
+    """Certified bound / N* per cell: NaN where unproven or |x1| < radius (the suboptimality map).
 
     N* T >= t_f* (the sampled input is one continuous input), so N* >=
     ceil(:func:`min_time_lower` / T), with t_f* bounded for every a <= a_hi.
@@ -336,11 +340,17 @@ def _suboptimality(cfg, grid, bound, radius, a_hi):
     near = np.where((b[0] < 0) & (b[1] > 0), 0.0, np.minimum(np.abs(b[0]), np.abs(b[1])))
     use = (near >= radius) & (np.abs(b[0]) <= p.position_range) & (np.abs(b[1]) <= p.position_range)
     use &= np.isfinite(bound)  # over the proved cells
-    if not use.any():
-        return None
-    t_lo = min_time_lower(tuple(v[use] for v in b), a_hi, p.w_max)
-    n_star = np.ceil(div((t_lo, t_lo), (p.sample_time, p.sample_time))[0])
-    return float(np.max(bound[use] / n_star))
+    out = np.full(bound.shape, np.nan)
+    if use.any():
+        t_lo = min_time_lower(tuple(v[use] for v in b), a_hi, p.w_max)
+        n_star = np.ceil(div((t_lo, t_lo), (p.sample_time, p.sample_time))[0])
+        out[use] = bound[use] / n_star
+    return out
+
+
+def _suboptimality(ratio: np.ndarray) -> float | None:
+    """Certified max of bound / N* over the cells of :func:`_ratio_per_cell` (None: none)."""
+    return float(np.nanmax(ratio)) if np.isfinite(ratio).any() else None
 
 
 def _counterexample(spec, cfg, balls, reading, tries: int = 3):
@@ -526,6 +536,11 @@ def prove_law(
         worst, over, n_sim = _simulate(cfg, name, target, grid, bound, a_values, n_random)
     t3 = time.perf_counter()
     radius = 0.1 * p.position_range if excluded_radius is None else excluded_radius
+    ratio = (
+        _ratio_per_cell(cfg, grid, bound, radius, hi)
+        if tgt.certified
+        else np.full(bound.shape, np.nan)
+    )
     return LawProof(
         law=name,
         a_interval=(float(lo), float(hi)),
@@ -535,14 +550,13 @@ def prove_law(
         simulated_worst_samples=worst,
         simulated_states=n_sim or 0,
         simulation_over_bound=over or 0,
-        certified_max_ratio_nt=(
-            _suboptimality(cfg, grid, bound, radius, hi) if tgt.certified else None
-        ),
+        certified_max_ratio_nt=_suboptimality(ratio),
         excluded_radius=radius,
         cells=grid.size,
         grid=grid,
         bound=bound,
         balls=balls,
+        ratio_nt=ratio,
         timings_s={
             "proof": round(t2 - t0, 3),
             "cells_and_graph": round(t1 - t0, 3),
