@@ -492,9 +492,9 @@ def ratio_interval(iv: Any) -> str:
     if lo is None and hi is None:
         return "the whole searched range"
     if lo is None:
-        return f"[no lower limit found, {fmt(hi)}]"
+        return f"from below the searched 0.1 up to {fmt(hi)}"
     if hi is None:
-        return f"[{fmt(lo)}, no upper limit found]"
+        return f"from {fmt(lo)} up past the searched 10"
     return f"[{fmt(lo)}, {fmt(hi)}]"
 
 
