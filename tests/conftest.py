@@ -18,6 +18,9 @@ from scipy.signal import cont2discrete  # noqa: E402
 from derivations.common import PlantNumbers  # noqa: E402
 from ptoverify.config import Config, PDGains, Plant, PTOSettings, paper_config  # noqa: E402
 
+#: The hostile audit (tests/audit/run_audit.py) is a script, not a test module.
+collect_ignore = ["audit"]
+
 
 @pytest.fixture
 def paper_cfg() -> Config:
