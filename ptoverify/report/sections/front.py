@@ -135,9 +135,23 @@ def _finding_settling(res: Any) -> tuple[str, str, str] | None:
     if "pd" in sw and "pto" in sw:
         pd, pto = sw["pd"]["percentiles_ratio_nt"], sw["pto"]["percentiles_ratio_nt"]
         grid = res["sweep"]["grid"]
+        tf_pd = sw["pd"]["percentiles_ratio_tf"]
+        tf_pto = sw["pto"]["percentiles_ratio_tf"]
+        worst_x1 = sw["pto"]["worst_state_nt"][0]
         text += (
-            f". Over the envelope ({grid[0]} x {grid[1]} states, paper's gains) settling / (N* T) "
-            f"has median PD {fmt(pd['p50'])} [-], PTO {fmt(pto['p50'])} [-]"
+            f". Over the envelope ({grid[0]} x {grid[1]} states, paper's gains, 0.01 mm box) "
+            f"settling / (N* T) has median PD {fmt(pd['p50'])} [-], PTO {fmt(pto['p50'])} [-] "
+            f"and settling / t_f* median PD {fmt(tf_pd['p50'])} [-], PTO {fmt(tf_pto['p50'])} [-]; "
+            f"the PTO's worst ratio {fmt(pto['max'])} [-] starts at x1 = {fmt(worst_x1)} mm"
+        )
+        reach = res["environment"]["config"]["plant"]["position_range"]
+        if abs(worst_x1) < 0.05 * reach:
+            text += " (a small move: N* is a few samples there, and one sample more weighs much)"
+    if t is not None:
+        fl = t["floor"]
+        text += (
+            f". The 5 mm step's floors: t_f* = {_ms(fl['tf_s'])} (continuous), N* T = "
+            f"{_ms(fl['nt_s'])} (sampled)"
         )
     return (text + ".", "sweep", "responses and suboptimality maps")
 
