@@ -199,13 +199,13 @@ def _unit_from_name(name: str, v: Any) -> str:
 _PROPERTY_COLUMNS = (
     ("states", "states [count]"),
     ("stride_overs", "stride-overs [count]"),
-    ("crossings_into_linear", "crossings into the linear zone [count]"),
-    ("limit_cycles", "limit cycles [count]"),
-    ("not_settled", "not settled [count]"),
-    ("chattering", "chattering [count]"),
-    ("overshoots", "overshoots [count]"),
+    ("crossings_into_linear", "curve crossings landing in |x1| < d [count]"),
+    ("limit_cycles", "states in a limit cycle [count]"),
+    ("not_settled", "states not settled (0p001mm) [count]"),
+    ("states_chattering", "states that chatter [count]"),
+    ("overshoots", "moves from rest that overshoot [count]"),
     ("max_overshoot_mm", "max overshoot [mm]"),
-    ("time_to_linear_max_s", "max time to linear zone [s]"),
+    ("time_to_linear_max_s", "max time to |x1| < d [s]"),
     ("max_abs_u", "max |u| [mm/s]"),
 )
 
@@ -215,7 +215,16 @@ def properties(res: dict[str, Any]) -> list[Block]:
     rows = [
         [_law(law), *[p[k] for k, _ in _PROPERTY_COLUMNS]] for law, p in res["properties"].items()
     ]
-    blocks = [table(["law", *[h for _, h in _PROPERTY_COLUMNS]], rows)]
+    blocks = [
+        table(["law", *[h for _, h in _PROPERTY_COLUMNS]], rows),
+        Block(
+            "p",
+            text="Over the gate's grid of initial states, on the samples. A curve crossing is a "
+            "sample step across l1 or l2 (the PTO's switching curves, whatever the law); "
+            "d is the PTO's linear zone, so its time is a distance reached for PD and TO too. "
+            "Not settled: the record ends outside |x1| <= 0.001 mm (the definition 0p001mm).",
+        ),
+    ]
     base = [_law(law) for law in ("ptos", "cascade-p") if law in res["properties"]]
     if base:
         blocks.insert(
