@@ -73,30 +73,34 @@ def step(
     return flow(x1, x2, u, plant.sample_time, plant.a)
 
 
-def zoh_matrices(a: float, T: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # noqa: N803
+def zoh_matrices(a: ArrayLike, T: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # noqa: N803
     """Zero-order-hold matrices Ad, Bd of the sampled plant.
 
     x[k+1] = Ad x[k] + Bd u[k], exact for u constant over [kT, (k+1)T).
 
     Parameters
     ----------
-    a : float
-        Bandwidth [rad/s].
+    a : float or array_like, shape (n,)
+        Bandwidth [rad/s]; an array gives one pair of matrices per value.
     T : float
         Sampling period [s].
 
     Returns
     -------
-    Ad : ndarray, shape (2, 2)
-    Bd : ndarray, shape (2, 1)
+    Ad : ndarray, shape (2, 2), or (n, 2, 2) for an array of a
+    Bd : ndarray, shape (2, 1), or (n, 2, 1) for an array of a
 
     Examples
     --------
     >>> Ad, Bd = zoh_matrices(188.5, 0.002)
     >>> Ad.shape, Bd.shape
     ((2, 2), (2, 1))
+    >>> zoh_matrices([188.5, 94.2], 0.002)[0].shape
+    (2, 2, 2)
     """
+    a = np.asarray(a, dtype=float)
     g = -np.expm1(-a * T)  # 1 - e^{-aT}
-    Ad = np.array([[1.0, g / a], [0.0, 1.0 - g]])
-    Bd = np.array([[T - g / a], [g]])
+    one, zero = np.ones_like(a), np.zeros_like(a)
+    Ad = np.stack([np.stack([one, g / a], -1), np.stack([zero, 1.0 - g], -1)], -2)
+    Bd = np.stack([T - g / a, g], -1)[..., None]
     return Ad, Bd

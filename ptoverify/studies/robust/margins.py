@@ -61,7 +61,8 @@ def _edge(
     Scans a geometric grid of ``grid`` points from 1 to ``toward``
     (:data:`EDGE_CHUNK` points per call of ``stable``, which tests an array of
     ratios; the points beyond the first failure cannot change the edge), then
-    bisects the first stable/unstable pair to ``rtol`` relative.
+    narrows the first stable/unstable pair to ``rtol`` relative by multisection
+    (:data:`EDGE_CHUNK` points per call).
     """
     pts = np.geomspace(1.0, toward, grid)
     for at in range(1, grid, EDGE_CHUNK):
@@ -70,8 +71,18 @@ def _edge(
             j = at + int(bad[0])
             lo, hi = float(pts[j - 1]), float(pts[j])  # pts[0] is 1.0
             while abs(hi - lo) > rtol * min(abs(lo), abs(hi)):
-                mid = math.sqrt(lo * hi)
-                lo, hi = (mid, hi) if stable(np.array([mid]))[0] else (lo, mid)
+                # multisection: EDGE_CHUNK geometric points inside (lo, hi) in one call;
+                # the bracket becomes the last stable one before the first unstable one
+                inner = np.geomspace(lo, hi, EDGE_CHUNK + 2)[1:-1]
+                fails = np.flatnonzero(~stable(inner))
+                i = int(fails[0]) if fails.size else inner.size
+                new = (
+                    float(inner[i - 1]) if i > 0 else lo,
+                    float(inner[i]) if i < inner.size else hi,
+                )
+                if new == (lo, hi):  # the bracket is as narrow as floats allow
+                    break
+                lo, hi = new
             return lo
     return None
 
@@ -113,19 +124,17 @@ def linear_loop_radii(
         raise InputError(
             f"linear_loop_radii: no linear loop for {law!r} with delay {delay_samples}"
         )
-    a, T = cfg.plant.a, cfg.plant.sample_time
-    K = np.array([gains])  # noqa: N806
-
-    def loop(r: float) -> NDArray[np.float64]:
-        Ad, Bd = zoh_matrices(a * r, T)  # noqa: N806
-        if delay_samples == 0:
-            return Ad - Bd @ K
-        return np.block([[Ad, Bd], [-K, np.zeros((1, 1))]])
-
     ratios = np.atleast_1d(np.asarray(a_ratio, dtype=float))
     if ratios.size == 0:
         return np.empty(0)
-    mats = np.stack([loop(float(r)) for r in ratios])
+    K = np.array([gains])  # noqa: N806
+    Ad, Bd = zoh_matrices(cfg.plant.a * ratios, cfg.plant.sample_time)  # noqa: N806
+    if delay_samples == 0:
+        mats = Ad - Bd @ K
+    else:  # [[Ad, Bd], [-K, 0]] for every ratio
+        mats = np.zeros((ratios.size, 3, 3))
+        mats[:, :2, :2], mats[:, :2, 2:] = Ad, Bd
+        mats[:, 2, :2] = -K
     return np.abs(np.linalg.eigvals(mats)).max(axis=-1)
 
 
