@@ -137,24 +137,37 @@ def _header(path, head: str, what: str) -> list[str]:
 
 
 def _rows(fh, path, what: str) -> tuple[list[list[str]], list[int]]:
-    """Read the data rows line by line, rejecting NUL bytes and overlong lines at once."""
-    rows, lines = [], []
-    line = 1
-    while True:
-        text = fh.readline(MAX_LINE)
-        if not text:
-            return rows, lines
-        line += 1
-        if "\x00" in text:
-            raise InputError(f"{what} '{path}' line {line}: NUL bytes; not a CSV text file")
-        if len(text) >= MAX_LINE and not text.endswith("\n"):
-            raise InputError(
-                f"{what} '{path}' line {line}: longer than {MAX_LINE} characters "
-                "(a row holds a few numbers)"
-            )
-        if text.strip():
-            rows.append(next(csv.reader([text])))
-            lines.append(line)
+    """Read the data rows line by line, rejecting NUL bytes and overlong lines at once.
+
+    One :func:`csv.reader` parses the checked, non-blank lines; a row that would
+    span lines (a quoted line break) is malformed.
+    """
+    lines: list[int] = []
+
+    def checked():
+        line = 1
+        while True:
+            text = fh.readline(MAX_LINE)
+            if not text:
+                return
+            line += 1
+            if "\x00" in text:
+                raise InputError(f"{what} '{path}' line {line}: NUL bytes; not a CSV text file")
+            if len(text) >= MAX_LINE and not text.endswith("\n"):
+                raise InputError(
+                    f"{what} '{path}' line {line}: longer than {MAX_LINE} characters "
+                    "(a row holds a few numbers)"
+                )
+            if text.strip():
+                lines.append(line)
+                yield text
+
+    rows = []
+    for row in csv.reader(checked()):
+        if len(rows) + 1 != len(lines):
+            raise InputError(f"{what} '{path}' line {lines[len(rows)]}: a quoted field spans lines")
+        rows.append(row)
+    return rows, lines
 
 
 def _to_float(text: str) -> float:
