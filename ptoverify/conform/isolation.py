@@ -184,11 +184,10 @@ def child_main(ppid: int, fd: int, memory_limit: int) -> None:
     _, sys_path, spec, cfg = recv()
     sys.path[:] = sys_path
     try:
-        user, failures = wrap_callable(load_callable(spec), cfg)
+        user, failures = wrap_callable(load_callable(spec), cfg, in_child=True)
     except InputError as exc:
         _send_answer(sock, {"kind": "input", "message": str(exc)})
         return
-    user.in_child = True
     _send_answer(
         sock, {"kind": "ready", "mode": user.mode, "reason": user.reason, "failures": failures}
     )
