@@ -47,6 +47,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ptoverify.config import Config, Plant
+from ptoverify.errors import InputError
 from ptoverify.model.laws import Law, make_law
 from ptoverify.model.mintime import min_time
 from ptoverify.model.reach import zonotope_steps_each
@@ -66,6 +67,9 @@ __all__ = [
     "evaluate_probes",
     "trajectory_properties",
     "horizon_steps",
+    "MAX_BOX_WORK",
+    "box_work",
+    "check_box_work",
     "map_states",
     "robust_maps",
     "BATCH_STATES",
@@ -137,6 +141,66 @@ def horizon_steps(cfg: Config) -> int:
     w = p.w_max * box.w_max_ratio[0]
     a = p.a * box.a_ratio[0]
     return int(math.ceil((2.0 * p.position_range / w + 60.0 / a) / p.sample_time))
+
+
+#: Most perturbation cells x horizon samples a robustness study may need [cell-samples]:
+#: the default box (30 cells) at the longest horizon the loader lets through (about 12,000
+#: samples, range / (w_max T) = 2000 and a T = 0.01) needs 360,000.
+MAX_BOX_WORK = 400_000
+
+
+def box_work(cfg: Config, s: RobustSettings | None = None) -> tuple[int, int]:
+    """Return the perturbation cells of the maps and the horizon of every trajectory.
+
+    The study's time grows with their product (every search, margin scan and
+    map cell simulates :func:`horizon_steps` samples per state).
+
+    Parameters
+    ----------
+    cfg : Config
+        Nominal configuration with its box.
+    s : RobustSettings, optional
+        Grid sizes (n_a, n_w).
+
+    Returns
+    -------
+    cells : int
+        a_ratio x w_max_ratio x delay values of the maps [-].
+    horizon : int
+        Samples simulated per trajectory [samples].
+    """
+    ars, wrs, delays = _map_axes(cfg, s or RobustSettings())
+    return len(ars) * len(wrs) * len(delays), horizon_steps(cfg)
+
+
+def check_box_work(cfg: Config, s: RobustSettings | None = None) -> None:
+    """Raise InputError, before any simulation, when the box needs more than :data:`MAX_BOX_WORK`.
+
+    Parameters
+    ----------
+    cfg : Config
+        Nominal configuration with its box.
+    s : RobustSettings, optional
+        Grid sizes (n_a, n_w).
+
+    Raises
+    ------
+    InputError
+        Naming the ``[robustness]`` keys that set the work and the limit.
+    """
+    cells, horizon = box_work(cfg, s)
+    if cells * horizon <= MAX_BOX_WORK:
+        return
+    box = cfg.robustness
+    n_delay = box.delay_samples[1] - box.delay_samples[0] + 1
+    raise InputError(
+        f"config key 'robustness.delay_samples' = {list(box.delay_samples)} gives {cells} "
+        f"perturbation cells ({n_delay} delays x a_ratio x w_max_ratio values) and "
+        f"'robustness.a_ratio' / 'robustness.w_max_ratio' down to {box.a_ratio[0]:g} / "
+        f"{box.w_max_ratio[0]:g} a horizon of {horizon:,} samples: {cells * horizon:,} "
+        f"cell-samples, over the limit of {MAX_BOX_WORK:,} (narrow the delays or raise "
+        "the lower ratios)"
+    )
 
 
 def _true_plant(plant: Plant, a_ratio: float, w_ratio: float) -> Plant:
@@ -581,6 +645,7 @@ def robust_maps(
     (11, 4)
     """
     s = settings or RobustSettings()
+    check_box_work(cfg, s)
     if runner is None:
         cells = map_cells(s.laws, cfg, s)
     else:
