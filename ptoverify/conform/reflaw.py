@@ -20,7 +20,18 @@ DEFAULT_RTOL = 1e-6  #: agreement tolerance relative to w_max
 
 @memo(maxsize=8)
 def reference(cfg: Config) -> Law:
-    """Return ``make_law("pto", cfg)``, built once per configuration."""
+    """Return ``make_law("pto", cfg)``, built once per configuration.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (the memo's key).
+
+    Returns
+    -------
+    Law
+        The reference law (corrected omega0), u [mm/s].
+    """
     return make_law("pto", cfg)
 
 
