@@ -30,13 +30,19 @@ LAYERS = (
     ("sim", ("ptoverify.sim",)),
     ("studies", ("ptoverify.studies",)),
     ("conform", ("ptoverify.conform",)),
-    ("output", ("ptoverify.outdir", "ptoverify.progress")),
+    ("output", ("ptoverify.outdir", "ptoverify.outfiles", "ptoverify.progress")),
     ("report", ("ptoverify.report",)),
     ("entry", ("ptoverify.cli", "ptoverify.commands", "ptoverify.testing", "ptoverify.__main__")),
 )
 
 #: The output layer: everything else in ptoverify is numeric.
-OUTPUT = {"ptoverify.cli", "ptoverify.__main__", "ptoverify.outdir", "ptoverify.progress"}
+OUTPUT = {
+    "ptoverify.cli",
+    "ptoverify.__main__",
+    "ptoverify.outdir",
+    "ptoverify.outfiles",
+    "ptoverify.progress",
+}
 
 
 def layer_of(module: str) -> int:
@@ -666,3 +672,78 @@ def test_pending_private_files_still_offend():
     """PENDING_PRIVATE only shrinks: a listed file that no longer offends is removed."""
     fixed = sorted(PENDING_PRIVATE - set(private_offenders()))
     assert fixed == [], f"remove from PENDING_PRIVATE: {fixed}"
+
+
+MAX_MODULE_LINES = 600  #: STYLE.md: modules under ~600 lines (split a module that grows past)
+
+
+def test_every_module_is_at_most_600_lines():
+    too_long = {
+        m: n
+        for m, path in modules().items()
+        if m.startswith("ptoverify")
+        and (n := len(path.read_text().splitlines())) > MAX_MODULE_LINES
+    }
+    assert too_long == {}, f"modules over {MAX_MODULE_LINES} lines (split them): {too_long}"
+
+
+def _functools_caches(module: str) -> list[str]:
+    """Uses of functools.lru_cache / functools.cache in ``module``, and cached_property
+    without a comment on the line above saying why it is not a memo."""
+    path = modules()[module]
+    text = path.read_text()
+    lines = text.splitlines()
+    out = []
+    for node in ast.walk(ast.parse(text, filename=str(path))):
+        name = None
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
+            if node.value.id == "functools":
+                name = node.attr
+        elif isinstance(node, ast.ImportFrom) and node.module == "functools":
+            for alias in node.names:
+                if alias.name in ("lru_cache", "cache", "cached_property"):
+                    out.append(f"{module}:{node.lineno} imports functools.{alias.name}")
+        if name in ("lru_cache", "cache"):
+            out.append(f"{module}:{node.lineno} uses functools.{name}")
+        elif name == "cached_property":
+            above = lines[node.lineno - 2].strip() if node.lineno >= 2 else ""
+            if not above.startswith("#"):
+                out.append(f"{module}:{node.lineno} cached_property without a reason")
+    return out
+
+
+def test_no_functools_cache_outside_the_memo_module():
+    """One memo mechanism (ptoverify.model.memo, keyed on configuration objects)."""
+    offenders = [
+        hit
+        for m in modules()
+        if m.startswith("ptoverify") and m != "ptoverify.model.memo"
+        for hit in _functools_caches(m)
+    ]
+    assert offenders == []
+
+
+def test_functools_cache_rule_catches_a_cache(tmp_path, monkeypatch):
+    pkg = tmp_path / "ptoverify"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "a.py").write_text("import functools\n\n@functools.lru_cache\ndef f(x):\n    return x\n")
+    (pkg / "b.py").write_text("from functools import cache\n")
+    (pkg / "c.py").write_text(
+        "import functools\nclass C:\n    @functools.cached_property\n    def p(self):\n"
+        "        return 1\n"
+    )
+    (pkg / "d.py").write_text(
+        "import functools\nclass D:\n    # a lazy attribute of one object, not a memo\n"
+        "    @functools.cached_property\n    def p(self):\n        return 1\n"
+    )
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
+    modules.cache_clear()
+    try:
+        assert len(_functools_caches("ptoverify.a")) == 1
+        assert len(_functools_caches("ptoverify.b")) == 1
+        assert len(_functools_caches("ptoverify.c")) == 1
+        assert _functools_caches("ptoverify.d") == []
+    finally:
+        modules.cache_clear()
+        imports.cache_clear()

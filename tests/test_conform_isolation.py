@@ -122,6 +122,19 @@ def test_human_output_names_the_isolation_failure(tmp_path):
     assert len(lines) == 1 and lines[0].startswith("FAILED isolation: the law's process exited")
 
 
+def test_keyboard_interrupt_in_mode_detection_is_the_laws_finding(tmp_path):
+    """Audit R2: reported as the law raising it, without ptoverify's traceback, exit 1."""
+    spec = law_file(tmp_path, "def f(x1, x2, cfg):\n    raise KeyboardInterrupt\n")
+    code, out, err = cli("conform", "--law", spec, "--json", "--timeout", "30")
+    assert code == 1, (code, out[-500:], err[-500:])
+    data = json.loads(out)
+    assert data["conforms"] is False
+    details = [f["detail"] for f in data["failures"]]
+    assert any(d.startswith("the law raised KeyboardInterrupt") for d in details), details
+    assert not any("SIGINT" in d for d in details), details
+    assert "Traceback" not in err and "userlaw.py" not in err, err[-2000:]
+
+
 @pytest.mark.slow
 def test_memory_hog_is_a_finding(tmp_path):
     """An allocation beyond the child's address-space limit is a finding, not a dead host."""

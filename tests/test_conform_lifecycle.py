@@ -40,6 +40,26 @@ def f(x1, x2, cfg):
     return reference_law(x1, x2, cfg)
 """
 
+#: audit R1: a double-forked grandchild in a new session (it escapes any process group)
+DAEMON = """\
+import os, signal, time
+def daemon():
+    if os.fork() == 0:
+        os.setsid()
+        if os.fork() == 0:
+            time.sleep(300)
+        os._exit(0)
+"""
+DAEMON_THEN = {
+    "raise": DAEMON + "def f(x1, x2, cfg):\n    daemon()\n    raise ValueError('boom')\n",
+    # the run's end by its timeout: the law hangs after starting the daemon
+    "hang": DAEMON + "def f(x1, x2, cfg):\n    daemon()\n    time.sleep(300)\n",
+    # the law kills its own parent (the supervisor): its tree is lost, the token is not
+    "kill-parent": DAEMON
+    + "def f(x1, x2, cfg):\n    daemon()\n    time.sleep(0.5)\n"
+    + "    os.kill(os.getppid(), signal.SIGKILL)\n    time.sleep(300)\n",
+}
+
 
 def tagged(tag: str) -> list[int]:
     """Pids of live (not zombie) processes whose environment carries ``tag``."""
@@ -98,6 +118,48 @@ def test_killed_conform_leaves_no_process_and_no_file(tmp_path, sig):
         proc.wait(10)
         left = [] if wait_for(lambda: not tagged(tag), 5.0) else tagged(tag)
         assert not left, f"processes of the run still alive 5 s after {sig.name}: {left}"
+        assert not list(tmpdir.iterdir()), f"files left: {list(tmpdir.iterdir())}"
+    finally:
+        for pid in tagged(tag):
+            os.kill(pid, signal.SIGKILL)
+
+
+@pytest.mark.parametrize("name", sorted(DAEMON_THEN))
+def test_a_setsid_grandchild_does_not_outlive_the_run(tmp_path, name):
+    """Audit R1: the run ends (exit 1), then nothing of it is left within 5 s."""
+    proc, tag, tmpdir = start(
+        tmp_path,
+        DAEMON_THEN[name],
+        "--timeout",
+        "4",
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        assert proc.wait(120) == 1
+        left = [] if wait_for(lambda: not tagged(tag), 5.0) else tagged(tag)
+        assert not left, f"processes of the run still alive 5 s after its end: {left}"
+        assert not list(tmpdir.iterdir()), f"files left: {list(tmpdir.iterdir())}"
+    finally:
+        for pid in tagged(tag):
+            os.kill(pid, signal.SIGKILL)
+
+
+def test_sigkilled_conform_takes_a_setsid_grandchild_down(tmp_path):
+    """Audit R1: SIGKILL of conform while the law loops; its daemon was reparented to the
+    supervisor (a subreaper), which kills it on its own death signal."""
+    body = DAEMON + "def f(x1, x2, cfg):\n    daemon()\n    while True:\n        pass\n"
+    proc, tag, tmpdir = start(
+        tmp_path, body, "--timeout", "600", stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
+    try:
+        # conform, the supervisor, the worker and the daemon (its first parent exited)
+        assert wait_for(lambda: len(tagged(tag)) >= 4, 60), f"not started: {tagged(tag)}"
+        time.sleep(0.5)
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(10)
+        left = [] if wait_for(lambda: not tagged(tag), 5.0) else tagged(tag)
+        assert not left, f"processes of the run still alive 5 s after SIGKILL: {left}"
         assert not list(tmpdir.iterdir()), f"files left: {list(tmpdir.iterdir())}"
     finally:
         for pid in tagged(tag):

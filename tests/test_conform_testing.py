@@ -34,6 +34,8 @@ CASES = {
     "hang": ("time.sleep(10_000)", "{'timeout': 4}", "timeout"),
     "memory": ("bytearray(64 << 30)", "{}", "MemoryError"),
     "pytest_skip": ("pytest.skip('not today')", "{}", "Skipped"),
+    # audit R2: a KeyboardInterrupt from the law is the law's, not the user pressing Ctrl-C
+    "keyboard_interrupt": ("raise KeyboardInterrupt", "{}", "the law raised KeyboardInterrupt"),
     "frozen_config": (
         "object.__setattr__(cfg.plant, 'w_max', 1e9)",
         "{}",
@@ -70,7 +72,7 @@ def inner_pytest(tmp_path: Path, statement: str, kwargs: str) -> subprocess.Comp
     )
 
 
-FAST = ("os_exit_0", "pytest_skip")  #: the rest is marked slow
+FAST = ("os_exit_0", "pytest_skip", "keyboard_interrupt")  #: the rest is marked slow
 
 
 @pytest.mark.parametrize(

@@ -27,7 +27,7 @@ import ptoverify.model.zones as zones_mod
 import ptoverify.model.zones.margins as zone_margins
 import ptoverify.studies.claims as claims_mod
 import ptoverify.studies.robust as robust_mod
-import ptoverify.studies.robust.maps as robust_maps_mod
+import ptoverify.studies.robust.trajectory as robust_trajectory_mod
 from ptoverify.config import Config, PDGains, Plant, PTOSettings, Robustness, paper_config
 from ptoverify.studies.checks import GATES, ROBUST_GATES, ROBUST_STUDY_GATES, run_checks
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED
@@ -283,10 +283,12 @@ ROBUST_CFG = dataclasses.replace(
 
 
 def _pto_replaced_in_robust(monkeypatch, law):
-    """The robustness study builds ``law(cfg)`` where it would build the PTO."""
-    real = robust_maps_mod.make_law
+    """The robustness study builds ``law(cfg)`` where it would build the PTO (nominal_law)."""
+    real = robust_trajectory_mod.make_law
     monkeypatch.setattr(
-        robust_maps_mod, "make_law", lambda name, c: law(c) if name == "pto" else real(name, c)
+        robust_trajectory_mod,
+        "make_law",
+        lambda name, c: law(c) if name == "pto" else real(name, c),
     )
 
 

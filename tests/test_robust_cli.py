@@ -215,3 +215,73 @@ def test_every_law_is_studied_by_default(small_config):
     res = json.loads(out)
     assert tuple(res["maps"]["laws"]) == LAWS == tuple(res["worst"])
     assert math.isfinite(res["timings_s"]["total"])
+
+
+WIDEST_BOX = """\
+[robustness]
+a_ratio = [0.1, 10.0]
+w_max_ratio = [0.05, 1.0]
+delay_samples = [0, 10]
+position_quantum = 5.0
+velocity_noise = 300.0
+"""
+
+
+def test_the_widest_box_is_bad_input_at_once(tmp_path):
+    """Audit R8: the widest box the loader accepts is refused before any simulation."""
+    import time
+
+    from ptoverify.config import load_config
+    from ptoverify.studies.robust.maps import MAX_BOX_WORK, RobustSettings, horizon_steps
+
+    path = tmp_path / "widest.toml"
+    path.write_text(PAPER_PLANT + WIDEST_BOX)
+    cfg = load_config(path)
+    # the work counted independently: every a_ratio, w_max_ratio and delay of the maps
+    s = RobustSettings()
+    cells = s.n_a * s.n_w * 11
+    assert cells * horizon_steps(cfg) > MAX_BOX_WORK
+    t0 = time.perf_counter()
+    code, out, err = _run(["robust", "--config", str(path), "--grid", "3", "--generations",
+                           "0", "--population", "5", "--quiet", "--json"])  # fmt: skip
+    assert time.perf_counter() - t0 < 10.0
+    assert code == 2 and out == "", (code, out)
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("ptoverify: error:"), err
+    assert "robustness.delay_samples" in lines[0] and f"{MAX_BOX_WORK:,}" in lines[0], lines[0]
+
+
+PAPER_PLANT = SMALL.split("[robustness]")[0].replace(
+    "position_range = 5.0", "position_range = 50.0"
+)
+
+
+def test_box_work_limit_admits_the_default_box_at_every_accepted_plant(tmp_path):
+    """The limit's justification: the default box at the longest horizon the loader allows
+    (range / (w_max T) = 2000 samples, a T = 0.01) is within it, and one delay more is not."""
+    from ptoverify.config import load_config
+    from ptoverify.errors import InputError
+    from ptoverify.studies.robust.maps import (
+        MAX_BOX_WORK,
+        RobustSettings,
+        box_work,
+        check_box_work,
+    )
+
+    a = 2.0 * math.pi * 30.0
+    T = 0.01 / a * (1 + 1e-9)
+    R = 2000.0 * 300.0 * T * (1 - 1e-9)
+    text = PAPER_PLANT.replace("sample_time = 0.002", f"sample_time = {T!r}").replace(
+        "position_range = 50.0", f"position_range = {R!r}"
+    )
+    path = tmp_path / "longest.toml"
+    path.write_text(text)
+    cfg = load_config(path)  # accepted by the loader
+    cells, horizon = box_work(cfg)
+    assert cells == 30 and cells * horizon <= MAX_BOX_WORK
+    check_box_work(cfg, RobustSettings())
+    path.write_text(text + "[robustness]\ndelay_samples = [0, 2]\n")
+    wider = load_config(path)
+    assert box_work(wider)[0] * box_work(wider)[1] > MAX_BOX_WORK
+    with pytest.raises(InputError, match="robustness.delay_samples"):
+        check_box_work(wider)

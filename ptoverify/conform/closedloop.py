@@ -16,7 +16,6 @@ by default E_ref + max(2, ceil(E_ref / 2)) samples).
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
@@ -26,6 +25,7 @@ from ptoverify.config import Config
 from ptoverify.conform.agreement import failure, reference
 from ptoverify.conform.userlaw import LawFault
 from ptoverify.model.laws import Law
+from ptoverify.model.memo import memo
 from ptoverify.sim.settling import DEFINITIONS
 from ptoverify.verdict import FAIL, PASS, UNVERIFIED, Verdict
 
@@ -114,7 +114,7 @@ def settle_samples(res, plant, a_ratio: float = 1.0) -> NDArray[np.float64]:
     return np.where(np.isnan(grid), np.inf, np.rint(grid / T))
 
 
-@functools.lru_cache(maxsize=8)
+@memo(maxsize=8)
 def _settling_reference(cfg: Config) -> dict:
     """Settling sweep states, their N*, and the reference's settling steps (cached)."""
     from ptoverify.model.mintime import discrete_min_steps_batch
@@ -234,7 +234,8 @@ def sweep_sizes(mode: str, sweep: tuple[int, int, int] | None) -> tuple[int, int
     tuple of int
     """
     if sweep is not None:
-        return sweep
+        n1, n2, rest = sweep
+        return int(n1), int(n2), int(rest)  # a memo key (model.memo): plain ints
     return (101, 101, 200) if mode == "vectorized" else (21, 21, 40)
 
 

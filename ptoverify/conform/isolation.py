@@ -7,12 +7,16 @@ Decisions:
   re-import of the caller's ``__main__``, and its stdout and stderr are an
   anonymous temporary file from its first instruction on, so nothing it (or a
   process it forks) does can hold ptoverify's own stdout or stderr open.
-* Nothing is left running: first thing, the child asks the kernel to SIGKILL it
-  when its parent dies (Linux ``prctl(PR_SET_PDEATHSIG)`` through ctypes), then
-  checks that the parent is still the one that started it (the race between
-  fork and prctl); a watchdog thread polling the parent pid is the portable
-  fallback.  On every exit path of the parent the child's process group is
-  killed.  A grandchild that starts its own session escapes the group.
+* Nothing is left running (:mod:`ptoverify.conform.reaper`): on Linux the child
+  is a supervisor that runs no user code, a child subreaper that forks the
+  worker running the law; every process the law starts, a ``setsid`` daemon
+  included, stays its descendant, and it kills them all when the worker ends,
+  when ptoverify asks (SIGTERM) and when ptoverify dies, by any signal
+  (``prctl(PR_SET_PDEATHSIG)`` through ctypes, checked against the race
+  between fork and prctl).  The worker dies with the supervisor (the same
+  prctl); a watchdog thread polling the parent pid is the portable fallback.
+  On every exit path ptoverify then kills what carries the run's token in its
+  environment and the child's process group.
 * Nothing is left on disk: the log is :func:`tempfile.TemporaryFile`
   (unlinked at once); named ``ptoverify-law-*.log`` files from older
   versions' dead runs are removed by the next run.
@@ -27,6 +31,7 @@ from __future__ import annotations
 import json
 import os
 import pickle
+import secrets
 import signal
 import socket
 import struct
@@ -40,6 +45,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ptoverify.config import Config
+from ptoverify.conform.reaper import TOKEN_VAR, kill_marked
 from ptoverify.conform.userlaw import (
     DEFAULT_TIMEOUT_S,
     LawFault,
@@ -67,22 +73,16 @@ _JSON_LEN = struct.Struct("!I")  #: JSON part of a child's answer
 _MAX_HEADER = 16 << 20  #: largest JSON part a child may send [bytes]
 _POLL_S = 0.2  #: how often a waiting parent checks that the child still lives [s]
 _STALE_S = 3600.0  #: named law logs older than this are stale [s]
+_STOP_S = 5.0  #: longest wait for the supervisor to kill the law's processes and end [s]
 
 #: the child's first instructions, before anything else is imported
 _BOOT = """\
 import os, sys
-ppid = int(sys.argv[1])
-if sys.platform.startswith("linux"):
-    try:
-        import ctypes
-        ctypes.CDLL(None, use_errno=True).prctl(1, 9, 0, 0, 0)  # PR_SET_PDEATHSIG, SIGKILL
-    except (OSError, AttributeError):
-        pass
-if os.getppid() != ppid:
-    os._exit(70)
 sys.path.insert(0, sys.argv[4])
+from ptoverify.conform.reaper import supervise
+watch = supervise(int(sys.argv[1]), int(sys.argv[2]))
 from ptoverify.conform.isolation import child_main
-child_main(ppid, int(sys.argv[2]), int(sys.argv[3]))
+child_main(watch, int(sys.argv[2]), int(sys.argv[3]))
 """
 
 
@@ -184,11 +184,10 @@ def child_main(ppid: int, fd: int, memory_limit: int) -> None:
     _, sys_path, spec, cfg = recv()
     sys.path[:] = sys_path
     try:
-        user, failures = wrap_callable(load_callable(spec), cfg)
+        user, failures = wrap_callable(load_callable(spec), cfg, in_child=True)
     except InputError as exc:
         _send_answer(sock, {"kind": "input", "message": str(exc)})
         return
-    user.in_child = True
     _send_answer(
         sock, {"kind": "ready", "mode": user.mode, "reason": user.reason, "failures": failures}
     )
@@ -292,6 +291,7 @@ class IsolatedLaw:
         self.mode, self.reason = "unknown", "not loaded yet"
         self._deadline = time.monotonic() + timeout
         self._log = tempfile.TemporaryFile(prefix="ptoverify-law-")
+        self._token = secrets.token_hex(16)
         self._sock, child = socket.socketpair()
         root = str(Path(__file__).resolve().parents[2])
         argv = [sys.executable, "-c", _BOOT, str(os.getpid()), str(child.fileno())]
@@ -303,6 +303,7 @@ class IsolatedLaw:
                 stderr=self._log,
                 pass_fds=(child.fileno(),),
                 start_new_session=True,
+                env={**os.environ, TOKEN_VAR: self._token},
             )
         except OSError as exc:
             self._sock.close()
@@ -417,11 +418,23 @@ class IsolatedLaw:
         return float(self(np.array([x1]), np.array([x2]))[0])
 
     def _kill(self) -> None:
-        """SIGKILL the child's process group (the law's own children too) and reap it."""
+        """Kill the child, every process the law started, and reap the child.
+
+        Linux: SIGTERM to the supervisor, which kills its tree and ends
+        (SIGKILL after :data:`_STOP_S`); then SIGKILL to whatever still carries
+        the run's token.  Everywhere: SIGKILL to the child's process group.
+        """
+        if sys.platform.startswith("linux"):
+            try:
+                self._proc.send_signal(signal.SIGTERM)  # no signal once it is reaped
+                self._proc.wait(_STOP_S)
+            except (subprocess.TimeoutExpired, OSError):
+                pass
         try:
             os.killpg(self._proc.pid, signal.SIGKILL)
         except (ProcessLookupError, PermissionError):
             pass
+        kill_marked(self._token)
         try:
             self._proc.wait(5.0)
         except subprocess.TimeoutExpired:

@@ -43,7 +43,6 @@ never a pass.
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
@@ -55,6 +54,7 @@ from ptoverify.conform.agreement import failure, reference
 from ptoverify.conform.closedloop import BAND_MM, SETTLING, as_law, settle_samples, sweep_sizes
 from ptoverify.conform.perturbation import Perturbation, perturbation, robust_box
 from ptoverify.conform.userlaw import LawFault
+from ptoverify.model.memo import memo
 from ptoverify.sim.simulate import BatchResult
 from ptoverify.verdict import FAIL, PASS, Verdict
 
@@ -226,7 +226,7 @@ def _states(cfg: Config, sizes: tuple[int, int, int]) -> tuple[NDArray, NDArray,
     return x1, x2, default_steps(cfg)
 
 
-@functools.lru_cache(maxsize=16)
+@memo(maxsize=16)
 def reference_loop(cfg: Config, p: Perturbation, sizes: tuple[int, int, int]) -> LoopMeasures:
     """Measure the reference under ``p`` on the sweep ``sizes`` (cached).
 

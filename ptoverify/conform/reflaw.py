@@ -8,20 +8,30 @@ and the failure entry every property reports.
 
 from __future__ import annotations
 
-import functools
-
 from ptoverify import verdict
 from ptoverify.config import Config
 from ptoverify.model.laws import Law, make_law
+from ptoverify.model.memo import memo
 
 __all__ = ["DEFAULT_RTOL", "reference", "tie_band", "omega0_ref", "failure"]
 
 DEFAULT_RTOL = 1e-6  #: agreement tolerance relative to w_max
 
 
-@functools.lru_cache(maxsize=8)
+@memo(maxsize=8)
 def reference(cfg: Config) -> Law:
-    """Return ``make_law("pto", cfg)``, built once per configuration."""
+    """Return ``make_law("pto", cfg)``, built once per configuration.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (the memo's key).
+
+    Returns
+    -------
+    Law
+        The reference law (corrected omega0), u [mm/s].
+    """
     return make_law("pto", cfg)
 
 

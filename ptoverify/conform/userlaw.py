@@ -332,7 +332,9 @@ def _probe_states(cfg: Config) -> tuple[NDArray, NDArray]:
     return x1, x2
 
 
-def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
+def wrap_callable(
+    fn: Callable, cfg: Config, *, in_child: bool = False
+) -> tuple[UserLaw, list[dict]]:
     """Check the signature, detect vectorized or scalar, test purity on probe states.
 
     Parameters
@@ -341,6 +343,10 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
         The user law ``u = f(x1, x2, cfg)``.
     cfg : Config
         Configuration.
+    in_child : bool
+        True in the isolated child: a ``KeyboardInterrupt`` the law raises is
+        a finding from the first probe call on (mode detection included), not
+        an interruption of the judging run.
 
     Returns
     -------
@@ -355,7 +361,7 @@ def wrap_callable(fn: Callable, cfg: Config) -> tuple[UserLaw, list[dict]]:
         raise InputError(f"the law's signature does not accept (x1, x2, cfg): {exc}") from None
     except ValueError:
         pass  # no signature available (builtins): try it
-    law = UserLaw(fn, cfg)
+    law = UserLaw(fn, cfg, in_child=in_child)
     p1, p2 = _probe_states(cfg)
     try:
         first = law(p1, p2)

@@ -181,8 +181,17 @@ LAWS: dict[str, tuple[str, tuple[int, ...], int]] = {
         (1,),
         30,
     ),
-    # a law can kill its judge (same user): not a pass, nothing may be left running
-    "kill-parent": ("import os, signal\n    os.kill(os.getppid(), signal.SIGKILL)", (1, -9), 30),
+    # a law can kill its parent: since R1 that is the supervisor, not ptoverify, so the run
+    # goes on: 1 (the law's process was killed) or 2 (the law's answer, None, arrived before
+    # the worker's own death signal); never a pass, nothing may be left running
+    "kill-parent": ("import os, signal\n    os.kill(os.getppid(), signal.SIGKILL)", (1, 2), 30),
+    # ptoverify itself, found by the law as its grandparent: exit -9, nothing left running
+    "kill-judge": (
+        "import os, signal\n    ppid = int(open(f'/proc/{os.getppid()}/stat').read()"
+        ".rsplit(')', 1)[1].split()[1])\n    os.kill(ppid, signal.SIGKILL)",
+        (1, -9),
+        30,
+    ),
 }
 
 MODULE_LAWS: dict[str, tuple[str, tuple[int, ...]]] = {

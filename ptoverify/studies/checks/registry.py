@@ -41,6 +41,8 @@ class GateContext:
         """Return keyword arguments capping IPOPT (empty without a cap)."""
         return {} if self.max_iter is None else {"max_iter": self.max_iter}
 
+    # Not a memo (model.memo): a lazy attribute of this one run's context, computed at
+    # most once per context and dropped with it; named_properties' memo is keyed on cfg.
     @functools.cached_property
     def pto_properties(self):
         """Closed-loop properties of the corrected PTO law over the default grid."""

@@ -40,22 +40,27 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ptoverify.config import Config, Plant
-from ptoverify.model.laws import Law, make_law
-from ptoverify.model.mintime import min_time
-from ptoverify.model.reach import zonotope_steps_each
-from ptoverify.sim.flow import Trajectory
+from ptoverify.config import Config
+from ptoverify.errors import InputError
+from ptoverify.model.laws import Law
 from ptoverify.sim.lockstep import Ask, simulate_asks
-from ptoverify.sim.settling import grid_settling
-from ptoverify.sim.simulate import BatchResult, Mismatch, simulate_batch
-from ptoverify.studies.properties import oscillating, stride_over_counts
+from ptoverify.sim.simulate import BatchResult, Mismatch
 from ptoverify.studies.robust.results import MapCell, PropertyMax, RobustMaps
+from ptoverify.studies.robust.trajectory import (
+    SETTLING,
+    LawSpec,
+    _limit_cycle_mm,
+    _measure,
+    horizon_steps,
+    nominal_law,
+    trajectory_properties,
+)
 from ptoverify.studies.sweep import even_points
 
 __all__ = [
@@ -66,18 +71,22 @@ __all__ = [
     "evaluate_probes",
     "trajectory_properties",
     "horizon_steps",
+    "MAX_BOX_WORK",
+    "box_work",
+    "check_box_work",
     "map_states",
     "robust_maps",
     "BATCH_STATES",
     "map_cells",
     "maps_dict",
+    "SETTLING",
+    "LawSpec",
+    "nominal_law",
 ]
 
 LAWS = ("to", "pd", "pto", "pto-printed")
 #: Properties searched for their worst case (larger is worse for each).
 PROPERTIES = ("stride_overs", "limit_cycle_mm", "overshoot_mm", "settling_ratio_nt")
-#: The settling definition of the maps and the worst-case search (the sweep's, by name).
-SETTLING = "box-0p01mm"
 
 
 @dataclass(frozen=True)
@@ -120,188 +129,64 @@ class RobustSettings:
 # -- per-trajectory properties -------------------------------------------------
 
 
-def horizon_steps(cfg: Config) -> int:
-    """Return the horizon [samples]: twice the envelope at the slowest drive, + 60/a.
+#: Most perturbation cells x horizon samples a robustness study may need [cell-samples]:
+#: the default box (30 cells) at the longest horizon the loader lets through (about 12,000
+#: samples, range / (w_max T) = 2000 and a T = 0.01) needs 360,000.
+MAX_BOX_WORK = 400_000
+
+
+def box_work(cfg: Config, s: RobustSettings | None = None) -> tuple[int, int]:
+    """Return the perturbation cells of the maps and the horizon of every trajectory.
+
+    The study's time grows with their product (every search, margin scan and
+    map cell simulates :func:`horizon_steps` samples per state).
 
     Parameters
     ----------
     cfg : Config
-        Nominal configuration with its box (the slowest a and w_max of the box).
+        Nominal configuration with its box.
+    s : RobustSettings, optional
+        Grid sizes (n_a, n_w).
 
     Returns
     -------
-    int
-        Samples simulated per trajectory.
+    cells : int
+        a_ratio x w_max_ratio x delay values of the maps [-].
+    horizon : int
+        Samples simulated per trajectory [samples].
     """
-    p, box = cfg.plant, cfg.robustness
-    w = p.w_max * box.w_max_ratio[0]
-    a = p.a * box.a_ratio[0]
-    return int(math.ceil((2.0 * p.position_range / w + 60.0 / a) / p.sample_time))
+    ars, wrs, delays = _map_axes(cfg, s or RobustSettings())
+    return len(ars) * len(wrs) * len(delays), horizon_steps(cfg)
 
 
-def _true_plant(plant: Plant, a_ratio: float, w_ratio: float) -> Plant:
-    return replace(plant, a=plant.a * a_ratio, w_max=plant.w_max * w_ratio)
-
-
-def _n_star(x1: NDArray, x2: NDArray, a_ratio: NDArray, w_ratio: NDArray, plant: Plant) -> NDArray:
-    """N* of each state for its own true plant (a_ratio, w_max_ratio), nan where not found.
-
-    One vectorized zonotope search for every mix of plants
-    (:func:`ptoverify.model.reach.zonotope_steps_each`), started from the continuous
-    bound ceil(t_f* / T) of the true plant (t_f* in the plant's dimensionless time,
-    min_time of the unit plant; the start only changes the number of tests).
-    """
-    a, w = plant.a * a_ratio, plant.w_max * w_ratio
-    unit = replace(plant, a=1.0, w_max=1.0)
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        tau = min_time(a * x1 / w, x2 / w, unit).t_f  # a t_f* [-]
-        n0 = np.nan_to_num(np.ceil(tau / (a * plant.sample_time) - 1e-9), nan=1.0, posinf=1.0)
-    steps = zonotope_steps_each(x1, x2, np.maximum(n0, 1.0), a, w, plant.sample_time)
-    return np.where(steps >= 0, steps, np.nan).astype(float)
-
-
-LawSpec = str | Callable[[Config], Law]
-
-
-def nominal_law(spec: LawSpec, cfg: Config) -> Law:
-    """Build the nominal law: a name for :func:`make_law`, or a factory ``f(cfg) -> Law``.
+def check_box_work(cfg: Config, s: RobustSettings | None = None) -> None:
+    """Raise InputError, before any simulation, when the box needs more than :data:`MAX_BOX_WORK`.
 
     Parameters
     ----------
-    spec : str or callable
-        Law name (``to``, ``pd``, ``pto``, ``pto-printed``) or a factory.
     cfg : Config
-        Nominal configuration (the law's design).
+        Nominal configuration with its box.
+    s : RobustSettings, optional
+        Grid sizes (n_a, n_w).
 
-    Returns
-    -------
-    Law
-        The law.
+    Raises
+    ------
+    InputError
+        Naming the ``[robustness]`` keys that set the work and the limit.
     """
-    return make_law(spec, cfg) if isinstance(spec, str) else spec(cfg)
-
-
-def trajectory_properties(
-    law_name: LawSpec,
-    cfg: Config,
-    x1: NDArray,
-    x2: NDArray,
-    mismatch: Mismatch,
-    *,
-    steps: int | None = None,
-    with_settling: bool | NDArray[np.bool_] = True,
-    batch: BatchResult | None = None,
-) -> dict[str, NDArray[np.float64]]:
-    """Simulate ``law_name`` (nominal design) on a mismatched plant and measure each state.
-
-    Parameters
-    ----------
-    law_name : str or callable
-        ``to``, ``pd``, ``pto`` or ``pto-printed``, or a factory ``f(cfg) -> Law``.
-    cfg : Config
-        Nominal configuration (the law's design and the box).
-    x1, x2 : ndarray, shape (n,)
-        Initial states [mm], [mm/s].
-    mismatch : Mismatch
-        The plant and measurement (a_ratio and w_max_ratio may be arrays of shape (n,)).
-    steps : int, optional
-        Horizon [samples]; default covers the slowest plant of the box.
-    with_settling : bool or ndarray of bool, shape (n,)
-        Also compute the settling ratios (needs t_f* and N* of each true plant),
-        for every state or for the states of a mask (nan elsewhere).
-    batch : BatchResult, optional
-        The simulation of exactly these states, mismatch and horizon, when the
-        caller already has it (it is measured, not simulated again).
-
-    Returns
-    -------
-    dict
-        Arrays of shape (n,): ``stride_overs`` [-], ``limit_cycle_mm`` [mm],
-        ``overshoot_mm`` [mm] (nan where x0 is not at rest), ``settling_s`` [s],
-        ``settling_ratio_nt`` and ``settling_ratio_tf`` [-] (see module docstring).
-
-    Examples
-    --------
-    >>> from ptoverify.config import paper_config
-    >>> cfg = paper_config()
-    >>> out = trajectory_properties("pd", cfg, np.array([5.0]), np.array([0.0]), Mismatch())
-    >>> float(out["stride_overs"][0]), bool(out["settling_ratio_nt"][0] > 1.0)
-    (0.0, True)
-    """
-    x1 = np.atleast_1d(np.asarray(x1, dtype=float))
-    x2 = np.atleast_1d(np.asarray(x2, dtype=float))
-    steps = horizon_steps(cfg) if steps is None else steps
-    if batch is None:
-        batch = simulate_batch(
-            nominal_law(law_name, cfg), cfg.plant, x1, x2, steps, mismatch=mismatch
-        )
-    return _measure(batch, cfg, x1, x2, mismatch, with_settling, with_tf=True)
-
-
-def _limit_cycle_mm(x1: NDArray) -> NDArray[np.float64]:
-    """Peak |x1| [mm] of the last quarter of each trajectory that oscillates there, else 0."""
-    window = max(20, (x1.shape[0] - 1) // 4)
-    tail = x1[-window:]
-    return np.where(oscillating(tail, 1e-3), np.abs(tail).max(axis=0), 0.0)
-
-
-def _measure(
-    b: BatchResult,
-    cfg: Config,
-    x1: NDArray,
-    x2: NDArray,
-    mismatch: Mismatch,
-    with_settling: bool | NDArray[np.bool_],
-    *,
-    with_tf: bool,
-) -> dict[str, NDArray[np.float64]]:
-    """Measure the properties of :func:`trajectory_properties` on a simulated batch.
-
-    ``with_tf`` False leaves ``settling_ratio_tf`` out (the study reads only the
-    ratio to N*T; t_f* of each true plant is then not computed).
-    """
-    n = x1.size
-    amp = _limit_cycle_mm(b.x1)
-    rest = np.flatnonzero((x2 == 0.0) & (np.abs(x1) >= cfg.pto.d) & (x1 != 0.0))
-    over = np.full(n, np.nan)
-    if rest.size:  # the largest excursion beyond the origin, on the side opposite to x1_0
-        run = b.x1[:, rest] if rest.size < n else b.x1
-        over[rest] = np.maximum((-np.sign(x1[rest])[None, :] * run).max(axis=0), 0.0)
-    out = {
-        "stride_overs": stride_over_counts(b.x1, b.x2, b.region, cfg).astype(float),
-        "limit_cycle_mm": amp,
-        "overshoot_mm": over,
-    }
-    need = np.broadcast_to(np.asarray(with_settling, dtype=bool), (n,))
-    if not need.any():
-        return out
-    T = cfg.plant.sample_time
-    sel = np.flatnonzero(need)
-    x1s, x2s = (b.x1, b.x2) if sel.size == n else (b.x1[:, sel], b.x2[:, sel])
-    # the true state on the samples; the box's velocity band is the design a's (the one
-    # box every law is judged by, whatever the true plant)
-    t = np.arange(x1s.shape[0]) * T
-    us = np.zeros((x1s.shape[0] - 1, x1s.shape[1]))  # not read on the samples
-    settled = np.full(n, np.nan)
-    settled[sel] = grid_settling(Trajectory(t, x1s, x2s, us, cfg.plant.a), None, SETTLING)
-    settle = np.where(np.isnan(settled), np.inf, settled)
-    ar = np.broadcast_to(np.asarray(mismatch.a_ratio, dtype=float), (n,))
-    wr = np.broadcast_to(np.asarray(mismatch.w_max_ratio, dtype=float), (n,))
-    n_star = np.full(n, np.nan)
-    n_star[sel] = _n_star(x1[sel], x2[sel], ar[sel], wr[sel], cfg.plant)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        out["settling_s"] = np.where(need, settle, np.nan)
-        ratio_nt = np.where(n_star > 0, settle / (n_star * T), 0.0)
-        out["settling_ratio_nt"] = np.where(need & ~np.isnan(n_star), ratio_nt, np.nan)
-    if with_tf:
-        t_f = np.full(n, np.nan)
-        for key in set(zip(ar[need].tolist(), wr[need].tolist(), strict=True)):
-            on = (ar == key[0]) & (wr == key[1]) & need
-            t_f[on] = min_time(x1[on], x2[on], _true_plant(cfg.plant, *key)).t_f
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio_tf = np.where(t_f > 0, settle / t_f, 0.0)
-            out["settling_ratio_tf"] = np.where(need & ~np.isnan(t_f), ratio_tf, np.nan)
-    return out
+    cells, horizon = box_work(cfg, s)
+    if cells * horizon <= MAX_BOX_WORK:
+        return
+    box = cfg.robustness
+    n_delay = box.delay_samples[1] - box.delay_samples[0] + 1
+    raise InputError(
+        f"config key 'robustness.delay_samples' = {list(box.delay_samples)} gives {cells} "
+        f"perturbation cells ({n_delay} delays x a_ratio x w_max_ratio values) and "
+        f"'robustness.a_ratio' / 'robustness.w_max_ratio' down to {box.a_ratio[0]:g} / "
+        f"{box.w_max_ratio[0]:g} a horizon of {horizon:,} samples: {cells * horizon:,} "
+        f"cell-samples, over the limit of {MAX_BOX_WORK:,} (narrow the delays or raise "
+        "the lower ratios)"
+    )
 
 
 # -- maps ----------------------------------------------------------------------
@@ -581,6 +466,7 @@ def robust_maps(
     (11, 4)
     """
     s = settings or RobustSettings()
+    check_box_work(cfg, s)
     if runner is None:
         cells = map_cells(s.laws, cfg, s)
     else:

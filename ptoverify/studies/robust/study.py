@@ -23,6 +23,7 @@ from ptoverify.sim.lockstep import run_together
 from ptoverify.studies.robust.cluster import dask_runner
 from ptoverify.studies.robust.maps import (
     RobustSettings,
+    check_box_work,
     evaluate_probes,
     map_cells,
     maps_dict,
@@ -123,8 +124,14 @@ def run_robust(
     -------
     RobustResult
         The study.
+
+    Raises
+    ------
+    InputError
+        The box needs more than ``maps.MAX_BOX_WORK`` cell-samples (checked first).
     """
     s = settings or RobustSettings()
+    check_box_work(cfg, s)
     report = progress or (lambda stage, frac: None)
     timings: dict[str, float] = {}
     booked: dict[str, float] = {}
