@@ -79,7 +79,9 @@ def test_independent_copy_conforms_cli(capsys):
 
 def test_reference_scalar_mode_detected(paper_cfg):
     grid = conformance_grid(paper_cfg, n=11, n_curve=11)
-    r = conform_callable(reference_law_scalar, paper_cfg, sweep=SMALL, n_random=1000, grid=grid)
+    r = conform_callable(
+        reference_law_scalar, paper_cfg, sweep=SMALL, n_random=1000, n_band=2000, grid=grid
+    )
     assert r.mode == "scalar" and "state by state" in r.mode_reason
     assert r.conforms, r.failures
     # scalar path of the same law: Newton for omega_c vs the vectorized W_-1 iteration,
