@@ -14,6 +14,7 @@ from ptoverify.report.render import (
     table,
 )
 from ptoverify.report.standing import ratio_interval
+from ptoverify.verdict import time_order
 
 from .common import (
     _GATE_UNITS,
@@ -101,20 +102,27 @@ def _finding_settling(res: Any) -> tuple[str, str, str] | None:
 
     Both numbers stand in the same sentence, so the finding cannot overstate.
     """
-    from ptoverify.report.standing import reading_words, step_readings
+    from ptoverify.report.standing import bandwidth_hz, reading_words, step_readings
 
     step = step_readings(res)
     if not step:
         return None
+    T = res["environment"]["config"]["plant"]["sample_time"]  # noqa: N806 - the paper's symbol
     parts = []
     for a, r in step.items():
         v = r["values"]
         pd, pto = v["settling_pd_s"], v["settling_pto_s"]
-        if pd is None or pto is None:
+        order = time_order(pto, pd, T)
+        if order is None:
             continue
-        fast = "PD" if pd < pto else "the corrected PTO"
+        first = {
+            -1: "the corrected PTO settles first",
+            0: "PD and the corrected PTO tie (less than one sample apart)",
+            1: "PD settles first",
+        }[order]
         parts.append(
-            f"under {reading_words('a', a)} {fast} settles first (PD {_ms(pd)}, PTO {_ms(pto)})"
+            f"under {reading_words('a', a, bandwidth_hz(res))} {first} "
+            f"(PD {_ms(pd)}, PTO {_ms(pto)})"
         )
     if not parts:
         return None
@@ -123,14 +131,18 @@ def _finding_settling(res: Any) -> tuple[str, str, str] | None:
     )
     t = res["tuning"]
     if t is not None:
+        from ptoverify.report.standing import time_verdict
+
         tuned = [
-            f"PD {_ms(by['pd']['settling_2pct_s'])} vs PTO {_ms(by['pto']['settling_2pct_s'])} "
-            f"at overshoot <= {qty(t['bounds_mm'][name], 'mm')}"
+            f"at overshoot <= {qty(t['bounds_mm'][name], 'mm')} the PTO "
+            f"{time_verdict(by['pto']['settling_2pct_s'], by['pd']['settling_2pct_s'], T)}, "
+            f"PD {_ms(by['pd']['settling_2pct_s'])} vs PTO {_ms(by['pto']['settling_2pct_s'])}"
             for name, by in t["best"].items()
             if "pd" in by and "pto" in by
         ]
         if tuned:
-            text += "; at each law's best tuning (a = 2 pi f): " + "; ".join(tuned)
+            a0 = reading_words("a", next(iter(step)), bandwidth_hz(res))
+            text += f"; at each law's best tuning ({a0}): " + "; ".join(tuned)
     sw = res["sweep"]["laws"]
     if "pd" in sw and "pto" in sw:
         pd, pto = sw["pd"]["percentiles_ratio_nt"], sw["pto"]["percentiles_ratio_nt"]
@@ -181,14 +193,15 @@ def _finding_claims(res: Any) -> tuple[str, str, str] | None:
         if c31t is not None:
             best = [r for r in c31t["readings"] if "best-tuned" in r["label"]]
             if best:
-                text += (
-                    "; at both laws' best tuning they settle alike ("
-                    + "; ".join(
-                        f"PD {_ms(r['values']['settling_pd_s'])} vs PTO "
-                        f"{_ms(r['values']['settling_pto_s'])}"
-                        for r in best
-                    )
-                    + ")"
+                from ptoverify.report.standing import time_verdict
+
+                T = res["environment"]["config"]["plant"]["sample_time"]  # noqa: N806
+                text += "; at both laws' best tuning, " + "; ".join(
+                    f"at overshoot <= {qty(r['reading']['bound_mm'], 'mm')} the PTO "
+                    f"{time_verdict(v['settling_pto_s'], v['settling_pd_s'], T)}, "
+                    f"PD {_ms(v['settling_pd_s'])} vs PTO {_ms(v['settling_pto_s'])}"
+                    for r in best
+                    for v in [r["values"]]
                 )
     return (text + ".", "claims", "claims with every reading")
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from typing import Any
 
@@ -11,6 +12,8 @@ from ptoverify.report.render import (
     qty,
     table,
 )
+from ptoverify.report.standing import TIE_NOTE
+from ptoverify.report.words import claim_title
 
 from .common import _claim_qty, _law, _ms, _same, figure, measured_quantity
 
@@ -239,6 +242,33 @@ def properties(res: dict[str, Any]) -> list[Block]:
     return blocks
 
 
+#: A tie as the claims record it: ``<metric>_<law>_s = <metric>_<law>_s (...)``.
+_TIE = re.compile(r"^(\w+?)_(to|pd|pto)_s = (\w+?)_(to|pd|pto)_s\b")
+
+
+def tie_words(tie: str) -> str:
+    """Say a recorded tie in words: ``rise_time_pto_s = rise_time_pd_s`` -> ``rise time: PTO ties PD``.
+
+    Parameters
+    ----------
+    tie : str
+        One entry of a reading's ``ties``.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> tie_words("rise_time_pto_s = rise_time_pd_s (less than one sample apart)")
+    'rise time: PTO ties PD'
+    """
+    m = _TIE.match(tie)
+    if m is None:
+        return tie
+    return f"{m.group(1).replace('_', ' ')}: {m.group(2).upper()} ties {m.group(4).upper()}"
+
+
 def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     """Every claim: what is measured, paper value, value between samples and on the grid."""
     rows = []
@@ -264,13 +294,13 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             differs = not _same(r["measured"], r["measured_grid"])
             readings.append(
                 [
-                    c["id"],
+                    claim_title(c),
                     r["label"],
                     _claim_qty(r["measured"], c["unit"]),
                     _claim_qty(r["measured_grid"], c["unit"]) if differs else "same",
                     r["verdict"],
                     r["verdict_grid"] or "n/a",
-                    ", ".join(r["ties"] or []) or "none",
+                    "; ".join(tie_words(t) for t in r["ties"] or []) or "none",
                 ]
             )
     blocks = [
@@ -278,8 +308,9 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             "p",
             text="'measured' is read on the exact trajectory between samples (the input is "
             "constant over a sample and the flow is closed form); where the value read on the "
-            "2 ms sample grid differs it is shown next to it, with the verdict the same rule "
-            "gives on the grid. Times are shown in ms.",
+            f"{_ms(res['environment']['config']['plant']['sample_time'])} sample grid differs it "
+            "is shown next to it, with the verdict the same rule gives on the grid. Times are "
+            f"shown in ms. {TIE_NOTE}",
         ),
         table(
             [
@@ -305,7 +336,7 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 "on the sample grid",
                 "verdict",
                 "verdict on grid",
-                "true ties",
+                "tied times (less than one sample apart)",
             ],
             readings,
         ),

@@ -78,7 +78,7 @@ def _evaluate(
         grid = _Ctx(cfg, rd, paper, grid=True, law_cfg=law_cfg)
         measured_g, values_g, ok_g, _ = cl.measure(grid, cl)
         if exact.ties:
-            detail += "; true tie between samples: " + ", ".join(exact.ties)
+            detail += "; a tie (less than one sample apart): " + ", ".join(exact.ties)
         results.append(
             ReadingResult(
                 rd,

@@ -15,6 +15,7 @@ from ptoverify.model.memo import memo
 from ptoverify.sim import metrics as mt
 from ptoverify.sim.exact import Compared, ExactMetrics, exact_metrics
 from ptoverify.sim.simulate import SimResult, simulate
+from ptoverify.verdict import time_order
 
 from .types import (
     _FLOORS,
@@ -113,16 +114,21 @@ class _Ctx:
         return self.value(self.metric(law, "sine", "phase_delay_deg")), out.residual_rms
 
     def less(self, law_a: str, law_b: str, signal: str, key: str, names: tuple[str, str]) -> bool:
-        """Whether law_a's metric is strictly below law_b's; a true tie is recorded and is not.
+        """Whether law_a's time metric is below law_b's by the tie rule; a tie is recorded.
 
-        Exact values tie within the sum of their accuracies
-        (:meth:`ptoverify.sim.exact.Compared.compare`), grid values only when equal.
+        The one tie rule of the suite (:func:`ptoverify.verdict.time_order`,
+        :data:`ptoverify.verdict.TIME_TIE_RULE`): two times less than one sample
+        period apart tie, exact and grid values alike (grid values tie only when
+        equal); two exact values closer than their summed accuracies
+        (:meth:`ptoverify.sim.exact.Compared.compare`) tie as well.
         """
         a, b = self.metric(law_a, signal, key), self.metric(law_b, signal, key)
-        order = a.compare(b, grid=self.grid)
+        x, y = (a.grid, b.grid) if self.grid else (a.exact, b.exact)
+        order = time_order(x, y, self.cfg.plant.sample_time)
+        if order is not None and a.compare(b, grid=self.grid) == 0:
+            order = 0  # not told apart to the precision they are computed to
         if order == 0:
-            tol = 0.0 if self.grid else a.accuracy + b.accuracy
-            self.ties.append(f"{names[0]} = {names[1]} (|difference| <= {tol:.3g})")
+            self.ties.append(f"{names[0]} = {names[1]} (less than one sample apart)")
         return order == -1
 
 

@@ -126,7 +126,7 @@ class ReadingResult:
         The verdict the same rule gives on the grid values (grid values tie
         only when equal).
     ties : tuple of str
-        True ties between exact values met by a comparison (the claim's strict
+        Ties met by a comparison of times under the tie rule (the claim's strict
         inequality then does not hold), e.g. ``rise_time_pto_s = rise_time_pd_s``.
     """
 
