@@ -176,29 +176,47 @@ def _unkey(value: Any) -> Any:
 
 #: A dimension a merged combination of readings leaves free.
 _ANY = object()
-#: The place of the dimension being merged, while grouping.
-_HOLE = object()
 
 
 def _merge(cubes: list[tuple], domains: list[list]) -> list[tuple]:
-    """Merge value combinations that cover every value of one dimension into one that leaves it free."""
-    cubes = list(dict.fromkeys(cubes))
-    changed = True
-    while changed:
-        changed = False
-        for i, domain in enumerate(domains):
-            groups: dict[tuple, set] = {}
-            for c in cubes:
-                groups.setdefault(c[:i] + (_HOLE,) + c[i + 1 :], set()).add(c[i])
-            for rest, seen in groups.items():
-                if len(domain) > 1 and set(domain) <= seen:
-                    merged = rest[:i] + (_ANY,) + rest[i + 1 :]
-                    cubes = [c for c in cubes if c[:i] + (_HOLE,) + c[i + 1 :] != rest] + [merged]
-                    changed = True
-                    break
-            if changed:
-                break
-    return cubes
+    """Return the fewest value combinations, some dimensions left free, that cover ``cubes``.
+
+    A dimension is left free (:data:`_ANY`) in a combination when every one of its
+    values gives the same verdict there (prime combinations, as Quine-McCluskey
+    finds them); a greedy cover then picks the primes that cover most readings.
+    """
+    full = set(cubes)
+    level, primes = set(full), set()
+    while level:
+        merged_from, nxt = set(), set()
+        for c in level:
+            for i, domain in enumerate(domains):
+                if c[i] is _ANY or len(domain) < 2:
+                    continue
+                sibs = {c[:i] + (v,) + c[i + 1 :] for v in domain}
+                if sibs <= level:
+                    merged_from |= sibs
+                    nxt.add(c[:i] + (_ANY,) + c[i + 1 :])
+        primes |= level - merged_from
+        level = nxt
+
+    def covers(p: tuple, m: tuple) -> bool:
+        return all(x is _ANY or x == y for x, y in zip(p, m, strict=True))
+
+    left, chosen = set(full), []
+    order = {c: k for k, c in enumerate(cubes)}
+    while left:
+        best = max(
+            primes,
+            key=lambda p: (
+                sum(covers(p, m) for m in left),
+                sum(x is _ANY for x in p),
+                -min((order[m] for m in full if covers(p, m)), default=0),
+            ),
+        )
+        chosen.append(best)
+        left = {m for m in left if not covers(best, m)}
+    return sorted(chosen, key=lambda p: min(order[m] for m in full if covers(p, m)))
 
 
 def bandwidth_hz(res: Mapping) -> float | None:
