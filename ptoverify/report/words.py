@@ -15,16 +15,28 @@ plural       a count with its noun, singular or plural
 claim_title  a claim's human title (the paper's words), from its record
 display_unit the unit a claim's number is shown in (s -> ms, a count's noun)
 claim_quantity a claim's number in its display unit (``1 sign reversal``, ``16.14 ms``)
+plain        a lower layer's sentence with the configuration file's jargon in words
+gate_words   a gate's name in words, for prose
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from typing import Any
 
 from ptoverify.report.render import qty
 
-__all__ = ["LAW_WORDS", "law_name", "plural", "claim_title", "display_unit", "claim_quantity"]
+__all__ = [
+    "LAW_WORDS",
+    "law_name",
+    "plural",
+    "claim_title",
+    "display_unit",
+    "claim_quantity",
+    "plain",
+    "gate_words",
+]
 
 #: How each law is named in the report's text, tables and figure titles.
 LAW_WORDS: dict[str, str] = {
@@ -163,3 +175,57 @@ def claim_quantity(v: float | None, unit: str) -> str:
         return plural(int(v), COUNT_NOUNS[unit])
     u, scale = display_unit(unit)
     return qty(v * scale, u)
+
+
+#: Configuration-file jargon (a TOML table's name) and the words a reader knows.
+_JARGON = (
+    (re.compile(r"\[robustness\] box"), "perturbation box"),
+    (re.compile(r"\[robustness\] (\w+)"), lambda m: "the " + m.group(1).replace("_", " ")),
+    (re.compile(r"\[(\w+)\] table"), lambda m: f"the configuration's {m.group(1)} settings"),
+)
+
+
+def plain(text: str) -> str:
+    """Return text with the configuration file's jargon in words (``[robustness] box``).
+
+    Parameters
+    ----------
+    text : str
+        A sentence written by a lower layer (a gate's description).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> plain("anywhere in the [robustness] box (true a)")
+    'anywhere in the perturbation box (true a)'
+    >>> plain("limit from [robustness] settling_ratio_limit")
+    'limit from the settling ratio limit'
+    """
+    for pattern, words in _JARGON:
+        text = pattern.sub(words, text)
+    return text
+
+
+def gate_words(name: str) -> str:
+    """Return a gate's name in words: ``robust-no-limit-cycle`` -> ``no limit cycle (perturbed plant)``.
+
+    Parameters
+    ----------
+    name : str
+        The gate's stable name (the gate table's first column).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> gate_words("robust-settling"), gate_words("odd-symmetry")
+    ('settling (perturbed plant)', 'odd symmetry')
+    """
+    if name.startswith("robust-"):
+        return name.removeprefix("robust-").replace("-", " ") + " (perturbed plant)"
+    return name.replace("-", " ")

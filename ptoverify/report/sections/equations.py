@@ -5,6 +5,7 @@ from __future__ import annotations
 import html
 import math
 import re
+from collections.abc import Mapping
 from typing import Any
 
 from ptoverify.report.render import (
@@ -127,14 +128,20 @@ def same_counterexample(errata: list[dict[str, Any]]) -> dict[str, str]:
     >>> same_counterexample([{"id": "18", "counterexample": ce}, {"id": "19", "counterexample": ce}])
     {'19': '18'}
     """
-    import json
 
-    seen: dict[str, str] = {}
+    def canon(v: Any) -> Any:  # a hashable form of nested mappings and lists
+        if isinstance(v, Mapping):
+            return tuple(sorted((k, canon(v[k])) for k in v))
+        if isinstance(v, (list, tuple)):
+            return tuple(canon(x) for x in v)
+        return v
+
+    seen: dict[Any, str] = {}
     out: dict[str, str] = {}
     for r in errata:
         if not r["counterexample"]:
             continue
-        key = json.dumps(r["counterexample"], sort_keys=True)
+        key = canon(r["counterexample"])
         if key in seen:
             out[r["id"]] = seen[key]
         else:

@@ -14,6 +14,7 @@ from ptoverify.report.render import (
     table,
 )
 from ptoverify.report.standing import ratio_interval
+from ptoverify.report.words import gate_words, plain, plural
 from ptoverify.verdict import time_order
 
 from .common import (
@@ -104,6 +105,8 @@ def _finding_settling(res: Any) -> tuple[str, str, str] | None:
     """
     from ptoverify.report.standing import bandwidth_hz, reading_words, step_readings
 
+    from .studies import sweep_definition_words
+
     step = step_readings(res)
     if not step:
         return None
@@ -151,7 +154,8 @@ def _finding_settling(res: Any) -> tuple[str, str, str] | None:
         tf_pto = sw["pto"]["percentiles_ratio_tf"]
         worst_x1 = sw["pto"]["worst_state_nt"][0]
         text += (
-            f". Over the envelope ({grid[0]} x {grid[1]} states, paper's gains, 0.01 mm box) "
+            f". Over the envelope ({grid[0]} x {grid[1]} states, paper's gains, settling "
+            f"definition {sweep_definition_words(res['sweep'])}) "
             f"settling / (N* T) has median PD {fmt(pd['p50'])} [-], PTO {fmt(pto['p50'])} [-] "
             f"and settling / t_f* median PD {fmt(tf_pd['p50'])} [-], PTO {fmt(tf_pto['p50'])} [-]; "
             f"the PTO's worst ratio {fmt(pto['max'])} [-] starts at x1 = {fmt(worst_x1)} mm"
@@ -169,7 +173,7 @@ def _finding_settling(res: Any) -> tuple[str, str, str] | None:
 
 
 def _finding_claims(res: Any) -> tuple[str, str, str] | None:
-    from ptoverify.report.standing import claim_standing
+    from ptoverify.report.standing import bandwidth_hz, claim_standing, reading_words
 
     cl = res["claims"]
     fail = [c for c in cl if claim_standing(c)[0] == "fails"]
@@ -184,7 +188,8 @@ def _finding_claims(res: Any) -> tuple[str, str, str] | None:
         text += (
             f"; the headline claim that PD needs {qty(c31['paper_value'], '%')} more settling "
             f"time than the PTO measures PD needing {qty(abs(more), '%')} "
-            f"{'more' if more >= 0 else 'less'} at the paper's gains (a = 2 pi f)"
+            f"{'more' if more >= 0 else 'less'} at the paper's gains "
+            f"({reading_words('a', '2pi*f', bandwidth_hz(res))})"
         )
         t = res["tuning"]
         c31t = next(
@@ -250,11 +255,13 @@ def _finding_robust(res: Any) -> tuple[str, str, str] | None:
 def _finding_gates(res: Any) -> tuple[str, str, str]:
     s = res["summary"]
     nom, per = s["gates_nominal"], s["gates_perturbed"]
-    failed = [c["name"] for c in res["checks"] if c["status"] != "pass"]
+    failed = [gate_words(c["name"]) for c in res["checks"] if c["status"] != "pass"]
     text = (
         f"{nom['pass']} of {nom['total']} verification gates pass on the nominal plant"
         + (
-            f"; under the [robustness] box's perturbations {per['pass']} of {per['total']} pass"
+            f"; on the perturbed plant (true a, drive limit, computation delay and encoder "
+            f"quantum over the configuration's perturbation box) {per['pass']} of "
+            f"{plural(per['total'], 'gate')} pass"
             if per["total"]
             else "; the gates under perturbation were not run (robustness skipped)"
         )
@@ -298,7 +305,7 @@ def summary(res: dict[str, Any]) -> list[Block]:
         [
             c["name"],
             "perturbed plant" if c["name"].startswith("robust-") else "nominal plant",
-            c["description"],
+            plain(c["description"]),
             c["status"],
             "unbounded"
             if c["measured_unbounded"]

@@ -6,6 +6,7 @@ import re
 from collections.abc import Mapping
 from typing import Any
 
+from ptoverify.conform.closedloop import SETTLING as CONFORM_SETTLING
 from ptoverify.report.render import (
     Block,
     fmt,
@@ -14,6 +15,7 @@ from ptoverify.report.render import (
 )
 from ptoverify.report.standing import TIE_NOTE
 from ptoverify.report.words import claim_title
+from ptoverify.sim.settling import DEFINITIONS
 
 from .common import _claim_qty, _law, _ms, _same, figure, measured_quantity
 
@@ -374,6 +376,37 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     return blocks
 
 
+#: ``ptoverify conform``'s settling definition (its settling / (N* T)), in words.
+CONFORM_SETTLING_WORDS = f"|x1| <= {DEFINITIONS[CONFORM_SETTLING].band_mm:g} mm for good"
+
+
+def sweep_definition_words(sw: Mapping[str, Any]) -> str:
+    """Name the sweep's settling definition with what it bounds: ``box-0p01mm (|x1| <= ...)``.
+
+    Parameters
+    ----------
+    sw : Mapping
+        ``results["sweep"]`` (``settings``: ``band`` [mm], ``hold`` [s],
+        ``velocity_band`` [mm/s] or None; ``velocity_band`` as used [mm/s]).
+
+    Returns
+    -------
+    str
+    """
+    box, st = DEFINITIONS["box-0p01mm"], sw["settings"]
+    name = (
+        box.name
+        if (st["band"], st["hold"], st["velocity_band"]) == (box.band_mm, box.hold_s, None)
+        else "the sweep's own box"
+    )
+    vel = (
+        f"|x2| <= a x {fmt(st['band'])} mm"
+        if st["velocity_band"] is None
+        else f"|x2| <= {qty(sw['velocity_band'], 'mm/s')}"
+    )
+    return f"{name} (|x1| <= {qty(st['band'], 'mm')} and {vel}, held {_ms(st['hold'])})"
+
+
 def sweep(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     """Settling time over t_f* and over N* T, per law, with percentiles."""
     sw = res["sweep"]
@@ -395,9 +428,12 @@ def sweep(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
         Block(
             "p",
             text=f"Grid of {sw['grid'][0]} x {sw['grid'][1]} initial states over the envelope, "
-            f"horizon {sw['steps']} samples; settling time read between samples (0.01 mm band, "
-            "staying there), divided by the continuous minimum time t_f* and by the sampled "
-            "limit N* T (zonotope N*).",
+            f"horizon {sw['steps']} samples; settling time under the definition "
+            f"{sweep_definition_words(sw)}, read between samples, divided by the continuous "
+            "minimum time t_f* and by the sampled limit N* T (zonotope N*). `ptoverify conform` "
+            f"reports settling / (N* T) under {CONFORM_SETTLING} ({CONFORM_SETTLING_WORDS}), read "
+            "on the samples, over its own smaller sweep of states: a narrower band and other "
+            "states, so its medians differ from these.",
         ),
         table(
             [
