@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ptoverify.config import Config
+from ptoverify.counts import plural
 from ptoverify.model.laws import Law, make_law
 from ptoverify.model.memo import memo
 from ptoverify.sim import metrics as mt
@@ -148,7 +149,7 @@ def _step_to_osc(c: _Ctx, cl: _Claim) -> Outcome:
         amp,
         {"amplitude_mm": amp, "reversals": rev},
         ok,
-        f"TO error over the last half: amplitude {amp:.4f} mm, {rev} sign reversals",
+        f"TO error over the last half: amplitude {amp:.4f} mm, {plural(rev, 'sign reversal')}",
     )
 
 
@@ -210,8 +211,8 @@ def _ramp_to_osc(c: _Ctx, cl: _Claim) -> Outcome:
         },
         okp and okv,
         (
-            f"TO last half: position error {ap:.4f} mm ({rp} reversals), velocity error "
-            f"{av:.2f} mm/s ({rv} reversals)"
+            f"TO last half: position error {ap:.4f} mm ({plural(rp, 'sign reversal')}), velocity "
+            f"error {av:.2f} mm/s ({plural(rv, 'sign reversal')})"
         ),
     )
 
@@ -242,7 +243,8 @@ def _ramp_pto_smooth(c: _Ctx, cl: _Claim) -> Outcome:
             "overshoot_mm": c.overshoot("pto", "ramp"),
         },
         ok,
-        f"PTO ramp error: {rev} sign reversals outside 0.01 mm; settles to 0.01 mm at {_ms(ts)}",
+        f"PTO ramp error: {plural(rev, 'sign reversal')} outside 0.01 mm; settles to 0.01 mm "
+        f"at {_ms(ts)}",
     )
 
 
