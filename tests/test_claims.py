@@ -341,7 +341,7 @@ def test_times_less_than_one_sample_apart_tie_and_are_not_quicker(monkeypatch, f
     beyond = _quicker_with_pto_rise(monkeypatch, lambda band: -1.1 * T)
     for x in below.readings:
         assert x.verdict == "not reproduced" and x.ties, x.label
-        assert "a tie (less than one sample apart)" in x.detail
+        assert "less than one sample apart, a tie: rise time: PTO ties PD" in x.detail
         assert "rise_time_pto_s = rise_time_pd_s" in x.ties[0]
         assert 0 < x.values["rise_time_pd_s"] - x.values["rise_time_pto_s"] < T
     for x in beyond.readings:

@@ -50,6 +50,7 @@ __all__ = [
     "TIE_NOTE",
     "time_verdict",
     "claim_quantity",
+    "ratio_phrase",
 ]
 
 
@@ -230,7 +231,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
                 "yes" if d1 is not None else "no: needs delay compensation or lower gains",
                 "PTO linear zone with one sample of delay: "
                 + (
-                    f"stable for a_true / a_design in {ratio_interval(d1)}"
+                    f"stable for a_true / a_design {ratio_phrase(d1)}"
                     if d1
                     else m["linear_loop_note_delay1"]
                 ),
@@ -243,8 +244,9 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
         rows.append(
             [
                 "Tolerates a bandwidth other than the design value?",
-                f"a_true / a_design in {ratio_interval(nd)}" if nd else m["linear_loop_note"],
-                f"PTO linear loop stable for {ratio_interval(nd)}; PD for {ratio_interval(pd_nd)}",
+                f"a_true / a_design {ratio_phrase(nd)}" if nd else m["linear_loop_note"],
+                f"PTO linear loop stable for a_true / a_design {ratio_phrase(nd)}; PD "
+                f"{ratio_phrase(pd_nd)}",
             ]
         )
     loops = res["poles"]["loops"]
@@ -449,12 +451,33 @@ def ratio_interval(iv: Any) -> str:
         return "no interval (unstable at the design point)"
     lo, hi = iv
     if lo is None and hi is None:
-        return "the whole searched range"
+        return "anywhere in the searched [0.1, 10]"
     if lo is None:
-        return f"from below the searched 0.1 up to {fmt(hi)}"
+        return f"up to {fmt(hi)} (no lower limit down to the searched 0.1)"
     if hi is None:
-        return f"from {fmt(lo)} up past the searched 10"
+        return f"from {fmt(lo)} (no upper limit up to the searched 10)"
     return f"[{fmt(lo)}, {fmt(hi)}]"
+
+
+def ratio_phrase(iv: Any) -> str:
+    """Return what follows "a_true / a_design" in a sentence: ``in [lo, hi]``, ``up to hi (...)``.
+
+    Parameters
+    ----------
+    iv : sequence or None
+        As :func:`ratio_interval`.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> ratio_phrase([0.5, 1.2]), ratio_phrase([None, 1.5])
+    ('in [0.5, 1.2]', 'up to 1.5 (no lower limit down to the searched 0.1)')
+    """
+    text = ratio_interval(iv)
+    return f"in {text}" if text.startswith("[") else text
 
 
 def adoption(res: Mapping) -> str:

@@ -17,6 +17,7 @@ display_unit the unit a claim's number is shown in (s -> ms, a count's noun)
 claim_quantity a claim's number in its display unit (``1 sign reversal``, ``16.14 ms``)
 plain        a lower layer's sentence with the configuration file's jargon in words
 gate_words   a gate's name in words, for prose
+setting_words the gains a study ran at, in words
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ __all__ = [
     "claim_quantity",
     "plain",
     "gate_words",
+    "setting_words",
 ]
 
 #: How each law is named in the report's text, tables and figure titles.
@@ -198,3 +200,33 @@ def gate_words(name: str) -> str:
     if name.startswith("robust-"):
         return name.removeprefix("robust-").replace("-", " ") + " (perturbed plant)"
     return name.replace("-", " ")
+
+
+def setting_words(setting: str) -> str:
+    """Return the gains a study ran at in words: ``tuned pto-paper`` -> ``each law at its best ...``.
+
+    Parameters
+    ----------
+    setting : str
+        ``configured`` or ``tuned <bound>``, a bound of
+        :data:`ptoverify.studies.tune.fair.FAIR_BOUNDS`.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> setting_words("configured")
+    'each law at the configured gains'
+    >>> setting_words("tuned pto-paper")
+    "each law at its best tuning, overshoot <= the PTO's overshoot at the paper's gains"
+    """
+    from ptoverify.studies.tune.fair import FAIR_BOUNDS
+
+    if setting == "configured":
+        return "each law at the configured gains"
+    if setting.startswith("tuned "):
+        bound = setting.removeprefix("tuned ")
+        return f"each law at its best tuning, overshoot <= {FAIR_BOUNDS.get(bound, bound)}"
+    return setting

@@ -16,7 +16,7 @@ import numpy as np
 from matplotlib.colors import ListedColormap
 
 from ptoverify.report.plots.common import folder, save_drawing
-from ptoverify.report.words import law_name
+from ptoverify.report.words import law_name, setting_words
 
 __all__ = ["plot_penalty", "plot_design", "save_charts", "save_penalty", "LAW_COLOURS"]
 
@@ -69,7 +69,7 @@ def plot_penalty(penalty: Mapping, axes) -> dict:
     left.set_ylabel(f"settling time ({penalty['settling_definition']}) [ms]")
     right.set_xlabel("move size [mm]")
     right.set_ylabel("settling / (N* T) [-]")
-    left.set_title(f"gains: {penalty['setting']}", fontsize=9)
+    left.set_title(setting_words(penalty["setting"]), fontsize=9)
     right.set_title("ratio to the sampled limit (not settled: no point)", fontsize=9)
     for ax in axes:
         ax.grid(True, which="both", lw=0.3)

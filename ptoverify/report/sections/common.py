@@ -155,6 +155,10 @@ def _display_unit(unit: str) -> tuple[str, float]:
     return display_unit(unit)
 
 
+#: Tokens of the claims' value names, as a reader writes them.
+_TOKEN_WORDS = {"pto": "PTO", "pd": "PD", "to": "TO", "rms": "RMS"}
+
+
 def measured_quantity(c: dict[str, Any]) -> str:
     """Describe what a claim's 'measured' number is, in words with its unit.
 
@@ -176,7 +180,9 @@ def measured_quantity(c: dict[str, Any]) -> str:
     name = next(
         (k for k, v in values.items() if isinstance(v, (int, float)) and v == c["measured"]), ""
     )
-    words = re.sub(r"_(mm_s|mm|s|deg|percent)$", "", name).replace("_", " ")
+    words = " ".join(
+        _TOKEN_WORDS.get(w, w) for w in re.sub(r"_(mm_s|mm|s|deg|percent)$", "", name).split("_")
+    )
     unit, _ = _display_unit(c["unit"])
     return f"{words or 'value'} [{unit or '-'}]"
 

@@ -13,7 +13,7 @@ from ptoverify.report.render import (
     qty,
     table,
 )
-from ptoverify.report.standing import ratio_interval
+from ptoverify.report.standing import ratio_phrase
 from ptoverify.report.words import gate_words, plain, plural
 from ptoverify.verdict import time_order
 
@@ -238,17 +238,17 @@ def _finding_robust(res: Any) -> tuple[str, str, str] | None:
         return None
     m = rob["margins"]["pto"]
     d1, nd = m["linear_loop_a_ratio_stable_delay1"], m["linear_loop_a_ratio_stable"]
-    text = f"Without delay the PTO's linear zone is stable for a_true / a_design in {ratio_interval(nd)}"
+    text = f"Without delay the PTO's linear zone is stable for a_true / a_design {ratio_phrase(nd)}"
     if "pd" in rob["margins"]:
         pd = rob["margins"]["pd"]
-        text += f" (PD: {ratio_interval(pd['linear_loop_a_ratio_stable'])})"
+        text += f" (PD: {ratio_phrase(pd['linear_loop_a_ratio_stable'])})"
     text += "; with a one-sample computation delay it is " + (
-        f"stable for {ratio_interval(d1)}" if d1 else "unstable even at the design bandwidth"
+        f"stable for a_true / a_design {ratio_phrase(d1)}"
+        if d1
+        else "unstable even at the design bandwidth"
     )
     if "pd" in rob["margins"]:
-        text += (
-            f" (PD: {ratio_interval(rob['margins']['pd']['linear_loop_a_ratio_stable_delay1'])})"
-        )
+        text += f" (PD: {ratio_phrase(rob['margins']['pd']['linear_loop_a_ratio_stable_delay1'])})"
     return (text + ".", "robustness", "robustness")
 
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
 from typing import Any
 
@@ -244,35 +243,10 @@ def properties(res: dict[str, Any]) -> list[Block]:
     return blocks
 
 
-#: A tie as the claims record it: ``<metric>_<law>_s = <metric>_<law>_s (...)``.
-_TIE = re.compile(r"^(\w+?)_(to|pd|pto)_s = (\w+?)_(to|pd|pto)_s\b")
-
-
-def tie_words(tie: str) -> str:
-    """Say a recorded tie in words: ``rise_time_pto_s = rise_time_pd_s`` -> ``rise time: PTO ties PD``.
-
-    Parameters
-    ----------
-    tie : str
-        One entry of a reading's ``ties``.
-
-    Returns
-    -------
-    str
-
-    Examples
-    --------
-    >>> tie_words("rise_time_pto_s = rise_time_pd_s (less than one sample apart)")
-    'rise time: PTO ties PD'
-    """
-    m = _TIE.match(tie)
-    if m is None:
-        return tie
-    return f"{m.group(1).replace('_', ' ')}: {m.group(2).upper()} ties {m.group(4).upper()}"
-
-
 def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     """Every claim: what is measured, paper value, value between samples and on the grid."""
+    from ptoverify.studies.claims.types import tie_words
+
     rows = []
     for c in res["claims"]:
         differs = not _same(c["measured"], c["measured_grid"])

@@ -322,7 +322,8 @@ def _conclusion(c: _Ctx, cl: _Claim) -> Outcome:
         },
         ok,
         (
-            f"step: PTO oscillates {osc_pto} (amplitude {a_pto:.4f} mm), TO {osc_to}; overshoot "
+            f"step: PTO {'oscillates' if osc_pto else 'does not oscillate'} (amplitude "
+            f"{a_pto:.4f} mm), TO {'oscillates' if osc_to else 'does not'}; overshoot "
             f"PTO {os_pto:.3f} mm, TO {os_to:.3f} mm; settling PTO {_ms(ts_pto)} vs PD "
             f"{_ms(ts_pd)}"
         ),
