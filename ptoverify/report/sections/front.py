@@ -259,9 +259,8 @@ def _finding_gates(res: Any) -> tuple[str, str, str]:
     text = (
         f"{nom['pass']} of {nom['total']} verification gates pass on the nominal plant"
         + (
-            f"; on the perturbed plant (true a, drive limit, computation delay and encoder "
-            f"quantum over the configuration's perturbation box) {per['pass']} of "
-            f"{plural(per['total'], 'gate')} pass"
+            f"; on the perturbed plant (the model mismatch of the robustness section) "
+            f"{per['pass']} of {plural(per['total'], 'gate')} pass"
             if per["total"]
             else "; the gates under perturbation were not run (robustness skipped)"
         )
