@@ -281,7 +281,8 @@ def plot_robust_map(
     ax.set_yticks(range(len(wrs)), [f"{r:.3g}" for r in wrs], fontsize=7)
     ax.set_xlabel("a_true / a_design [-]")
     ax.set_ylabel("w_max,true / w_max [-]")
-    ax.set_title(f"{law_name(law)}, a delay of {plural(delay, 'sample')}", fontsize=9)
+    lag = f"a delay of {plural(delay, 'sample')}" if delay else "no delay"
+    ax.set_title(f"{law_name(law)}, {lag}", fontsize=9)
     return {"map": mesh}
 
 
