@@ -453,9 +453,9 @@ def ratio_interval(iv: Any) -> str:
     if lo is None and hi is None:
         return "anywhere in the searched [0.1, 10]"
     if lo is None:
-        return f"up to {fmt(hi)} (no lower limit down to the searched 0.1)"
+        return f"up to {fmt(hi)}, with no lower limit down to the searched 0.1"
     if hi is None:
-        return f"from {fmt(lo)} (no upper limit up to the searched 10)"
+        return f"from {fmt(lo)}, with no upper limit up to the searched 10"
     return f"[{fmt(lo)}, {fmt(hi)}]"
 
 
@@ -474,7 +474,7 @@ def ratio_phrase(iv: Any) -> str:
     Examples
     --------
     >>> ratio_phrase([0.5, 1.2]), ratio_phrase([None, 1.5])
-    ('in [0.5, 1.2]', 'up to 1.5 (no lower limit down to the searched 0.1)')
+    ('in [0.5, 1.2]', 'up to 1.5, with no lower limit down to the searched 0.1')
     """
     text = ratio_interval(iv)
     return f"in {text}" if text.startswith("[") else text
