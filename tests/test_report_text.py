@@ -19,9 +19,8 @@ def committed():
     """The sections rebuilt from the committed report's results.json and records, with the
     Section 6 claims computed afresh."""
     import derivations
-    from ptoverify.report.collect import build_sections, results_view
-
     from ptoverify.config import paper_config
+    from ptoverify.report.collect import build_sections, results_view
     from ptoverify.studies.claims import evaluate_claims
 
     folder = ROOT / "reports" / "paper"
