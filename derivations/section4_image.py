@@ -277,16 +277,21 @@ def _rec_18_19() -> list[EquationRecord]:
         img[sgn] = {tx1: m1.subs(x1, l1_x1(x2)), tx2: m2.subs(x1, l1_x1(x2))}
     claim18 = judge((p18[0] - p18[-1]).subs(img[+1], simultaneous=True), sp.Integer(0), l1_points)
 
-    def state(ce):
-        p = ce["point"]
-        num = {S[key]: val for key, val in p.items()}
-        return {
-            "state_on_l1": [float(l1_x1(x2).subs(num)), p["x2"]],
-            "image_under_plus_omega_m": [
-                float(img[+1][tx1].subs(num)),
-                float(img[+1][tx2].subs(num)),
-            ],
-        }
+    def state_under(sgn: int):
+        """Return the extra fields: the state on l1 and its image one sample later under sgn."""
+
+        def state(ce):
+            p = ce["point"]
+            num = {S[key]: val for key, val in p.items()}
+            return {
+                "state_on_l1": [float(l1_x1(x2).subs(num)), p["x2"]],
+                f"image_under_{'plus' if sgn > 0 else 'minus'}_omega_m": [
+                    float(img[sgn][tx1].subs(num)),
+                    float(img[sgn][tx2].subs(num)),
+                ],
+            }
+
+        return state
 
     steps.append(
         f"claim: images of l1 under the exact +omega_m map satisfy the last line: {claim18.verdict}"
@@ -306,7 +311,7 @@ def _rec_18_19() -> list[EquationRecord]:
                 "19: l~1 coincides with l1 under the +omega_m map",
                 "20-27: see the inherits of (16)",
             ],
-            extra=state,
+            extra=state_under(+1),
         )
     ]
     r19 = p19.subs(img[+1], simultaneous=True)
@@ -324,7 +329,9 @@ def _rec_18_19() -> list[EquationRecord]:
                 "rule (1) needs the states whose next sample under -omega_m lands on l1: the preimage "
                 "of l1, derived as the l1 residual of the -omega_m one-step image (record 19c)",
             ],
-            combine([j_plus, j_minus]),
+            # the -omega_m image first: the sample rule (1) concerns, and a counterexample
+            # of (19)'s own (under +omega_m (19) is (18) rearranged, so (18)'s point and values)
+            combine([j_minus, j_plus]),
             "Claim: the one-step images of l1 form l~1. "
             + ("False for either input sign. " if j_minus.verdict == "erratum" else "")
             + "On l~1 the "
@@ -335,7 +342,7 @@ def _rec_18_19() -> list[EquationRecord]:
                 "20-23: corrected intersection with x1 = d from record 19c (records 22c)",
                 "24-27: same algebra with the corrected intersection point",
             ],
-            extra=state,
+            extra=state_under(-1 if j_minus.verdict == "erratum" else +1),
         )
     )
     # 19c: verify the preimage by mapping back, and its side

@@ -14,6 +14,7 @@ config      Plant, PDGains, PTOSettings, Robustness ([robustness] box), Config; 
             loading and validation (ranges named per key); paper defaults
 verdict     Verdict (PASS, FAIL, UNVERIFIED, NOT_RUN), at_most, tie_band (defined once)
 errors      InputError (exit 2), ConfigError, SolverError
+counts      plural: a count with its noun in the right number (every layer's sentences)
 
 Plant, curves and ground truth
 plant       flow (eq. 7), step (one-sample map, eq. 15), zoh_matrices

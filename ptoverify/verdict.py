@@ -25,6 +25,9 @@ __all__ = [
     "at_most",
     "tie_band",
     "TIE_BAND_REL",
+    "TIME_TIE_SAMPLES",
+    "TIME_TIE_RULE",
+    "time_order",
 ]
 
 PASS, FAIL, UNVERIFIED, NOT_RUN = "pass", "fail", "unverified", "not_run"
@@ -59,6 +62,51 @@ def tie_band(w_max: float, a: float, position_range: float) -> float:
     5.3e-06
     """
     return TIE_BAND_REL * (w_max + a * position_range)
+
+
+#: Two laws' times (settling, rise) tie when they are less than this many sample
+#: periods T apart: a sampled loop acts once per sample, so a smaller difference
+#: is not one it can be said to win.  Every "faster", "quicker", "beats" and
+#: "ties" of the claims, the verdict table and the headline is decided by
+#: :func:`time_order` under this rule.
+TIME_TIE_SAMPLES = 1.0
+
+#: The tie rule in words, as the report states it.
+TIME_TIE_RULE = "two times tie when they are less than one sample period T apart"
+
+
+def time_order(t_a: float | None, t_b: float | None, sample_time: float) -> int | None:
+    """Order two times of one metric under the tie rule: -1 (a first), 0 (tie), +1.
+
+    Parameters
+    ----------
+    t_a, t_b : float or None
+        The two times [s]; None or NaN when undefined (a law never settles).
+    sample_time : float
+        The sample period T [s].
+
+    Returns
+    -------
+    int or None
+        0 when ``|t_a - t_b| < TIME_TIE_SAMPLES * T`` (:data:`TIME_TIE_RULE`;
+        times on the sample grid tie only when equal), else -1 or +1; None when
+        either time is undefined.
+
+    Examples
+    --------
+    >>> time_order(0.0220, 0.0223, 0.002), time_order(0.020, 0.024, 0.002)
+    (0, -1)
+    >>> time_order(0.026, 0.024, 0.002), time_order(None, 0.02, 0.002)
+    (1, None)
+    """
+    if t_a is None or t_b is None or math.isnan(t_a) or math.isnan(t_b):
+        return None
+    if math.isinf(t_a) or math.isinf(t_b):
+        return 0 if t_a == t_b else (-1 if t_a < t_b else 1)
+    # a relative guard: grid times one sample apart differ by T up to round-off
+    if abs(t_a - t_b) < TIME_TIE_SAMPLES * sample_time * (1.0 - 1e-9):
+        return 0
+    return -1 if t_a < t_b else 1
 
 
 @dataclass(frozen=True)

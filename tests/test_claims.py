@@ -315,11 +315,13 @@ def _quicker_with_pto_rise(monkeypatch, offset):
 
 
 def test_verdicts_are_computed_from_the_exact_metrics(monkeypatch, fresh_claim_caches):
-    """Shift PTO's exact rise time 1 ms below PD's: every reading becomes quicker, though the
-    sample-grid values (and the grid verdicts) are untouched; the flag says where they differ.
+    """Shift PTO's exact rise time 1.5 samples below PD's: every reading becomes quicker,
+    though the sample-grid values (and the grid verdicts) are untouched; the flag says where
+    they differ.
     """
-    quick = _quicker_with_pto_rise(monkeypatch, lambda band: -1e-3)
-    slow = _quicker_with_pto_rise(monkeypatch, lambda band: +1e-3)
+    T = paper_config().plant.sample_time
+    quick = _quicker_with_pto_rise(monkeypatch, lambda band: -1.5 * T)
+    slow = _quicker_with_pto_rise(monkeypatch, lambda band: +1.5 * T)
     assert {x.verdict for x in quick.readings} == {"reproduced"}
     assert {x.verdict for x in slow.readings} == {"not reproduced"}
     for q, s in zip(quick.readings, slow.readings, strict=True):
@@ -329,16 +331,19 @@ def test_verdicts_are_computed_from_the_exact_metrics(monkeypatch, fresh_claim_c
         assert not q.ties and not s.ties
 
 
-def test_a_true_tie_is_reported_and_is_not_quicker(monkeypatch, fresh_claim_caches):
-    """Within the tie band (the two exact values' summed accuracy) PTO is not quicker, even when
-    its value is numerically below PD's; just beyond the band the order decides.
+def test_times_less_than_one_sample_apart_tie_and_are_not_quicker(monkeypatch, fresh_claim_caches):
+    """The tie rule (ptoverify.verdict.TIME_TIE_RULE): within one sample period PTO is not
+    quicker, even when its value is below PD's; a tie is recorded and said in the detail;
+    beyond one sample the order decides.
     """
-    below = _quicker_with_pto_rise(monkeypatch, lambda band: -0.5 * band)
-    beyond = _quicker_with_pto_rise(monkeypatch, lambda band: -2.0 * band)
+    T = paper_config().plant.sample_time
+    below = _quicker_with_pto_rise(monkeypatch, lambda band: -0.9 * T)
+    beyond = _quicker_with_pto_rise(monkeypatch, lambda band: -1.1 * T)
     for x in below.readings:
         assert x.verdict == "not reproduced" and x.ties, x.label
-        assert "true tie" in x.detail and "rise_time_pto_s = rise_time_pd_s" in x.ties[0]
-        assert 0 < x.values["rise_time_pd_s"] - x.values["rise_time_pto_s"] < 1e-12
+        assert "less than one sample apart, a tie: rise time: PTO ties PD" in x.detail
+        assert "rise_time_pto_s = rise_time_pd_s" in x.ties[0]
+        assert 0 < x.values["rise_time_pd_s"] - x.values["rise_time_pto_s"] < T
     for x in beyond.readings:
         assert x.verdict == "reproduced" and not x.ties, x.label
 

@@ -206,8 +206,16 @@ def test_report_renders_in_headless_chromium(two_reports, tmp_path):
         "const W=document.documentElement.clientWidth;"
         "const wide=[...document.querySelectorAll('td,th')].filter("
         "c=>c.getBoundingClientRect().right>W+1).length;"
+        # an equation wider than its cell must scroll inside it (div.eq), never be clipped
+        # by the cell or run past it
+        "const clip=m.filter(e=>{const c=e.closest('td,th');if(!c)return false;"
+        "const cr=c.getBoundingClientRect();const right=Math.max(e.getBoundingClientRect()"
+        ".right,...[...e.querySelectorAll('*')].map(x=>x.getBoundingClientRect().right));"
+        "if(right<=cr.right+1)return false;const w=e.closest('.eq');"
+        "return !(w&&getComputedStyle(w).overflowX==='auto'"
+        "&&w.getBoundingClientRect().right<=cr.right+1&&w.scrollWidth>w.clientWidth);}).length;"
         "document.title=`IMAGES ${ok}/${imgs.length} MATH ${mh}/${m.length} ROWS ${rows} "
-        "FINDINGS ${fv}/${li.length} RAW ${raw} WIDE ${wide}`;"
+        "FINDINGS ${fv}/${li.length} RAW ${raw} WIDE ${wide} CLIP ${clip}`;"
         "}</script>"
     )
     probe_page = index.parent / "probe.html"
@@ -248,6 +256,7 @@ def test_report_renders_in_headless_chromium(two_reports, tmp_path):
     assert 4 <= n_findings <= 6 and shown == n_findings, f"headline findings not rendered: {title}"
     assert parts[9] == "0", f"raw Python text on the page: {title}"
     assert parts[11] == "0", f"table cells wider than a 1280 px page: {title}"
+    assert parts[13] == "0", f"equations clipped or running out of their cells: {title}"
     png = shot.read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 50_000, "blank screenshot"
     # a non-blank page: many distinct pixel rows (decode via matplotlib, already a dependency)

@@ -38,23 +38,88 @@ def test_claim_standing_names_the_deciding_reading():
     claim = {"readings": [_reading("2pi*f", "not reproduced"), _reading("f", "reproduced")]}
     assert claim_standing(claim) == (
         "depends",
-        "holds only with a = f (the bandwidth read as rad/s)",
+        "holds with a = f (the bandwidth read as rad/s); "
+        "fails with a = 2 pi f (the bandwidth read in Hz)",
+    )
+    # with the configuration's bandwidth, each reading of a is named by its value
+    assert claim_standing(claim, 30.0)[1] == (
+        "holds with a = 30 rad/s (30 Hz read as rad/s); fails with a = 2 pi x 30 Hz = 188.5 rad/s"
     )
     claim["readings"][0]["verdict"] = "reproduced"
     assert claim_standing(claim)[0] == "holds"
     for r in claim["readings"]:
         r["verdict"] = "not reproduced"
-    assert claim_standing(claim)[0] == "fails"
+    assert claim_standing(claim) == ("fails", "under all 2 readings tried")
 
 
-def test_claim_standing_counts_when_no_single_reading_decides():
+def test_claim_standing_names_two_dimensions_when_no_single_one_decides():
+    """Verdicts decided by a and the band together: the condition names both, per side."""
     rs_ = [
         _reading("2pi*f", "reproduced", 0.02),
         _reading("2pi*f", "not reproduced", 0.05),
         _reading("f", "not reproduced", 0.02),
         _reading("f", "reproduced", 0.05),
     ]
-    assert claim_standing({"readings": rs_}) == ("depends", "holds under 2 of 4 readings")
+    standing, cond = claim_standing({"readings": rs_})
+    assert standing == "depends"
+    holds, fails = cond.split("; ")
+    assert holds == (
+        "holds with (a = 2 pi f (the bandwidth read in Hz) and the 2 % band) or "
+        "(a = f (the bandwidth read as rad/s) and the 5 % band)"
+    )
+    assert fails == (
+        "fails with (a = 2 pi f (the bandwidth read in Hz) and the 5 % band) or "
+        "(a = f (the bandwidth read as rad/s) and the 2 % band)"
+    )
+
+
+def test_claim_standing_leaves_out_a_dimension_that_does_not_matter_on_one_side():
+    """Only a = 2 pi f with the 2 % band holds; each failing alternative leaves one
+    dimension out (every value of it fails there)."""
+    rs_ = [
+        _reading("2pi*f", "reproduced", 0.02),
+        _reading("2pi*f", "not reproduced", 0.05),
+        _reading("f", "not reproduced", 0.02),
+        _reading("f", "not reproduced", 0.05),
+    ]
+    cond = claim_standing({"readings": rs_})[1]
+    assert cond.startswith("holds with a = 2 pi f (the bandwidth read in Hz) and the 2 % band;")
+    fails = cond.split("; ")[1].removeprefix("fails with ").split(" or ")
+    assert len(fails) == 2 and all(" and " not in f for f in fails), cond
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_claim_standing_condition_reproduces_every_verdict(seed):
+    """Random verdicts over a 2 x 3 x 2 reading grid: every reading matches exactly one side
+    of the condition, the side of its own verdict (the condition is computed, never typed)."""
+    import random
+
+    from ptoverify.report.standing_claims import reading_words
+
+    rng = random.Random(seed)
+    rs_ = [
+        {
+            "reading": {"a": a, "tracking": tr, "pto": p},
+            "verdict": rng.choice(["reproduced", "not reproduced"]),
+        }
+        for a in ("2pi*f", "f")
+        for tr in ("feed-forward", "none", "error")
+        for p in ("corrected", "printed")
+    ]
+    standing, cond = claim_standing({"readings": rs_})
+    if standing != "depends":
+        return
+    holds, fails = (side.split(" with ", 1)[1] for side in cond.split("; "))
+
+    def alternatives(side):
+        alts = side.split(" or ")
+        return [(a[1:-1] if a.startswith("(") else a).split(" and ") for a in alts]
+
+    for r in rs_:
+        words = {reading_words(d, v) for d, v in r["reading"].items()}
+        in_holds = any(set(alt) <= words for alt in alternatives(holds))
+        in_fails = any(set(alt) <= words for alt in alternatives(fails))
+        assert in_holds == (r["verdict"] == "reproduced") and in_fails != in_holds, (r, cond)
 
 
 def test_reviewer_table_has_every_claim(base):
@@ -109,11 +174,11 @@ def test_settling_finding_names_who_settles_first_under_each_reading(base):
     )
     v = prim["values"]
     first = "PD settles first" if v["settling_pd_s"] < v["settling_pto_s"] else "PTO settles first"
-    assert f"(the bandwidth read in Hz) {first}" in text.replace("the corrected PTO", "PTO")
+    assert f"188.5 rad/s {first}" in text.replace("the corrected PTO", "PTO")
     v["settling_pd_s"], v["settling_pto_s"] = v["settling_pto_s"], v["settling_pd_s"]
     flipped = front._finding_settling(results_view(data))[0].replace("the corrected PTO", "PTO")
     other = "PTO settles first" if first == "PD settles first" else "PD settles first"
-    assert f"(the bandwidth read in Hz) {other}" in flipped
+    assert f"188.5 rad/s {other}" in flipped
 
 
 def test_claims_finding_says_more_or_less(base):
@@ -218,12 +283,12 @@ def test_versus_row_names_each_reading_and_infeasible_tunings(base):
     )
     answer = _rows(data)[VERSUS_QUESTION][1]
     two_pi, hz = answer.split("; ")
-    assert two_pi.startswith("a = 2 pi f") and "loses to PD" in two_pi
-    assert hz.startswith("a = f") and "beats PD" in hz
+    assert two_pi.startswith("a = 2 pi x 30 Hz = 188.5 rad/s") and "loses to PD" in two_pi
+    assert hz.startswith("a = 30 rad/s (30 Hz read as rad/s)") and "beats PD" in hz
     assert "no cascade P gains meet the constraints" in hz
     evidence = _rows(data)[VERSUS_QUESTION][2]
     assert "cascade P no tuning" in evidence and "settling definition 2pct" in evidence
-    assert "PTO 20 ms (0.7692 N*T, 0.8333 t_f*)" in evidence  # 20 / 26, 20 / 24
+    assert "PTO (corrected) 20 ms (0.7692 N*T, 0.8333 t_f*)" in evidence  # 20 / 26, 20 / 24
 
 
 def test_versus_row_with_one_reading_names_the_configured_a(base):
@@ -237,7 +302,7 @@ def test_versus_row_with_one_reading_names_the_configured_a(base):
     answer = _rows(data)[VERSUS_QUESTION][1]
     assert answer.startswith("a = 123 rad/s (the configuration's): beats PD")
     data["tuning"]["versus"] = _versus(T, {"2pi": {"pd": -3 * T}, "hz": {"pd": 3 * T}})
-    assert _rows(data)[VERSUS_QUESTION][1].startswith("a = 2 pi f")
+    assert _rows(data)[VERSUS_QUESTION][1].startswith("a = 2 pi x 30 Hz")
 
 
 def test_versus_row_says_when_tuning_was_skipped(base):
@@ -260,3 +325,55 @@ def test_tuned_delay_row_follows_the_tuned_loops_margins(base):
     assert answer.startswith("no: ") and "PTO" in answer
     laws[0]["delay_margin_samples"] = -1
     assert "unstable even without delay" in _rows(data)[q][2]
+
+
+# ---------------------------------------------------------------- one tie rule
+@pytest.mark.parametrize("samples", [-2.5, -1.01, -0.99, -0.5, 0.0, 0.3, 0.99, 1.01, 3.0])
+def test_claims_verdict_table_and_headline_share_one_tie_rule(base, samples):
+    """The PTO's time minus PD's, in samples: the claims' comparison (a claim of a quicker
+    PTO), the verdict table's and the baselines' row, and the headline all decide beats /
+    ties / loses alike, by the rule the report states (ptoverify.verdict.TIME_TIE_RULE)."""
+    from ptoverify.config import paper_config
+    from ptoverify.report.standing import TIE_NOTE, time_verdict, versus_verdict
+    from ptoverify.sim.exact import Compared
+    from ptoverify.studies.claims.measure import _Ctx
+    from ptoverify.verdict import TIME_TIE_RULE
+
+    cfg = paper_config()
+    T = cfg.plant.sample_time
+    pd = 0.0236
+    pto = pd + samples * T
+    expect = "ties" if abs(samples) < 1 else ("beats" if samples < 0 else "loses")
+    # the claims: "PTO quicker than PD" holds only when it beats PD; a tie is recorded
+    for grid in (False, True):
+        ctx = _Ctx.__new__(_Ctx)
+        ctx.cfg, ctx.grid, ctx.ties = cfg, grid, []
+        times = {"pto": Compared(pto, pto, 0.0, 1e-15), "pd": Compared(pd, pd, 0.0, 1e-15)}
+        ctx.metric = lambda law, signal, key, times=times: times[law]
+        quicker = ctx.less("pto", "pd", "step", "settling_2pct_s", ("a", "b"))
+        assert quicker == (expect == "beats") and bool(ctx.ties) == (expect == "ties")
+    # the verdict table's rows
+    assert time_verdict(pto, pd, T).startswith(
+        {"beats": "beats", "ties": "ties", "loses": "loses"}[expect]
+    )
+    row = versus_verdict(pto - pd, {"law": "pd", "infeasible": ""}, {"infeasible": ""}, T)
+    assert row.startswith(expect if expect != "loses" else "loses to")
+    # the headline: who settles first under the primary reading
+    data = copy.deepcopy(base)
+    data["environment"]["config"]["plant"]["sample_time"] = T
+    c = next(c for c in data["claims"] if c["id"] == "step-pd-31-percent")
+    for r in c["readings"]:
+        r["values"]["settling_pd_s"], r["values"]["settling_pto_s"] = pd, pto
+    text = front._finding_settling(results_view(data))[0]
+    said = {"beats": "the corrected PTO settles first", "ties": "tie (less than one sample apart)"}
+    assert said.get(expect, "PD settles first") in text
+    # and the rule is stated where the verdicts are shown
+    assert TIME_TIE_RULE in TIE_NOTE
+
+
+def test_the_tie_rule_is_stated_beside_the_verdicts_and_the_claims(base):
+    from ptoverify.report.sections import claims, verdict
+    from ptoverify.verdict import TIME_TIE_RULE
+
+    for blocks in (verdict(results_view(base)), claims(results_view(base), {})):
+        assert any(TIME_TIE_RULE in b.text for b in blocks)

@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from ptoverify.config import Config
+from ptoverify.conform.closedloop import SETTLING
 from ptoverify.conform.evidence import ConformEvidence
 from ptoverify.conform.gate import ConformResult
 from ptoverify.errors import InputError
@@ -45,8 +46,12 @@ from ptoverify.report.conform_conditions import (
     state,
 )
 from ptoverify.report.render import Block, Section, render_html, render_markdown
+from ptoverify.sim.settling import DEFINITIONS
 
 __all__ = ["check_report_target", "write_conform_report", "build_sections", "quantity", "state"]
+
+#: The settling definition of ``ptoverify report``'s suboptimality maps (the sweep's box).
+SWEEP_SETTLING = DEFINITIONS["box-0p01mm"]
 
 #: display name of a Verdict unit
 _UNITS = {"1": "count", "": "", "mm/s": "mm/s", "samples": "samples"}
@@ -313,13 +318,19 @@ def _closed_loop(r: ConformResult, ev: ConformEvidence) -> list[Block]:
     if s is None:
         blocks.append(_p(f"Settling / (N* T): {ev.settling_note}."))
         return blocks
+    name = s["definition"] if "definition" in s else SETTLING
     blocks.append(
         _p(
-            f"Settling time t_s (definition {s.get('definition', '0p001mm')}: |x1| <= "
+            f"Settling time t_s (definition {name}: |x1| <= "
             f"{quantity(s['band_mm'], 'mm')} for good, read on the samples) divided by "
             f"the discrete-time limit N* T (T = {quantity(s['sample_time_s'], 's')}), over the "
-            f"{s['states']} initial states of the settling sweep with N* >= 1 "
-            "(dimensionless; 1 is the fastest any sampled controller can be)."
+            f"{s['states']} initial states of this gate's settling sweep with N* >= 1 "
+            "(dimensionless; 1 is the fastest any sampled controller can be). Not the "
+            "suboptimality maps of `ptoverify report`: those read settling under "
+            f"{SWEEP_SETTLING.name} (|x1| <= {quantity(SWEEP_SETTLING.band_mm, 'mm')} and "
+            f"|x2| <= a x {quantity(SWEEP_SETTLING.velocity_band_mm, 'mm')}, held "
+            f"{quantity(1e3 * SWEEP_SETTLING.hold_s, 'ms')}) between the samples, over their own "
+            "grid of the envelope, so the reference's median there differs from this one."
         )
     )
     rows = []

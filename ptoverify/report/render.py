@@ -4,7 +4,9 @@ A report is a list of sections ``(anchor, title, blocks)``; a :class:`Block` is 
 paragraph, a table, a figure or a raw fragment (HTML with a plain-text twin
 for Markdown).  :func:`render_html` and :func:`render_markdown` print them.
 Every text that reaches the HTML goes through :func:`html.escape`; equations
-arrive as raw fragments of SymPy's presentation MathML (``derivations.render_html``).
+arrive as raw fragments of SymPy's presentation MathML (``derivations.render_html``),
+each in a ``div.eq`` that scrolls sideways inside its cell (:data:`CSS`), so a wide
+equation is neither clipped nor pushes its table past the page.
 
 Used by :mod:`ptoverify.report.collect` and :mod:`ptoverify.report.sections`, which
 both import it and not each other.
@@ -310,11 +312,15 @@ math{font-size:1.05em}code{font-size:.85em}pre{background:#f6f6f6;padding:.5em;o
 .headline ol{flex:1 1 28em;font-size:1.05em}.headline li{margin:.4em 0}
 .headline figure{flex:1 1 24em;margin:0}.row{display:flex;gap:1em;flex-wrap:wrap}
 .row figure{flex:1 1 22em}.erratum-block{border-left:4px solid #d88;padding:.2em 1em;margin:1em 0}
-table.derivations{table-layout:fixed;width:100%}table.derivations td{overflow-x:auto;
-overflow-wrap:anywhere}table.derivations th:nth-child(1),table.derivations td:nth-child(1){width:3.5em}
+table.derivations,.erratum-block table.forms{table-layout:fixed;width:100%}
+table.derivations th,table.derivations td,table.forms th,table.forms td{min-width:0;
+overflow-wrap:anywhere}
+.eq{overflow-x:auto;overflow-y:hidden;max-width:100%}.eq math{max-width:none}
+table.derivations th:nth-child(1),table.derivations td:nth-child(1){width:3.5em}
 table.derivations th:nth-child(2),table.derivations td:nth-child(2){width:9em}
 table.derivations th:nth-child(5),table.derivations td:nth-child(5){width:22%}
-td{overflow-wrap:break-word}table{max-width:100%}.erratum-block table td{overflow-x:auto;max-width:60em}"""
+table.forms th{width:7em}
+td{overflow-wrap:break-word}table{max-width:100%}"""
 
 #: Cell texts that get a CSS class (colour) of their own.
 STATUS_WORDS = frozenset(

@@ -27,6 +27,14 @@ from collections.abc import Mapping
 from typing import Any
 
 from ptoverify.report.render import fmt, qty
+from ptoverify.report.standing_claims import (
+    READING_WORDS,
+    bandwidth_hz,
+    claim_standing,
+    reading_words,
+)
+from ptoverify.report.words import LAW_WORDS, claim_quantity, claim_title, law_name, plural
+from ptoverify.verdict import TIME_TIE_RULE, time_order
 
 __all__ = [
     "claim_standing",
@@ -39,104 +47,11 @@ __all__ = [
     "READING_WORDS",
     "LAW_WORDS",
     "VERSUS_QUESTION",
+    "TIE_NOTE",
+    "time_verdict",
+    "claim_quantity",
+    "ratio_phrase",
 ]
-
-#: How each reading dimension of a claim reads in words.
-READING_WORDS: dict[str, dict[Any, str]] = {
-    "a": {
-        "2pi*f": "a = 2 pi f (the bandwidth read in Hz)",
-        "f": "a = f (the bandwidth read as rad/s)",
-    },
-    "pto": {"corrected": "the corrected PTO", "printed": "the PTO as printed"},
-    "tracking": {
-        "feed-forward": "feed-forward",
-        "none": "no feed-forward",
-        "error": "the law on the error, no feed-forward",
-    },
-    "gains": {},
-    "band": {},
-}
-
-
-def _ms(seconds: float | None) -> str:
-    return "never" if seconds is None else qty(1e3 * seconds, "ms")
-
-
-def reading_words(dim: str, value: Any) -> str:
-    """Return one reading dimension's value in words (``a = f (the bandwidth read as rad/s)``).
-
-    Parameters
-    ----------
-    dim : str
-        The dimension (``a``, ``band``, ``pto``, ``tracking``, ``gains``).
-    value : Any
-        Its value in the claims' ``reading``.
-
-    Returns
-    -------
-    str
-    """
-    words = READING_WORDS.get(dim, {})
-    if value in words:
-        return words[value]
-    if dim == "band" and isinstance(value, float):
-        return f"the {fmt(100 * value)} % band"
-    if dim == "gains" and value is None:
-        return "the paper's gains"
-    if dim == "gains":
-        return f"tuning {value}"
-    return f"{dim} = {fmt(value)}"
-
-
-def claim_standing(claim: Mapping) -> tuple[str, str]:
-    """Return ``(standing, condition)`` of one claim: holds, fails or depends.
-
-    Parameters
-    ----------
-    claim : Mapping
-        One entry of ``results.json``'s ``claims`` (``readings``, each with its
-        ``reading`` dimensions and ``verdict``).
-
-    Returns
-    -------
-    tuple of str
-        ``holds`` (every reading reproduces it), ``fails`` (none does) or
-        ``depends``; the condition names the dimension that decides a claim that
-        depends (every reading with the named values reproduces it and no other
-        does), else how many readings reproduce it.
-
-    Examples
-    --------
-    >>> r = lambda a, v: {"reading": {"a": a, "band": 0.02}, "verdict": v}
-    >>> claim_standing({"readings": [r("2pi*f", "not reproduced"), r("f", "reproduced")]})
-    ('depends', 'holds only with a = f (the bandwidth read as rad/s)')
-    """
-    readings = list(claim["readings"])
-    ok = [r["verdict"] == "reproduced" for r in readings]
-    if readings and all(ok):
-        return "holds", "under every reading tried"
-    if not any(ok):
-        return "fails", f"under every reading tried ({len(readings)})"
-    dims = list(dict.fromkeys(k for r in readings for k in r["reading"]))
-    for dim in dims:
-        values = {}
-        for r, good in zip(readings, ok, strict=True):
-            values.setdefault(_key(r["reading"][dim] if dim in r["reading"] else None), []).append(
-                good
-            )
-        if len(values) > 1 and all(all(v) or not any(v) for v in values.values()):
-            holding = [k for k, v in values.items() if all(v)]
-            words = " or ".join(reading_words(dim, _unkey(k)) for k in holding)
-            return "depends", f"holds only with {words}"
-    return "depends", f"holds under {sum(ok)} of {len(readings)} readings"
-
-
-def _key(value: Any) -> Any:
-    return tuple(value) if isinstance(value, (list, tuple)) else value
-
-
-def _unkey(value: Any) -> Any:
-    return list(value) if isinstance(value, tuple) else value
 
 
 def reviewer_rows(res: Mapping) -> list[list[str]]:
@@ -153,16 +68,21 @@ def reviewer_rows(res: Mapping) -> list[list[str]]:
         One row per claim; ``measured`` is the primary reading's value with its unit.
     """
     rows = []
+    hz = bandwidth_hz(res)
     for c in res["claims"]:
-        standing, cond = claim_standing(c)
+        standing, cond = claim_standing(c, hz)
         unit = c["unit"]
         rows.append(
             [
-                c["claim"],
+                claim_title(c),
                 standing,
                 cond,
-                qty(c["paper_value"], unit) if c["paper_value"] is not None else "qualitative",
-                qty(c["measured"], unit) if c["measured"] is not None else "see the claims table",
+                claim_quantity(c["paper_value"], unit)
+                if c["paper_value"] is not None
+                else "qualitative",
+                claim_quantity(c["measured"], unit)
+                if c["measured"] is not None
+                else "see the claims table",
             ]
         )
     return rows
@@ -192,12 +112,51 @@ def step_readings(res: Mapping) -> dict[str, Mapping]:
     return out
 
 
-def _faster(pto: float | None, pd: float | None, sample: float) -> str:
-    if pto is None or pd is None:
+def _ms(seconds: float | None) -> str:
+    return "never" if seconds is None else qty(1e3 * seconds, "ms")
+
+
+#: The tie rule as the verdict table states it (the one rule of
+#: :func:`ptoverify.verdict.time_order`, which the claims' verdicts use too).
+TIE_NOTE = (
+    f"Ties: {TIME_TIE_RULE}; every 'beats', 'ties', 'loses', 'settles first' and every "
+    "claim of a quicker or shorter time in this report is decided by that one rule."
+)
+
+
+def time_verdict(pto: float | None, other: float | None, sample: float, name: str = "PD") -> str:
+    """Return the PTO's time against another law's under the tie rule: beats, ties or loses.
+
+    Parameters
+    ----------
+    pto, other : float or None
+        The two times [s] (None: that law never settles).
+    sample : float
+        T [s].
+    name : str
+        The other law's display name.
+
+    Returns
+    -------
+    str
+        ``beats PD``, ``ties PD (less than one sample apart)``, ``loses to PD``, or
+        no verdict; decided by :func:`ptoverify.verdict.time_order`.
+
+    Examples
+    --------
+    >>> time_verdict(0.02225, 0.02231, 0.002), time_verdict(0.020, 0.030, 0.002)
+    ('ties PD (less than one sample apart)', 'beats PD')
+    """
+    order = time_order(pto, other, sample)
+    if order is None:
         return "no verdict (a law never settles)"
-    if abs(pto - pd) <= sample:
-        return "ties PD (within one sample)"
-    return "beats PD" if pto < pd else "loses to PD"
+    if order == 0:
+        return f"ties {name} (less than one sample apart)"
+    return f"beats {name}" if order < 0 else f"loses to {name}"
+
+
+def _faster(pto: float | None, pd: float | None, sample: float) -> str:
+    return time_verdict(pto, pd, sample)
 
 
 def engineer_rows(res: Mapping) -> list[list[str]]:
@@ -232,7 +191,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             v = r["values"]
             verdicts.append(_faster(v["settling_pto_s"], v["settling_pd_s"], T))
             parts.append(
-                f"{reading_words('a', a)}: PTO {_ms(v['settling_pto_s'])}, "
+                f"{reading_words('a', a, bandwidth_hz(res))}: PTO {_ms(v['settling_pto_s'])}, "
                 f"PD {_ms(v['settling_pd_s'])}"
             )
         answer = (
@@ -240,7 +199,8 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             if len(set(verdicts)) == 1
             else "depends on the reading of a: "
             + "; ".join(
-                f"{reading_words('a', a)}: {w}" for a, w in zip(step, verdicts, strict=True)
+                f"{reading_words('a', a, bandwidth_hz(res))}: {w}"
+                for a, w in zip(step, verdicts, strict=True)
             )
         )
         rows.append(
@@ -271,7 +231,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
                 "yes" if d1 is not None else "no: needs delay compensation or lower gains",
                 "PTO linear zone with one sample of delay: "
                 + (
-                    f"stable for a_true / a_design in {ratio_interval(d1)}"
+                    f"stable for a_true / a_design {ratio_phrase(d1)}"
                     if d1
                     else m["linear_loop_note_delay1"]
                 ),
@@ -284,8 +244,9 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
         rows.append(
             [
                 "Tolerates a bandwidth other than the design value?",
-                f"a_true / a_design in {ratio_interval(nd)}" if nd else m["linear_loop_note"],
-                f"PTO linear loop stable for {ratio_interval(nd)}; PD for {ratio_interval(pd_nd)}",
+                f"a_true / a_design {ratio_phrase(nd)}" if nd else m["linear_loop_note"],
+                f"PTO linear loop stable for a_true / a_design {ratio_phrase(nd)}; PD "
+                f"{ratio_phrase(pd_nd)}",
             ]
         )
     loops = res["poles"]["loops"]
@@ -343,27 +304,24 @@ def tuned_delay_row(res: Mapping) -> list[str] | None:
         return None
 
     def words(n: int) -> str:
-        return "unstable even without delay" if n < 0 else f"{n} sample{'s' if n != 1 else ''}"
+        return "unstable even without delay" if n < 0 else plural(n, "sample")
 
     short = [x for x in tuned if x["delay_margin_samples"] < 1]
     answer = (
         "yes: every tuned loop tolerates at least one sample"
         if not short
         else "no: "
-        + ", ".join(LAW_WORDS.get(x["law"], x["law"]) for x in short)
+        + ", ".join(law_name(x["law"]) for x in short)
         + (" is" if len(short) == 1 else " are each")
         + " unstable at the best tuning with one sample of delay (tune with the delay in "
         "the loop, or compensate it)"
     )
     evidence = "; ".join(
-        f"{LAW_WORDS.get(x['law'], x['law'])}: tolerates {words(x['delay_margin_samples'])}"
-        for x in tuned
+        f"{law_name(x['law'])}: tolerates {words(x['delay_margin_samples'])}" for x in tuned
     )
     return ["Do the tuned gains tolerate a one-sample computation delay?", answer, evidence]
 
 
-#: How the compared laws are named in the verdict table.
-LAW_WORDS = {"pto": "PTO", "pd": "PD", "ptos": "PTOS", "cascade-p": "cascade P"}
 #: The question of the baselines' row.
 VERSUS_QUESTION = "Faster than fair-tuned PD, PTOS and the cascade P loop (step)?"
 
@@ -378,21 +336,22 @@ def versus_verdict(diff: float | None, other: Mapping, pto: Mapping, sample: flo
     other, pto : Mapping
         The two tuned laws (``law``, ``infeasible``) of ``tuning.versus``.
     sample : float
-        T [s]: a difference within one sample is a tie.
+        T [s]: a tie under :func:`ptoverify.verdict.time_order` (less than one sample apart).
 
     Returns
     -------
     str
         E.g. ``beats PTOS by 1.264 ms``.
     """
-    name = LAW_WORDS.get(other["law"], other["law"])
+    name = law_name(other["law"])
     if pto["infeasible"]:
         return f"no verdict against {name} (no PTO gains meet the constraints)"
     if other["infeasible"] or diff is None:
         return f"no {name} gains meet the constraints"
-    if abs(diff) <= sample:
-        return f"ties {name} (within one sample, {_ms(abs(diff))} apart)"
-    return f"{'beats' if diff < 0 else 'loses to'} {name} by {_ms(abs(diff))}"
+    order = time_order(diff, 0.0, sample)
+    if order == 0:
+        return f"ties {name} (less than one sample apart: {_ms(abs(diff))})"
+    return f"{'beats' if order < 0 else 'loses to'} {name} by {_ms(abs(diff))}"
 
 
 def versus_row(res: Mapping) -> list[str]:
@@ -427,13 +386,15 @@ def versus_row(res: Mapping) -> list[str]:
             if x["law"] != "pto"
         ]
         words = (
-            reading_words("a", {"2pi": "2pi*f", "hz": "f"}.get(r["reading"], r["reading"]))
+            reading_words(
+                "a", {"2pi": "2pi*f", "hz": "f"}.get(r["reading"], r["reading"]), bandwidth_hz(res)
+            )
             if len(v["readings"]) > 1
             else f"a = {qty(r['a'], 'rad/s')} (the configuration's)"
         )
         answers.append(f"{words}: {', '.join(verdicts)}")
         times = ", ".join(
-            f"{LAW_WORDS.get(x['law'], x['law'])} "
+            f"{law_name(x['law'])} "
             + (
                 "no tuning"
                 if x["infeasible"]
@@ -466,7 +427,7 @@ def _margins(loop: Mapping) -> str:
     delay = (
         "unstable without delay"
         if n < 0
-        else f"tolerates {n} sample{'s' if n != 1 else ''} of computation delay"
+        else f"tolerates {plural(n, 'sample')} of computation delay"
     )
     return (
         f"gain margin {qty(loop['gain_margin_db'], 'dB')}, phase margin "
@@ -490,12 +451,33 @@ def ratio_interval(iv: Any) -> str:
         return "no interval (unstable at the design point)"
     lo, hi = iv
     if lo is None and hi is None:
-        return "the whole searched range"
+        return "anywhere in the searched [0.1, 10]"
     if lo is None:
-        return f"from below the searched 0.1 up to {fmt(hi)}"
+        return f"up to {fmt(hi)}, with no lower limit down to the searched 0.1"
     if hi is None:
-        return f"from {fmt(lo)} up past the searched 10"
+        return f"from {fmt(lo)}, with no upper limit up to the searched 10"
     return f"[{fmt(lo)}, {fmt(hi)}]"
+
+
+def ratio_phrase(iv: Any) -> str:
+    """Return what follows "a_true / a_design" in a sentence: ``in [lo, hi]``, ``up to hi (...)``.
+
+    Parameters
+    ----------
+    iv : sequence or None
+        As :func:`ratio_interval`.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> ratio_phrase([0.5, 1.2]), ratio_phrase([None, 1.5])
+    ('in [0.5, 1.2]', 'up to 1.5, with no lower limit down to the searched 0.1')
+    """
+    text = ratio_interval(iv)
+    return f"in {text}" if text.startswith("[") else text
 
 
 def adoption(res: Mapping) -> str:

@@ -11,7 +11,7 @@ measured on the Section 6 step: its settling time under the named definition
 :data:`SETTLING` (:data:`ptoverify.sim.settling.DEFINITIONS`, the tuner's
 objective), and that time over the step's floors N* T and t_f*.  The comparison
 records, for each other law, the PTO's settling minus the other's [s]; the
-report reads its verdict (beats, ties within one sample, loses) off these numbers.
+report reads its verdict (beats, ties, loses; :func:`ptoverify.verdict.time_order`) off these numbers.
 
 A law whose tuning finds no gains meeting the constraints is recorded with the
 reason and no numbers.
@@ -93,7 +93,7 @@ class ReadingVersus:
     a : float
         The plant's bandwidth under that reading [rad/s].
     sample_time : float
-        T [s] (a tie is a difference within one sample).
+        T [s] (two times less than one sample apart tie: :data:`ptoverify.verdict.TIME_TIE_RULE`).
     bound_mm : float
         The shared overshoot bound [mm].
     nt_s, tf_s : float

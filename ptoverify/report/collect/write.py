@@ -32,7 +32,13 @@ def downloads_intro(traces: list[str]) -> str:
     str
         Markdown-style text with links (the HTML renders them as links too).
     """
-    links = ", ".join(f"[{Path(t).stem.replace('_', ' ')}]({t})" for t in traces)
+    from ptoverify.report.words import law_name
+
+    def words(stem: str) -> str:  # "pto-printed_ramp" -> "PTO as printed, ramp"
+        law, _, signal = stem.rpartition("_")
+        return f"{law_name(law)}, {signal}" if law else stem
+
+    links = "; ".join(f"[{words(Path(t).stem)}]({t})" for t in traces)
     text = (
         f'Verifies the PTO law of the paper "{PAPER_TITLE}" against its own equations, '
         "exact minimum times and simulation. Every number below is computed; the paper's "

@@ -16,16 +16,20 @@ import numpy as np
 from matplotlib.colors import ListedColormap
 
 from ptoverify.report.plots.common import folder, save_drawing
+from ptoverify.report.words import law_name, setting_words
 
 __all__ = ["plot_penalty", "plot_design", "save_charts", "save_penalty", "LAW_COLOURS"]
 
 #: Colour and label of each law in these figures.
 LAW_COLOURS = {
-    "to": ("tab:red", "TO"),
-    "pd": ("tab:blue", "PD"),
-    "pto": ("tab:green", "PTO (corrected)"),
-    "ptos": ("tab:purple", "PTOS"),
-    "cascade-p": ("tab:brown", "cascade P"),
+    law: (colour, law_name(law))
+    for law, colour in (
+        ("to", "tab:red"),
+        ("pd", "tab:blue"),
+        ("pto", "tab:green"),
+        ("ptos", "tab:purple"),
+        ("cascade-p", "tab:brown"),
+    )
 }
 
 
@@ -55,7 +59,7 @@ def plot_penalty(penalty: Mapping, axes) -> dict:
     (drawn["t_f*"],) = left.loglog(s, 1e3 * _col(penalty["t_f_s"]), "k-", lw=1.0, label="t_f*")
     (drawn["N* T"],) = left.loglog(s, 1e3 * _col(penalty["nt_s"]), "k:", lw=1.0, label="N* T")
     for law, c in penalty["laws"].items():
-        colour, label = LAW_COLOURS.get(law, ("grey", law))
+        colour, label = LAW_COLOURS.get(law, ("grey", law_name(law)))
         (drawn[label],) = left.loglog(
             s, 1e3 * _col(c["settling_s"]), color=colour, lw=1.3, label=label
         )
@@ -65,7 +69,7 @@ def plot_penalty(penalty: Mapping, axes) -> dict:
     left.set_ylabel(f"settling time ({penalty['settling_definition']}) [ms]")
     right.set_xlabel("move size [mm]")
     right.set_ylabel("settling / (N* T) [-]")
-    left.set_title(f"gains: {penalty['setting']}", fontsize=9)
+    left.set_title(setting_words(penalty["setting"]), fontsize=9)
     right.set_title("ratio to the sampled limit (not settled: no point)", fontsize=9)
     for ax in axes:
         ax.grid(True, which="both", lw=0.3)

@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 from ptoverify.config import Plant
 from ptoverify.model.curves import level_curve_x1
 from ptoverify.model.laws import Region
+from ptoverify.report.words import law_name
 
 if TYPE_CHECKING:  # data types for annotations only
     from matplotlib.axes import Axes
@@ -35,10 +36,10 @@ SIZE = (6.4, 4.2)
 RENDER_RC = {"text.hinting": "no_hinting"}
 #: Line style of each law in the response figures.
 STYLE = {
-    "to": dict(color="tab:red", lw=1.0, label="TO"),
-    "pd": dict(color="tab:blue", lw=1.3, label="PD"),
-    "pto": dict(color="tab:green", lw=1.6, label="PTO (corrected zone)"),
-    "pto-printed": dict(color="tab:orange", lw=1.2, ls="--", label="PTO (as printed)"),
+    "to": dict(color="tab:red", lw=1.0, label=law_name("to")),
+    "pd": dict(color="tab:blue", lw=1.3, label=law_name("pd")),
+    "pto": dict(color="tab:green", lw=1.6, label=law_name("pto")),
+    "pto-printed": dict(color="tab:orange", lw=1.2, ls="--", label=law_name("pto-printed")),
 }
 #: Colour and legend label of each region of the PTO law (Fig. 6).
 REGION_STYLE = {

@@ -28,6 +28,7 @@ from ptoverify.report.plots.common import (
     new_axes,
     switching_curves,
 )
+from ptoverify.report.words import law_name
 
 if TYPE_CHECKING:  # data types for annotations only: no simulator, no zone construction
     from ptoverify.model.zones import PTOZone
@@ -263,7 +264,7 @@ def plot_fig6(zone: PTOZone, cfg: Config, batch: BatchResult, law: str, ax=None)
     drawn = plot_zones(zone, cfg, ax)
     ax = drawn["l1 (eq. 9), x2 <= 0"].axes
     x1, x2 = batch.x1[:, 0], batch.x2[:, 0]
-    (line,) = ax.plot(x1, x2, color="0.4", lw=0.8, label=f"{law} trajectory")
+    (line,) = ax.plot(x1, x2, color="0.4", lw=0.8, label=f"{law_name(law)} trajectory")
     drawn[line.get_label()] = line
     reg = batch.region[:, 0]
     lo, hi = ax.get_xlim()
@@ -274,7 +275,8 @@ def plot_fig6(zone: PTOZone, cfg: Config, batch: BatchResult, law: str, ax=None)
             key = f"sample in {lab}"
             drawn[key] = ax.scatter(x1[k], x2[k], s=14, color=col, zorder=3, label=key)
     ax.set_title(
-        f"Fig. 6: {law} from ({x1[0]:g} mm, {x2[0]:g} mm/s), region of each sample", fontsize=9
+        f"Fig. 6: {law_name(law)} from ({x1[0]:g} mm, {x2[0]:g} mm/s), region of each sample",
+        fontsize=9,
     )
     ax.legend(fontsize=6, loc="lower left")
     return drawn

@@ -20,13 +20,14 @@ from matplotlib.colors import ListedColormap
 from numpy.typing import NDArray
 
 from ptoverify.report.plots.common import (
-    STYLE,
     folder,
     new_axes,
     new_figure,
     save_figure,
     write_png,
 )
+from ptoverify.report.words import law_name, plural
+from ptoverify.sim.settling import DEFINITIONS
 
 if TYPE_CHECKING:  # data types for annotations only: no solver, no sweep
     from ptoverify.model.ocp import ConvergenceStudy
@@ -87,6 +88,9 @@ def plot_sweep(
     ls = res.laws[law]
     ratio = ls.ratio_tf if which == "tf" else ls.ratio_nt
     den = "t_f*" if which == "tf" else "N* T"
+    box, st = DEFINITIONS["box-0p01mm"], res.settings
+    named = (st.band, st.hold, st.velocity_band) == (box.band_mm, box.hold_s, None)
+    definition = box.name if named else f"a {st.band:g} mm box"
     drawn: dict = {}
     finite = ratio[np.isfinite(ratio)]
     if vmax is None:
@@ -130,7 +134,7 @@ def plot_sweep(
     ax.set_xlabel("initial position x1 [mm]")
     ax.set_ylabel("initial velocity x2 [mm/s]")
     ax.set_title(
-        f"{law}: settling (0.01 mm) / {den}; grey: never settles "
+        f"{law_name(law)}: settling ({definition}) / {den}; grey: never settles "
         f"({100 * (1 - ls.fraction_settled):.0f} %)",
         fontsize=8,
     )
@@ -277,7 +281,8 @@ def plot_robust_map(
     ax.set_yticks(range(len(wrs)), [f"{r:.3g}" for r in wrs], fontsize=7)
     ax.set_xlabel("a_true / a_design [-]")
     ax.set_ylabel("w_max,true / w_max [-]")
-    ax.set_title(f"{law}, delay {delay} sample{'s' if delay != 1 else ''}", fontsize=9)
+    lag = f"a delay of {plural(delay, 'sample')}" if delay else "no delay"
+    ax.set_title(f"{law_name(law)}, {lag}", fontsize=9)
     return {"map": mesh}
 
 
@@ -317,12 +322,8 @@ def save_robust(maps: Mapping, outdir: str | Path) -> list[Path]:
 
 
 def _law_name(law: str) -> str:
-    """Return a law's name for a legend (the response figures' labels; else the id)."""
-    return (
-        STYLE[law]["label"]
-        if law in STYLE
-        else {"ptos": "PTOS", "cascade-p": "cascade P"}.get(law, law)
-    )
+    """Return a law's display name (:func:`ptoverify.report.words.law_name`)."""
+    return law_name(law)
 
 
 def plot_pareto(tuning: Mapping, ax=None) -> dict:
@@ -588,5 +589,5 @@ def save_proof_map(proof: Any, path: str | Path) -> Path:
     fig.colorbar(mesh, ax=ax, label="certified samples to the target ellipse [samples]")
     ax.set_xlabel("x1 [mm]")
     ax.set_ylabel("x2 [mm/s]")
-    ax.set_title(f"{proof.law}: certified bound per cell (red: unproven)")
+    ax.set_title(f"{law_name(proof.law)}: certified bound per cell (red: unproven)")
     return write_png(fig, path)

@@ -7,13 +7,12 @@ from typing import Any
 import numpy as np
 
 from ptoverify.report.render import Block, fmt, qty, table
+from ptoverify.report.words import setting_words
 
 from .common import _law, _ms, figure
 
 #: How many move sizes the penalty table shows (evenly spread over the log-spaced sizes).
 TABLE_SIZES = 6
-#: Short names of the laws in the chart's cells and sentences.
-SHORT = {"pd": "PD", "pto": "PTO", "ptos": "PTOS", "cascade-p": "cascade P", "to": "TO"}
 
 
 def _worst(values: Any, sizes: Any) -> tuple[Any, Any]:
@@ -52,9 +51,8 @@ def _penalty_blocks(p: Any, figures: dict[str, str], stem: str, csv: str) -> lis
     return [
         Block(
             "p",
-            text=f"Gains: {p['setting']}. The worst settling / (N* T) over the moves: "
-            + "; ".join(worst)
-            + f". The curves as CSV: [{csv}]({csv}).",
+            text=f"Gains: {setting_words(p['setting'])}. The worst settling / (N* T) over the "
+            "moves: " + "; ".join(worst) + f". The curves as CSV: [{csv}]({csv}).",
         ),
         table(
             ["move", "t_f*", "N* T", *[f"{_law(law)} settling" for law in laws]],
@@ -74,7 +72,7 @@ def _design_blocks(d: Any, figures: dict[str, str]) -> list[Block]:
     lead = []
     for law, f in sm["fastest"].items():
         by = f", ahead by up to x{fmt(f['by_max'])}" if f["by_max"] else ""
-        lead.append(f"{SHORT.get(law, law)} in {f['cells']} of {sm['cells']} cells{by}")
+        lead.append(f"{_law(law)} in {f['cells']} of {sm['cells']} cells{by}")
 
     def where(cells: Any) -> str:
         return "; ".join(_cell_words(t, f) for t, f in cells) if cells else "none"
@@ -94,7 +92,7 @@ def _design_blocks(d: Any, figures: dict[str, str]) -> list[Block]:
         pt = d["points"][sm["paper_cell"]]
         text += (
             f" At the configuration's own point ({_cell_words(pt['sample_time'], pt['bandwidth_hz'])})"
-            f" the fastest is {SHORT.get(pt['fastest'], pt['fastest'] or 'none')}."
+            f" the fastest is {_law(pt['fastest']) if pt['fastest'] else 'none'}."
         )
     text += " `ptoverify design` draws finer charts, and tunes each law at each point (--tuned)."
     grid = {(p["sample_time"], p["bandwidth_hz"]): p for p in d["points"]}
@@ -104,7 +102,7 @@ def _design_blocks(d: Any, figures: dict[str, str]) -> list[Block]:
         for f in fs:
             p = grid[(t, f)]
             by = p["fastest_by"]
-            cell = SHORT.get(p["fastest"], p["fastest"] or "none")
+            cell = _law(p["fastest"]) if p["fastest"] else "none"
             if isinstance(by, (int, float)):
                 cell += f" (next x{fmt(by)})"
             pto = next((r for r in p["laws"] if r["law"] == "pto"), None)

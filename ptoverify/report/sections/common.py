@@ -12,22 +12,15 @@ from ptoverify.report.render import (
     qty,
     table,
 )
+from ptoverify.report.words import LAW_WORDS, claim_quantity, display_unit, law_name
 
-LAW_WORDS = {
-    "to": "TO",
-    "pd": "PD",
-    "pto": "PTO (corrected)",
-    "pto-printed": "PTO as printed",
-    "ptos": "PTOS",
-    "cascade-p": "cascade P",
-}
-
+__all__ = ["LAW_WORDS", "CAPTIONS", "figure", "verdict", "measured_quantity"]
 
 _MATH = '<math xmlns="http://www.w3.org/1998/Math/MathML" display="block">{}</math>'
 
 
 def _law(name: str) -> str:
-    return LAW_WORDS.get(name, name)
+    return law_name(name)
 
 
 def _ms(seconds: float | None) -> str:
@@ -135,7 +128,7 @@ def verdict(res: Any) -> list[Block]:
     -------
     list of Block
     """
-    from ptoverify.report.standing import adoption, engineer_rows, reviewer_rows
+    from ptoverify.report.standing import TIE_NOTE, adoption, engineer_rows, reviewer_rows
 
     return [
         Block("p", text=adoption(res)),
@@ -147,21 +140,23 @@ def verdict(res: Any) -> list[Block]:
         Block(
             "p",
             text="'holds': every reading tried reproduces the claim; 'fails': none does; "
-            "'depends': some do, and the condition names what decides it. Readings: the "
-            "bandwidth's a as 2 pi f or as f in rad/s, the settling band, the PTO's zone as "
-            "printed or corrected, the tracking, the tuning (see section claims).",
+            "'depends': some do, and the condition names the readings it holds with and "
+            "those it fails with. Readings: the bandwidth's a as 2 pi f or as f in rad/s, the "
+            "settling band, the PTO's zone as printed or corrected, the tracking, the tuning "
+            "(see the Section 6 claims).",
         ),
+        Block("p", text=TIE_NOTE),
     ]
 
 
 # ------------------------------------------------------------------ units
 def _display_unit(unit: str) -> tuple[str, float]:
-    """Return the unit a claim's number is shown in, and the factor from its stored unit."""
-    if unit == "s":
-        return "ms", 1e3
-    if unit == "reversals":
-        return "sign reversals", 1.0
-    return unit, 1.0
+    """Return the unit a claim's number is shown in (:func:`ptoverify.report.words.display_unit`)."""
+    return display_unit(unit)
+
+
+#: Tokens of the claims' value names, as a reader writes them.
+_TOKEN_WORDS = {"pto": "PTO", "pd": "PD", "to": "TO", "rms": "RMS"}
 
 
 def measured_quantity(c: dict[str, Any]) -> str:
@@ -185,16 +180,15 @@ def measured_quantity(c: dict[str, Any]) -> str:
     name = next(
         (k for k, v in values.items() if isinstance(v, (int, float)) and v == c["measured"]), ""
     )
-    words = re.sub(r"_(mm_s|mm|s|deg|percent)$", "", name).replace("_", " ")
+    words = " ".join(
+        _TOKEN_WORDS.get(w, w) for w in re.sub(r"_(mm_s|mm|s|deg|percent)$", "", name).split("_")
+    )
     unit, _ = _display_unit(c["unit"])
     return f"{words or 'value'} [{unit or '-'}]"
 
 
 def _claim_qty(v: float | None, unit: str) -> str:
-    if v is None:
-        return "n/a"
-    u, scale = _display_unit(unit)
-    return qty(v * scale, u)
+    return claim_quantity(v, unit)
 
 
 def _same(a: float | None, b: float | None) -> bool:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import html
 import math
 import re
+from collections.abc import Mapping
 from typing import Any
 
 from ptoverify.report.render import (
@@ -99,6 +100,55 @@ def _eq_links(head: str, ids: set[str]) -> str:
     return "".join(parts)
 
 
+#: What the extra fields of a counterexample are, in words.
+EXTRA_WORDS = {
+    "state_on_l1": "a state on l1 (x1, x2)",
+    "image_under_plus_omega_m": "its state one sample later under u = +omega_m (x1, x2)",
+    "image_under_minus_omega_m": "its state one sample later under u = -omega_m (x1, x2)",
+}
+
+
+def same_counterexample(errata: list[dict[str, Any]]) -> dict[str, str]:
+    """Map each erratum whose counterexample repeats an earlier erratum's to that erratum's id.
+
+    Parameters
+    ----------
+    errata : list of dict
+        The erratum records (``id``, ``counterexample``) in the report's order.
+
+    Returns
+    -------
+    dict
+        Erratum id -> id of the first erratum with the same counterexample (point
+        and values); an erratum with a counterexample of its own is not a key.
+
+    Examples
+    --------
+    >>> ce = {"point": {"a": 1.0}, "printed": [2.0], "derived": [0.0]}
+    >>> same_counterexample([{"id": "18", "counterexample": ce}, {"id": "19", "counterexample": ce}])
+    {'19': '18'}
+    """
+
+    def canon(v: Any) -> Any:  # a hashable form of nested mappings and lists
+        if isinstance(v, Mapping):
+            return tuple(sorted((k, canon(v[k])) for k in v))
+        if isinstance(v, (list, tuple)):
+            return tuple(canon(x) for x in v)
+        return v
+
+    seen: dict[Any, str] = {}
+    out: dict[str, str] = {}
+    for r in errata:
+        if not r["counterexample"]:
+            continue
+        key = canon(r["counterexample"])
+        if key in seen:
+            out[r["id"]] = seen[key]
+        else:
+            seen[key] = r["id"]
+    return out
+
+
 def _counterexample_rows(ce: dict[str, Any], unit: str) -> tuple[list[str], list[list[str]]]:
     """Table rows of a counterexample: its point (with units), printed and derived values."""
     cols = [("random admissible point", ce)]
@@ -122,7 +172,13 @@ def _counterexample_rows(ce: dict[str, Any], unit: str) -> tuple[list[str], list
         )
     for n in extra:
         u = "mm, mm/s" if isinstance(ce[n], (list, tuple)) and len(ce[n]) == 2 else ""
-        rows.append([n.replace("_", " "), f"{fmt(ce[n])} {u}".strip(), *["" for _ in cols[1:]]])
+        rows.append(
+            [
+                EXTRA_WORDS.get(n, n.replace("_", " ")),
+                f"{fmt(ce[n])} {u}".strip(),
+                *["" for _ in cols[1:]],
+            ]
+        )
     for which in ("printed", "derived"):
         vals = [c[which] for _, c in cols]
         vals = [v[0] if isinstance(v, (list, tuple)) and len(v) == 1 else v for v in vals]
@@ -242,12 +298,22 @@ def errata(res: dict[str, Any], records: list, rendered: dict | None = None) -> 
             "equations downstream that change with it.",
         )
     ]
+    repeats = same_counterexample(err)
     for r in err:
         done = rendered.get(r["id"], {})
         ml = done.get("mathml", {})
         unit = done.get("unit") or _expr_unit(r["derived"]) or _expr_unit(r["printed"])
         head, rows = _counterexample_rows(r["counterexample"] or {}, unit)
         tb = table(head, rows)
+        if r["id"] in repeats:
+            ce_words = (
+                f"No counterexample of its own: the one computed for it is eq. "
+                f"({repeats[r['id']]})'s (the same point and values), so it is not repeated here."
+            )
+        elif not r["counterexample"]:
+            ce_words = "No counterexample was computed for it."
+        else:
+            ce_words = "Counterexample (each row in its own unit):"
         forms = []
         for key, label in (
             ("printed", "printed"),
@@ -263,7 +329,7 @@ def errata(res: dict[str, Any], records: list, rendered: dict | None = None) -> 
                     body = (
                         f"<code>{html.escape(tilde_text(r[key]) + (' = 0' if zero else ''))}</code>"
                     )
-                forms.append(f"<tr><th>{label}</th><td>{body}</td></tr>")
+                forms.append(f'<tr><th>{label}</th><td><div class="eq">{body}</div></td></tr>')
         down = [i.split(":", 1) for i in r["inherits"]]
         lis = "".join(
             f"<li>eq. {_eq_links(h.strip(), ids)}: {html.escape(tilde_text(t.strip()))}</li>"
@@ -276,8 +342,9 @@ def errata(res: dict[str, Any], records: list, rendered: dict | None = None) -> 
             f'<div class="erratum-block" id="erratum-{html.escape(r["id"])}">'
             f'<h3>Eq. ({html.escape(r["id"])}) <a href="#eq-{html.escape(r["id"])}">'
             "(in the derivations table)</a></h3>"
-            f"<p>{html.escape(tilde_text(r['note']))}</p><table>{''.join(forms)}</table>"
-            "<p>Counterexample (each row in its own unit):</p>"
+            f"<p>{html.escape(tilde_text(r['note']))}</p>"
+            f'<table class="forms">{"".join(forms)}</table>'
+            f"<p>{html.escape(ce_words)}</p>"
         )
         md = (
             f"### Eq. ({r['id']})\n\n{tilde_text(r['note'])}\n\n"
@@ -289,10 +356,11 @@ def errata(res: dict[str, Any], records: list, rendered: dict | None = None) -> 
                 if r["corrected"]
                 else ""
             )
-            + "Counterexample (each row in its own unit):"
+            + ce_words
         )
         blocks.append(Block("raw", text=md, html=inner))
-        blocks.append(tb)
+        if ce_words.startswith("Counterexample"):
+            blocks.append(tb)
         blocks.append(
             Block(
                 "raw",
@@ -365,7 +433,8 @@ def derivations(res: dict[str, Any], records: list, rendered: dict | None = None
 
         def cell(key: str, text: str, ml=ml) -> str:
             m = ml.get(key, "")
-            return _MATH.format(m) if m else f"<code>{html.escape(text)}</code>"
+            body = _MATH.format(m) if m else f"<code>{html.escape(text)}</code>"
+            return f'<div class="eq">{body}</div>'
 
         note = html.escape(r.note)
         if r.verdict == "erratum":

@@ -13,7 +13,9 @@ from ptoverify.report.render import (
     qty,
     table,
 )
-from ptoverify.report.standing import ratio_interval
+from ptoverify.report.standing import ratio_phrase
+from ptoverify.report.words import gate_words, plain, plural
+from ptoverify.verdict import time_order
 
 from .common import (
     _GATE_UNITS,
@@ -101,20 +103,29 @@ def _finding_settling(res: Any) -> tuple[str, str, str] | None:
 
     Both numbers stand in the same sentence, so the finding cannot overstate.
     """
-    from ptoverify.report.standing import reading_words, step_readings
+    from ptoverify.report.standing import bandwidth_hz, reading_words, step_readings
+
+    from .studies import sweep_definition_words
 
     step = step_readings(res)
     if not step:
         return None
+    T = res["environment"]["config"]["plant"]["sample_time"]  # noqa: N806 - the paper's symbol
     parts = []
     for a, r in step.items():
         v = r["values"]
         pd, pto = v["settling_pd_s"], v["settling_pto_s"]
-        if pd is None or pto is None:
+        order = time_order(pto, pd, T)
+        if order is None:
             continue
-        fast = "PD" if pd < pto else "the corrected PTO"
+        first = {
+            -1: "the corrected PTO settles first",
+            0: "PD and the corrected PTO tie (less than one sample apart)",
+            1: "PD settles first",
+        }[order]
         parts.append(
-            f"under {reading_words('a', a)} {fast} settles first (PD {_ms(pd)}, PTO {_ms(pto)})"
+            f"under {reading_words('a', a, bandwidth_hz(res))} {first} "
+            f"(PD {_ms(pd)}, PTO {_ms(pto)})"
         )
     if not parts:
         return None
@@ -123,14 +134,18 @@ def _finding_settling(res: Any) -> tuple[str, str, str] | None:
     )
     t = res["tuning"]
     if t is not None:
+        from ptoverify.report.standing import time_verdict
+
         tuned = [
-            f"PD {_ms(by['pd']['settling_2pct_s'])} vs PTO {_ms(by['pto']['settling_2pct_s'])} "
-            f"at overshoot <= {qty(t['bounds_mm'][name], 'mm')}"
+            f"at overshoot <= {qty(t['bounds_mm'][name], 'mm')} the PTO "
+            f"{time_verdict(by['pto']['settling_2pct_s'], by['pd']['settling_2pct_s'], T)}, "
+            f"PD {_ms(by['pd']['settling_2pct_s'])} vs PTO {_ms(by['pto']['settling_2pct_s'])}"
             for name, by in t["best"].items()
             if "pd" in by and "pto" in by
         ]
         if tuned:
-            text += "; at each law's best tuning (a = 2 pi f): " + "; ".join(tuned)
+            a0 = reading_words("a", next(iter(step)), bandwidth_hz(res))
+            text += f"; at each law's best tuning ({a0}): " + "; ".join(tuned)
     sw = res["sweep"]["laws"]
     if "pd" in sw and "pto" in sw:
         pd, pto = sw["pd"]["percentiles_ratio_nt"], sw["pto"]["percentiles_ratio_nt"]
@@ -139,7 +154,8 @@ def _finding_settling(res: Any) -> tuple[str, str, str] | None:
         tf_pto = sw["pto"]["percentiles_ratio_tf"]
         worst_x1 = sw["pto"]["worst_state_nt"][0]
         text += (
-            f". Over the envelope ({grid[0]} x {grid[1]} states, paper's gains, 0.01 mm box) "
+            f". Over the envelope ({grid[0]} x {grid[1]} states, paper's gains, settling "
+            f"definition {sweep_definition_words(res['sweep'])}) "
             f"settling / (N* T) has median PD {fmt(pd['p50'])} [-], PTO {fmt(pto['p50'])} [-] "
             f"and settling / t_f* median PD {fmt(tf_pd['p50'])} [-], PTO {fmt(tf_pto['p50'])} [-]; "
             f"the PTO's worst ratio {fmt(pto['max'])} [-] starts at x1 = {fmt(worst_x1)} mm"
@@ -157,7 +173,7 @@ def _finding_settling(res: Any) -> tuple[str, str, str] | None:
 
 
 def _finding_claims(res: Any) -> tuple[str, str, str] | None:
-    from ptoverify.report.standing import claim_standing
+    from ptoverify.report.standing import bandwidth_hz, claim_standing, reading_words
 
     cl = res["claims"]
     fail = [c for c in cl if claim_standing(c)[0] == "fails"]
@@ -172,7 +188,8 @@ def _finding_claims(res: Any) -> tuple[str, str, str] | None:
         text += (
             f"; the headline claim that PD needs {qty(c31['paper_value'], '%')} more settling "
             f"time than the PTO measures PD needing {qty(abs(more), '%')} "
-            f"{'more' if more >= 0 else 'less'} at the paper's gains (a = 2 pi f)"
+            f"{'more' if more >= 0 else 'less'} at the paper's gains "
+            f"({reading_words('a', '2pi*f', bandwidth_hz(res))})"
         )
         t = res["tuning"]
         c31t = next(
@@ -181,14 +198,15 @@ def _finding_claims(res: Any) -> tuple[str, str, str] | None:
         if c31t is not None:
             best = [r for r in c31t["readings"] if "best-tuned" in r["label"]]
             if best:
-                text += (
-                    "; at both laws' best tuning they settle alike ("
-                    + "; ".join(
-                        f"PD {_ms(r['values']['settling_pd_s'])} vs PTO "
-                        f"{_ms(r['values']['settling_pto_s'])}"
-                        for r in best
-                    )
-                    + ")"
+                from ptoverify.report.standing import time_verdict
+
+                T = res["environment"]["config"]["plant"]["sample_time"]  # noqa: N806
+                text += "; at both laws' best tuning, " + "; ".join(
+                    f"at overshoot <= {qty(r['reading']['bound_mm'], 'mm')} the PTO "
+                    f"{time_verdict(v['settling_pto_s'], v['settling_pd_s'], T)}, "
+                    f"PD {_ms(v['settling_pd_s'])} vs PTO {_ms(v['settling_pto_s'])}"
+                    for r in best
+                    for v in [r["values"]]
                 )
     return (text + ".", "claims", "claims with every reading")
 
@@ -220,28 +238,29 @@ def _finding_robust(res: Any) -> tuple[str, str, str] | None:
         return None
     m = rob["margins"]["pto"]
     d1, nd = m["linear_loop_a_ratio_stable_delay1"], m["linear_loop_a_ratio_stable"]
-    text = f"Without delay the PTO's linear zone is stable for a_true / a_design in {ratio_interval(nd)}"
+    text = f"Without delay the PTO's linear zone is stable for a_true / a_design {ratio_phrase(nd)}"
     if "pd" in rob["margins"]:
         pd = rob["margins"]["pd"]
-        text += f" (PD: {ratio_interval(pd['linear_loop_a_ratio_stable'])})"
+        text += f" (PD: {ratio_phrase(pd['linear_loop_a_ratio_stable'])})"
     text += "; with a one-sample computation delay it is " + (
-        f"stable for {ratio_interval(d1)}" if d1 else "unstable even at the design bandwidth"
+        f"stable for a_true / a_design {ratio_phrase(d1)}"
+        if d1
+        else "unstable even at the design bandwidth"
     )
     if "pd" in rob["margins"]:
-        text += (
-            f" (PD: {ratio_interval(rob['margins']['pd']['linear_loop_a_ratio_stable_delay1'])})"
-        )
+        text += f" (PD: {ratio_phrase(rob['margins']['pd']['linear_loop_a_ratio_stable_delay1'])})"
     return (text + ".", "robustness", "robustness")
 
 
 def _finding_gates(res: Any) -> tuple[str, str, str]:
     s = res["summary"]
     nom, per = s["gates_nominal"], s["gates_perturbed"]
-    failed = [c["name"] for c in res["checks"] if c["status"] != "pass"]
+    failed = [gate_words(c["name"]) for c in res["checks"] if c["status"] != "pass"]
     text = (
         f"{nom['pass']} of {nom['total']} verification gates pass on the nominal plant"
         + (
-            f"; under the [robustness] box's perturbations {per['pass']} of {per['total']} pass"
+            f"; on the perturbed plant (the model mismatch of the robustness section) "
+            f"{per['pass']} of {plural(per['total'], 'gate')} pass"
             if per["total"]
             else "; the gates under perturbation were not run (robustness skipped)"
         )
@@ -285,7 +304,7 @@ def summary(res: dict[str, Any]) -> list[Block]:
         [
             c["name"],
             "perturbed plant" if c["name"].startswith("robust-") else "nominal plant",
-            c["description"],
+            plain(c["description"]),
             c["status"],
             "unbounded"
             if c["measured_unbounded"]

@@ -13,6 +13,7 @@ from ptoverify.report.render import (
     table,
 )
 from ptoverify.report.standing import ratio_interval
+from ptoverify.report.words import plural
 
 from .common import _law, _ms, figure
 
@@ -74,8 +75,8 @@ def proofs(res: Any, figures: dict[str, str]) -> list[Block]:
     rows = [
         [
             _law(law),
-            f"{p['bound_samples']} samples" if p["bound_samples"] is not None else "n/a",
-            f"{p['simulated_worst_samples']} samples"
+            plural(p["bound_samples"], "sample") if p["bound_samples"] is not None else "n/a",
+            plural(p["simulated_worst_samples"], "sample")
             if p["simulated_worst_samples"] is not None
             else "n/a",
             f"{p['simulation_over_bound']} of {p['simulated_states']}",
@@ -110,6 +111,13 @@ _PROP_WORDS = {
     "overshoot_mm": ("overshoot", "mm"),
     "settling_ratio_nt": ("settling / (N* T)", "-"),
 }
+
+
+def _amount(v: Any, unit: str) -> str:
+    """Return a worst-case value with its unit; a stride-over count in words (``0 stride-overs``)."""
+    if unit == "count" and isinstance(v, (int, float)) and float(v).is_integer():
+        return plural(int(v), "stride-over")
+    return qty(v, unit)
 
 
 def simulate_command(law: str, worst: dict[str, Any]) -> str:
@@ -234,13 +242,20 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 [
                     _law(law),
                     words,
-                    "unbounded (never settles)" if w["grid_unbounded"] else qty(w["grid"], unit),
-                    "unbounded (never settles)" if w["unbounded"] else qty(w["searched"], unit),
+                    "unbounded (never settles)"
+                    if w["grid_unbounded"]
+                    else _amount(w["grid"], unit),
+                    "unbounded (never settles)" if w["unbounded"] else _amount(w["searched"], unit),
                     f"({fmt(w['state'][0])} mm, {fmt(w['state'][1])} mm/s)"
                     if w["state"]
                     else "n/a",
                     f"a ratio {fmt(p['a_ratio'])} [-], w_max ratio {fmt(p['w_max_ratio'])} "
-                    f"[-], delay {fmt(p['delay_samples'])} samples",
+                    "[-], "
+                    + (
+                        f"a delay of {plural(p['delay_samples'], 'sample')}"
+                        if p["delay_samples"]
+                        else "no delay"
+                    ),
                 ]
             )
             bad = (
@@ -360,6 +375,8 @@ def tuning(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     -------
     list of Block
     """
+    from ptoverify.studies.tune.measure import WORST_GRID
+
     t = res["tuning"]
     if not t:
         return [
@@ -425,9 +442,17 @@ def tuning(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 "overshoot",
                 "10-90 % rise",
                 "0.01 mm settling",
-                "worst settling / (N* T) over the envelope",
+                f"worst settling / (N* T), {WORST_GRID[0]} x {WORST_GRID[1]} grid [-]",
             ],
             rows,
+        ),
+        Block(
+            "p",
+            text="The last column: the tuner's check of the whole envelope, settling under "
+            f"box-0p01mm read on the samples over a coarse {WORST_GRID[0]} x {WORST_GRID[1]} "
+            "grid of initial states; the suboptimality maps' worst ratio (section 9) reads the "
+            "same definition between samples over a much finer grid, which reaches smaller "
+            "moves and so finds a larger worst ratio.",
         ),
         *figure(figures, "tuning_pareto"),
         Block("p", text="The paper's PD-vs-PTO claims judged at the best tuning of both laws:"),

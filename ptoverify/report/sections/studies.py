@@ -5,12 +5,16 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from ptoverify.conform.closedloop import SETTLING as CONFORM_SETTLING
 from ptoverify.report.render import (
     Block,
     fmt,
     qty,
     table,
 )
+from ptoverify.report.standing import TIE_NOTE
+from ptoverify.report.words import claim_title
+from ptoverify.sim.settling import DEFINITIONS
 
 from .common import _claim_qty, _law, _ms, _same, figure, measured_quantity
 
@@ -241,6 +245,8 @@ def properties(res: dict[str, Any]) -> list[Block]:
 
 def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     """Every claim: what is measured, paper value, value between samples and on the grid."""
+    from ptoverify.studies.claims.types import tie_words
+
     rows = []
     for c in res["claims"]:
         differs = not _same(c["measured"], c["measured_grid"])
@@ -264,13 +270,13 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             differs = not _same(r["measured"], r["measured_grid"])
             readings.append(
                 [
-                    c["id"],
+                    claim_title(c),
                     r["label"],
                     _claim_qty(r["measured"], c["unit"]),
                     _claim_qty(r["measured_grid"], c["unit"]) if differs else "same",
                     r["verdict"],
                     r["verdict_grid"] or "n/a",
-                    ", ".join(r["ties"] or []) or "none",
+                    "; ".join(tie_words(t) for t in r["ties"] or []) or "none",
                 ]
             )
     blocks = [
@@ -278,8 +284,9 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             "p",
             text="'measured' is read on the exact trajectory between samples (the input is "
             "constant over a sample and the flow is closed form); where the value read on the "
-            "2 ms sample grid differs it is shown next to it, with the verdict the same rule "
-            "gives on the grid. Times are shown in ms.",
+            f"{_ms(res['environment']['config']['plant']['sample_time'])} sample grid differs it "
+            "is shown next to it, with the verdict the same rule gives on the grid. Times are "
+            f"shown in ms. {TIE_NOTE}",
         ),
         table(
             [
@@ -305,7 +312,7 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 "on the sample grid",
                 "verdict",
                 "verdict on grid",
-                "true ties",
+                "tied times (less than one sample apart)",
             ],
             readings,
         ),
@@ -343,6 +350,37 @@ def claims(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     return blocks
 
 
+#: ``ptoverify conform``'s settling definition (its settling / (N* T)), in words.
+CONFORM_SETTLING_WORDS = f"|x1| <= {DEFINITIONS[CONFORM_SETTLING].band_mm:g} mm for good"
+
+
+def sweep_definition_words(sw: Mapping[str, Any]) -> str:
+    """Name the sweep's settling definition with what it bounds: ``box-0p01mm (|x1| <= ...)``.
+
+    Parameters
+    ----------
+    sw : Mapping
+        ``results["sweep"]`` (``settings``: ``band`` [mm], ``hold`` [s],
+        ``velocity_band`` [mm/s] or None; ``velocity_band`` as used [mm/s]).
+
+    Returns
+    -------
+    str
+    """
+    box, st = DEFINITIONS["box-0p01mm"], sw["settings"]
+    name = (
+        box.name
+        if (st["band"], st["hold"], st["velocity_band"]) == (box.band_mm, box.hold_s, None)
+        else "the sweep's own box"
+    )
+    vel = (
+        f"|x2| <= a x {fmt(st['band'])} mm"
+        if st["velocity_band"] is None
+        else f"|x2| <= {qty(sw['velocity_band'], 'mm/s')}"
+    )
+    return f"{name} (|x1| <= {qty(st['band'], 'mm')} and {vel}, held {_ms(st['hold'])})"
+
+
 def sweep(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
     """Settling time over t_f* and over N* T, per law, with percentiles."""
     sw = res["sweep"]
@@ -364,9 +402,12 @@ def sweep(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
         Block(
             "p",
             text=f"Grid of {sw['grid'][0]} x {sw['grid'][1]} initial states over the envelope, "
-            f"horizon {sw['steps']} samples; settling time read between samples (0.01 mm band, "
-            "staying there), divided by the continuous minimum time t_f* and by the sampled "
-            "limit N* T (zonotope N*).",
+            f"horizon {sw['steps']} samples; settling time under the definition "
+            f"{sweep_definition_words(sw)}, read between samples, divided by the continuous "
+            "minimum time t_f* and by the sampled limit N* T (zonotope N*). `ptoverify conform` "
+            f"reports settling / (N* T) under {CONFORM_SETTLING} ({CONFORM_SETTLING_WORDS}), read "
+            "on the samples, over its own smaller sweep of states: a narrower band and other "
+            "states, so its medians differ from these.",
         ),
         table(
             [

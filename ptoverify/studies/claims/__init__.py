@@ -48,14 +48,18 @@ verdicts and the rule texts read them from there.
   twice that of each other law.
 * "Lags by a large value": the mean ramp error exceeds d, the paper's linear
   zone (1 % of the position range, its own scale for "close to the target").
-* "Faster", "more stable", "quicker": strict inequalities of the metric.
+* "Faster", "more stable", "quicker": strict inequalities of the metric; for
+  times (settling, rise) under the suite's one tie rule
+  (:data:`ptoverify.verdict.TIME_TIE_RULE`, :func:`ptoverify.verdict.time_order`),
+  the rule the report states and its verdict table uses: two times less than one
+  sample period T apart tie.
 * Time metrics (settling, rise time), overshoots and phase delays are measured
   between the samples, on the exact continuous trajectory
   (:mod:`ptoverify.sim.exact`), and every verdict is decided on those values.  Two
-  exact values closer than the sum of their accuracies (:attr:`Compared.accuracy
-  <ptoverify.sim.exact.Compared.accuracy>`: brentq's tolerance and the round-off of
-  the flow over the crossed signal's slope, ~1e-15 s here) are a true tie: the
-  strict inequality does not hold, and the reading lists the tie in ``ties`` and
+  exact times less than one sample apart (or closer than the sum of their
+  accuracies, :attr:`Compared.accuracy <ptoverify.sim.exact.Compared.accuracy>`)
+  are a tie: the strict inequality does not hold, and the reading lists the tie in
+  ``ties`` and
   its detail.  The same rule is also applied to the sample-grid values (which
   tie when equal, at one sample); each reading carries ``measured_grid``,
   ``values_grid``, ``verdict_grid`` and ``verdict_differs_on_grid``, so a reader

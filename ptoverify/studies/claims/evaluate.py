@@ -19,7 +19,7 @@ from ptoverify.studies.tune import (
 from .catalogue import CLAIMS
 from .measure import _Ctx
 from .sentences import TUNED_CLAIMS
-from .types import ClaimResult, Reading, ReadingResult
+from .types import ClaimResult, Reading, ReadingResult, tie_words
 
 if TYPE_CHECKING:
     from .measure import _Claim
@@ -78,7 +78,9 @@ def _evaluate(
         grid = _Ctx(cfg, rd, paper, grid=True, law_cfg=law_cfg)
         measured_g, values_g, ok_g, _ = cl.measure(grid, cl)
         if exact.ties:
-            detail += "; true tie between samples: " + ", ".join(exact.ties)
+            detail += "; less than one sample apart, a tie: " + ", ".join(
+                tie_words(t) for t in exact.ties
+            )
         results.append(
             ReadingResult(
                 rd,

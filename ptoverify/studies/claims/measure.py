@@ -10,11 +10,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ptoverify.config import Config
+from ptoverify.counts import plural
 from ptoverify.model.laws import Law, make_law
 from ptoverify.model.memo import memo
 from ptoverify.sim import metrics as mt
 from ptoverify.sim.exact import Compared, ExactMetrics, exact_metrics
 from ptoverify.sim.simulate import SimResult, simulate
+from ptoverify.verdict import time_order
 
 from .types import (
     _FLOORS,
@@ -113,16 +115,21 @@ class _Ctx:
         return self.value(self.metric(law, "sine", "phase_delay_deg")), out.residual_rms
 
     def less(self, law_a: str, law_b: str, signal: str, key: str, names: tuple[str, str]) -> bool:
-        """Whether law_a's metric is strictly below law_b's; a true tie is recorded and is not.
+        """Whether law_a's time metric is below law_b's by the tie rule; a tie is recorded.
 
-        Exact values tie within the sum of their accuracies
-        (:meth:`ptoverify.sim.exact.Compared.compare`), grid values only when equal.
+        The one tie rule of the suite (:func:`ptoverify.verdict.time_order`,
+        :data:`ptoverify.verdict.TIME_TIE_RULE`): two times less than one sample
+        period apart tie, exact and grid values alike (grid values tie only when
+        equal); two exact values closer than their summed accuracies
+        (:meth:`ptoverify.sim.exact.Compared.compare`) tie as well.
         """
         a, b = self.metric(law_a, signal, key), self.metric(law_b, signal, key)
-        order = a.compare(b, grid=self.grid)
+        x, y = (a.grid, b.grid) if self.grid else (a.exact, b.exact)
+        order = time_order(x, y, self.cfg.plant.sample_time)
+        if order is not None and a.compare(b, grid=self.grid) == 0:
+            order = 0  # not told apart to the precision they are computed to
         if order == 0:
-            tol = 0.0 if self.grid else a.accuracy + b.accuracy
-            self.ties.append(f"{names[0]} = {names[1]} (|difference| <= {tol:.3g})")
+            self.ties.append(f"{names[0]} = {names[1]} (less than one sample apart)")
         return order == -1
 
 
@@ -142,7 +149,7 @@ def _step_to_osc(c: _Ctx, cl: _Claim) -> Outcome:
         amp,
         {"amplitude_mm": amp, "reversals": rev},
         ok,
-        f"TO error over the last half: amplitude {amp:.4f} mm, {rev} sign reversals",
+        f"TO error over the last half: amplitude {amp:.4f} mm, {plural(rev, 'sign reversal')}",
     )
 
 
@@ -204,8 +211,8 @@ def _ramp_to_osc(c: _Ctx, cl: _Claim) -> Outcome:
         },
         okp and okv,
         (
-            f"TO last half: position error {ap:.4f} mm ({rp} reversals), velocity error "
-            f"{av:.2f} mm/s ({rv} reversals)"
+            f"TO last half: position error {ap:.4f} mm ({plural(rp, 'sign reversal')}), velocity "
+            f"error {av:.2f} mm/s ({plural(rv, 'sign reversal')})"
         ),
     )
 
@@ -236,7 +243,8 @@ def _ramp_pto_smooth(c: _Ctx, cl: _Claim) -> Outcome:
             "overshoot_mm": c.overshoot("pto", "ramp"),
         },
         ok,
-        f"PTO ramp error: {rev} sign reversals outside 0.01 mm; settles to 0.01 mm at {_ms(ts)}",
+        f"PTO ramp error: {plural(rev, 'sign reversal')} outside 0.01 mm; settles to 0.01 mm "
+        f"at {_ms(ts)}",
     )
 
 
@@ -314,7 +322,8 @@ def _conclusion(c: _Ctx, cl: _Claim) -> Outcome:
         },
         ok,
         (
-            f"step: PTO oscillates {osc_pto} (amplitude {a_pto:.4f} mm), TO {osc_to}; overshoot "
+            f"step: PTO {'oscillates' if osc_pto else 'does not oscillate'} (amplitude "
+            f"{a_pto:.4f} mm), TO {'oscillates' if osc_to else 'does not'}; overshoot "
             f"PTO {os_pto:.3f} mm, TO {os_to:.3f} mm; settling PTO {_ms(ts_pto)} vs PD "
             f"{_ms(ts_pd)}"
         ),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 
 from ptoverify.config import Config
@@ -126,7 +127,7 @@ class ReadingResult:
         The verdict the same rule gives on the grid values (grid values tie
         only when equal).
     ties : tuple of str
-        True ties between exact values met by a comparison (the claim's strict
+        Ties met by a comparison of times under the tie rule (the claim's strict
         inequality then does not hold), e.g. ``rise_time_pto_s = rise_time_pd_s``.
     """
 
@@ -263,3 +264,30 @@ def _more_or_less(percent: float) -> str:
     if not math.isfinite(percent):
         return "an undefined amount of"
     return f"{abs(percent):.1f} % {'more' if percent >= 0 else 'less'} time"
+
+
+#: A tie as :meth:`measure._Ctx.less` records it: ``<metric>_<law>_s = <metric>_<law>_s``.
+_TIE = re.compile(r"^(\w+?)_(to|pd|pto)_s = (\w+?)_(to|pd|pto)_s\b")
+
+
+def tie_words(tie: str) -> str:
+    """Say a recorded tie in words: ``rise_time_pto_s = rise_time_pd_s`` -> ``rise time: PTO ties PD``.
+
+    Parameters
+    ----------
+    tie : str
+        One entry of a reading's ``ties``.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> tie_words("rise_time_pto_s = rise_time_pd_s (less than one sample apart)")
+    'rise time: PTO ties PD'
+    """
+    m = _TIE.match(tie)
+    if m is None:
+        return tie
+    return f"{m.group(1).replace('_', ' ')}: {m.group(2).upper()} ties {m.group(4).upper()}"
