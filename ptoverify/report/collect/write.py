@@ -182,6 +182,7 @@ def write_report(
             "paper": PAPER_TITLE,
             "figures": sorted(figures.values()),
             "traces": res["_traces"],
+            "jobs": res["_jobs"],  # processes the stages ran in
             "generated": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         }
         title = f'Verification of "{PAPER_TITLE}" (configuration {cfg.name!r})'
