@@ -130,11 +130,11 @@ def _leaves(obj, path=""):
 
 @pytest.mark.slow
 def test_committed_report_matches_fresh_computation(two_reports):
-    """reports/paper/results.json (regenerate: `ptoverify report --out reports/paper`) holds
+    """reports/paper/results.json (regenerate: `ptoverify report --out reports/paper --jobs 1`) holds
     the numbers a fresh run computes: same structure, every number within 1e-6 relative
     (round-off across BLAS builds), every verdict and status identical."""
     committed = ROOT / "reports" / "paper" / "results.json"
-    assert committed.exists(), "run: ptoverify report --out reports/paper"
+    assert committed.exists(), "run: ptoverify report --out reports/paper --jobs 1"
     old = json.loads(committed.read_text())
     new = _without_meta(two_reports[0])
     old["meta"].pop("generated")
