@@ -251,6 +251,20 @@ def test_the_widest_box_is_bad_input_at_once(tmp_path):
     assert "robustness.delay_samples" in lines[0] and f"{MAX_BOX_WORK:,}" in lines[0], lines[0]
 
 
+def test_report_refuses_the_widest_box_before_any_stage(tmp_path):
+    """``report`` checks the box's work before its stages run: exit 2 at once, no folder."""
+    import time
+
+    path = tmp_path / "widest.toml"
+    path.write_text(PAPER_PLANT + WIDEST_BOX)
+    out = tmp_path / "rep"
+    t0 = time.perf_counter()
+    code, stdout, err = _run(["report", "--config", str(path), "--out", str(out), "--quiet"])
+    assert time.perf_counter() - t0 < 10.0, "the stages ran before the refusal"
+    assert code == 2 and "robustness.delay_samples" in err and len(err.splitlines()) == 1, err
+    assert not out.exists()
+
+
 PAPER_PLANT = SMALL.split("[robustness]")[0].replace(
     "position_range = 5.0", "position_range = 50.0"
 )

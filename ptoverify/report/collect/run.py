@@ -67,6 +67,13 @@ def collect(
     if jobs is not None and jobs < 1:
         raise InputError(f"--jobs must be at least 1, got {jobs}")
     names = [n for n in _STAGE_FUNCTIONS if n not in {_SKIP_STAGE[s] for s in skip}]
+    if "robust" not in skip:  # the box's work is bounded: say so before any stage runs
+        from ptoverify.studies.robust import RobustSettings
+        from ptoverify.studies.robust.maps import check_box_work
+
+        from .settings import ROBUST_SETTINGS
+
+        check_box_work(cfg, RobustSettings(**ROBUST_SETTINGS))
     jobs = min(jobs or default_jobs(), len(names))
     done: dict[str, tuple[dict[str, Any], float]] = {}
 
