@@ -173,4 +173,5 @@ def conform_table(
         {"read": round(t_read, 4), "total": round(total, 4)},
         cfg.name,
         precision=precision,
+        reference=cfg.conform.reference,
     )
