@@ -184,3 +184,35 @@ def test_report_names_the_baseline(tmp_path, capsys):
     assert code == 0
     md = (out / "report.md").read_text()
     assert "reference ptos law" in md and "| reference law | ptos |" in md.replace("  ", " ")
+
+
+def test_ptos_table_filling_the_lattice_is_covered(tmp_path, capsys):
+    """A PTOS table on the lattice (not the probe set): its zone regions have no area at k = a."""
+    from ptoverify.conform.agreement import random_states
+    from ptoverify.conform.probes import LATTICE
+
+    ex = _example()
+    cfg = with_reference(paper_config(), "ptos")
+    x1, x2 = random_states(cfg, 2 * LATTICE * LATTICE)
+    u = [ex.ptos(a, b, cfg) for a, b in zip(x1.tolist(), x2.tolist())]
+
+    def write(path, keep):
+        path.write_text(
+            "x1,x2,u\n"
+            + "".join(
+                f"{a!r},{b!r},{c!r}\n"
+                for a, b, c, k in zip(x1.tolist(), x2.tolist(), u, keep.tolist())
+                if k
+            )
+        )
+        return str(path)
+
+    full = write(tmp_path / "lattice.csv", np.ones(x1.size, dtype=bool))
+    assert main(["conform", "--table", full, "--reference", "ptos", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["properties"]["coverage"]["status"] == "pass" and out["conforms"]
+    # the rule still bites: half the envelope is not enough
+    half = write(tmp_path / "half.csv", x1 < 0)
+    assert main(["conform", "--table", half, "--reference", "ptos", "--json"]) == 1
+    out = json.loads(capsys.readouterr().out)
+    assert out["properties"]["coverage"]["status"] == "fail"
