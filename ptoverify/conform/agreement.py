@@ -1,4 +1,4 @@
-"""Agreement with the reference PTO law, region by region.
+"""Agreement with the reference law (the PTO, or a baseline), region by region.
 
 Part of ``ptoverify conform`` (:mod:`ptoverify.conform.gate` has the command's
 decisions).  The probed states and tables are in :mod:`ptoverify.conform.probes`,
@@ -204,7 +204,7 @@ def agreement(
     *,
     precision: str = "float64",
 ) -> tuple[dict, list[dict]]:
-    """Compare u with the reference PTO law, region by region.
+    """Compare u with the reference law, region by region.
 
     Parameters
     ----------

@@ -281,7 +281,7 @@ class Response:
     Attributes
     ----------
     user, reference : SimResult
-        The user law's and the reference PTO law's responses (same reference signal).
+        The user law's and the reference law's responses (same reference signal).
     user_metrics, reference_metrics : dict
         ``simulate --json`` metrics, exact between samples ([mm], [s], [deg]), only
         those of :data:`SIGNAL_METRICS` for the signal.

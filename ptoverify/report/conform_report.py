@@ -137,7 +137,7 @@ def _verdict(r: ConformResult, ev: ConformEvidence, cfg: Config) -> list[Block]:
     if rd is not None and rd["cycling"]:
         blocks.append(
             _p(
-                f"WARNING: the reference PTO law itself limit-cycles or does not settle with a "
+                f"WARNING: the reference law itself limit-cycles or does not settle with a "
                 f"{rd['delay_samples']}-sample computation delay from {rd['cycling']} of "
                 f"{rd['states']} initial states (the closed-loop sweep of this gate). "
                 "Conformance to it does not make a law delay-tolerant: compensate the delay, "
