@@ -14,7 +14,10 @@ from typing import Any
 
 from ptoverify.errors import ConfigError
 
-__all__ = ["ConformLimits", "conform_limits_from_mapping"]
+__all__ = ["ConformLimits", "conform_limits_from_mapping", "CONFORM_REFERENCES"]
+
+#: the laws ``conform`` can judge against (``[conform] reference``, ``conform --reference``)
+CONFORM_REFERENCES = ("pto", "ptos", "cascade-p")
 
 
 def _number(key: str, value: Any) -> float:
@@ -40,11 +43,17 @@ class ConformLimits:
         Under a perturbation, a count property (states that limit-cycle, stride
         over or exceed w_max) may exceed the reference's count by this fraction
         of the initial states [-], in [0, 1].
+    reference : str
+        The reference law the implementation is judged against, one of
+        :data:`CONFORM_REFERENCES`: ``pto`` (the corrected PTO, default), ``ptos``
+        or ``cascade-p`` (the baselines, with the configuration's ``[ptos]`` or
+        ``[cascade]`` gains).
     """
 
     settling_margin: float = 0.5
     settling_min_samples: int = 2
     count_margin: float = 0.01
+    reference: str = "pto"
 
     def settling_limit(self, reference_worst: float) -> float:
         """Return the settling limit [samples] for the reference's worst [samples].
@@ -99,9 +108,15 @@ def conform_limits_from_mapping(raw: Any) -> ConformLimits:
         if not 0.0 <= v <= hi:
             raise ConfigError(f"config key 'conform.{key}' must be in [0, {hi:g}], got {v!r}")
         out[key] = v
+    ref = raw.get("reference", base.reference)
+    if ref not in CONFORM_REFERENCES:
+        raise ConfigError(
+            f"config key 'conform.reference' must be one of {', '.join(CONFORM_REFERENCES)}, "
+            f"got {ref!r}"
+        )
     n = raw.get("settling_min_samples", base.settling_min_samples)
     if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= 1000:
         raise ConfigError(
             f"config key 'conform.settling_min_samples' must be an integer in [0, 1000], got {n!r}"
         )
-    return ConformLimits(settling_min_samples=int(n), **out)
+    return ConformLimits(settling_min_samples=int(n), reference=ref, **out)

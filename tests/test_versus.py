@@ -83,3 +83,17 @@ def test_json_has_no_non_finite_numbers(result):
     js = result.to_json()
     walk(js)
     assert js["readings"][0]["laws"][0]["law"] == "pto"
+
+
+def test_tuned_margins_against_independent_eigenvalues(result):
+    from linear_loop_reference import check_interval, hand_gains
+
+    for r in result.readings:
+        c = CFG if r.reading == "2pi" else CFG.with_plant(a=CFG.bandwidth_hz)
+        for t in r.laws:
+            if t.infeasible:
+                assert t.a_ratio_stable is None and t.a_ratio_stable_delay1 is None
+                continue
+            k = hand_gains(t.law, tuned_config(c, t.law, t.gains))
+            check_interval(t.a_ratio_stable, *k, c.plant.a, c.plant.sample_time, 0)
+            check_interval(t.a_ratio_stable_delay1, *k, c.plant.a, c.plant.sample_time, 1)

@@ -8,6 +8,7 @@ import sys
 import time
 from pathlib import Path
 
+from ptoverify.conform_limits import CONFORM_REFERENCES
 from ptoverify.errors import InputError
 
 from .common import _add_junit, _check_junit, _config, finite_float, print_json, write_atomic
@@ -123,8 +124,14 @@ shows it; a law that raises, returns NaN/inf, or has memory is a finding), 2 bad
 (import error, missing attribute, not callable, wrong signature, a non-number or wrong
 shape returned, unreadable table).
 
+--reference ptos|cascade-p judges your implementation of a baseline instead (PTOS or the
+cascade P loop, with the configuration's [ptos] / [cascade] gains): the same gate, but the
+baselines are continuous, so nothing is excluded as a curve tie, and the probes crowd the
+baseline's linear-region edge in place of |x1| = d.
+
 examples:
   ptoverify conform --law ptoverify.conform.gate:reference_law
+  ptoverify conform --law examples/my_ptos.py:ptos --reference ptos
   ptoverify conform --law examples/my_pto.py:pto --json
   ptoverify conform --emit-grid grid.csv      # fill in column u, then:
   ptoverify conform --table grid_with_u.csv
@@ -173,6 +180,14 @@ def _add_conform(sub) -> None:
         help="also write a report folder for a review (index.html, report.md, results.json, "
         "figures/): verdict, properties, map of |u - u_ref| with the region boundaries, "
         "closed loop, step/ramp/sine responses; checked before computing, written atomically",
+    )
+    p.add_argument(
+        "--reference",
+        choices=CONFORM_REFERENCES,
+        default=None,
+        help="the law to judge against: pto (the corrected PTO, default), or a baseline, ptos "
+        "or cascade-p, with the configuration's [ptos] / [cascade] gains (default: the "
+        "configuration's [conform] reference, pto)",
     )
     p.add_argument(
         "--precision",
@@ -237,6 +252,10 @@ def _cmd_conform(args: argparse.Namespace) -> int:
         if value is not None and value.strip() == "":
             raise InputError(f"{flag} is empty")
     cfg = _config(args)
+    if args.reference is not None:
+        from ptoverify.conform.reflaw import with_reference
+
+        cfg = with_reference(cfg, args.reference)
     rtol = conform.DEFAULT_RTOL if args.tolerance is None else args.tolerance
     if not 0 < rtol < 1:
         raise InputError(f"--tolerance must be in (0, 1), got {rtol:g}")

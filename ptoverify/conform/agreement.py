@@ -1,4 +1,4 @@
-"""Agreement with the reference PTO law, region by region.
+"""Agreement with the reference law (the PTO, or a baseline), region by region.
 
 Part of ``ptoverify conform`` (:mod:`ptoverify.conform.gate` has the command's
 decisions).  The probed states and tables are in :mod:`ptoverify.conform.probes`,
@@ -36,7 +36,14 @@ from ptoverify.conform.probes import (
     read_table,
     table_coverage,
 )
-from ptoverify.conform.reflaw import DEFAULT_RTOL, failure, omega0_ref, reference, tie_band
+from ptoverify.conform.reflaw import (
+    DEFAULT_RTOL,
+    failure,
+    has_curves,
+    omega0_ref,
+    reference,
+    tie_band,
+)
 from ptoverify.model.curves import level_residual, switching_function
 from ptoverify.model.laws import Region
 
@@ -67,7 +74,13 @@ __all__ = [
 
 
 def ties(x1: NDArray, x2: NDArray, cfg: Config) -> NDArray[np.bool_]:
-    """Points outside |x1| < d within TIE_BAND of l1/l2 or l1*/l2* (region may flip)."""
+    """Points outside |x1| < d within TIE_BAND of l1/l2 or l1*/l2* (region may flip).
+
+    None for a baseline reference (:func:`ptoverify.conform.reflaw.has_curves`):
+    it is continuous in the state, so no float tie flips its u.
+    """
+    if not has_curves(cfg):
+        return np.zeros(np.shape(x1), dtype=bool)
     a, w = cfg.plant.a, cfg.plant.w_max
     band = tie_band(cfg)
     near = np.abs(switching_function(x1, x2, a, w)) <= band
@@ -115,7 +128,7 @@ def reference_values(
         y1, y2 = as_seen(x1[s], x2[s], precision)
         u_ref[s], reg[s] = reference(cfg)(y1, y2)
         tie[s] = ties(y1, y2, cfg)
-        if precision == "float32":
+        if precision == "float32" and has_curves(cfg):  # a baseline is continuous
             tie[s] |= float32_ties(y1, y2, cfg, om)
     return u_ref, reg, tie
 
@@ -191,7 +204,7 @@ def agreement(
     *,
     precision: str = "float64",
 ) -> tuple[dict, list[dict]]:
-    """Compare u with the reference PTO law, region by region.
+    """Compare u with the reference law, region by region.
 
     Parameters
     ----------

@@ -221,7 +221,8 @@ class Boundaries:
         Label -> (x1 [mm], x2 [mm/s]) of l1, l2 (eqs. 9, 11) and, when the
         reference has a switching zone, l1*, l2* (eqs. 13, 14).
     d : float
-        Half-width of the linear zone |x1| < d [mm].
+        Half-width of the linear zone |x1| < d [mm] (a baseline reference: its
+        linear region's, :func:`ptoverify.conform.reflaw.linear_edge`).
     omega0 : float or None
         Level of l1*, l2* [mm/s] (None: no switching zone).
     zoom_x1 : float
@@ -256,7 +257,9 @@ def boundaries(cfg: Config, points: int = 400) -> Boundaries:
     >>> sorted(b.curves), b.d
     (['l1', 'l1*', 'l2', 'l2*'], 0.5)
     """
-    a, w, d = cfg.plant.a, cfg.plant.w_max, cfg.pto.d
+    from ptoverify.conform.reflaw import linear_edge
+
+    a, w, d = cfg.plant.a, cfg.plant.w_max, linear_edge(cfg)
     neg, pos = np.linspace(-w, 0.0, points), np.linspace(0.0, w, points)
     curves = {
         "l1": (level_curve_x1(neg, a, w), neg),
@@ -278,7 +281,7 @@ class Response:
     Attributes
     ----------
     user, reference : SimResult
-        The user law's and the reference PTO law's responses (same reference signal).
+        The user law's and the reference law's responses (same reference signal).
     user_metrics, reference_metrics : dict
         ``simulate --json`` metrics, exact between samples ([mm], [s], [deg]), only
         those of :data:`SIGNAL_METRICS` for the signal.

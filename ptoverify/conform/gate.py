@@ -3,7 +3,12 @@
 ``ptoverify conform`` judges a user's law ``u = f(x1, x2, cfg)`` (a Python
 callable) or a table of its values (CSV, columns x1, x2, u) against the
 reference ``make_law("pto", cfg)`` (corrected omega0) and, for a callable, by
-the closed-loop properties that ``ptoverify check`` gates.  Every property is
+the closed-loop properties that ``ptoverify check`` gates.  With
+``--reference ptos`` or ``--reference cascade-p`` (``[conform] reference``) the
+reference is that baseline (:mod:`ptoverify.model.baselines`, the
+configuration's gains) and everything below is the same gate, except that a
+baseline is continuous, so no state is a curve tie, and the probes crowd its
+linear region's edge (:mod:`ptoverify.conform.reflaw`).  Every property is
 a :class:`ptoverify.verdict.Verdict`; the law conforms only when every one is
 ``pass`` (``fail``, ``unverified`` and ``not_run`` fail closed).
 
@@ -199,7 +204,7 @@ PROPERTIES = (
 
 # ------------------------------------------------------------------ reference
 def reference_law(x1, x2, cfg: Config):
-    """Evaluate the reference PTO law (corrected omega0) as a user-style callable.
+    """Evaluate the reference law (PTO, corrected omega0, unless ``[conform] reference``).
 
     Parameters
     ----------
@@ -224,7 +229,7 @@ def reference_law(x1, x2, cfg: Config):
 
 
 def reference_law_scalar(x1: float, x2: float, cfg: Config) -> float:
-    """Evaluate the reference PTO law on Python floats only (exercises scalar mode)."""
+    """Evaluate the reference law on Python floats only (exercises scalar mode)."""
     if not isinstance(x1, float) or not isinstance(x2, float):
         raise TypeError("scalar law: x1 and x2 must be floats")
     return reference(cfg).scalar(x1, x2)[0]
@@ -399,6 +404,7 @@ def _finish(user, props, failures, agree, timings, t0, cfg, target, opt, runs, o
         opt.precision,
         tuple(runs),
         opt.perturbations,
+        cfg.conform.reference,
     )
 
 
@@ -575,4 +581,5 @@ def _aborted(user, props, failures, ab, timings, t0, cfg, target, opt, output) -
         opt.precision,
         (),
         opt.perturbations,
+        cfg.conform.reference,
     )

@@ -9,6 +9,9 @@ decisions):
   grid, ``N_RANDOM`` seeded random states (one jittered state in each cell of
   a ``LATTICE`` x ``LATTICE`` lattice, the rest uniform) and ``N_BAND`` seeded
   states in a band around l1/l2, l1*/l2* and |x1| = d;
+* with a baseline reference (``[conform] reference``) d is its linear
+  region's edge (:func:`ptoverify.conform.reflaw.linear_edge`) and there is no
+  l1*, l2*; the states around l1, l2 stay (the plant's switching curves);
 * :func:`read_table`: a CSV with columns x1, x2, u (regular files, in chunks);
 * :func:`table_coverage`: does a table hold the probe set (or fill the lattice)?
 """
@@ -22,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ptoverify.config import Config
-from ptoverify.conform.reflaw import omega0_ref, tie_band
+from ptoverify.conform.reflaw import linear_edge, omega0_ref, tie_band
 from ptoverify.errors import InputError
 from ptoverify.model.curves import level_curve_x1, root_22
 
@@ -78,7 +81,7 @@ def conformance_grid(cfg: Config, n: int = 61, n_curve: int = 121) -> tuple[NDAr
         under x -> -x.
     """
     p = cfg.plant
-    a, w, R, d = p.a, p.w_max, p.position_range, cfg.pto.d
+    a, w, R, d = p.a, p.w_max, p.position_range, linear_edge(cfg)
     band = tie_band(cfg)
     g1, g2 = np.meshgrid(np.linspace(-R, R, n), np.linspace(-w, w, n))
     xs, vs = [g1.ravel()], [g2.ravel()]
@@ -197,7 +200,7 @@ def band_states(cfg: Config, n: int = N_BAND) -> tuple[NDArray, NDArray]:
     """
     rng = np.random.default_rng(RANDOM_SEED + 3)
     p = cfg.plant
-    a, w, R, d = p.a, p.w_max, p.position_range, cfg.pto.d
+    a, w, R, d = p.a, p.w_max, p.position_range, linear_edge(cfg)
     lo, hi = 10.0 * tie_band(cfg) / a, max(2.0 * d, 0.02 * R)
     om = omega0_ref(cfg)
     n_c = 3 * n // 8

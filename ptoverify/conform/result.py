@@ -129,6 +129,8 @@ class ConformResult:
         The closed loops under perturbation (:mod:`ptoverify.conform.perturbed`).
     perturbations : tuple of Perturbation
         The perturbations asked for (empty: the nominal loop only).
+    reference : str
+        The reference law judged against (``pto``, ``ptos``, ``cascade-p``).
     """
 
     conforms: bool
@@ -144,6 +146,7 @@ class ConformResult:
     precision: str = "float64"
     perturbed: tuple = ()
     perturbations: tuple = ()
+    reference: str = "pto"
 
     @property
     def reference_fails(self) -> list[str]:
@@ -167,6 +170,7 @@ class ConformResult:
             "target": self.target,
             "mode_reason": self.mode_reason,
             "config": self.config,
+            "reference": self.reference,
             "agreement": self.agreement,
             "properties": {k: v.to_json() for k, v in self.properties.items()},
             "failures": self.failures,
@@ -252,11 +256,15 @@ def format_result(result: ConformResult) -> str:
     if "regions" in a:
         src = ", ".join(f"{k} {v}" for k, v in a.get("sources", {}).items())
         lines.append(
-            f"agreement with reference PTO: {a['points']} states ({src}), {a['excluded']} "
-            f"excluded (within {a['tie_band_mm_s']:.3g} mm/s of l1/l2/l1*/l2*"
-            + (", or float32 ties" if a.get("precision") == "float32" else "")
-            + "), "
-            f"tolerance {a['tolerance_mm_s']:.3g} mm/s ({a['rtol']:g} w_max), "
+            f"agreement with reference {r.reference}: {a['points']} states ({src}), {a['excluded']} "
+            + (
+                f"excluded (within {a['tie_band_mm_s']:.3g} mm/s of l1/l2/l1*/l2*"
+                + (", or float32 ties" if a.get("precision") == "float32" else "")
+                + "), "
+                if r.reference == "pto"
+                else "excluded (a continuous reference has no curve ties), "
+            )
+            + f"tolerance {a['tolerance_mm_s']:.3g} mm/s ({a['rtol']:g} w_max), "
             f"max |du| = {a['max_abs_du']:.3g} mm/s"
         )
         for name, e in a["regions"].items():

@@ -21,12 +21,14 @@ from ptoverify.conform.agreement import (
     agreement,
     conformance_grid,
     failure,
+    random_states,
     read_table,
     region_counts,
     table_coverage,
     ties,
 )
 from ptoverify.conform.closedloop import CLOSED_PROPERTIES
+from ptoverify.conform.reflaw import has_curves
 from ptoverify.conform.result import ConformResult, agreement_verdict, input_bound
 from ptoverify.model.laws import Region
 from ptoverify.verdict import FAIL, NOT_RUN, PASS, Verdict
@@ -39,6 +41,9 @@ MIN_PER_REGION = 100  #: judged table states per reference region (the origin: 1
 def _coverage(agree: dict, cov: dict, cfg: Config) -> Verdict:
     """Judge coverage: the probe set held, or the lattice filled and every region populated."""
     need = region_counts(*conformance_grid(cfg), cfg)
+    if not has_curves(cfg):  # a baseline: only its regions of positive area (module docstring)
+        lattice = region_counts(*random_states(cfg, LATTICE * LATTICE), cfg)
+        need = {k: v for k, v in need.items() if k in lattice}
     have = {k: v["points"] - v["excluded"] for k, v in agree["regions"].items()}
     short = []
     for name in need:
@@ -173,4 +178,5 @@ def conform_table(
         {"read": round(t_read, 4), "total": round(total, 4)},
         cfg.name,
         precision=precision,
+        reference=cfg.conform.reference,
     )

@@ -167,7 +167,10 @@ def assert_conforms(
     bad = [v for v in verdicts if not v.passed and not (result.conforms and v.status == NOT_RUN)]
     if result.conforms and not bad:
         return result
-    lines = [f"{target} does not conform to the reference PTO law (config {cfg.name}):"]
+    lines = [
+        f"{target} does not conform to the reference {cfg.conform.reference} law "
+        f"(config {cfg.name}):"
+    ]
     lines.append(f"  {conform.summary_line(result)}")
     for v in bad:
         lines.append(f"  {v.name}: {failure_message(v, states.get(v.name))} -- {v.detail}")

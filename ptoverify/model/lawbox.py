@@ -1,4 +1,4 @@
-"""Rigorous enclosures of the laws (PD, PTO eq. 35, TO eq. 12) over boxes of states.
+"""Rigorous enclosures of the laws (PD, PTO eq. 35, TO eq. 12, cascade P) over boxes of states.
 
 A box is ``(x1lo, x1hi, x2lo, x2hi)``, arrays [mm], [mm/s].  The enclosure
 holds for the mathematical law (real arithmetic), computed with the
@@ -14,7 +14,9 @@ with certified signs of the switching functions (eqs. 9, 11, 13, 14); an
 uncertain sign keeps every possible branch, and omega_c (eqs. 28-32) is
 enclosed by bisection certified by the sign of its residual.  Inside the
 linear zone, u = sat(-k1 x1 - k2 x2) is monotone too.  A box that straddles
-|x1| = d gets the hull of its pieces.
+|x1| = d gets the hull of its pieces.  The cascade P loop u = sat(-kp x1) is
+PD's case with kd = 0 (the same linear-law enclosure); PTOS is not enclosed
+(:func:`require_enclosure`).
 
 Catalogue: :class:`LawSpec`, :func:`law_spec`, :func:`sigma_point`,
 :func:`omega_c_iv`, :func:`enclose`.
@@ -28,10 +30,25 @@ from dataclasses import dataclass
 import numpy as np
 
 from ptoverify.config import Config
+from ptoverify.errors import InputError
 from ptoverify.model.intervals import add, div, down, h_iv, mul, sub, up
 from ptoverify.model.laws import make_law
 
-__all__ = ["LawSpec", "law_spec", "sigma_point", "omega_c_iv", "enclose", "LawBox"]
+__all__ = [
+    "LawSpec",
+    "law_spec",
+    "sigma_point",
+    "omega_c_iv",
+    "enclose",
+    "LawBox",
+    "ENCLOSED_LAWS",
+    "require_enclosure",
+]
+
+#: The laws with a certified enclosure here (``prove --law`` accepts exactly these).  The
+#: cascade P loop u = sat(-kp x1) is PD's enclosure with kd = 0; PTOS has none (its
+#: square-root branch and its per-state clip of the velocity term are not enclosed).
+ENCLOSED_LAWS = ("pto", "pto-printed", "pd", "to", "cascade-p")
 
 _BISECTIONS = 40  #: bisection steps of the omega_c enclosure (width (w - omega0) / 2^40)
 
@@ -43,7 +60,7 @@ class LawSpec:
     Attributes
     ----------
     name : str
-        Law name (``pd``, ``pto``, ``pto-printed``, ``to``).
+        Law name (``pd``, ``pto``, ``pto-printed``, ``to``, ``cascade-p``).
     a : float
         Bandwidth the law is designed with [rad/s].
     w_max : float
@@ -78,14 +95,16 @@ def law_spec(name: str, cfg: Config) -> LawSpec:
     Parameters
     ----------
     name : str
-        ``pd``, ``pto``, ``pto-printed`` or ``to``.
+        ``pd``, ``pto``, ``pto-printed``, ``to`` or ``cascade-p``
+        (:data:`ENCLOSED_LAWS`; another name is InputError).
     cfg : Config
         Configuration.
 
     Returns
     -------
     LawSpec
-        Parameters of the law (the PTO's zone level from the law itself).
+        Parameters of the law (the PTO's zone level from the law itself; the
+        cascade P loop as PD with kd = 0).
 
     Examples
     --------
@@ -93,12 +112,41 @@ def law_spec(name: str, cfg: Config) -> LawSpec:
     >>> law_spec("to", paper_config()).d
     0.0
     """
+    require_enclosure(name)
     p = cfg.plant
-    law = make_law(name, cfg)
     if name == "pd":
         return LawSpec(name, p.a, p.w_max, math.inf, cfg.pd.kp, cfg.pd.kd, math.nan)
+    if name == "cascade-p":  # PD with kd = 0 (model.baselines.cascade_law is that law)
+        from ptoverify.model.baselines import cascade_gain
+
+        return LawSpec(name, p.a, p.w_max, math.inf, cascade_gain(cfg), 0.0, math.nan)
+    law = make_law(name, cfg)
     g1, g2, d, level = law.family.params  # the PTO block's (k1, k2, d, zone level)
     return LawSpec(name, p.a, p.w_max, d, g1, g2, level)
+
+
+def require_enclosure(name: str) -> None:
+    """Raise InputError unless the law ``name`` has a certified enclosure (:data:`ENCLOSED_LAWS`).
+
+    Parameters
+    ----------
+    name : str
+        Law name.
+
+    Raises
+    ------
+    InputError
+        One line naming the law and the laws that have one.
+
+    Examples
+    --------
+    >>> require_enclosure("cascade-p")
+    """
+    if name not in ENCLOSED_LAWS:
+        raise InputError(
+            f"law '{name}' has no certified enclosure, so it cannot be proved "
+            f"(prove covers {', '.join(ENCLOSED_LAWS)})"
+        )
 
 
 def _iv(x):

@@ -114,8 +114,13 @@ def _verdict(r: ConformResult, ev: ConformEvidence, cfg: Config) -> list[Block]:
     a = r.agreement
     if r.conforms:
         head = (
-            f"CONFORMS: {r.target} agrees with the reference PTO law (eq. 35, corrected "
-            f"omega0) and passes every property ({len(r.properties)} of {len(r.properties)})."
+            f"CONFORMS: {r.target} agrees with the reference "
+            + (
+                "PTO law (eq. 35, corrected omega0)"
+                if r.reference == "pto"
+                else f"{r.reference} law (a baseline, with the configuration's gains)"
+            )
+            + f" and passes every property ({len(r.properties)} of {len(r.properties)})."
         )
     else:
         failing = r.failed_properties() or [
@@ -137,7 +142,7 @@ def _verdict(r: ConformResult, ev: ConformEvidence, cfg: Config) -> list[Block]:
     if rd is not None and rd["cycling"]:
         blocks.append(
             _p(
-                f"WARNING: the reference PTO law itself limit-cycles or does not settle with a "
+                f"WARNING: the reference law itself limit-cycles or does not settle with a "
                 f"{rd['delay_samples']}-sample computation delay from {rd['cycling']} of "
                 f"{rd['states']} initial states (the closed-loop sweep of this gate). "
                 "Conformance to it does not make a law delay-tolerant: compensate the delay, "
@@ -150,6 +155,7 @@ def _verdict(r: ConformResult, ev: ConformEvidence, cfg: Config) -> list[Block]:
         blocks.append(_p(f"First failing property: {f['property']}{where}: {f['detail']}"))
     rows = [
         ["law", r.target],
+        ["reference law", r.reference],
         ["evaluated as", f"{r.mode} ({r.mode_reason})" if r.mode_reason else r.mode],
         ["precision", precision_text(r.precision)],
         ["perturbation", perturbation_text(r)],
@@ -334,7 +340,7 @@ def _closed_loop(r: ConformResult, ev: ConformEvidence) -> list[Block]:
         )
     )
     rows = []
-    for label, key in (("your law", "user"), ("reference PTO", "reference")):
+    for label, key in (("your law", "user"), ("reference law", "reference")):
         st = s[key]
         rows.append(
             [
@@ -362,7 +368,7 @@ def _responses(ev: ConformEvidence, figures: dict[str, str]) -> list[Block]:
         _p(
             "The Section 6 references (5 mm step; ramp to 30 mm at 200 mm/s; 5 mm, 5 Hz "
             "sine; reference velocity fed forward), simulated with your law called through "
-            "the same isolated process as the conformance, next to the reference PTO law. "
+            "the same isolated process as the conformance, next to the reference law. "
             "Metrics are exact between samples, and only those that mean something for the "
             "signal: settling and rise for the step, the overshoot past the end value for "
             "the ramp (its settling from the start would measure the ramp), the phase delay "
@@ -386,7 +392,7 @@ def _responses(ev: ConformEvidence, figures: dict[str, str]) -> list[Block]:
         rows.append(
             ["largest |x1 (yours) - x1 (reference)|", quantity(resp.max_abs_dx1_mm, "mm"), "0 mm"]
         )
-        blocks.append(_table([f"{name}: metric", "your law", "reference PTO"], rows))
+        blocks.append(_table([f"{name}: metric", "your law", "reference law"], rows))
     return blocks
 
 

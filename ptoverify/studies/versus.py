@@ -33,6 +33,7 @@ from ptoverify.model.poles import delay_margin_samples
 from ptoverify.sim.settling import definition
 from ptoverify.sim.simulate import reference
 from ptoverify.studies.ptos_claim import READINGS, reading_config
+from ptoverify.studies.robust.margins import law_margins
 from ptoverify.studies.tune import TuneBudget, fair_tunings
 
 __all__ = ["SETTLING", "VERSUS_LAWS", "TunedLaw", "ReadingVersus", "Versus", "versus"]
@@ -70,6 +71,13 @@ class TunedLaw:
         Whole samples of computation delay the tuned linear loop tolerates
         (:func:`ptoverify.model.poles.delay_margin_samples`; -1: unstable without
         delay) [samples]; None: infeasible.
+    a_ratio_stable : tuple of (float or None) or None
+        The interval of a_true / a_design around 1 where the tuned linear loop
+        stays stable (:func:`ptoverify.studies.robust.linear_loop_margin`; an
+        endpoint None: beyond the searched [0.1, 10]) [-]; None: unstable at the
+        design point, or infeasible.
+    a_ratio_stable_delay1 : tuple of (float or None) or None
+        The same with a one-sample computation delay [-].
     """
 
     law: str
@@ -80,6 +88,8 @@ class TunedLaw:
     ratio_tf: float | None
     infeasible: str = ""
     delay_margin_samples: int | None = None
+    a_ratio_stable: tuple[float | None, float | None] | None = None
+    a_ratio_stable_delay1: tuple[float | None, float | None] | None = None
 
 
 @dataclass(frozen=True)
@@ -215,6 +225,7 @@ def versus(cfg: Config, budget: TuneBudget | None = None) -> Versus:
             ts = r.best.settling_2pct_s
             gains = linear_loop_gains(law, r.config)  # every law compared has a linear loop
             margin = delay_margin_samples(c.plant.a, c.plant.sample_time, *gains)
+            robust = law_margins(law, r.config, limit_cycles=False)
             laws.append(
                 TunedLaw(
                     law,
@@ -224,6 +235,8 @@ def versus(cfg: Config, budget: TuneBudget | None = None) -> Versus:
                     _ratio(ts, nt),
                     _ratio(ts, tf),
                     delay_margin_samples=margin,
+                    a_ratio_stable=robust.linear.interval,
+                    a_ratio_stable_delay1=robust.linear_delay1.interval,
                 )
             )
         pto = laws[0].settling_s

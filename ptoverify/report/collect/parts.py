@@ -260,7 +260,11 @@ def _plots():
 
 
 def _robust(cfg: Config) -> tuple[dict[str, Any], list]:
-    """Run the robustness study at :data:`ROBUST_SETTINGS`: its JSON and its gates."""
+    """Run the robustness study at :data:`ROBUST_SETTINGS`: its JSON and its gates.
+
+    The JSON also holds ``baseline_margins``: PTOS and the cascade P loop at the
+    configured gains (:func:`_baseline_margins`), for the margins table.
+    """
     from dataclasses import asdict
 
     from ptoverify.studies.robust import RobustSettings, robust_gates, run_robust
@@ -274,7 +278,32 @@ def _robust(cfg: Config) -> tuple[dict[str, Any], list]:
     res["settings"] = asdict(settings)
     res["settling"] = SETTLING
     res["drive"] = drive_sweeps(cfg).to_json()
+    res["baseline_margins"] = _baseline_margins(cfg, settings)
     return res, robust_gates(result)
+
+
+#: The baselines whose margins the report's robustness table adds (at the configured gains).
+BASELINES = ("ptos", "cascade-p")
+
+
+def _baseline_margins(cfg: Config, settings) -> dict[str, Any]:
+    """Margins of the baselines at the configured gains (no maps, no search), with the gains.
+
+    The linear-loop margins of :func:`ptoverify.studies.robust.law_margins`
+    (eigenvalues, without and with a one-sample delay; about 0.1 s a law).  The
+    simulated no-limit-cycle margin is left out: it would add about a quarter to
+    the robustness stage (measured, benchmarks/README.md).  Their fair-tuned
+    margins come with the tuning (``tuning.versus``).
+    """
+    from ptoverify.model.baselines import cascade_gain, ptos_design
+    from ptoverify.studies.robust import law_margins
+
+    p = ptos_design(cfg)
+    gains = {"ptos": {"alpha": p.alpha, "k": p.k}, "cascade-p": {"kp": cascade_gain(cfg)}}
+    return {
+        law: {"gains": gains[law], **law_margins(law, cfg, settings, limit_cycles=False).to_json()}
+        for law in BASELINES
+    }
 
 
 def tuning_results(cfg: Config) -> dict[str, Any]:

@@ -16,6 +16,7 @@ from ptoverify.report.standing import ratio_interval
 from ptoverify.report.words import plural
 
 from .common import _law, _ms, figure
+from .robust_rows import baseline_margin_rows
 
 # ------------------------------------------------------------------ proofs
 _PROOF_WORDS = {
@@ -212,6 +213,7 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
                 else m["no_limit_cycle_note"] or "n/a",
             ]
         )
+    rows += baseline_margin_rows(res)
     best = rob["most_robust"]
     blocks += [
         Block(

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 from ptoverify.config import Config
 from ptoverify.errors import InputError
+from ptoverify.model.lawbox import require_enclosure
 from ptoverify.model.memo import memo
 from ptoverify.studies.prove.run import LawProof, Resolution, prove_law
 
@@ -164,7 +165,8 @@ def run_prove(
     cfg : Config
         Configuration.
     laws : tuple of str
-        Laws, the reference first.
+        Laws, the reference first (each of
+        :data:`ptoverify.model.lawbox.ENCLOSED_LAWS`; ``ptos`` is InputError).
     a_interval : tuple of float, optional
         The plant's a [rad/s]; default the nominal a.
     pieces : int, optional
@@ -189,6 +191,8 @@ def run_prove(
     """
     if not 0.0 <= excursion <= cfg.plant.position_range:
         raise InputError(f"--excursion must be in [0, position_range], got {excursion:g}")
+    for name in laws:  # before any work: a law without a certified enclosure is bad input
+        require_enclosure(name)
     t0 = time.perf_counter()
     mapper = _dask_mapper(dask) if dask else map
     n = pieces or default_pieces(a_interval)

@@ -32,6 +32,7 @@ from ptoverify.studies.robust.maps import (
 )
 from ptoverify.studies.robust.margins import (
     MARGIN_RANGE,
+    law_margins,
     linear_loop_margin,
     linear_loop_radii,
     most_robust,
@@ -78,6 +79,7 @@ __all__ = [
     "RobustSettings",
     "check_dask_address",
     "dask_runner",
+    "law_margins",
     "describe_case",
     "evaluate_probes",
     "grid_worst",

@@ -39,6 +39,7 @@ __all__ = [
     "linear_loop_margin",
     "no_limit_cycle_margin",
     "margin_job",
+    "law_margins",
     "most_robust",
 ]
 
@@ -215,6 +216,46 @@ def no_limit_cycle_margin(
     s = settings or RobustSettings()
     job = margin_job(nominal_law(law, cfg), cfg, s, rtol=rtol)
     return job(lambda probes: evaluate_probes(cfg, probes))
+
+
+def law_margins(
+    law: str, cfg: Config, settings: RobustSettings | None = None, *, limit_cycles: bool = True
+) -> LawMargins:
+    """Return the margins of one law at the configuration's gains, without maps or search.
+
+    What :func:`ptoverify.studies.robust.run_robust` records per law
+    (:func:`linear_loop_margin` without and with a one-sample delay, and
+    :func:`no_limit_cycle_margin`), for a law the study does not map: the
+    report's rows for the baselines.
+
+    Parameters
+    ----------
+    law : str
+        Law name.
+    cfg : Config
+        Nominal configuration (its gains are the law's).
+    settings : RobustSettings, optional
+        The state grid of the no-limit-cycle margin.
+    limit_cycles : bool
+        Also compute the no-limit-cycle margin (simulated); False: the two
+        eigenvalue margins only.
+
+    Returns
+    -------
+    LawMargins
+        ``no_limit_cycle`` None when not computed.
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> m = law_margins("cascade-p", paper_config(), limit_cycles=False)
+    >>> m.linear.interval is not None, m.no_limit_cycle is None
+    (True, True)
+    """
+    nlc = no_limit_cycle_margin(law, cfg, settings) if limit_cycles else None
+    return LawMargins(
+        linear_loop_margin(law, cfg), linear_loop_margin(law, cfg, delay_samples=1), nlc
+    )
 
 
 SCAN_CHUNK = 8  #: scan points of each side tested per step of :func:`_edges`
