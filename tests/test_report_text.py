@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from ptoverify.report.render import CSS, render_html
-from ptoverify.report.words import claim_quantity, law_name, plain, plural
+from ptoverify.report.words import claim_quantity, claim_title, law_name, plain, plural
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -61,6 +61,19 @@ def _texts(sections):
 )
 def test_plural_agrees_with_its_count(count, noun, want):
     assert plural(count, noun) == want
+
+
+def test_a_negative_more_reads_as_less_and_the_number_says_what_it_is():
+    from ptoverify.report.words import claim_measured_words
+
+    def claim(name, v, unit):
+        return {"measured": v, "unit": unit, "readings": [{"values": {"x_s": 9.0, name: v}}]}
+
+    assert claim_measured_words(claim("pd_more_percent", -36.41, "%")) == "PD 36.41 % less"
+    assert claim_measured_words(claim("pd_more_percent", 31.0, "%")) == "PD 31 % more"
+    assert claim_measured_words(claim("phase_delay_deg", 0.38, "deg")) == "phase delay 0.38 deg"
+    assert claim_measured_words(claim("error_reversals", 1.0, "reversals")) == "1 sign reversal"
+    assert claim_measured_words({"measured": None, "unit": "s", "readings": []}) == "n/a"
 
 
 def test_claim_quantity_counts_in_words_and_times_in_ms():
@@ -140,6 +153,37 @@ def test_a_claim_that_depends_names_both_sides(committed):
     for claim, standing, cond, *_ in reviewer_rows(results_view(data)):
         if standing == "depends":
             assert cond.startswith("holds with ") and "; fails with " in cond, (claim, cond)
+
+
+@pytest.mark.slow
+def test_one_standing_word_per_claim_in_the_verdict_and_the_summary(committed):
+    """The summary's claims table says holds / fails / depends as the verdict table does,
+    never a second vocabulary (ambiguous, not reproduced) for the same claim; the verdict's
+    measured numbers never read as a negative 'more'."""
+    data, sections = committed
+    by = {a: blocks for a, _t, blocks in sections}
+    tables = lambda a: [b for b in by[a] if b.kind == "table"]  # noqa: E731
+    reviewer = next(t for t in tables("verdict") if t.headers[1] == "standing")
+    verdict = {row[0]: row[1] for row in reviewer.rows}
+    summary = next(t for t in tables("summary") if t.headers[0] == "claim")
+    assert summary.headers[1] == "standing"
+    titles = {c["claim"]: claim_title(c) for c in data["claims"]}
+    assert summary.rows
+    for row in summary.rows:
+        assert row[1] in ("fails", "depends"), row
+        assert verdict[titles[row[0]]] == row[1], (row[0], row[1], verdict[titles[row[0]]])
+    assert not [r for r in reviewer.rows if r[4].startswith("-")], reviewer.rows
+
+
+@pytest.mark.slow
+def test_the_verdict_names_a_settling_band_not_where_the_suite_uses_it(committed):
+    from ptoverify.sim.settling import DEFINITIONS
+
+    _data, sections = committed
+    texts = [t for a, t in _texts(sections) if a == "verdict"]
+    used = [d.description for d in DEFINITIONS.values() if any(d.description in t for t in texts)]
+    assert not used, used
+    assert any("settled: abs(e) <= 2 % of the reference's size" in t for t in texts)
 
 
 # ---------------------------------------------------------------- equations

@@ -287,7 +287,10 @@ def test_versus_row_names_each_reading_and_infeasible_tunings(base):
     assert hz.startswith("a = 30 rad/s (30 Hz read as rad/s)") and "beats PD" in hz
     assert "no cascade P gains meet the constraints" in hz
     evidence = _rows(data)[VERSUS_QUESTION][2]
-    assert "cascade P no tuning" in evidence and "settling definition 2pct" in evidence
+    assert (
+        "cascade P no tuning" in evidence
+        and "settled: abs(e) <= 2 % of the reference's size" in evidence
+    )
     assert "PTO (corrected) 20 ms (0.7692 N*T, 0.8333 t_f*)" in evidence  # 20 / 26, 20 / 24
 
 

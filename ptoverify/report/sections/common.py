@@ -12,7 +12,13 @@ from ptoverify.report.render import (
     qty,
     table,
 )
-from ptoverify.report.words import LAW_WORDS, claim_quantity, display_unit, law_name
+from ptoverify.report.words import (
+    LAW_WORDS,
+    claim_quantity,
+    claim_value_name,
+    display_unit,
+    law_name,
+)
 
 __all__ = ["LAW_WORDS", "CAPTIONS", "figure", "verdict", "measured_quantity"]
 
@@ -155,10 +161,6 @@ def _display_unit(unit: str) -> tuple[str, float]:
     return display_unit(unit)
 
 
-#: Tokens of the claims' value names, as a reader writes them.
-_TOKEN_WORDS = {"pto": "PTO", "pd": "PD", "to": "TO", "rms": "RMS"}
-
-
 def measured_quantity(c: dict[str, Any]) -> str:
     """Describe what a claim's 'measured' number is, in words with its unit.
 
@@ -176,15 +178,8 @@ def measured_quantity(c: dict[str, Any]) -> str:
     """
     if c["measured"] is None:
         return "qualitative (no single number; see detail)"
-    values = c["readings"][0]["values"] if c["readings"] else {}
-    name = next(
-        (k for k, v in values.items() if isinstance(v, (int, float)) and v == c["measured"]), ""
-    )
-    words = " ".join(
-        _TOKEN_WORDS.get(w, w) for w in re.sub(r"_(mm_s|mm|s|deg|percent)$", "", name).split("_")
-    )
     unit, _ = _display_unit(c["unit"])
-    return f"{words or 'value'} [{unit or '-'}]"
+    return f"{claim_value_name(c) or 'value'} [{unit or '-'}]"
 
 
 def _claim_qty(v: float | None, unit: str) -> str:
