@@ -214,6 +214,24 @@ def test_derivation_and_errata_cells_wrap_each_equation():
     assert "<td><math" not in page, "an equation outside its scrolling wrapper"
 
 
+def test_the_tilde_is_drawn_whether_or_not_the_mathml_was_rendered_beforehand():
+    """Eq. (15)'s x~1 draws as x with a tilde, never as 'tx1', on either path."""
+    import derivations
+    from ptoverify.report.sections import derivations as derivation_section
+    from ptoverify.report.sections import render_records
+
+    data = json.loads((ROOT / "reports" / "paper" / "results.json").read_text())
+    recs = [
+        derivations.EquationRecord.from_json(r)
+        for r in data["derivations"]
+        if r["id"] in ("15", "17")
+    ]
+    for rendered in (None, render_records(recs)):
+        page = "".join(b.html for b in derivation_section({}, recs, rendered) if b.kind == "raw")
+        assert "<mi>tx</mi>" not in page
+        assert page.count('<mover accent="true"><mi>x</mi><mo>~</mo></mover>') >= 2
+
+
 # ---------------------------------------------------------------- errata counterexamples
 def test_a_repeated_counterexample_is_said_not_copied():
     from ptoverify.report.sections import errata
