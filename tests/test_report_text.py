@@ -127,6 +127,7 @@ JARGON = (
     r"\b1 (samples|reversals|sign reversals|stride-overs|readings|gates)\b",
     r"delay 1 samples",
     r"\bpto-printed\b",
+    r"\bposition_range\b",
 )
 
 

@@ -44,8 +44,9 @@ def proofs(res: Any, figures: dict[str, str]) -> list[Block]:
     blocks = [
         Block(
             "p",
-            text="Proved over the continuum of initial states (|x1| <= position_range, "
-            "|x2| <= w_max) with outward-rounded interval arithmetic and python-flint arb "
+            text="Proved over the continuum of initial states (|x1| <= "
+            f"{qty(res['environment']['config']['plant']['position_range'], 'mm')}, "
+            f"|x2| <= w_max = {qty(res['environment']['config']['plant']['w_max'], 'mm/s')}) with outward-rounded interval arithmetic and python-flint arb "
             "certificates (`ptoverify prove`): each property is proved, refuted with a "
             "certified counterexample, or unproven with the region where the proof fails. "
             "Coverage is the fraction of the envelope's area proved.",
