@@ -187,6 +187,25 @@ def test_the_verdict_names_a_settling_band_not_where_the_suite_uses_it(committed
     assert any("settled: abs(e) <= 2 % of the reference's size" in t for t in texts)
 
 
+@pytest.mark.slow
+def test_the_robustness_section_says_why_its_worst_settling_differs_from_the_sweep(committed):
+    """One quantity, two values (the nominal robustness cell, the sweep's worst): the text
+    gives both and says each is the worst of its own grid."""
+    from ptoverify.report.render import fmt
+
+    data, sections = committed
+    texts = " ".join(t for a, t in _texts(sections) if a == "robustness")
+    worst = data["sweep"]["laws"]["pto"]["worst_ratio_nt"]
+    nominal = next(
+        c["settling_ratio_nt"]["max"]
+        for c in data["robust"]["maps"]["laws"]["pto"]
+        if (c["a_ratio"], c["w_max_ratio"], c["delay_samples"]) == (1, 1, 0)
+    )
+    assert nominal != worst
+    assert f"PTO (corrected) {fmt(nominal)} from" in texts and f"{fmt(worst)} from" in texts
+    assert "each is the worst of its own grid" in texts
+
+
 # ---------------------------------------------------------------- equations
 def test_equations_scroll_inside_their_cells():
     """Every equation sits in a div.eq that scrolls sideways; the equation tables are fixed to
