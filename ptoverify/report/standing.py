@@ -261,8 +261,8 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
         rows.append(
             [
                 "Stability margins of the linear loops (sampled, nominal plant)?",
-                f"PTO linear zone: {_margins(lin)}",
-                f"PD: {_margins(pd)}",
+                _thinner(lin, pd),
+                f"PTO linear zone: {_margins(lin)}; PD: {_margins(pd)}",
             ]
         )
     p = res["properties"]["pto"] if "pto" in res["properties"] else None
@@ -433,6 +433,16 @@ def _proved_stride(res: Mapping) -> str:
     if prop["status"] == "proved":
         return "; no stride-over is proved for every state of the envelope"
     return f"; no stride-over is {prop['status']} over the continuum (see the proofs)"
+
+
+def _thinner(lin: Mapping, pd: Mapping) -> str:
+    """Say which linear loop has the thinner margins (gain, phase, delay), or that it is mixed."""
+    keys = ("gain_margin_db", "phase_margin_deg", "delay_margin_samples")
+    if all(lin[k] < pd[k] for k in keys):
+        return "thinner in the PTO's linear zone than in PD on gain, phase and delay"
+    if all(lin[k] > pd[k] for k in keys):
+        return "thicker in the PTO's linear zone than in PD on gain, phase and delay"
+    return "mixed: see the margins of each loop"
 
 
 def _margins(loop: Mapping) -> str:
