@@ -128,6 +128,7 @@ JARGON = (
     r"delay 1 samples",
     r"\bpto-printed\b",
     r"\bposition_range\b",
+    r"see the settling definitions",
 )
 
 

@@ -20,7 +20,14 @@ from ptoverify.report.words import (
     law_name,
 )
 
-__all__ = ["LAW_WORDS", "CAPTIONS", "figure", "verdict", "measured_quantity"]
+__all__ = [
+    "LAW_WORDS",
+    "CAPTIONS",
+    "figure",
+    "verdict",
+    "measured_quantity",
+    "settling_band_words",
+]
 
 _MATH = '<math xmlns="http://www.w3.org/1998/Math/MathML" display="block">{}</math>'
 
@@ -204,3 +211,27 @@ def _downstream_ids(inherits: list[str]) -> list[str]:
         if re.fullmatch(r"[\w\-, ]+", head.strip()) and not what.strip().startswith("unchanged"):
             out.append(head.strip())
     return out
+
+
+def settling_band_words(name: str, fallback: str) -> str:
+    """Return a named settling definition as its band and hold, in words.
+
+    Parameters
+    ----------
+    name : str
+        A name of :data:`ptoverify.sim.settling.DEFINITIONS`.
+    fallback : str
+        What to say for a name that is not there.
+
+    Returns
+    -------
+    str
+        ``abs(e) <= 0.01 mm, abs(e') <= a * 0.01 mm [mm/s], held 50 ms``.
+    """
+    from ptoverify.sim.settling import DEFINITIONS
+
+    d = DEFINITIONS.get(name)
+    if d is None:
+        return fallback
+    held = f", held {_ms(d.hold_s)}" if d.hold_s > 0 else ""
+    return d.band_text() + held

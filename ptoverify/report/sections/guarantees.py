@@ -15,7 +15,7 @@ from ptoverify.report.render import (
 from ptoverify.report.standing import ratio_interval
 from ptoverify.report.words import plural
 
-from .common import _law, _ms, figure
+from .common import _law, _ms, figure, settling_band_words
 
 # ------------------------------------------------------------------ proofs
 _PROOF_WORDS = {
@@ -274,8 +274,9 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             "p",
             text="Worst cases: the grid's worst cell, then a seeded search over (initial "
             "state x perturbation) started from it; the searched value is never below the grid's. "
-            f"Settling is read on the samples under `{rob['settling']}` (see the settling "
-            "definitions), over N* T of the true plant." + _nominal_vs_sweep(res),
+            f"Settling is read on the samples under {rob['settling']} "
+            f"({settling_band_words(rob['settling'], rob['settling'])}), over N* T of the "
+            "true plant." + _nominal_vs_sweep(res),
         ),
         table(["law", "property", "grid worst", "searched worst", "state", "perturbation"], wrows),
     ]
