@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from ptoverify.report.render import CSS, render_html
-from ptoverify.report.words import claim_quantity, law_name, plain, plural
+from ptoverify.report.words import claim_quantity, claim_title, law_name, plain, plural
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -63,6 +63,19 @@ def test_plural_agrees_with_its_count(count, noun, want):
     assert plural(count, noun) == want
 
 
+def test_a_negative_more_reads_as_less_and_the_number_says_what_it_is():
+    from ptoverify.report.words import claim_measured_words
+
+    def claim(name, v, unit):
+        return {"measured": v, "unit": unit, "readings": [{"values": {"x_s": 9.0, name: v}}]}
+
+    assert claim_measured_words(claim("pd_more_percent", -36.41, "%")) == "PD 36.41 % less"
+    assert claim_measured_words(claim("pd_more_percent", 31.0, "%")) == "PD 31 % more"
+    assert claim_measured_words(claim("phase_delay_deg", 0.38, "deg")) == "phase delay 0.38 deg"
+    assert claim_measured_words(claim("error_reversals", 1.0, "reversals")) == "1 sign reversal"
+    assert claim_measured_words({"measured": None, "unit": "s", "readings": []}) == "n/a"
+
+
 def test_claim_quantity_counts_in_words_and_times_in_ms():
     assert claim_quantity(1.0, "reversals") == "1 sign reversal"
     assert claim_quantity(3.0, "reversals") == "3 sign reversals"
@@ -114,6 +127,8 @@ JARGON = (
     r"\b1 (samples|reversals|sign reversals|stride-overs|readings|gates)\b",
     r"delay 1 samples",
     r"\bpto-printed\b",
+    r"\bposition_range\b",
+    r"see the settling definitions",
 )
 
 
@@ -142,6 +157,61 @@ def test_a_claim_that_depends_names_both_sides(committed):
             assert cond.startswith("holds with ") and "; fails with " in cond, (claim, cond)
 
 
+@pytest.mark.slow
+def test_one_standing_word_per_claim_in_the_verdict_and_the_summary(committed):
+    """The summary's claims table says holds / fails / depends as the verdict table does,
+    never a second vocabulary (ambiguous, not reproduced) for the same claim; the verdict's
+    measured numbers never read as a negative 'more'."""
+    data, sections = committed
+    by = {a: blocks for a, _t, blocks in sections}
+    tables = lambda a: [b for b in by[a] if b.kind == "table"]  # noqa: E731
+    reviewer = next(t for t in tables("verdict") if t.headers[1] == "standing")
+    verdict = {row[0]: row[1] for row in reviewer.rows}
+    summary = next(t for t in tables("summary") if t.headers[0] == "claim")
+    assert summary.headers[1] == "standing"
+    titles = {c["claim"]: claim_title(c) for c in data["claims"]}
+    assert summary.rows
+    for row in summary.rows:
+        assert row[1] in ("fails", "depends"), row
+        assert verdict[titles[row[0]]] == row[1], (row[0], row[1], verdict[titles[row[0]]])
+    assert not [r for r in reviewer.rows if r[4].startswith("-")], reviewer.rows
+
+
+@pytest.mark.slow
+def test_the_verdict_names_a_settling_band_not_where_the_suite_uses_it(committed):
+    from ptoverify.sim.settling import DEFINITIONS
+
+    _data, sections = committed
+    every = [
+        f"{a}: {t[:80]}"
+        for a, t in _texts(sections)
+        for d in DEFINITIONS.values()
+        if d.description in t
+    ]
+    assert not every, every
+    texts = [t for a, t in _texts(sections) if a == "verdict"]
+    assert any("settled: abs(e) <= 2 % of the reference's size" in t for t in texts)
+
+
+@pytest.mark.slow
+def test_the_robustness_section_says_why_its_worst_settling_differs_from_the_sweep(committed):
+    """One quantity, two values (the nominal robustness cell, the sweep's worst): the text
+    gives both and says each is the worst of its own grid."""
+    from ptoverify.report.render import fmt
+
+    data, sections = committed
+    texts = " ".join(t for a, t in _texts(sections) if a == "robustness")
+    worst = data["sweep"]["laws"]["pto"]["worst_ratio_nt"]
+    nominal = next(
+        c["settling_ratio_nt"]["max"]
+        for c in data["robust"]["maps"]["laws"]["pto"]
+        if (c["a_ratio"], c["w_max_ratio"], c["delay_samples"]) == (1, 1, 0)
+    )
+    assert nominal != worst
+    assert f"PTO (corrected) {fmt(nominal)} from" in texts and f"{fmt(worst)} from" in texts
+    assert "each is the worst of its own grid" in texts
+
+
 # ---------------------------------------------------------------- equations
 def test_equations_scroll_inside_their_cells():
     """Every equation sits in a div.eq that scrolls sideways; the equation tables are fixed to
@@ -168,6 +238,24 @@ def test_derivation_and_errata_cells_wrap_each_equation():
     page = render_html([("errata", "Errata", errata({"derivations": err}, recs))], "t")
     assert page.count('<table class="forms">') == len(err)
     assert "<td><math" not in page, "an equation outside its scrolling wrapper"
+
+
+def test_the_tilde_is_drawn_whether_or_not_the_mathml_was_rendered_beforehand():
+    """Eq. (15)'s x~1 draws as x with a tilde, never as 'tx1', on either path."""
+    import derivations
+    from ptoverify.report.sections import derivations as derivation_section
+    from ptoverify.report.sections import render_records
+
+    data = json.loads((ROOT / "reports" / "paper" / "results.json").read_text())
+    recs = [
+        derivations.EquationRecord.from_json(r)
+        for r in data["derivations"]
+        if r["id"] in ("15", "17")
+    ]
+    for rendered in (None, render_records(recs)):
+        page = "".join(b.html for b in derivation_section({}, recs, rendered) if b.kind == "raw")
+        assert "<mi>tx</mi>" not in page
+        assert page.count('<mover accent="true"><mi>x</mi><mo>~</mo></mover>') >= 2
 
 
 # ---------------------------------------------------------------- errata counterexamples

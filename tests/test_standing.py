@@ -287,7 +287,10 @@ def test_versus_row_names_each_reading_and_infeasible_tunings(base):
     assert hz.startswith("a = 30 rad/s (30 Hz read as rad/s)") and "beats PD" in hz
     assert "no cascade P gains meet the constraints" in hz
     evidence = _rows(data)[VERSUS_QUESTION][2]
-    assert "cascade P no tuning" in evidence and "settling definition 2pct" in evidence
+    assert (
+        "cascade P no tuning" in evidence
+        and "settled: abs(e) <= 2 % of the reference's size" in evidence
+    )
     assert "PTO (corrected) 20 ms (0.7692 N*T, 0.8333 t_f*)" in evidence  # 20 / 26, 20 / 24
 
 
@@ -377,3 +380,13 @@ def test_the_tie_rule_is_stated_beside_the_verdicts_and_the_claims(base):
 
     for blocks in (verdict(results_view(base)), claims(results_view(base), {})):
         assert any(TIME_TIE_RULE in b.text for b in blocks)
+
+
+def test_the_margins_answer_names_the_thinner_loop_and_flips():
+    from ptoverify.report.standing import _thinner
+
+    thin = {"gain_margin_db": 3.4, "phase_margin_deg": 54.6, "delay_margin_samples": 0}
+    thick = {"gain_margin_db": 13.2, "phase_margin_deg": 60.7, "delay_margin_samples": 1}
+    assert _thinner(thin, thick).startswith("thinner in the PTO's linear zone")
+    assert _thinner(thick, thin).startswith("thicker in the PTO's linear zone")
+    assert _thinner({**thin, "phase_margin_deg": 70.0}, thick).startswith("mixed")

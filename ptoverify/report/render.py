@@ -305,7 +305,8 @@ CSS = """body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto;
 color:#222;line-height:1.4}table{border-collapse:collapse;margin:1em 0;font-size:.9em}
 th,td{border:1px solid #ccc;padding:.3em .5em;vertical-align:top;text-align:left}
 th{background:#f0f0f0}.pass,.verified,.reproduced{background:#e6f4e6}
-.fail,.erratum,.not-reproduced{background:#fbe3e3}.unverified,.ambiguous,.unchecked,.inherits{background:#fff4d6}
+.fail,.erratum,.not-reproduced,.fails{background:#fbe3e3}.holds{background:#e6f4e6}
+.unverified,.ambiguous,.unchecked,.inherits,.depends{background:#fff4d6}
 img{max-width:100%;border:1px solid #ddd}figure{margin:1em 0}nav a{margin-right:1em}
 math{font-size:1.05em}code{font-size:.85em}pre{background:#f6f6f6;padding:.5em;overflow-x:auto}
 .headline{display:flex;gap:1.5em;align-items:flex-start;flex-wrap:wrap}
@@ -335,6 +336,9 @@ STATUS_WORDS = frozenset(
         "reproduced",
         "not reproduced",
         "ambiguous",
+        "holds",
+        "fails",
+        "depends",
     }
 )
 

@@ -33,7 +33,14 @@ from ptoverify.report.standing_claims import (
     claim_standing,
     reading_words,
 )
-from ptoverify.report.words import LAW_WORDS, claim_quantity, claim_title, law_name, plural
+from ptoverify.report.words import (
+    LAW_WORDS,
+    claim_measured_words,
+    claim_quantity,
+    claim_title,
+    law_name,
+    plural,
+)
 from ptoverify.verdict import TIME_TIE_RULE, time_order
 
 __all__ = [
@@ -65,7 +72,8 @@ def reviewer_rows(res: Mapping) -> list[list[str]]:
     Returns
     -------
     list of list of str
-        One row per claim; ``measured`` is the primary reading's value with its unit.
+        One row per claim; ``measured`` is the primary reading's value with its unit
+        and what it is (:func:`ptoverify.report.words.claim_measured_words`).
     """
     rows = []
     hz = bandwidth_hz(res)
@@ -80,9 +88,7 @@ def reviewer_rows(res: Mapping) -> list[list[str]]:
                 claim_quantity(c["paper_value"], unit)
                 if c["paper_value"] is not None
                 else "qualitative",
-                claim_quantity(c["measured"], unit)
-                if c["measured"] is not None
-                else "see the claims table",
+                claim_measured_words(c) if c["measured"] is not None else "see the claims table",
             ]
         )
     return rows
@@ -255,8 +261,8 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
         rows.append(
             [
                 "Stability margins of the linear loops (sampled, nominal plant)?",
-                f"PTO linear zone: {_margins(lin)}",
-                f"PD: {_margins(pd)}",
+                _thinner(lin, pd),
+                f"PTO linear zone: {_margins(lin)}; PD: {_margins(pd)}",
             ]
         )
     p = res["properties"]["pto"] if "pto" in res["properties"] else None
@@ -354,6 +360,14 @@ def versus_verdict(diff: float | None, other: Mapping, pto: Mapping, sample: flo
     return f"{'beats' if order < 0 else 'loses to'} {name} by {_ms(abs(diff))}"
 
 
+def _settling_words(name: str, description: str) -> str:
+    """Return a named settling definition as its band in words (the description if unknown)."""
+    from ptoverify.sim.settling import DEFINITIONS
+
+    d = DEFINITIONS.get(name)
+    return d.band_text() if d is not None else description
+
+
 def versus_row(res: Mapping) -> list[str]:
     """Return the row saying whether the corrected PTO beats fair-tuned PD, PTOS, cascade P.
 
@@ -406,7 +420,7 @@ def versus_row(res: Mapping) -> list[str]:
             f"{words}, overshoot <= {qty(r['bound_mm'], 'mm')}: {times}; "
             f"N*T = {_ms(r['nt_s'])}, t_f* = {_ms(r['tf_s'])}"
         )
-    evidence.append(f"settling definition {v['settling']}: {v['settling_description']}")
+    evidence.append(f"settled: {_settling_words(v['settling'], v['settling_description'])}")
     return [VERSUS_QUESTION, "; ".join(answers), "; ".join(evidence)]
 
 
@@ -419,6 +433,16 @@ def _proved_stride(res: Mapping) -> str:
     if prop["status"] == "proved":
         return "; no stride-over is proved for every state of the envelope"
     return f"; no stride-over is {prop['status']} over the continuum (see the proofs)"
+
+
+def _thinner(lin: Mapping, pd: Mapping) -> str:
+    """Say which linear loop has the thinner margins (gain, phase, delay), or that it is mixed."""
+    keys = ("gain_margin_db", "phase_margin_deg", "delay_margin_samples")
+    if all(lin[k] < pd[k] for k in keys):
+        return "thinner in the PTO's linear zone than in PD on gain, phase and delay"
+    if all(lin[k] > pd[k] for k in keys):
+        return "thicker in the PTO's linear zone than in PD on gain, phase and delay"
+    return "mixed: see the margins of each loop"
 
 
 def _margins(loop: Mapping) -> str:

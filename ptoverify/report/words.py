@@ -15,6 +15,8 @@ plural       a count with its noun, singular or plural
 claim_title  a claim's human title (the paper's words), from its record
 display_unit the unit a claim's number is shown in (s -> ms, a count's noun)
 claim_quantity a claim's number in its display unit (``1 sign reversal``, ``16.14 ms``)
+claim_value_name what a claim's measured number is, in words (``phase delay``)
+claim_measured_words a claim's measured number with what it is (``PD 36.41 % less``)
 plain        a lower layer's sentence with the configuration file's jargon in words
 gate_words   a gate's name in words, for prose
 setting_words the gains a study ran at, in words
@@ -35,6 +37,8 @@ __all__ = [
     "claim_title",
     "display_unit",
     "claim_quantity",
+    "claim_value_name",
+    "claim_measured_words",
     "plain",
     "gate_words",
     "setting_words",
@@ -146,6 +150,77 @@ def claim_quantity(v: float | None, unit: str) -> str:
         return plural(int(v), COUNT_NOUNS[unit])
     u, scale = display_unit(unit)
     return qty(v * scale, u)
+
+
+#: Tokens of the claims' value names, as a reader writes them.
+_TOKEN_WORDS = {"pto": "PTO", "pd": "PD", "to": "TO", "rms": "RMS"}
+
+
+def claim_value_name(c: Mapping) -> str:
+    """Return what a claim's measured number is, in words, without its unit.
+
+    The name of the primary reading's value that equals the claim's number, with
+    its unit suffix dropped (``phase_delay_deg`` -> ``phase delay``).
+
+    Parameters
+    ----------
+    c : Mapping
+        A claim of ``results["claims"]`` (``measured``, ``readings``).
+
+    Returns
+    -------
+    str
+        The words; empty when the number is not measured or no value matches.
+
+    Examples
+    --------
+    >>> claim_value_name({"measured": -3.0, "readings": [{"values": {"pd_more_percent": -3.0}}]})
+    'PD more'
+    """
+    if c["measured"] is None:
+        return ""
+    values = c["readings"][0]["values"] if c["readings"] else {}
+    name = next(
+        (k for k, v in values.items() if isinstance(v, (int, float)) and v == c["measured"]), ""
+    )
+    return " ".join(
+        _TOKEN_WORDS.get(w, w) for w in re.sub(r"_(mm_s|mm|s|deg|percent)$", "", name).split("_")
+    ).strip()
+
+
+def claim_measured_words(c: Mapping) -> str:
+    """Return a claim's measured number with what it is, a negative 'more' read as 'less'.
+
+    Parameters
+    ----------
+    c : Mapping
+        A claim of ``results["claims"]`` (``measured``, ``unit``, ``readings``).
+
+    Returns
+    -------
+    str
+        ``<what> <number with unit>`` (``phase delay 0.3822 deg``); a value named
+        ``... more`` that is negative reads ``... <|number|> less`` (``PD 36.41 %
+        less``); a count is its number with its noun (``1 sign reversal``);
+        ``n/a`` when not measured.
+
+    Examples
+    --------
+    >>> c = {"measured": -36.4, "unit": "%",
+    ...      "readings": [{"values": {"pd_more_percent": -36.4}}]}
+    >>> claim_measured_words(c)
+    'PD 36.4 % less'
+    """
+    v, name = c["measured"], claim_value_name(c)
+    if v is None:
+        return "n/a"
+    if name.endswith(" more") and v < 0:
+        return f"{name[: -len(' more')]} {claim_quantity(-v, c['unit'])} less"
+    if name.endswith(" more"):
+        return f"{name[: -len(' more')]} {claim_quantity(v, c['unit'])} more"
+    if c["unit"] in COUNT_NOUNS:
+        return claim_quantity(v, c["unit"])
+    return f"{name} {claim_quantity(v, c['unit'])}".strip()
 
 
 #: Configuration-file jargon (a TOML table's name) and the words a reader knows.

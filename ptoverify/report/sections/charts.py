@@ -9,7 +9,7 @@ import numpy as np
 from ptoverify.report.render import Block, fmt, qty, table
 from ptoverify.report.words import setting_words
 
-from .common import _law, _ms, figure
+from .common import _law, _ms, figure, settling_band_words
 
 #: How many move sizes the penalty table shows (evenly spread over the log-spaced sizes).
 TABLE_SIZES = 6
@@ -154,7 +154,7 @@ def charts(res: Any, figures: dict[str, str]) -> list[Block]:
             text="How much slower than the limit is each law, for a given move? Point-to-point "
             f"moves from rest, {p['count']} sizes log-spaced from "
             f"{qty(p['sizes_mm'][0], 'mm')} to {qty(p['sizes_mm'][-1], 'mm')}; settling "
-            f"definition {p['settling_definition']} ({p['definition_description']}), beside the "
+            f"definition {p['settling_definition']} ({settling_band_words(p['settling_definition'], p['definition_description'])}), beside the "
             "continuous "
             "minimum time t_f* and the sampled limit N* T.",
         ),

@@ -12,9 +12,22 @@ from ptoverify.report.render import (
     qty,
     table,
 )
-from ptoverify.report.words import LAW_WORDS, claim_quantity, display_unit, law_name
+from ptoverify.report.words import (
+    LAW_WORDS,
+    claim_quantity,
+    claim_value_name,
+    display_unit,
+    law_name,
+)
 
-__all__ = ["LAW_WORDS", "CAPTIONS", "figure", "verdict", "measured_quantity"]
+__all__ = [
+    "LAW_WORDS",
+    "CAPTIONS",
+    "figure",
+    "verdict",
+    "measured_quantity",
+    "settling_band_words",
+]
 
 _MATH = '<math xmlns="http://www.w3.org/1998/Math/MathML" display="block">{}</math>'
 
@@ -155,10 +168,6 @@ def _display_unit(unit: str) -> tuple[str, float]:
     return display_unit(unit)
 
 
-#: Tokens of the claims' value names, as a reader writes them.
-_TOKEN_WORDS = {"pto": "PTO", "pd": "PD", "to": "TO", "rms": "RMS"}
-
-
 def measured_quantity(c: dict[str, Any]) -> str:
     """Describe what a claim's 'measured' number is, in words with its unit.
 
@@ -176,15 +185,8 @@ def measured_quantity(c: dict[str, Any]) -> str:
     """
     if c["measured"] is None:
         return "qualitative (no single number; see detail)"
-    values = c["readings"][0]["values"] if c["readings"] else {}
-    name = next(
-        (k for k, v in values.items() if isinstance(v, (int, float)) and v == c["measured"]), ""
-    )
-    words = " ".join(
-        _TOKEN_WORDS.get(w, w) for w in re.sub(r"_(mm_s|mm|s|deg|percent)$", "", name).split("_")
-    )
     unit, _ = _display_unit(c["unit"])
-    return f"{words or 'value'} [{unit or '-'}]"
+    return f"{claim_value_name(c) or 'value'} [{unit or '-'}]"
 
 
 def _claim_qty(v: float | None, unit: str) -> str:
@@ -209,3 +211,27 @@ def _downstream_ids(inherits: list[str]) -> list[str]:
         if re.fullmatch(r"[\w\-, ]+", head.strip()) and not what.strip().startswith("unchanged"):
             out.append(head.strip())
     return out
+
+
+def settling_band_words(name: str, fallback: str) -> str:
+    """Return a named settling definition as its band and hold, in words.
+
+    Parameters
+    ----------
+    name : str
+        A name of :data:`ptoverify.sim.settling.DEFINITIONS`.
+    fallback : str
+        What to say for a name that is not there.
+
+    Returns
+    -------
+    str
+        ``abs(e) <= 0.01 mm, abs(e') <= a * 0.01 mm [mm/s], held 50 ms``.
+    """
+    from ptoverify.sim.settling import DEFINITIONS
+
+    d = DEFINITIONS.get(name)
+    if d is None:
+        return fallback
+    held = f", held {_ms(d.hold_s)}" if d.hold_s > 0 else ""
+    return d.band_text() + held

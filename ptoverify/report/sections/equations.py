@@ -425,7 +425,7 @@ def derivations(res: dict[str, Any], records: list, rendered: dict | None = None
     rows_html, rows_md = [], []
     tainted = inherited_errata(records)
     for r in records:
-        ml = rendered[r.id]["mathml"] if r.id in rendered else r.to_mathml()
+        ml = (rendered[r.id] if r.id in rendered else render_records([r])[r.id])["mathml"]
         verdict, css = r.verdict, r.verdict
         if r.verdict == "verified" and r.id in tainted:
             verdict = f"verified algebra; inherits the erratum of eq. ({tainted[r.id]})"

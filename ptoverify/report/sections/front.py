@@ -211,11 +211,6 @@ def _finding_claims(res: Any) -> tuple[str, str, str] | None:
     return (text + ".", "claims", "claims with every reading")
 
 
-def _count(counts: Any, verdict: str) -> int:
-    """Return how many claims have ``verdict`` (0 when the tally has no such verdict)."""
-    return counts[verdict] if verdict in counts else 0
-
-
 def c31_paper(res: dict[str, Any]) -> float | None:
     """Return the paper's value of the 31 % claim [%] from the claims results.
 
@@ -299,7 +294,6 @@ def headline(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
 
 def summary(res: dict[str, Any]) -> list[Block]:
     """Gates with measured values and limits in their units, errata and failing claims."""
-    s = res["summary"]
     rows = [
         [
             c["name"],
@@ -338,7 +332,10 @@ def summary(res: dict[str, Any]) -> list[Block]:
                 + "</p>",
             )
         )
-    bad = [c for c in res["claims"] if c["verdict"] != "reproduced"]
+    from ptoverify.report.standing import bandwidth_hz, claim_standing
+
+    hz = bandwidth_hz(res)
+    bad = [c for c in res["claims"] if claim_standing(c, hz)[0] != "holds"]
     if bad:
         rows = []
         for c in bad:
@@ -347,7 +344,7 @@ def summary(res: dict[str, Any]) -> list[Block]:
             rows.append(
                 [
                     c["claim"],
-                    c["verdict"],
+                    claim_standing(c, hz)[0],
                     measured_quantity(c),
                     _claim_qty(c["paper_value"], c["unit"]),
                     _claim_qty(c["measured"], c["unit"]),
@@ -360,8 +357,9 @@ def summary(res: dict[str, Any]) -> list[Block]:
         blocks.append(
             Block(
                 "p",
-                text=f"Section 6 claims not reproduced ({_count(s['claim_verdicts'], 'not reproduced')}) "
-                f"or holding under some readings only ({_count(s['claim_verdicts'], 'ambiguous')}). "
+                text=f"Section 6 claims that fail under every reading tried "
+                f"({sum(claim_standing(c, hz)[0] == 'fails' for c in bad)}) or hold under some "
+                f"readings only ({sum(claim_standing(c, hz)[0] == 'depends' for c in bad)}). "
                 "'measured' is the primary reading (feed-forward, a = 2 pi f, corrected PTO), "
                 "between samples; the range spans every reading.",
             )
@@ -370,7 +368,7 @@ def summary(res: dict[str, Any]) -> list[Block]:
             table(
                 [
                     "claim",
-                    "verdict",
+                    "standing",
                     "what is measured",
                     "paper",
                     "measured",

@@ -15,7 +15,7 @@ from ptoverify.report.render import (
 from ptoverify.report.standing import ratio_interval
 from ptoverify.report.words import plural
 
-from .common import _law, _ms, figure
+from .common import _law, _ms, figure, settling_band_words
 from .robust_rows import baseline_margin_rows
 
 # ------------------------------------------------------------------ proofs
@@ -45,8 +45,9 @@ def proofs(res: Any, figures: dict[str, str]) -> list[Block]:
     blocks = [
         Block(
             "p",
-            text="Proved over the continuum of initial states (|x1| <= position_range, "
-            "|x2| <= w_max) with outward-rounded interval arithmetic and python-flint arb "
+            text="Proved over the continuum of initial states (|x1| <= "
+            f"{qty(res['environment']['config']['plant']['position_range'], 'mm')}, "
+            f"|x2| <= w_max = {qty(res['environment']['config']['plant']['w_max'], 'mm/s')}) with outward-rounded interval arithmetic and python-flint arb "
             "certificates (`ptoverify prove`): each property is proved, refuted with a "
             "certified counterexample, or unproven with the region where the proof fails. "
             "Coverage is the fraction of the envelope's area proved.",
@@ -219,8 +220,8 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
         Block(
             "p",
             text="Margins: the interval of a_true / a_design around 1 on which each "
-            "property holds (endpoints to 1e-6 relative; 'beyond' where it reaches past the "
-            "searched [0.1, 10]).",
+            "property holds (endpoints to 1e-6 relative, searched over [0.1, 10]; an end "
+            "that reaches the search's bound is named as such, never as a margin).",
         ),
         table(
             [
@@ -275,8 +276,9 @@ def robustness(res: dict[str, Any], figures: dict[str, str]) -> list[Block]:
             "p",
             text="Worst cases: the grid's worst cell, then a seeded search over (initial "
             "state x perturbation) started from it; the searched value is never below the grid's. "
-            f"Settling is read on the samples under `{rob['settling']}` (see the settling "
-            "definitions), over N* T of the true plant.",
+            f"Settling is read on the samples under {rob['settling']} "
+            f"({settling_band_words(rob['settling'], rob['settling'])}), over N* T of the "
+            "true plant." + _nominal_vs_sweep(res),
         ),
         table(["law", "property", "grid worst", "searched worst", "state", "perturbation"], wrows),
     ]
@@ -505,3 +507,61 @@ def environment(res: dict[str, Any]) -> list[Block]:
                 cell = fmt(v)
             cfg_rows.append([key, cell])
     return [table(["item", "value"], rows), table(["configuration key", "value"], cfg_rows)]
+
+
+def _nominal_vs_sweep(res: Any) -> str:
+    """Say why the nominal cell's worst settling / (N* T) differs from the sweep's worst.
+
+    Both are read under the same definition; the robustness grid holds fewer
+    initial states than the suboptimality sweep, whose finer grid reaches smaller
+    moves (N* of a few samples, where one sample more weighs much).
+
+    Parameters
+    ----------
+    res : Results
+        The results (``robust.maps``, ``sweep``; either may be None).
+
+    Returns
+    -------
+    str
+        A sentence (with a leading space), or "" when either study is missing.
+    """
+    rob, sw = res["robust"], res["sweep"]
+    if not rob or not sw:
+        return ""
+    maps = rob["maps"]
+    pairs = []
+    for law, cells in maps["laws"].items():
+        cell = next(
+            (
+                c
+                for c in cells
+                if c["a_ratio"] == 1 and c["w_max_ratio"] == 1 and c["delay_samples"] == 0
+            ),
+            None,
+        )
+        if cell is None or law not in sw["laws"] or cell["settling_ratio_nt"]["max"] is None:
+            continue
+        worst, states = sw["laws"][law]["worst_ratio_nt"], sw["laws"][law]["worst_states_nt"]
+        if worst is None or not states:
+            continue
+        here, there = cell["settling_ratio_nt"], states[0]
+        pairs.append(
+            f"{_law(law)} {fmt(here['max'])} from {_state(here['state'])} here, "
+            f"{fmt(worst)} from {_state(there[:2])} there"
+        )
+    if not pairs:
+        return ""
+    st = sw["settings"]
+    return (
+        f" On the nominal plant (no delay) the worst settling / (N* T) over these "
+        f"{maps['states']} states differs from the suboptimality maps' worst over "
+        f"{st['n1']} x {st['n2']} states ({'; '.join(pairs)}): each is the worst of its "
+        "own grid, and the worst states are small moves, where N* is a few samples and one "
+        "sample more weighs much."
+    )
+
+
+def _state(x: Any) -> str:
+    """Return an initial state ``(x1 mm, x2 mm/s)`` in words."""
+    return f"({qty(x[0], 'mm')}, {qty(x[1], 'mm/s')})"
