@@ -18,8 +18,9 @@ phase        plot_fig2 (eqs. 8-11), plot_fig3 (eq. 12), plot_zones (Fig. 4, eqs.
              plot_fig5 (eq. 19), plot_fig6, plot_zone_geometry, zone_geometry_xlim
 paper        plot_response (Figs. 7-13), plot_state_trajectories (Fig. 14), FigureInputs,
              save_all (Figs. 2-14 and the zone geometry as PNGs)
-studies      plot_sweep, save_sweep; plot_robust_map, save_robust; plot_pareto,
-             save_tuning; plot_convergence, plot_switch_profiles, save_ground_truth
+studies      plot_sweep, save_sweep; plot_robust_map, save_robust; save_tuning;
+             plot_convergence, plot_switch_profiles, save_ground_truth
+pareto       plot_pareto (the tuning's fronts, with an inset of the PTO's minus the PD's)
 charts       plot_penalty, plot_design, save_charts, save_penalty (move-size penalty,
              coarse design chart)
 conformance  plot_du_map, plot_conform_response, save_conform_figures (conform --report)
@@ -54,6 +55,7 @@ from ptoverify.report.plots.paper import (
     plot_state_trajectories,
     save_all,
 )
+from ptoverify.report.plots.pareto import plot_pareto
 from ptoverify.report.plots.phase import (
     plot_fig2,
     plot_fig3,
@@ -66,7 +68,6 @@ from ptoverify.report.plots.phase import (
 from ptoverify.report.plots.studies import (
     ROBUST_MAPS,
     plot_convergence,
-    plot_pareto,
     plot_robust_map,
     plot_sweep,
     plot_switch_profiles,
