@@ -165,7 +165,7 @@ def test_cli_rejects_huge_gain(tmp_path, capsys):
     ],
 )
 def test_integers_beyond_the_float_range_are_bad_input(tmp_path, old, new, key):
-    """Audit run 5, config/r5-int-400-digits, -range, quantum-int-huge and int-5000-digits.
+    """Audit run 6, config/r6-int-400-digits, -range, quantum-int-huge and int-5000-digits.
 
     TOML integers are unbounded: 10**400 overflowed ``float()`` and a 5000-digit one
     tripped Python's integer-string limit, both internal errors.

@@ -1244,7 +1244,7 @@ def build_cases(tmpfs: Path | None) -> list[Case]:  # noqa: C901 - a flat list o
                 one_line=False,
             )
         )
-    cases += run5_cases()
+    cases += run6_cases()
     return cases
 
 
@@ -1263,15 +1263,15 @@ def _file_check(rel: str, mode_bits: int = 0o444) -> Callable[[Path, str, str], 
     return check
 
 
-def run5_cases() -> list[Case]:  # noqa: C901 - a flat list of cases
-    """Cases added in run 5 (names hold ``/r5-``): classes of issue 28 not named before."""
+def run6_cases() -> list[Case]:  # noqa: C901 - a flat list of cases
+    """Cases added in run 6 (names hold ``/r6-``): classes of issue 28 not named before."""
     cases: list[Case] = []
     add = cases.append
 
     def law(name, body, expect, bound=60, extra=(), timeout="60", check=None, cmd=None):
         add(
             Case(
-                f"conform-law/r5-{name}",
+                f"conform-law/r6-{name}",
                 cmd or [PTO, "conform", "--law", "law.py:pto", "--timeout", timeout, *extra],
                 expect,
                 bound,
@@ -1362,7 +1362,7 @@ def run5_cases() -> list[Case]:  # noqa: C901 - a flat list of cases
     def ac(name, body, kwargs, expect, allowed=("InputError", "ConfigError")):
         add(
             Case(
-                f"assert_conforms/r5-{name}",
+                f"assert_conforms/r6-{name}",
                 [PY, "-c", HARNESS, "law.py:pto", json.dumps(kwargs)],
                 expect,
                 90,
@@ -1404,7 +1404,7 @@ def run5_cases() -> list[Case]:  # noqa: C901 - a flat list of cases
     }.items():
         add(
             Case(
-                f"config/r5-{name}",
+                f"config/r6-{name}",
                 [PTO, "zone", "--no-verify", "--no-outcome", "--config", "c.toml", "--json"],
                 (2,),
                 20,
@@ -1413,7 +1413,7 @@ def run5_cases() -> list[Case]:  # noqa: C901 - a flat list of cases
         )
     add(
         Case(
-            "extreme/r5-name-unicode-400-bytes/report-default-out",
+            "extreme/r6-name-unicode-400-bytes/report-default-out",
             [
                 PTO,
                 "report",
@@ -1519,7 +1519,7 @@ def run5_cases() -> list[Case]:  # noqa: C901 - a flat list of cases
         ),
         "bandwidth-1e-300": (["--sample-times", "0.002", "--bandwidths", "1e-300", *one], (2,), 30),
     }.items():
-        add(Case(f"design/r5-{name}", [PTO, "design", *argv], expect, bound))
+        add(Case(f"design/r6-{name}", [PTO, "design", *argv], expect, bound))
 
     # prove: every law at the extreme configurations
     for cname in ("samples-2000", "aT-20", "tiny-range", "max-gains"):
@@ -1528,7 +1528,7 @@ def run5_cases() -> list[Case]:  # noqa: C901 - a flat list of cases
                 continue
             add(
                 Case(
-                    f"extreme/r5-{cname}/prove-{law_name}",
+                    f"extreme/r6-{cname}/prove-{law_name}",
                     [PTO, "prove", "--law", law_name, "--json", "--config", "c.toml"],
                     (0, 1, 2),
                     150,
@@ -1549,7 +1549,7 @@ def run5_cases() -> list[Case]:  # noqa: C901 - a flat list of cases
     }.items():
         add(
             Case(
-                f"report/r5-{name}",
+                f"report/r6-{name}",
                 cmd,
                 expect,
                 bound,
@@ -1559,7 +1559,7 @@ def run5_cases() -> list[Case]:  # noqa: C901 - a flat list of cases
         )
     add(
         Case(
-            "signal/r5-report-skip-sigint",
+            "signal/r6-report-skip-sigint",
             [PTO, "report", "--skip", "robust,tuning", "--jobs", "2", "--out", "rep", "--quiet"],
             (130,),
             30,
@@ -1570,7 +1570,7 @@ def run5_cases() -> list[Case]:  # noqa: C901 - a flat list of cases
     )
     add(
         Case(
-            "signal/r5-design-cascade-sigterm",
+            "signal/r6-design-cascade-sigterm",
             [PTO, "design", "--laws", "cascade-p", "ptos", "--grid", "40", "--out", "de"],
             (143,),
             30,
