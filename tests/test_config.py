@@ -162,10 +162,14 @@ def test_cli_rejects_huge_gain(tmp_path, capsys):
             "position_quantum",
         ),
         ("kp = 356.0", "kp = 1" + "0" * 5000, "not valid TOML"),
+        ("k2 = 3.6", "k2 = 3.6\n[conform]\nsettling_margin = 1" + "0" * 400, "settling_margin"),
     ],
 )
 def test_integers_beyond_the_float_range_are_bad_input(tmp_path, old, new, key):
-    """Audit run 6, config/r6-int-400-digits, -range, quantum-int-huge and int-5000-digits.
+    """Huge TOML integers are bad input naming the key (audit run 6, config/r6-int-*).
+
+    Cases config/r6-int-400-digits, -int-400-digits-range, -quantum-int-huge,
+    -conform-margin-400-digits and -int-5000-digits.
 
     TOML integers are unbounded: 10**400 overflowed ``float()`` and a 5000-digit one
     tripped Python's integer-string limit, both internal errors.

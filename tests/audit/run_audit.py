@@ -1390,6 +1390,7 @@ def run6_cases() -> list[Case]:  # noqa: C901 - a flat list of cases
     for name, text in {
         "int-400-digits": cfg(plant__w_max="1" + "0" * 400),
         "int-400-digits-range": cfg(plant__position_range="-1" + "0" * 400),
+        "conform-margin-400-digits": PAPER + "[conform]\nsettling_margin = 1" + "0" * 400 + "\n",
         "int-5000-digits": cfg(pd__kp="1" + "0" * 5000),
         "seed-400-digits": PAPER + "[robustness]\nseed = 1" + "0" * 400 + "\n",
         "delay-1e30": PAPER + "[robustness]\ndelay_samples = [0, 1" + "0" * 30 + "]\n",
