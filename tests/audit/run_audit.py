@@ -104,12 +104,14 @@ LAWS: dict[str, tuple[str, tuple[int, ...], int]] = {
         (2,),
         30,
     ),
-    "masked-all": ("return np.ma.masked_all(np.shape(x1))", (1, 2), 30),
+    # a masked law is judged in full (exit 1, 28-55 s on the loaded machine): the bound is
+    # that of the other judged laws, not of a rejection (run 6: 30 s was an audit mistake)
+    "masked-all": ("return np.ma.masked_all(np.shape(x1))", (1, 2), 90),
     "masked-wrong": (
         "u = np.ma.masked_array(np.zeros(np.shape(x1)), mask=True)\n    u[...] = np.ma.masked"
         "\n    return u",
         (1, 2),
-        30,
+        90,
     ),
     "structured-array": (
         "u = np.zeros(np.shape(x1), dtype=[('u', float)])\n    return u",
@@ -1351,6 +1353,28 @@ def run6_cases() -> list[Case]:  # noqa: C901 - a flat list of cases
         40,
         timeout="20",
     )
+    lies = (
+        "class Liar(np.ndarray):\n"
+        "        def __array_ufunc__(self, uf, method, *a, **k):\n"
+        "            return np.zeros(np.shape(a[0]))\n"
+        "        def __array_function__(self, func, types, a, k):\n"
+        "            return np.zeros(np.shape(a[0]))\n"
+        "    return np.zeros(np.shape(x1)).view(Liar)"
+    )
+    law("ndarray-subclass-lies", lies, (1, 2))
+    flies = (
+        "class F(float):\n"
+        "        def __sub__(self, o): return F(0.0)\n"
+        "        __rsub__ = __add__ = __radd__ = __sub__\n"
+        "        def __abs__(self): return F(0.0)\n"
+        "        def __eq__(self, o): return True\n"
+        "        def __ne__(self, o): return False\n"
+        "        def __le__(self, o): return True\n"
+        "        __lt__ = __le__\n"
+        "        def __hash__(self): return 0\n"
+        "    return F(0.0)"
+    )
+    law("float-subclass-lies", flies, (1, 2))
     law(
         "float16-json-pipe-true",
         f16,
@@ -1373,6 +1397,8 @@ def run6_cases() -> list[Case]:  # noqa: C901 - a flat list of cases
         )
 
     good = "return ref(x1, x2, cfg)"
+    ac("ndarray-subclass-lies", lies, {}, (10, 11))
+    ac("float-subclass-lies", flies, {}, (10, 11))
     ac("precision-float16", good, {"precision": "float16"}, (11,))
     ac("float16-precision-float32", f16, {"precision": "float32"}, (10, 11))
     ac("perturbations-garbage", good, {"perturbations": ["x", 3]}, (11,))
