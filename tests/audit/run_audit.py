@@ -1726,7 +1726,20 @@ def run_case(case: Case, base: Path) -> dict:
         lines = [ln for ln in err_s.splitlines() if ln.strip()]
         if len(lines) != 1 or not lines[0].startswith("ptoverify: error:"):
             problems.append(f"exit 2 with {len(lines)} stderr lines: {err_s.strip()[:160]!r}")
-    if "--json" in (case.cmd if isinstance(case.cmd, list) else []) and code in (0, 1):
+    # exit 1 with one `error:` line and an empty stdout is a solver or cluster failure
+    # (README: "1 ... a solver failed"), not a result: no JSON object is owed (run 6)
+    err_lines = [ln for ln in err_s.splitlines() if ln.strip()]
+    solver_failed = (
+        code == 1
+        and not out_s.strip()
+        and len(err_lines) == 1
+        and err_lines[0].startswith("ptoverify: error:")
+    )
+    if (
+        "--json" in (case.cmd if isinstance(case.cmd, list) else [])
+        and code in (0, 1)
+        and not solver_failed
+    ):
         try:
             obj = json.loads(out_s)
             if not isinstance(obj, dict):
