@@ -895,7 +895,8 @@ def build_cases(tmpfs: Path | None) -> list[Case]:  # noqa: C901 - a flat list o
         "robust-grid-huge": (["robust", "--grid", "100000"], (2,)),
         "robust-population-huge": (["robust", "--population", "1000000000"], (2,)),
         "robust-generations-huge": (["robust", "--generations", "1000000000"], (2,)),
-        "robust-law-bad": (["robust", "--law", "ptos"], (2,)),
+        # ptos and cascade-p are robust laws since the baselines (run 6: the old value was one)
+        "robust-law-bad": (["robust", "--law", "pto-x"], (2,)),
         "robust-dask-empty": (["robust", "--dask", ""], (2,)),
         "robust-dask-port-0": (["robust", "--dask", "tcp://127.0.0.1:0"], (2,)),
         "robust-dask-port-huge": (["robust", "--dask", "tcp://127.0.0.1:99999"], (2,)),
