@@ -509,6 +509,6 @@ def load_config(path: str | Path | None) -> Config:
         raise ConfigError(f"config file '{path}' cannot be read: {exc}") from None
     try:
         data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
+    except ValueError as exc:  # TOMLDecodeError, or an integer over Python's 4300 digits
         raise ConfigError(f"config file '{path}' is not valid TOML: {exc}") from None
     return config_from_mapping(data)

@@ -22,9 +22,18 @@ CONFORM_REFERENCES = ("pto", "ptos", "cascade-p")
 
 def _number(key: str, value: Any) -> float:
     """Return ``value`` as a finite float, or raise ConfigError naming ``conform.key``."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ConfigError(f"config key 'conform.{key}' must be a finite number, got {value!r}")
-    return float(value)
+    try:
+        value = float(value)
+    except OverflowError:  # a TOML integer beyond the float range (e.g. 400 digits)
+        raise ConfigError(
+            f"config key 'conform.{key}' must be a finite number, got an integer of "
+            f"{value.bit_length()} bits"
+        ) from None
+    if not math.isfinite(value):
+        raise ConfigError(f"config key 'conform.{key}' must be a finite number, got {value!r}")
+    return value
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,13 @@ def _number(section: str, key: str, value: Any) -> float:
     where = f"{section}.{key}"
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ConfigError(f"config key '{where}' must be a number, got {value!r}")
-    value = float(value)
+    try:
+        value = float(value)
+    except OverflowError:  # a TOML integer beyond the float range (e.g. 400 digits)
+        raise ConfigError(
+            f"config key '{where}' must be finite, got an integer of "
+            f"{value.bit_length()} bits, beyond the float range"
+        ) from None
     if not math.isfinite(value):
         raise ConfigError(f"config key '{where}' must be finite, got {value!r}")
     return value

@@ -151,6 +151,36 @@ def test_cli_rejects_huge_gain(tmp_path, capsys):
     assert len(err) == 1 and "pto.k1" in err[0]
 
 
+@pytest.mark.parametrize(
+    "old,new,key",
+    [
+        ("w_max = 300.0", "w_max = 1" + "0" * 400, "plant.w_max"),
+        ("position_range = 50.0", "position_range = -1" + "0" * 400, "plant.position_range"),
+        (
+            "k2 = 3.6",
+            "k2 = 3.6\n[robustness]\nposition_quantum = 1" + "0" * 400,
+            "position_quantum",
+        ),
+        ("kp = 356.0", "kp = 1" + "0" * 5000, "not valid TOML"),
+        ("k2 = 3.6", "k2 = 3.6\n[conform]\nsettling_margin = 1" + "0" * 400, "settling_margin"),
+    ],
+)
+def test_integers_beyond_the_float_range_are_bad_input(tmp_path, old, new, key):
+    """Huge TOML integers are bad input naming the key (audit run 6, config/r6-int-*).
+
+    Cases config/r6-int-400-digits, -int-400-digits-range, -quantum-int-huge,
+    -conform-margin-400-digits and -int-5000-digits.
+
+    TOML integers are unbounded: 10**400 overflowed ``float()`` and a 5000-digit one
+    tripped Python's integer-string limit, both internal errors.
+    """
+    f = tmp_path / "c.toml"
+    f.write_text(GOOD.replace(old, new))
+    assert new in f.read_text()
+    with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
+        load_config(f)
+
+
 def test_digest_changes_with_every_value():
     cfg = paper_config()
     base = cfg.digest()

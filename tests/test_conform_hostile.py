@@ -150,6 +150,44 @@ def test_cli_rejects_a_law_returning_non_numbers(capsys, tmp_path, name):
 
 
 # ------------------------------------------------------------------ configuration
+class _Liar(np.ndarray):
+    """An array whose every ufunc and array function answers zeros (user code)."""
+
+    def __array_ufunc__(self, ufunc, method, *inputs, **kwargs):
+        raise AssertionError("the judge ran a method of the law's array subclass")
+
+    def __array_function__(self, func, types, args, kwargs):
+        raise AssertionError("the judge ran a method of the law's array subclass")
+
+
+class _RaisingArrayLike:
+    def __array__(self, dtype=None, copy=None):
+        raise RuntimeError("the law's object refuses to be an array")
+
+
+def test_conform_law_r6_ndarray_subclass_lies(paper_cfg):
+    """Audit run 6, conform-law/r6-ndarray-subclass-lies: an ndarray subclass returned by
+    the law ran its ``__array_ufunc__`` inside the judge (``vec - first`` in mode
+    detection), so the isolated child died with ptoverify's traceback. The output is now a
+    plain float64 array holding the same values, and a vectorized law returning it is
+    judged on those values."""
+
+    def law(x1, x2, cfg):
+        return np.asarray(reference_law(x1, x2, cfg), dtype=float).view(_Liar)
+
+    out = check_output(np.array([1.0, -2.0]).view(_Liar), (0.0, 0.0), 2)
+    assert type(out) is np.ndarray and out.dtype == np.float64
+    assert out.tolist() == [1.0, -2.0]
+    user, failures = wrap_callable(law, paper_cfg)
+    assert failures == [] and user.mode == "vectorized"
+    x1, x2 = np.array([0.3, -20.0]), np.array([5.0, 100.0])
+    got = user(x1, x2)
+    assert type(got) is np.ndarray
+    np.testing.assert_array_equal(got, reference_law(x1, x2, paper_cfg))
+    with pytest.raises(InputError, match="dtype object"):
+        check_output(_RaisingArrayLike(), (0.5, 1.0), 2)
+
+
 def test_law_writing_to_the_frozen_config_is_a_finding(paper_cfg):
     def law(x1, x2, cfg):
         object.__setattr__(cfg.plant, "w_max", 1e9)

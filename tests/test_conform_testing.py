@@ -126,3 +126,15 @@ def test_bad_limits_are_bad_input_before_the_law_runs(kwargs):
 
     with pytest.raises(InputError, match="assert_conforms: "):
         assert_conforms("examples/my_pto.py:pto", **kwargs)
+
+
+@pytest.mark.parametrize("perturbations", [("x", 3), 5, (None,)], ids=str)
+def test_assert_conforms_r6_perturbations_garbage(perturbations):
+    """Audit run 6, assert_conforms/r6-perturbations-garbage: perturbations that are not
+    Perturbation objects gave AttributeError ('str' object has no attribute 'mismatch')
+    after the law had run; they are bad input before it runs."""
+    from ptoverify.conform.testing import assert_conforms
+    from ptoverify.errors import InputError
+
+    with pytest.raises(InputError, match="assert_conforms: perturbations"):
+        assert_conforms("examples/my_pto.py:pto", perturbations=perturbations)

@@ -126,7 +126,8 @@ def assert_conforms(
         hung, ended or ran out of memory; the message lists them.
     ptoverify.errors.InputError
         When the law cannot be loaded, cannot be sent to the child (a lambda)
-        or has the wrong signature (bad input).
+        or has the wrong signature, or a limit or a perturbation is not valid
+        (bad input, before the law runs).
 
     Examples
     --------
@@ -150,6 +151,20 @@ def assert_conforms(
             f"assert_conforms: memory_limit must be a positive number of bytes or None, "
             f"got {memory_limit!r}"
         )
+    from ptoverify.conform.perturbation import Perturbation
+
+    try:
+        perturbations = tuple(perturbations)
+    except TypeError:
+        raise InputError(
+            f"assert_conforms: perturbations must be a tuple of Perturbation, got {perturbations!r}"
+        ) from None
+    wrong = [p for p in perturbations if not isinstance(p, Perturbation)]
+    if wrong:
+        raise InputError(
+            f"assert_conforms: perturbations must be Perturbation objects "
+            f"(ptoverify.conform.perturbation.perturbation), got {wrong[0]!r}"
+        )
     cfg = config if isinstance(config, Config) else load_config(config)
     spec = law_spec(law)
     target = spec if isinstance(law, str) else getattr(law, "__qualname__", spec)
@@ -160,7 +175,7 @@ def assert_conforms(
         timeout=timeout,
         memory_limit=memory_limit,
         precision=precision,
-        perturbations=tuple(perturbations),
+        perturbations=perturbations,
         **kwargs,
     )
     verdicts, states = conform_verdicts(result)
