@@ -82,7 +82,7 @@ def test_report_rows_for_the_baselines():
     assert len(rows) == 3 and labels[0].startswith("PTOS") and labels[1].startswith("cascade P")
     assert "configured gains" in labels[0] and "configured gains" in labels[1]
     assert "fair-tuned" in labels[2] and "120" in labels[2]
-    assert rows[2][1] == "from below the searched 0.1 up to 2.5"
+    assert rows[2][1] == "up to 2.5, with no lower limit down to the searched 0.1"
     assert rows[2][2] == "unstable at the design point"
     assert all(r[3].startswith("not simulated") for r in rows)
     data["tuning"] = None
