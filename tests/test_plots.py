@@ -185,7 +185,9 @@ def test_fig3_and_fig6_draw_the_batch_and_its_regions():
     zone = zone_for_law(CFG, "corrected")
     b = _batch("pto", [4 * CFG.pto.d], [-p.w_max / 3], 60)
     d = plots.plot_fig6(zone, CFG, b, "pto")
-    assert_array_equal(d["PTO (corrected) trajectory"].get_ydata(), b.x2[:, 0], err_msg="trajectory")
+    assert_array_equal(
+        d["PTO (corrected) trajectory"].get_ydata(), b.x2[:, 0], err_msg="trajectory"
+    )
     reg = b.region[:, 0]
     for code, (_, lab) in plots.REGION_STYLE.items():
         key = f"sample in {lab}"
