@@ -13,27 +13,12 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from ptoverify.errors import ConfigError
+from ptoverify.robustness import _number  # the one TOML number check (config uses it too)
 
 __all__ = ["ConformLimits", "conform_limits_from_mapping", "CONFORM_REFERENCES"]
 
 #: the laws ``conform`` can judge against (``[conform] reference``, ``conform --reference``)
 CONFORM_REFERENCES = ("pto", "ptos", "cascade-p")
-
-
-def _number(key: str, value: Any) -> float:
-    """Return ``value`` as a finite float, or raise ConfigError naming ``conform.key``."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ConfigError(f"config key 'conform.{key}' must be a finite number, got {value!r}")
-    try:
-        value = float(value)
-    except OverflowError:  # a TOML integer beyond the float range (e.g. 400 digits)
-        raise ConfigError(
-            f"config key 'conform.{key}' must be a finite number, got an integer of "
-            f"{value.bit_length()} bits"
-        ) from None
-    if not math.isfinite(value):
-        raise ConfigError(f"config key 'conform.{key}' must be a finite number, got {value!r}")
-    return value
 
 
 @dataclass(frozen=True)
@@ -113,7 +98,7 @@ def conform_limits_from_mapping(raw: Any) -> ConformLimits:
             raise ConfigError(f"unknown config key 'conform.{key}'")
     out: dict[str, Any] = {}
     for key, hi in (("settling_margin", 10.0), ("count_margin", 1.0)):
-        v = _number(key, raw.get(key, getattr(base, key)))
+        v = _number("conform", key, raw.get(key, getattr(base, key)))
         if not 0.0 <= v <= hi:
             raise ConfigError(f"config key 'conform.{key}' must be in [0, {hi:g}], got {v!r}")
         out[key] = v
