@@ -347,3 +347,34 @@ def test_saved_png_is_the_figure_drawn(tmp_path):
     with Image.open(path) as img:
         assert img.info["dpi"] == pytest.approx((plots.DPI, plots.DPI), abs=0.01)
         assert_array_equal(np.asarray(img.convert("RGBA")), drawn)
+
+
+def test_pareto_inset_draws_the_fronts_gap_it_is_given():
+    """The inset draws ``fronts_gap`` as given (the plot computes nothing), and is absent
+    when there is no gap."""
+    from matplotlib.figure import Figure
+
+    cand = {"overshoot_mm": 0.0, "settling_2pct_s": 0.03, "omega0": None, "gains": {}}
+    tuning = {
+        "fronts": {"pd": [cand], "pto": [cand]},
+        "best": {},
+        "paper": {},
+        "bounds_mm": {},
+        "floor": {"tf_s": 0.02, "nt_s": 0.021, "band_entry_s": 0.019},
+        "fronts_gap": {
+            "law": "pto",
+            "minus": "pd",
+            "overshoot_mm": [0.0, 0.5, 1.25],
+            "gap_s": [1e-3, -2e-3, 0.0],
+        },
+    }
+    ax = Figure().add_subplot()
+    plots.plot_pareto(tuning, ax)
+    (inset,) = ax.child_axes
+    (line,) = inset.get_lines()[:1]
+    assert_array_equal(np.unique(line.get_xdata()), [0.0, 0.5, 1.25])
+    assert set(np.round(line.get_ydata(), 12)) == {1.0, -2.0, 0.0}  # [ms]
+    assert "PTO (corrected) front - PD front" in inset.get_title()
+    ax = Figure().add_subplot()
+    plots.plot_pareto(tuning | {"fronts_gap": None}, ax)
+    assert not ax.child_axes

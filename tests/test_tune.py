@@ -21,8 +21,10 @@ from ptoverify.studies.claims import fair_comparison
 from ptoverify.studies.properties import law_properties
 from ptoverify.studies.tune import (
     BOUNDS,
+    Candidate,
     TuneBudget,
     fair_tunings,
+    front_gap,
     pareto_front,
     tune,
     worst_ratio_nt,
@@ -260,6 +262,15 @@ def test_fair_comparison_bounds_constraints_and_floor():
         o = [c["overshoot_mm"] for c in front]
         s = [c["settling_2pct_s"] for c in front]
         assert o == sorted(o) and s == sorted(s, reverse=True), law
+    # the inset's gap is the two fronts' difference, read off the fronts by their definition
+    gap = fc["fronts_gap"]
+    assert gap["law"] == "pto" and gap["minus"] == "pd" and len(gap["overshoot_mm"]) >= 1
+
+    def least(law, x):  # least settling on the law's front with overshoot <= x
+        return min(c["settling_2pct_s"] for c in fc["fronts"][law] if c["overshoot_mm"] <= x)
+
+    for x, g in zip(gap["overshoot_mm"], gap["gap_s"], strict=True):
+        assert g == least("pto", x) - least("pd", x)
     assert {c["id"] for c in fc["claims"]} == {
         "step-pd-31-percent",
         "step-pto-steadier-quicker",
@@ -535,3 +546,37 @@ def test_fair_tunings_name_their_bounds():
         fair_tunings(CFG, SMALL, ("pd",), ("nope",))
     with pytest.raises(InputError, match="bounds must be among"):
         fair_tunings(CFG, SMALL, ("pd",), ())
+
+
+def test_front_gap_is_the_difference_of_the_fronts_everywhere():
+    """front_gap against a brute-force reference: at random overshoot bounds x, the least
+    settling time of *all* candidates with overshoot <= x (the front's definition) minus the
+    other's, read at the last breakpoint at or left of x."""
+    rng = np.random.default_rng(7)
+    for trial in range(200):
+        pools = [
+            [
+                Candidate({}, s, s, s, o, True)
+                for o, s in zip(
+                    rng.choice(np.arange(0.0, 2.0, 0.125), n),  # ties in overshoot happen
+                    rng.uniform(0.02, 0.05, n),
+                    strict=True,
+                )
+            ]
+            for n in rng.integers(1, 12, 2)
+        ]
+        fa, fb = pareto_front(pools[0]), pareto_front(pools[1])
+        g = front_gap("a", fa, "b", fb)
+        lo = max(min(c.overshoot_mm for c in p) for p in pools)
+        hi = min(max(c.overshoot_mm for c in f) for f in (fa, fb))
+        if hi < lo:
+            assert g is None, trial
+            continue
+        assert g.overshoot_mm == tuple(sorted(g.overshoot_mm)) and g.overshoot_mm[0] == lo
+        for x in np.concatenate([rng.uniform(lo, hi, 20), [lo, hi]]):
+            want = min(c.settling_2pct_s for c in pools[0] if c.overshoot_mm <= x) - min(
+                c.settling_2pct_s for c in pools[1] if c.overshoot_mm <= x
+            )
+            k = np.searchsorted(g.overshoot_mm, x, side="right") - 1
+            assert g.gap_s[k] == want, (trial, x)
+    assert front_gap("a", [], "b", fb) is None

@@ -21,8 +21,9 @@ def plot_pareto(tuning: Mapping, ax=None) -> dict:
         :func:`ptoverify.studies.claims.fair_comparison`: ``fronts`` (law -> candidates
         with ``overshoot_mm`` [mm] and ``settling_2pct_s`` [s]), ``best`` (bound
         -> law -> candidate), ``paper`` (law -> metrics at the paper's gains),
-        ``bounds_mm`` (bound -> [mm]) and ``floor`` (``tf_s``, ``nt_s``,
-        ``band_entry_s`` [s]).
+        ``bounds_mm`` (bound -> [mm]), ``floor`` (``tf_s``, ``nt_s``,
+        ``band_entry_s`` [s]) and ``fronts_gap`` (the PTO's front minus the PD's:
+        ``overshoot_mm`` [mm], ``gap_s`` [s], or ``None``), drawn as an inset.
     ax : matplotlib Axes, optional
         Where to draw.
 
@@ -100,37 +101,19 @@ def plot_pareto(tuning: Mapping, ax=None) -> dict:
     ax.set_ylabel("2 % settling time of the step [ms]")
     ax.legend(list(drawn.values()), list(drawn), fontsize=6, loc="upper right")
     ax.grid(alpha=0.3)
-    _front_difference_inset(tuning["fronts"], ax)
+    _front_difference_inset(tuning["fronts_gap"], ax)
     return drawn
 
 
-def _front_difference_inset(fronts: Mapping, ax) -> None:
-    """Inset: the PTO's front minus the PD's at each overshoot (the fronts overlap at full scale)."""
-    steps = {}
-    for law in ("pto", "pd"):
-        pts = sorted(
-            (c["overshoot_mm"], 1e3 * c["settling_2pct_s"])
-            for c in fronts.get(law, ())
-            if c.get("settling_2pct_s") is not None and c.get("overshoot_mm") is not None
-        )
-        if not pts:
-            return
-        steps[law] = np.array(pts).T
-    lo = max(steps["pto"][0][0], steps["pd"][0][0])
-    hi = min(steps["pto"][0][-1], steps["pd"][0][-1])
-    if not hi > lo:
+def _front_difference_inset(gap, ax) -> None:
+    """Inset: the PTO's front minus the PD's (``fronts_gap``; the fronts overlap at full scale)."""
+    if gap is None:
         return
-    x = np.linspace(lo, hi, 400)
-
-    def value(law):  # a front is a step function (where="post"): the last point at or left of x
-        xs, ys = steps[law]
-        return ys[np.searchsorted(xs, x, side="right") - 1]
-
-    diff = value("pto") - value("pd")
+    x, y = np.asarray(gap["overshoot_mm"]), 1e3 * np.asarray(gap["gap_s"])
     ins = ax.inset_axes([0.1, 0.42, 0.42, 0.3])
-    ins.step(x, diff, where="post", color="tab:green", lw=1.2)
+    ins.step(x, y, where="post", color="tab:green", lw=1.2)
     ins.axhline(0.0, color="k", lw=0.6)
-    ins.set_title("PTO (corrected) front - PD front [ms]", fontsize=7)
+    ins.set_title(f"{law_name(gap['law'])} front - {law_name(gap['minus'])} front [ms]", fontsize=7)
     ins.tick_params(labelsize=6)
     ins.set_xlabel("overshoot [mm]", fontsize=6)
     ins.grid(alpha=0.3)

@@ -19,6 +19,7 @@ from ptoverify.studies.tune import (
     Candidate,
     TuneBudget,
     fair_tunings,
+    front_gap,
     pareto_front,
     worst_ratio_nt,
 )
@@ -104,7 +105,9 @@ def fair_comparison(cfg: Config, budget: TuneBudget | None = None) -> dict[str, 
         the paper's gains plus ``worst_ratio_nt``; ``fronts``: law -> the Pareto
         front of 2 % settling [s] vs overshoot [mm] over every candidate the
         tunings evaluated (cheap constraints; ``verified`` marks those checked on
-        the gate grid), by increasing overshoot; ``best``: bound name -> law ->
+        the gate grid), by increasing overshoot; ``fronts_gap``: the PTO's front
+        minus the PD's (:class:`~ptoverify.studies.tune.FrontGap` as JSON, or
+        ``None`` where the fronts do not overlap); ``best``: bound name -> law ->
         the best tuned gains with ``settling_2pct_s``, ``overshoot_mm``,
         ``rise_time_s``, ``settling_0p01mm_s`` and ``worst_ratio_nt`` (over the
         :data:`~ptoverify.studies.tune.WORST_GRID` envelope grid); ``claims``: one entry per claim
@@ -134,7 +137,8 @@ def fair_comparison(cfg: Config, budget: TuneBudget | None = None) -> dict[str, 
     for law in ("pd", "pto"):
         pool = [c for (lw, _), r in ft.results.items() if lw == law for c in r.front]
         uniq = {tuple(sorted(c.gains.items())): c for c in pool}
-        fronts[law] = [_cand_json(c) for c in pareto_front(list(uniq.values()))]
+        fronts[law] = pareto_front(list(uniq.values()))
+    gap = front_gap("pto", fronts["pto"], "pd", fronts["pd"])
     best: dict[str, dict[str, Any]] = {}
     for name in ft.bounds:
         best[name] = {}
@@ -171,7 +175,8 @@ def fair_comparison(cfg: Config, budget: TuneBudget | None = None) -> dict[str, 
         "bound_meaning": dict(FAIR_BOUNDS),
         "floor": floor,
         "paper": paper,
-        "fronts": fronts,
+        "fronts": {law: [_cand_json(c) for c in f] for law, f in fronts.items()},
+        "fronts_gap": None if gap is None else gap.to_json(),
         "best": best,
         "claims": claims,
         "evaluations": sum(r.evaluations for r in uniq_runs),

@@ -7,12 +7,14 @@ measure   one set of gains: Candidate, tuned_config, response_metrics (the
 screen    many gain sets' step responses in one simulation (the search's screen)
 search    tune: SciPy's differential evolution (searches side by side through
           ptoverify.sim.lockstep.run_together), a compass polish, the checks;
-          TuneResult, pareto_front
+          TuneResult
+fronts    pareto_front; front_gap, one law's front minus another's (FrontGap)
 fair      fair_tunings: the laws tuned under shared overshoot bounds (FairTunings;
           memoized per law and bound, infeasible tunings recorded with the reason)
 """
 
 from ptoverify.studies.tune.fair import FAIR_BOUNDS, FairTunings, TuneBudget, fair_tunings
+from ptoverify.studies.tune.fronts import FrontGap, front_gap, pareto_front
 from ptoverify.studies.tune.measure import (
     BOUNDS,
     LIMIT_CYCLE_BAND,
@@ -25,7 +27,7 @@ from ptoverify.studies.tune.measure import (
     tuned_config,
     worst_ratio_nt,
 )
-from ptoverify.studies.tune.search import TuneResult, pareto_front, tune
+from ptoverify.studies.tune.search import TuneResult, tune
 
 __all__ = [
     "BOUNDS",
@@ -35,10 +37,12 @@ __all__ = [
     "WORST_GRID",
     "Candidate",
     "FairTunings",
+    "FrontGap",
     "TuneBudget",
     "TuneResult",
     "evaluate",
     "fair_tunings",
+    "front_gap",
     "grid_counts",
     "pareto_front",
     "response_metrics",

@@ -59,6 +59,7 @@ from ptoverify.config import Config
 from ptoverify.errors import InfeasibleError, InputError
 from ptoverify.sim.lockstep import run_together
 from ptoverify.sim.simulate import reference
+from ptoverify.studies.tune.fronts import pareto_front
 from ptoverify.studies.tune.measure import (
     BOUNDS,
     LOG_GAINS,
@@ -75,36 +76,7 @@ from ptoverify.studies.tune.measure import (
 )
 from ptoverify.studies.tune.screen import ScreenedResponse, StepScreen, screened_candidate
 
-__all__ = ["TuneResult", "pareto_front", "tune"]
-
-
-def pareto_front(cands: list[Candidate]) -> list[Candidate]:
-    """Return the candidates not dominated in (overshoot [mm], settling_2pct [s]).
-
-    Parameters
-    ----------
-    cands : list of Candidate
-        Candidates with finite overshoot and settling (others are ignored).
-
-    Returns
-    -------
-    list of Candidate
-        The front, by increasing overshoot.
-
-    Examples
-    --------
-    >>> c = lambda o, s: Candidate({}, s, s, s, o, True)
-    >>> [x.overshoot_mm for x in pareto_front([c(0, 3), c(1, 2), c(2, 2.5), c(3, 1)])]
-    [0, 1, 3]
-    """
-    ok = [c for c in cands if math.isfinite(c.overshoot_mm) and math.isfinite(c.settling_2pct_s)]
-    ok.sort(key=lambda c: (c.overshoot_mm, c.settling_2pct_s))
-    front, best = [], math.inf
-    for c in ok:
-        if c.settling_2pct_s < best:
-            front.append(c)
-            best = c.settling_2pct_s
-    return front
+__all__ = ["TuneResult", "tune"]
 
 
 @dataclass(frozen=True)
