@@ -302,22 +302,6 @@ def test_laws_are_odd_bit_for_bit(name):
     assert np.array_equal(r_m, mirror[r])
 
 
-def test_mirror_pairs_spread_values_to_mirrors_and_refuse_unpaired_states():
-    from ptoverify.studies.sweep import mirror_pairs
-
-    rng = np.random.default_rng(2)
-    a1, a2 = rng.normal(size=7), rng.normal(size=7)
-    x1, x2 = np.concatenate([a1, [0.0], -a1]), np.concatenate([a2, [0.0], -a2])
-    perm = rng.permutation(x1.size)
-    x1, x2 = x1[perm], x2[perm]
-    reps, where = mirror_pairs(x1, x2)
-    assert reps.size == 8
-    # spreading |x| measured at the representatives gives every state's own |x|
-    assert np.array_equal(np.hypot(x1, x2)[reps][where], np.hypot(x1, x2))
-    assert np.array_equal(np.abs(x1[reps][where]), np.abs(x1))
-    assert mirror_pairs(np.array([1.0, 2.0]), np.array([0.0, 0.0])) is None
-
-
 def test_horizon_over_the_limit_is_bad_input_at_once(tmp_path, capsys):
     """T = 1e-7 s (accepted by the loader) makes the 0.05 s hold 5e5 samples: exit 2, no run."""
     import dataclasses

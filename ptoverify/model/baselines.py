@@ -194,7 +194,7 @@ def ptos_law(cfg: Config, *, alpha: float | None = None, k: float | None = None)
         f"linear region |x1| <= {p.y_l:.6g} mm"
     )
     # scalar: the vector path on one state
-    return Law("ptos", vector, None, cfg.plant.w_max, note, odd=True)
+    return Law("ptos", vector, None, cfg.plant.w_max, note)
 
 
 def _ptos_input(x1, x2, alpha, k, *, a: float, w: float):

@@ -68,11 +68,6 @@ class Law:
         What the law is, in one line (says when a variant falls back).
     family : LawFamily or None
         The family the law belongs to (the TO and PTO laws of one plant), if any.
-    odd : bool
-        Whether u(-x1, -x2) == -u(x1, x2) bit for bit, so that a state's mirror has
-        the negated trajectory (true of the suite's laws, tested; a law built
-        elsewhere, a user's or a shifted one, is not assumed odd).  Only odd laws
-        let the sweep and the robustness maps simulate one state of a mirrored pair.
     """
 
     name: str
@@ -81,7 +76,6 @@ class Law:
     w_max: float
     note: str = ""
     family: LawFamily | None = None
-    odd: bool = False
 
     def __post_init__(self) -> None:
         """Make ``scalar`` the vector path on one state where none is given."""
@@ -190,7 +184,7 @@ def pd_law(cfg: Config, *, gains: tuple[NDArray, NDArray] | None = None) -> Law:
     def vector(x1, x2):
         return _pd_input(x1, x2, kp, kd, w)
 
-    return Law("pd", vector, None, w, f"PD u = sat(-{kp:g} x1 - {kd:g} x2)", odd=True)
+    return Law("pd", vector, None, w, f"PD u = sat(-{kp:g} x1 - {kd:g} x2)")
 
 
 def _pto_block(a: float, w: float) -> Callable:
@@ -287,7 +281,7 @@ def to_law(cfg: Config) -> Law:
     """
     a, w = cfg.plant.a, cfg.plant.w_max
     family = _pto_family(a, w, (0.0, 0.0, 0.0, math.nan))
-    return Law("to", _bind(family), None, w, "time-optimal bang-bang, eq. (12)", family, odd=True)
+    return Law("to", _bind(family), None, w, "time-optimal bang-bang, eq. (12)", family)
 
 
 def pto_law(
@@ -346,7 +340,7 @@ def pto_law(
         per_state = gains if len(gains) == 4 else (*gains, *family.params[2:])
         return _state_gains_law(name, family.vector, per_state, w)
     note = note or f"PTO eq. (35), omega0 = {om:g} mm/s"
-    return Law(name, _bind(family), None, w, note, family, odd=True)
+    return Law(name, _bind(family), None, w, note, family)
 
 
 def pto_corrected_law(cfg: Config, *, gains: tuple[NDArray, NDArray] | None = None) -> Law:

@@ -475,13 +475,6 @@ def read_states(path: str | Path) -> tuple[NDArray[np.float64], NDArray[np.float
     return x1, x2
 
 
-def _to_float(text: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        return math.nan
-
-
 def batch_table(path: str | Path, cfg) -> dict[str, NDArray]:
     """``mintime --states``: closed form and exact N* for every state of a CSV.
 
@@ -509,33 +502,20 @@ def batch_table(path: str | Path, cfg) -> dict[str, NDArray]:
         A bad file or row (:func:`read_states`), or a state beyond 1000 x the
         envelope (|x1| > 1000 position_range or |x2| > 1000 w_max), its line named.
     """
+    from ptoverify.tables import read_columns
+
     plant = cfg.plant
-    x1, x2 = read_states(path)
+    (x1, x2), lines = read_columns(path, ("x1", "x2"), what="states file")
     far = np.flatnonzero(
         (np.abs(x1) > FAR_FACTOR * plant.position_range) | (np.abs(x2) > FAR_FACTOR * plant.w_max)
     )
     if far.size:
         k = int(far[0])
-        line = _data_line(path, k)
         raise InputError(
-            f"states file '{path}' line {line}: state ({x1[k]:g}, {x2[k]:g}) is far outside the "
+            f"states file '{path}' line {lines[k]}: state ({x1[k]:g}, {x2[k]:g}) is far outside the "
             f"envelope (|x1| <= {FAR_FACTOR * plant.position_range:g} mm, "
             f"|x2| <= {FAR_FACTOR * plant.w_max:g} mm/s accepted)"
         )
     mt = min_time(x1, x2, plant)
     dm = discrete_min_steps_batch(x1, x2, plant)
     return dict(zip(TABLE_COLUMNS, (x1, x2, mt.t_f, mt.t_switch, dm.steps, dm.time_s), strict=True))
-
-
-def _data_line(path: str | Path, k: int) -> int:
-    """File line number of the k-th data row (blank lines skipped), for messages."""
-    import csv
-
-    with open(path, newline="") as fh:
-        n = -1
-        for line, row in enumerate(csv.reader(fh), start=1):
-            if line > 1 and any(f.strip() for f in row):
-                n += 1
-                if n == k:
-                    return line
-    return -1

@@ -48,6 +48,7 @@ __all__ = [
     "grid_settling",
     "Overshoot",
     "overshoot",
+    "grid_overshoot",
     "definitions_table",
 ]
 
@@ -501,5 +502,33 @@ def overshoot(trajectory: Trajectory, target: float) -> Overshoot:
     tb = np.where(cj >= ai, cand_t[j, 0 * cols], t[i]) - float(t[0])
     pos = best > 0
     return Overshoot(
-        np.where(pos, best, 0.0), np.where(pos, tb, np.nan), np.maximum(also.max(axis=0), 0.0)
+        np.where(pos, best, 0.0), np.where(pos, tb, np.nan), grid_overshoot(X1, target)
     )
+
+
+def grid_overshoot(x1: NDArray, target: float) -> NDArray[np.float64]:
+    """Overshoot past ``target`` read on the samples only: the ``grid`` of :func:`overshoot`.
+
+    For studies that judge on the samples alone (the gate grid's properties, the
+    robustness maps), without the cost of the extrema between samples.
+
+    Parameters
+    ----------
+    x1 : ndarray, shape (n,) or (n, k)
+        Sampled positions [mm] (one trajectory, or k as columns).
+    target : float
+        Final value [mm]; the direction of travel is sign(target - x1[0]) (up when equal).
+
+    Returns
+    -------
+    ndarray, shape (k,)
+        max(0, max_k s (x1[k] - target)) [mm] per trajectory.
+
+    Examples
+    --------
+    >>> grid_overshoot(np.array([[2.0, -1.0], [-0.5, 0.25], [0.0, 0.0]]), 0.0).tolist()
+    [0.5, 0.25]
+    """
+    X1 = x1[:, None] if x1.ndim == 1 else x1
+    sgn = np.where(target >= X1[0], 1.0, -1.0)
+    return np.maximum((sgn * (X1 - target)).max(axis=0), 0.0)

@@ -164,9 +164,8 @@ def _law_at(
     s = SweepSettings()
     p = cfg.plant
     law = make_law(name, cfg)
-    st = settling_times(
-        law, p, x1, x2, steps, s.band, p.a * s.band, s.hold, mirror=True
-    ).time  # the sweep's settling, exact between samples
+    # the sweep's settling, exact between samples
+    st = settling_times(law, p, x1, x2, steps, s.band, p.a * s.band, s.hold).time
     ok = np.isfinite(nt)
     ratio = st[ok] / nt[ok]
     settled = np.isfinite(ratio)

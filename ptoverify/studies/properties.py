@@ -38,8 +38,6 @@ not settled
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -52,9 +50,10 @@ from ptoverify.sim.settling import (
     DEFINITIONS,
     SettlingDefinition,
     definition,
+    grid_overshoot,
     settling_time,
 )
-from ptoverify.sim.simulate import BatchResult, simulate_batch
+from ptoverify.sim.simulate import simulate_batch
 from ptoverify.studies.crossings import (
     STRIDE_BLOCK,
     _crossings,
@@ -74,7 +73,6 @@ __all__ = [
     "oscillating",
     "crossing_masks",
     "stride_over_counts",
-    "grid_simulation",
     "STRIDE_BLOCK",
 ]
 
@@ -202,33 +200,6 @@ def default_steps(cfg: Config) -> int:
     return int(math.ceil((2.0 * p.position_range / p.w_max + 60.0 / p.a) / p.sample_time))
 
 
-@contextmanager
-def grid_simulation(
-    law: Law, cfg: Config, x1: np.ndarray, x2: np.ndarray, steps: int
-) -> Iterator[BatchResult]:
-    """``simulate_batch(law, cfg.plant, x1, x2, steps)`` for the length of a ``with`` block.
-
-    Kept for its callers; the run is a plain :func:`simulate_batch` call.
-
-    Parameters
-    ----------
-    law : Law
-        The law (vectorized path).
-    cfg : Config
-        Configuration (its plant is simulated).
-    x1, x2 : ndarray, shape (n,)
-        Initial states [mm], [mm/s].
-    steps : int
-        Number of samples.
-
-    Yields
-    ------
-    BatchResult
-        The trajectories.
-    """
-    yield simulate_batch(law, cfg.plant, x1, x2, steps)
-
-
 def law_properties(
     law: Law,
     cfg: Config,
@@ -265,8 +236,8 @@ def law_properties(
     steps = default_steps(cfg) if steps is None else steps
     window = max(20, steps // 4) if window is None else window
     x1, x2, is_rest = initial_grid(cfg, n1, n2, rest)
-    with grid_simulation(law, cfg, x1, x2, steps) as res:
-        return _measure(law, cfg, res, x1, x2, is_rest, steps, window, band)
+    res = simulate_batch(law, cfg.plant, x1, x2, steps)
+    return _measure(law, cfg, res, x1, x2, is_rest, steps, window, band)
 
 
 def _measure(law, cfg, res, x1, x2, is_rest, steps, window, band) -> LawProperties:
@@ -289,10 +260,8 @@ def _measure(law, cfg, res, x1, x2, is_rest, steps, window, band) -> LawProperti
     chat = (R[1:-1] != R[:-2]) & (R[1:-1] != R[2:]) & (R[:-2] == R[2:])
     osc = oscillating(X1[-window:], band)
     t = np.arange(X1.shape[0]) * T
-    over = np.zeros(x1.size)  # only the states at rest can overshoot
-    # on the samples, as robust.trajectory_properties reads it (both move to
-    # settling.overshoot together: tests/test_robust.py ties them)
-    over[is_rest] = (-np.sign(x1[is_rest])[None, :] * X1[:, is_rest]).max(axis=0)
+    over = np.zeros(x1.size)  # only the states at rest can overshoot: past the origin,
+    over[is_rest] = grid_overshoot(X1[:, is_rest], 0.0)  # on the samples, as robust reads it
     box = definition("0p001mm")
     if band != box.band_mm:
         box = SettlingDefinition("properties", "the properties' band", band_mm=band)

@@ -64,7 +64,7 @@ from ptoverify.sim.exact import BatchSettling
 from ptoverify.sim.flow import Trajectory
 from ptoverify.sim.settling import DEFINITIONS, SettlingDefinition, settling_time
 from ptoverify.sim.simulate import simulate_batch
-from ptoverify.studies.grids import even_points, grid_states, mirror_pairs
+from ptoverify.studies.grids import even_points, grid_states
 
 __all__ = [
     "SweepSettings",
@@ -75,7 +75,6 @@ __all__ = [
     "sweep_definition",
     "grid_states",
     "even_points",
-    "mirror_pairs",
     "discrete_limit",
 ]
 
@@ -285,8 +284,6 @@ def settling_times(
     velocity_band: float,
     hold: float,
     chunk: int = CHUNK,
-    *,
-    mirror: bool = False,
 ) -> BatchSettling:
     """Settling times of ``law`` from each state, between samples and on the grid.
 
@@ -312,8 +309,6 @@ def settling_times(
     chunk : int
         At most this many states simulated at once (memory: about 25 bytes x
         chunk x steps).
-    mirror : bool
-        Ignored: every state is simulated (kept for older callers).
 
     Returns
     -------

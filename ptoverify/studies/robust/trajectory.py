@@ -19,7 +19,7 @@ from ptoverify.model.laws import Law, make_law
 from ptoverify.model.mintime import min_time
 from ptoverify.model.reach import zonotope_steps_each
 from ptoverify.sim.flow import Trajectory
-from ptoverify.sim.settling import grid_settling
+from ptoverify.sim.settling import grid_overshoot, grid_settling
 from ptoverify.sim.simulate import BatchResult, Mismatch, simulate_batch
 from ptoverify.studies.properties import oscillating, stride_over_counts
 
@@ -174,8 +174,7 @@ def _measure(
     rest = np.flatnonzero((x2 == 0.0) & (np.abs(x1) >= cfg.pto.d) & (x1 != 0.0))
     over = np.full(n, np.nan)
     if rest.size:  # the largest excursion beyond the origin, on the side opposite to x1_0
-        run = b.x1[:, rest] if rest.size < n else b.x1
-        over[rest] = np.maximum((-np.sign(x1[rest])[None, :] * run).max(axis=0), 0.0)
+        over[rest] = grid_overshoot(b.x1[:, rest] if rest.size < n else b.x1, 0.0)
     out = {
         "stride_overs": stride_over_counts(b.x1, b.x2, b.region, cfg).astype(float),
         "limit_cycle_mm": amp,

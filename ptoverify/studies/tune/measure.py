@@ -21,12 +21,10 @@ from ptoverify.model.laws import make_law, with_state_gains
 from ptoverify.model.memo import memo
 from ptoverify.model.mintime import discrete_min_steps_batch, min_time
 from ptoverify.model.poles import spectral_radii
-from ptoverify.sim.exact import (
-    settling_and_overshoot,
-)
+from ptoverify.sim.exact import settling_and_overshoot
+from ptoverify.sim.simulate import simulate_batch
 from ptoverify.studies.properties import (
     default_steps,
-    grid_simulation,
     initial_grid,
     oscillating,
     stride_over_counts,
@@ -471,11 +469,11 @@ def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
     fn = make_law(law, cfg)
     x1, x2, _ = initial_grid(cfg)
     steps = default_steps(cfg)
-    with grid_simulation(fn, cfg, x1, x2, steps) as res:
-        cycles = int(oscillating(res.x1[-max(20, steps // 4) :], LIMIT_CYCLE_BAND).sum())
-        if law != "pto":
-            return cycles, 0
-        return cycles, int(stride_over_counts(res.x1, res.x2, res.region, cfg).sum())
+    res = simulate_batch(fn, cfg.plant, x1, x2, steps)
+    cycles = int(oscillating(res.x1[-max(20, steps // 4) :], LIMIT_CYCLE_BAND).sum())
+    if law != "pto":
+        return cycles, 0
+    return cycles, int(stride_over_counts(res.x1, res.x2, res.region, cfg).sum())
 
 
 def grid_checked(cfg: Config, law: str, c: Candidate) -> Candidate:
