@@ -18,6 +18,8 @@ claim_standing  holds / fails / depends, with what it depends on
 reviewer_rows   the reviewer's table rows
 engineer_rows   the drive engineer's table rows (question, answer, evidence)
 versus_row      the PTO against fair-tuned PD, PTOS and cascade P, per reading of a
+versus_bound    the baselines' shared overshoot bound, and why it differs with a
+versus_note     the baselines' row in full, for the note under the verdict table
 adoption        the one-sentence recommendation
 """
 
@@ -49,6 +51,8 @@ __all__ = [
     "engineer_rows",
     "adoption",
     "versus_row",
+    "versus_bound",
+    "versus_note",
     "versus_verdict",
     "tuned_delay_row",
     "READING_WORDS",
@@ -61,13 +65,16 @@ __all__ = [
 ]
 
 
-def reviewer_rows(res: Mapping) -> list[list[str]]:
+def reviewer_rows(res: Mapping, short: bool = False) -> list[list[str]]:
     """Rows ``[claim, standing, condition, paper, measured]`` for every claim.
 
     Parameters
     ----------
     res : Mapping
         The results (:class:`ptoverify.report.results.Results`).
+    short : bool
+        Name the readings in the verdict table's short words
+        (:func:`ptoverify.report.standing_claims.short_legend`).
 
     Returns
     -------
@@ -78,7 +85,7 @@ def reviewer_rows(res: Mapping) -> list[list[str]]:
     rows = []
     hz = bandwidth_hz(res)
     for c in res["claims"]:
-        standing, cond = claim_standing(c, hz)
+        standing, cond = claim_standing(c, hz, short)
         unit = c["unit"]
         rows.append(
             [
@@ -165,13 +172,17 @@ def _faster(pto: float | None, pd: float | None, sample: float) -> str:
     return time_verdict(pto, pd, sample)
 
 
-def engineer_rows(res: Mapping) -> list[list[str]]:
+def engineer_rows(res: Mapping, short: bool = False) -> list[list[str]]:
     """Rows ``[question, answer, evidence]`` a drive engineer acts on.
 
     Parameters
     ----------
     res : Mapping
         The results (:class:`ptoverify.report.results.Results`).
+    short : bool
+        The verdict table's short cells: readings in short words
+        (:func:`ptoverify.report.standing_claims.short_legend`), the evidence
+        without what the answer already says; :func:`versus_note` holds the rest.
 
     Returns
     -------
@@ -190,6 +201,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             f"{qty(co['omega0'], 'mm/s')} ({'valid' if co['valid'] else 'invalid'})",
         ]
     ]
+    hz = bandwidth_hz(res)
     step = step_readings(res)
     if step:
         parts, verdicts = [], []
@@ -197,7 +209,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             v = r["values"]
             verdicts.append(_faster(v["settling_pto_s"], v["settling_pd_s"], T))
             parts.append(
-                f"{reading_words('a', a, bandwidth_hz(res))}: PTO {_ms(v['settling_pto_s'])}, "
+                f"{reading_words('a', a, hz, short)}: PTO {_ms(v['settling_pto_s'])}, "
                 f"PD {_ms(v['settling_pd_s'])}"
             )
         answer = (
@@ -205,7 +217,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             if len(set(verdicts)) == 1
             else "depends on the reading of a: "
             + "; ".join(
-                f"{reading_words('a', a, bandwidth_hz(res))}: {w}"
+                f"{reading_words('a', a, hz, short)}: {w}"
                 for a, w in zip(step, verdicts, strict=True)
             )
         )
@@ -219,9 +231,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             if "pd" in by and "pto" in by:
                 pd, pto = by["pd"]["settling_2pct_s"], by["pto"]["settling_2pct_s"]
                 verdicts.append(_faster(pto, pd, T))
-                parts.append(
-                    f"overshoot <= {qty(t['bounds_mm'][name], 'mm')}: PTO {_ms(pto)}, PD {_ms(pd)}"
-                )
+                parts.append(f"overshoot <= {_bound_words(t, name)}: PTO {_ms(pto)}, PD {_ms(pd)}")
         if parts:
             answer = verdicts[0] if len(set(verdicts)) == 1 else "; ".join(verdicts)
             rows.append(
@@ -247,12 +257,14 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
         pd_nd = (
             rob["margins"]["pd"]["linear_loop_a_ratio_stable"] if "pd" in rob["margins"] else None
         )
+        pto_words = (
+            "" if short else f"PTO linear loop stable for a_true / a_design {ratio_phrase(nd)}; "
+        )
         rows.append(
             [
                 "Tolerates a bandwidth other than the design value?",
                 f"a_true / a_design {ratio_phrase(nd)}" if nd else m["linear_loop_note"],
-                f"PTO linear loop stable for a_true / a_design {ratio_phrase(nd)}; PD "
-                f"{ratio_phrase(pd_nd)}",
+                f"{pto_words}PD{': a_true / a_design ' if short else ' '}{ratio_phrase(pd_nd)}",
             ]
         )
     loops = res["poles"]["loops"]
@@ -262,7 +274,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             [
                 "Stability margins of the linear loops (sampled, nominal plant)?",
                 _thinner(lin, pd),
-                f"PTO linear zone: {_margins(lin)}; PD: {_margins(pd)}",
+                f"PTO linear zone: {_margins(lin, short)}; PD: {_margins(pd, short)}",
             ]
         )
     p = res["properties"]["pto"] if "pto" in res["properties"] else None
@@ -273,18 +285,18 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
                 "Stride-overs, limit cycles, chattering (sampled grid)?",
                 ("none found" if clean else "found") + _proved_stride(res),
                 f"{p['states']} grid states: {p['stride_overs']} stride-overs, "
-                f"{p['limit_cycles']} limit cycles, {p['chattering']} chattering "
-                "(sampled: see the proofs for the continuum where they ran)",
+                f"{p['limit_cycles']} limit cycles, {p['chattering']} chattering"
+                + ("" if short else " (sampled: see the proofs for the continuum where they ran)"),
             ]
         )
-    rows.append(versus_row(res))
-    delay = tuned_delay_row(res)
+    rows.append(versus_row(res, short))
+    delay = tuned_delay_row(res, short)
     if delay:
         rows.append(delay)
     return rows
 
 
-def tuned_delay_row(res: Mapping) -> list[str] | None:
+def tuned_delay_row(res: Mapping, short: bool = False) -> list[str] | None:
     """Return the row on the tuned gains under computation delay (None: tuning skipped).
 
     Each law's linear loop at its fair tuning (``tuning.versus``, first reading of a),
@@ -295,6 +307,8 @@ def tuned_delay_row(res: Mapping) -> list[str] | None:
     ----------
     res : Mapping
         The results (:class:`ptoverify.report.results.Results`).
+    short : bool
+        The verdict table's short cells (the advice and the per-law words left out).
 
     Returns
     -------
@@ -312,18 +326,19 @@ def tuned_delay_row(res: Mapping) -> list[str] | None:
     def words(n: int) -> str:
         return "unstable even without delay" if n < 0 else plural(n, "sample")
 
-    short = [x for x in tuned if x["delay_margin_samples"] < 1]
+    unstable = [x for x in tuned if x["delay_margin_samples"] < 1]
     answer = (
         "yes: every tuned loop tolerates at least one sample"
-        if not short
+        if not unstable
         else "no: "
-        + ", ".join(law_name(x["law"]) for x in short)
-        + (" is" if len(short) == 1 else " are each")
-        + " unstable at the best tuning with one sample of delay (tune with the delay in "
-        "the loop, or compensate it)"
+        + ", ".join(law_name(x["law"]) for x in unstable)
+        + (" is" if len(unstable) == 1 else " are each")
+        + " unstable at the best tuning with one sample of delay"
+        + ("" if short else " (tune with the delay in the loop, or compensate it)")
     )
     evidence = "; ".join(
-        f"{law_name(x['law'])}: tolerates {words(x['delay_margin_samples'])}" for x in tuned
+        f"{law_name(x['law'])}: {'' if short else 'tolerates '}{words(x['delay_margin_samples'])}"
+        for x in tuned
     )
     return ["Do the tuned gains tolerate a one-sample computation delay?", answer, evidence]
 
@@ -332,7 +347,9 @@ def tuned_delay_row(res: Mapping) -> list[str] | None:
 VERSUS_QUESTION = "Faster than fair-tuned PD, PTOS and the cascade P loop (step)?"
 
 
-def versus_verdict(diff: float | None, other: Mapping, pto: Mapping, sample: float) -> str:
+def versus_verdict(
+    diff: float | None, other: Mapping, pto: Mapping, sample: float, short: bool = False
+) -> str:
     """Return the PTO's verdict against one fair-tuned law: beats, ties, loses, or no verdict.
 
     Parameters
@@ -343,6 +360,8 @@ def versus_verdict(diff: float | None, other: Mapping, pto: Mapping, sample: flo
         The two tuned laws (``law``, ``infeasible``) of ``tuning.versus``.
     sample : float
         T [s]: a tie under :func:`ptoverify.verdict.time_order` (less than one sample apart).
+    short : bool
+        A tie without the rule's words (the verdict table states the rule once).
 
     Returns
     -------
@@ -356,6 +375,8 @@ def versus_verdict(diff: float | None, other: Mapping, pto: Mapping, sample: flo
         return f"no {name} gains meet the constraints"
     order = time_order(diff, 0.0, sample)
     if order == 0:
+        if short:
+            return f"ties {name} ({_ms(abs(diff))} apart)"
         return f"ties {name} (less than one sample apart: {_ms(abs(diff))})"
     return f"{'beats' if order < 0 else 'loses to'} {name} by {_ms(abs(diff))}"
 
@@ -368,7 +389,58 @@ def _settling_words(name: str, description: str) -> str:
     return d.band_text() if d is not None else description
 
 
-def versus_row(res: Mapping) -> list[str]:
+def _bound_words(t: Mapping, name: str) -> str:
+    """Return a shared overshoot bound as its value and what it is: ``0 mm (the PTO's ...)``."""
+    return f"{qty(t['bounds_mm'][name], 'mm')} ({t['bound_meaning'][name]})"
+
+
+def _reading_a_words(res: Mapping, r: Mapping, several: bool, short: bool) -> str:
+    """Return one reading of ``tuning.versus`` as its a in words."""
+    if not several:
+        return f"a = {qty(r['a'], 'rad/s')} (the configuration's)"
+    rd = {"2pi": "2pi*f", "hz": "f"}.get(r["reading"], r["reading"])
+    return reading_words("a", rd, bandwidth_hz(res), short)
+
+
+def versus_bound(res: Mapping, short: bool = False) -> str:
+    """Say what the baselines' shared overshoot bound is, and why its value differs with a.
+
+    The bound (``tuning.versus.bound``, a name of
+    :data:`ptoverify.studies.tune.FAIR_BOUNDS`, its meaning in
+    ``tuning.bound_meaning``) is taken under each reading of a, so it is a function
+    of the plant of that reading: the sentence gives each reading's value and says
+    whether they differ.
+
+    Parameters
+    ----------
+    res : Mapping
+        The results (:class:`ptoverify.report.results.Results`; tuning not skipped).
+    short : bool
+        Readings of a in the verdict table's short words.
+
+    Returns
+    -------
+    str
+        E.g. ``overshoot bound = the PTO's overshoot at the paper's gains, taken under
+        each reading of a (so it differs): 0 mm at a = 188.5 rad/s, ...``.
+    """
+    t = res["tuning"]
+    v = t["versus"]
+    rs = v["readings"]
+    values = ", ".join(
+        f"{qty(r['bound_mm'], 'mm')} at {_reading_a_words(res, r, len(rs) > 1, short)}" for r in rs
+    )
+    meaning = t["bound_meaning"][v["bound"]]
+    if len(rs) == 1:
+        return f"overshoot bound = {meaning}: {values}"
+    differ = len({r["bound_mm"] for r in rs}) > 1
+    return (
+        f"overshoot bound = {meaning}, taken under each reading of a "
+        f"({'so it differs with a' if differ else 'the same under each'}): {values}"
+    )
+
+
+def versus_row(res: Mapping, short: bool = False) -> list[str]:
     """Return the row saying whether the corrected PTO beats fair-tuned PD, PTOS, cascade P.
 
     Read off ``tuning.versus`` (:func:`ptoverify.studies.versus.versus`): under each
@@ -380,6 +452,10 @@ def versus_row(res: Mapping) -> list[str]:
     ----------
     res : Mapping
         The results (:class:`ptoverify.report.results.Results`).
+    short : bool
+        The verdict table's short cells: readings in short words, the evidence the
+        bound (:func:`versus_bound`) and the times alone (:func:`versus_note` has
+        the floors and the settling definition).
 
     Returns
     -------
@@ -391,37 +467,59 @@ def versus_row(res: Mapping) -> list[str]:
         return [VERSUS_QUESTION, "not compared: the tuning was skipped", "no tuned results"]
     v = t["versus"]
     answers, evidence = [], []
+    if short:
+        evidence.append(versus_bound(res, short))
     for r in v["readings"]:
         laws = {x["law"]: x for x in r["laws"]}
         pto = laws["pto"]
         verdicts = [  # in the laws' order (results.json sorts the keys of pto_minus)
-            versus_verdict(r["pto_minus"][x["law"]], x, pto, r["sample_time"])
+            versus_verdict(r["pto_minus"][x["law"]], x, pto, r["sample_time"], short)
             for x in r["laws"]
             if x["law"] != "pto"
         ]
-        words = (
-            reading_words(
-                "a", {"2pi": "2pi*f", "hz": "f"}.get(r["reading"], r["reading"]), bandwidth_hz(res)
-            )
-            if len(v["readings"]) > 1
-            else f"a = {qty(r['a'], 'rad/s')} (the configuration's)"
-        )
+        words = _reading_a_words(res, r, len(v["readings"]) > 1, short)
         answers.append(f"{words}: {', '.join(verdicts)}")
         times = ", ".join(
             f"{law_name(x['law'])} "
             + (
                 "no tuning"
                 if x["infeasible"]
-                else f"{_ms(x['settling_s'])} ({fmt(x['ratio_nt'])} N*T, {fmt(x['ratio_tf'])} t_f*)"
+                else _ms(x["settling_s"])
+                + ("" if short else f" ({fmt(x['ratio_nt'])} N*T, {fmt(x['ratio_tf'])} t_f*)")
             )
             for x in r["laws"]
         )
+        if short:
+            evidence.append(f"{words}: {times}")
+            continue
         evidence.append(
             f"{words}, overshoot <= {qty(r['bound_mm'], 'mm')}: {times}; "
             f"N*T = {_ms(r['nt_s'])}, t_f* = {_ms(r['tf_s'])}"
         )
-    evidence.append(f"settled: {_settling_words(v['settling'], v['settling_description'])}")
+    if not short:
+        evidence.append(f"settled: {_settling_words(v['settling'], v['settling_description'])}")
     return [VERSUS_QUESTION, "; ".join(answers), "; ".join(evidence)]
+
+
+def versus_note(res: Mapping) -> str:
+    """Return the note under the verdict table: the baselines' row in full, with its bound.
+
+    Parameters
+    ----------
+    res : Mapping
+        The results (:class:`ptoverify.report.results.Results`).
+
+    Returns
+    -------
+    str
+        "" when the tuning was skipped; else the full evidence of :func:`versus_row`
+        (each law's time over N* T and t_f*, the floors, the settling definition)
+        and :func:`versus_bound`.
+    """
+    t = res["tuning"]
+    if t is None or "versus" not in t:
+        return ""
+    return f"The fair-tuned comparison in full: {versus_bound(res)}. {versus_row(res)[2]}."
 
 
 def _proved_stride(res: Mapping) -> str:
@@ -445,7 +543,7 @@ def _thinner(lin: Mapping, pd: Mapping) -> str:
     return "mixed: see the margins of each loop"
 
 
-def _margins(loop: Mapping) -> str:
+def _margins(loop: Mapping, short: bool = False) -> str:
     """Gain margin [dB], phase margin [deg] and delay margin [samples] of one loop."""
     n = loop["delay_margin_samples"]
     delay = (
@@ -453,6 +551,10 @@ def _margins(loop: Mapping) -> str:
         if n < 0
         else f"tolerates {plural(n, 'sample')} of computation delay"
     )
+    if short:
+        return f"{qty(loop['gain_margin_db'], 'dB')}, {qty(loop['phase_margin_deg'], 'deg')}, " + (
+            "unstable without delay" if n < 0 else f"{plural(n, 'sample')} of delay"
+        )
     return (
         f"gain margin {qty(loop['gain_margin_db'], 'dB')}, phase margin "
         f"{qty(loop['phase_margin_deg'], 'deg')}, {delay}"
