@@ -186,9 +186,14 @@ def _mixed_mathml(text: str) -> str | None:
     text with a comma (a list, side conditions) or with operators left in its words
     is not drawn: its plain form stays.
     """
+
+    def stacked(*rows: str) -> str:  # words on a line of their own: a narrow cell holds them
+        cells = "".join(f"<mtr><mtd>{r}</mtd></mtr>" for r in rows)
+        return f'<mtable columnalign="left">{cells}</mtable>'
+
     lead, sep, rest = text.partition(": ")
     if sep and _formula_mathml(rest) is not None:
-        return f"<mtext>{html.escape(lead)}: </mtext>{_formula_mathml(rest)}"
+        return stacked(f"<mtext>{html.escape(lead)}:</mtext>", str(_formula_mathml(rest)))
     words = text.split(" ")
     for end in range(len(words), 0, -1):
         head = " ".join(words[:end])
@@ -197,7 +202,7 @@ def _mixed_mathml(text: str) -> str | None:
         formula = _formula_mathml(head)
         tail = " ".join(words[end:])
         if formula is not None and not re.search(r"[=<>*/]", tail):  # the rest is words
-            return formula + (f"<mtext>&#xa0;{html.escape(tail)}</mtext>" if tail else "")
+            return stacked(formula, f"<mtext>{html.escape(tail)}</mtext>") if tail else formula
     return None
 
 
