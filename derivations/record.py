@@ -23,6 +23,8 @@ than 1e-30 by many orders of magnitude at the sampled points.
 
 from __future__ import annotations
 
+import html
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -150,11 +152,68 @@ class EquationRecord:
         return out
 
 
+#: A relation between two formulas in a form's text: ``lhs = rhs``, ``x1 <= 0``.
+_RELATION = re.compile(r"\s(<=|>=|=|<|>)\s")
+#: How each relation is drawn.
+_RELATION_MO = {"<=": "&#x2264;", ">=": "&#x2265;", "=": "=", "<": "&lt;", ">": "&gt;"}
+
+
+def _formula_mathml(text: str) -> str | None:
+    """MathML of a formula, relations between parts allowed (None if not a formula)."""
+    from derivations.printed import parse
+
+    sides = _RELATION.split(text.strip())
+    if "," in text:  # a list or a chain with side conditions: not one formula
+        return None
+    out = []
+    for k, side in enumerate(sides):
+        if k % 2:
+            out.append(f"<mo>{_RELATION_MO[side]}</mo>")
+            continue
+        try:
+            out.append(mathml(parse(side), printer="presentation"))
+        except Exception:  # noqa: BLE001 - prose, not a formula
+            return None
+    return "".join(out)
+
+
+def _mixed_mathml(text: str) -> str | None:
+    """MathML of a formula with words around it, the words as ``mtext`` (None: no formula).
+
+    A prose lead ending in ``": "`` is text; after it, the longest run of leading
+    words that is a formula with an operator is drawn as mathematics and the rest
+    as text: ``a*tx1 + tx2 = 0 on the image of l1`` -> formula, then words.  A
+    text with a comma (a list, side conditions) or with operators left in its words
+    is not drawn: its plain form stays.
+    """
+
+    def stacked(*rows: str) -> str:  # words on a line of their own: a narrow cell holds them
+        cells = "".join(f"<mtr><mtd>{r}</mtd></mtr>" for r in rows)
+        return f'<mtable columnalign="left">{cells}</mtable>'
+
+    lead, sep, rest = text.partition(": ")
+    if sep and _formula_mathml(rest) is not None:
+        return stacked(f"<mtext>{html.escape(lead)}:</mtext>", str(_formula_mathml(rest)))
+    words = text.split(" ")
+    for end in range(len(words), 0, -1):
+        head = " ".join(words[:end])
+        if not re.search(r"[-+*/=<>(]", head):
+            break
+        formula = _formula_mathml(head)
+        tail = " ".join(words[end:])
+        if formula is not None and not re.search(r"[=<>*/]", tail):  # the rest is words
+            return stacked(formula, f"<mtext>{html.escape(tail)}</mtext>") if tail else formula
+    return None
+
+
 @lru_cache(maxsize=1024)
 def _to_mathml(text: str) -> str:
     """MathML of a '; '-separated list of SymPy expressions ('' if unparsable).
 
-    Memoized: a definition's derived form is its printed one, rendered once.
+    A piece that is a formula with relations or with words around it (``lhs = 0
+    on the image of l1``) is drawn as the formula and the words as text
+    (:func:`_mixed_mathml`).  Memoized: a definition's derived form is its
+    printed one, rendered once.
     """
     from derivations.printed import parse
 
@@ -163,7 +222,10 @@ def _to_mathml(text: str) -> str:
         try:
             parts.append(mathml(parse(piece), printer="presentation"))
         except Exception:  # noqa: BLE001 - prose, not a formula: rendered as text
-            return ""
+            mixed = _mixed_mathml(piece)
+            if mixed is None:
+                return ""
+            parts.append(mixed)
     if len(parts) == 1:
         return "<mrow>" + parts[0] + "</mrow>"
     # one row per part: a chain of equations stacks instead of running off the page

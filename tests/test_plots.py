@@ -2,6 +2,7 @@
 
 import ast
 import os
+import re
 import subprocess
 import sys
 from dataclasses import replace
@@ -378,3 +379,48 @@ def test_pareto_inset_draws_the_fronts_gap_it_is_given():
     ax = Figure().add_subplot()
     plots.plot_pareto(tuning | {"fronts_gap": None}, ax)
     assert not ax.child_axes
+
+
+#: A symbol written as plain text where a reader expects mathematics: a subscript or a
+#: star (w_max, a_true, t_f*, N* T) outside $...$.
+_PLAIN_MATH = re.compile(r"[A-Za-z]_[A-Za-z{]|[A-Za-z]\*")
+
+
+def _labels(fig) -> list[str]:
+    """Every axis label, title and legend entry of a figure (colour bars included)."""
+    out = []
+    for ax in fig.axes:
+        out += [ax.get_xlabel(), ax.get_ylabel(), ax.get_title()]
+        legend = ax.get_legend()
+        if legend is not None:
+            out += [t.get_text() for t in legend.get_texts()]
+    return [t for t in out if t]
+
+
+def test_robust_map_and_charts_write_symbols_as_mathematics(tmp_path):
+    """The robustness maps' axes (w_max,true / w_max, a_true / a_design), the sweep's and the
+    penalty chart's N* T and t_f* are mathtext, which Matplotlib renders (savefig parses it)."""
+    from matplotlib.figure import Figure
+
+    maps = {
+        "a_ratio": [0.5, 1.0],
+        "w_max_ratio": [0.9, 1.0],
+        "delay_samples": [0],
+        "laws": {
+            "pd": [
+                {"delay_samples": 0, "w_max_ratio": w, "a_ratio": a, "limit_cycle_states": 0}
+                for w in (0.9, 1.0)
+                for a in (0.5, 1.0)
+            ]
+        },
+    }
+    ax = Figure().add_subplot()
+    plots.plot_robust_map(maps, "pd", "limit_cycle_states", 0, ax)
+    assert ax.get_ylabel() == r"$w_{\max,\mathrm{true}}/w_{\max}$ [-]"
+    assert ax.get_xlabel() == r"$a_{\mathrm{true}}/a_{\mathrm{design}}$ [-]"
+    files = plots.save_robust(maps, tmp_path)
+    assert all(f.stat().st_size > 1000 for f in files)
+    ax.figure.savefig(tmp_path / "one.png")  # a mathtext error raises here
+    for text in _labels(ax.figure):
+        bare = re.sub(r"\$[^$]*\$", "", text)
+        assert not _PLAIN_MATH.search(bare), f"plain-text symbol in {text!r}"

@@ -241,8 +241,16 @@ def test_report_renders_in_headless_chromium(two_reports, tmp_path):
         "if(right<=cr.right+1)return false;const w=e.closest('.eq');"
         "return !(w&&getComputedStyle(w).overflowX==='auto'"
         "&&w.getBoundingClientRect().right<=cr.right+1&&w.scrollWidth>w.clientWidth);}).length;"
+        # the verdict, heading to the end of its last table, within one 1000 px screen
+        "const vs=document.getElementById('verdict');const vt=[...vs.querySelectorAll('table')];"
+        "const vh=vt.length?Math.ceil(vt[vt.length-1].getBoundingClientRect().bottom"
+        "-vs.getBoundingClientRect().top):-1;"
+        # single-panel figures share a row: none drawn at less than 45 % of the content width
+        "const cw=vs.clientWidth;const hf=[...document.querySelectorAll('.figs figure.half img')];"
+        "const narrow=hf.filter(i=>i.getBoundingClientRect().width<0.45*cw).length;"
         "document.title=`IMAGES ${ok}/${imgs.length} MATH ${mh}/${m.length} ROWS ${rows} "
-        "FINDINGS ${fv}/${li.length} RAW ${raw} WIDE ${wide} CLIP ${clip}`;"
+        "FINDINGS ${fv}/${li.length} RAW ${raw} WIDE ${wide} CLIP ${clip} VERDICT ${vh} "
+        "HALF ${narrow}/${hf.length}`;"
         "}</script>"
     )
     probe_page = index.parent / "probe.html"
@@ -252,7 +260,7 @@ def test_report_renders_in_headless_chromium(two_reports, tmp_path):
             [
                 browser,
                 *flags,
-                "--window-size=1280,1600",
+                "--window-size=1280,1000",
                 "--virtual-time-budget=5000",
                 "--dump-dom",
                 probe_page.as_uri(),
@@ -284,6 +292,9 @@ def test_report_renders_in_headless_chromium(two_reports, tmp_path):
     assert parts[9] == "0", f"raw Python text on the page: {title}"
     assert parts[11] == "0", f"table cells wider than a 1280 px page: {title}"
     assert parts[13] == "0", f"equations clipped or running out of their cells: {title}"
+    assert 0 < int(parts[15]) <= 1000, f"the verdict does not fit one 1280 x 1000 screen: {title}"
+    narrow, halves = map(int, parts[17].split("/"))
+    assert halves >= 10 and narrow == 0, f"single-panel figures not paired across the page: {title}"
     png = shot.read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 50_000, "blank screenshot"
     # a non-blank page: many distinct pixel rows (decode via matplotlib, already a dependency)

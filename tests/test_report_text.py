@@ -303,3 +303,31 @@ def test_eq19_has_a_counterexample_of_its_own():
     assert by["19"].verdict == "erratum" and c19 is not None
     assert c19 != c18 and "image_under_minus_omega_m" in c19
     assert c19["printed"] != c18["printed"] and abs(c19["printed"][0]) > 1.0
+
+
+def test_a_form_with_words_draws_its_formula_as_mathematics():
+    """Eq. (18)'s derived form, a formula followed by where it holds, is MathML (the words as
+    text), in the derivations table as in its erratum; no form is shown as code."""
+    import derivations
+    from ptoverify.report.sections import derivations as derivation_section
+    from ptoverify.report.sections import errata
+
+    data = json.loads((ROOT / "reports" / "paper" / "results.json").read_text())
+    rec = next(r for r in data["derivations"] if r["id"] == "18")
+    assert " = 0 on " in rec["derived"], "the form this test is about changed"
+    r18 = derivations.EquationRecord.from_json(rec)
+    ml = r18.to_mathml()["derived"]
+    assert "<mo>=</mo><mn>0</mn></mtd>" in ml and "<mtext>on the image of l1" in ml
+    assert "*" not in re.sub(r"<mtext>.*?</mtext>", "", ml), "source text left in the MathML"
+    table = "".join(b.html for b in derivation_section({}, [r18]) if b.kind == "raw")
+    row = re.search(r'<tr id="eq-18".*?</tr>', table).group(0)
+    assert row.count("<math") == 2 and "<code>" not in row
+    page = render_html([("e", "E", errata({"derivations": [rec]}, [r18]))], "t")
+    assert "<code>" not in page
+    # a form that is not one formula (a chain with a side condition) stays plain, readable text
+    from ptoverify.report.sections.equations import readable
+
+    form = "x_l1(x2) <= x1 <= x_l1*(x2), x2 < 0"  # eq. (36)'s zone
+    chain = derivations.EquationRecord.from_json({**rec, "derived": form})
+    assert chain.to_mathml()["derived"] == ""
+    assert readable(chain.derived) == "x_l1(x2) \u2264 x1 \u2264 x_l1*(x2), x2 < 0"

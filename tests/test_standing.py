@@ -245,7 +245,12 @@ def _versus(T, diffs_by_reading, infeasible=()):
                 "pto_minus": minus,
             }
         )
-    return {"settling": "2pct", "settling_description": "2 % band", "readings": readings}
+    return {
+        "settling": "2pct",
+        "settling_description": "2 % band",
+        "bound": "pto-paper",
+        "readings": readings,
+    }
 
 
 def test_versus_row_flips_with_each_difference(base):
@@ -390,3 +395,46 @@ def test_the_margins_answer_names_the_thinner_loop_and_flips():
     assert _thinner(thin, thick).startswith("thinner in the PTO's linear zone")
     assert _thinner(thick, thin).startswith("thicker in the PTO's linear zone")
     assert _thinner({**thin, "phase_margin_deg": 70.0}, thick).startswith("mixed")
+
+
+# ---------------------------------------------------------------- the shared bound, explained
+def test_versus_row_says_what_the_bound_is_and_why_it_differs_with_a(base):
+    """The verdict's baselines' row names the bound's meaning (a function of the reading's
+    plant: the PTO's own overshoot at the paper's gains) and each reading's value; equal
+    values read as the same, different ones as differing with a."""
+    from ptoverify.report.standing import versus_bound, versus_row
+
+    data = copy.deepcopy(base)
+    t = data["tuning"]
+    meaning = t["bound_meaning"][t["versus"]["bound"]]
+    rs_ = t["versus"]["readings"]
+    assert len(rs_) == 2
+    rs_[0]["bound_mm"], rs_[1]["bound_mm"] = 0.0, 0.125
+    evidence = versus_row(results_view(data), short=True)[2]
+    assert evidence.startswith(f"overshoot bound = {meaning}, taken under each reading of a")
+    assert "so it differs with a): 0 mm at a = 188.5 rad/s, 0.125 mm at a = 30 rad/s" in evidence
+    rs_[1]["bound_mm"] = 0.0
+    text = versus_bound(results_view(data))
+    assert "the same under each" in text and "differs" not in text
+    # the verdict section shows the row short and the full row in its note
+    from ptoverify.report.sections import verdict
+
+    texts = [b.text for b in verdict(results_view(data))]
+    assert any(t_.startswith("The fair-tuned comparison in full: ") for t_ in texts)
+
+
+def test_short_verdict_words_are_explained_under_the_table(base):
+    """Every short reading word the verdict table uses is in the legend under it."""
+    from ptoverify.report.sections import verdict
+    from ptoverify.report.standing_claims import READING_WORDS, SHORT_WORDS
+
+    blocks = verdict(results_view(base))
+    cells = " ".join(c for b in blocks if b.kind == "table" for r in b.rows for c in r)
+    legend = next(b.text for b in blocks if "Short words: " in b.text)
+    for dim, words in SHORT_WORDS.items():
+        for value, word in words.items():
+            plain_ = word.lower() in READING_WORDS[dim][value].lower()  # says itself
+            if word in cells and not plain_:
+                assert f"{word}: {READING_WORDS[dim][value]}" in legend, word
+    assert "a = 188.5 rad/s reads the bandwidth in Hz" in legend
+    assert all(b.css.startswith("verdict") for b in blocks if b.kind == "table")

@@ -53,6 +53,10 @@ class Block:
         Table header and (already formatted) cells.
     html : str
         Raw HTML fragment, or the figure's relative path.
+    css : str
+        CSS classes of a table or a figure in the HTML (:data:`CSS`): ``verdict``
+        for the compact verdict tables; ``half`` for a single-panel figure, which
+        shares a row with its neighbour (consecutive figures form a grid).
     """
 
     kind: str
@@ -60,6 +64,7 @@ class Block:
     headers: tuple[str, ...] = ()
     rows: tuple[tuple[str, ...], ...] = ()
     html: str = ""
+    css: str = ""
 
 
 Section = tuple[str, str, list[Block]]
@@ -135,7 +140,7 @@ def qty(v: Any, unit: str, digits: int = 4) -> str:
     return f"{text} {unit}"
 
 
-def table(headers: list[str], rows: list[list[Any]]) -> Block:
+def table(headers: list[str], rows: list[list[Any]], css: str = "") -> Block:
     """Return a table block; every cell is formatted with :func:`fmt`.
 
     Parameters
@@ -144,13 +149,18 @@ def table(headers: list[str], rows: list[list[Any]]) -> Block:
         Column titles.
     rows : list of list
         Cell values.
+    css : str
+        CSS classes of the HTML table (:attr:`Block.css`).
 
     Returns
     -------
     Block
     """
     return Block(
-        "table", headers=tuple(headers), rows=tuple(tuple(fmt(c) for c in r) for r in rows)
+        "table",
+        headers=tuple(headers),
+        rows=tuple(tuple(fmt(c) for c in r) for r in rows),
+        css=css,
     )
 
 
@@ -229,7 +239,7 @@ def findings(items: list[tuple[str, str, str]], figure: str = "", caption: str =
     )
 
 
-def image(figures: dict[str, str], key: str, caption: str) -> list[Block]:
+def image(figures: dict[str, str], key: str, caption: str, css: str = "") -> list[Block]:
     """Return ``[figure block]`` when ``key`` is among the written figures, else ``[]``.
 
     Parameters
@@ -240,12 +250,14 @@ def image(figures: dict[str, str], key: str, caption: str) -> list[Block]:
         The figure's key (file stem).
     caption : str
         Caption and alt text.
+    css : str
+        ``half`` for a single-panel figure that shares a row (:attr:`Block.css`).
 
     Returns
     -------
     list of Block
     """
-    return [Block("img", text=caption, html=figures[key])] if key in figures else []
+    return [Block("img", text=caption, html=figures[key], css=css)] if key in figures else []
 
 
 #: A Markdown link to an anchor of this page: ``](#anchor)``.
@@ -321,7 +333,16 @@ table.derivations th:nth-child(1),table.derivations td:nth-child(1){width:3.5em}
 table.derivations th:nth-child(2),table.derivations td:nth-child(2){width:9em}
 table.derivations th:nth-child(5),table.derivations td:nth-child(5){width:22%}
 table.forms th{width:7em}
-td{overflow-wrap:break-word}table{max-width:100%}"""
+td{overflow-wrap:break-word}table{max-width:100%}
+table.verdict{width:100%;table-layout:fixed;font-size:.8em;line-height:1.25;margin:.4em 0}
+table.verdict th,table.verdict td{padding:.1em .35em}
+table.engineer th:nth-child(1){width:24%}table.engineer th:nth-child(2){width:32%}
+table.reviewer th:nth-child(1){width:40%}table.reviewer th:nth-child(2){width:4.6em}
+table.reviewer th:nth-child(4){width:5.6em}table.reviewer th:nth-child(5){width:15%}
+#verdict h2{margin-bottom:.3em}#verdict p{margin:.4em 0}
+.figs{display:grid;grid-template-columns:repeat(2,minmax(0,1fr));gap:.5em 1em;margin:1em 0}
+.figs figure{margin:0;grid-column:1/-1}.figs figure.half{grid-column:auto}
+.figs figure.half img{width:100%}"""
 
 #: Cell texts that get a CSS class (colour) of their own.
 STATUS_WORDS = frozenset(
@@ -349,8 +370,9 @@ def _html_block(b: Block) -> str:
     if b.kind == "raw":
         return b.html
     if b.kind == "img":
+        cls = f' class="{html.escape(b.css)}"' if b.css else ""
         return (
-            f'<figure><img src="{html.escape(b.html)}" alt="{html.escape(b.text)}">'
+            f'<figure{cls}><img src="{html.escape(b.html)}" alt="{html.escape(b.text)}">'
             f"<figcaption>{html.escape(b.text)}</figcaption></figure>"
         )
     head = "".join(f"<th>{html.escape(h)}</th>" for h in b.headers)
@@ -361,7 +383,26 @@ def _html_block(b: Block) -> str:
             cls = f' class="{c.replace(" ", "-")}"' if c in STATUS_WORDS else ""
             cells.append(f"<td{cls}>{html.escape(c)}</td>")
         body.append("<tr>" + "".join(cells) + "</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+    cls = f' class="{html.escape(b.css)}"' if b.css else ""
+    return f"<table{cls}><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+def _html_blocks(blocks: list[Block]) -> list[str]:
+    """Render blocks; a run of two or more figures shares a grid (``div.figs``, :data:`CSS`)."""
+    out: list[str] = []
+    run: list[Block] = []
+    for b in [*blocks, None]:
+        if b is not None and b.kind == "img":
+            run.append(b)
+            continue
+        if len(run) > 1:
+            out.append('<div class="figs">' + "".join(_html_block(f) for f in run) + "</div>")
+        else:
+            out += [_html_block(f) for f in run]
+        run = []
+        if b is not None:
+            out.append(_html_block(b))
+    return out
 
 
 def render_html(sections: list[Section], title: str, intro: str = "") -> str:
@@ -398,7 +439,7 @@ def render_html(sections: list[Section], title: str, intro: str = "") -> str:
     ]
     for anchor, heading, blocks in sections:
         parts.append(f'<section id="{anchor}"><h2>{html.escape(heading)}</h2>')
-        parts += [_html_block(b) for b in blocks]
+        parts += _html_blocks(blocks)
         parts.append("</section>")
     parts.append("</body></html>")
     return "\n".join(parts) + "\n"

@@ -17,7 +17,9 @@ Catalogue
 claim_standing  holds / fails / depends, with what it depends on
 reviewer_rows   the reviewer's table rows
 engineer_rows   the drive engineer's table rows (question, answer, evidence)
-versus_row      the PTO against fair-tuned PD, PTOS and cascade P, per reading of a
+versus_row      the PTO against fair-tuned PD, PTOS and cascade P (standing_versus)
+versus_bound    the baselines' shared overshoot bound, and why it differs with a
+versus_note     the baselines' row in full, for the note under the verdict table
 adoption        the one-sentence recommendation
 """
 
@@ -32,6 +34,14 @@ from ptoverify.report.standing_claims import (
     bandwidth_hz,
     claim_standing,
     reading_words,
+)
+from ptoverify.report.standing_versus import (
+    VERSUS_QUESTION,
+    bound_words,
+    versus_bound,
+    versus_note,
+    versus_row,
+    versus_verdict,
 )
 from ptoverify.report.words import (
     LAW_WORDS,
@@ -49,6 +59,8 @@ __all__ = [
     "engineer_rows",
     "adoption",
     "versus_row",
+    "versus_bound",
+    "versus_note",
     "versus_verdict",
     "tuned_delay_row",
     "READING_WORDS",
@@ -61,13 +73,16 @@ __all__ = [
 ]
 
 
-def reviewer_rows(res: Mapping) -> list[list[str]]:
+def reviewer_rows(res: Mapping, short: bool = False) -> list[list[str]]:
     """Rows ``[claim, standing, condition, paper, measured]`` for every claim.
 
     Parameters
     ----------
     res : Mapping
         The results (:class:`ptoverify.report.results.Results`).
+    short : bool
+        Name the readings in the verdict table's short words
+        (:func:`ptoverify.report.standing_claims.short_legend`).
 
     Returns
     -------
@@ -78,7 +93,7 @@ def reviewer_rows(res: Mapping) -> list[list[str]]:
     rows = []
     hz = bandwidth_hz(res)
     for c in res["claims"]:
-        standing, cond = claim_standing(c, hz)
+        standing, cond = claim_standing(c, hz, short)
         unit = c["unit"]
         rows.append(
             [
@@ -165,13 +180,17 @@ def _faster(pto: float | None, pd: float | None, sample: float) -> str:
     return time_verdict(pto, pd, sample)
 
 
-def engineer_rows(res: Mapping) -> list[list[str]]:
+def engineer_rows(res: Mapping, short: bool = False) -> list[list[str]]:
     """Rows ``[question, answer, evidence]`` a drive engineer acts on.
 
     Parameters
     ----------
     res : Mapping
         The results (:class:`ptoverify.report.results.Results`).
+    short : bool
+        The verdict table's short cells: readings in short words
+        (:func:`ptoverify.report.standing_claims.short_legend`), the evidence
+        without what the answer already says; :func:`versus_note` holds the rest.
 
     Returns
     -------
@@ -190,6 +209,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             f"{qty(co['omega0'], 'mm/s')} ({'valid' if co['valid'] else 'invalid'})",
         ]
     ]
+    hz = bandwidth_hz(res)
     step = step_readings(res)
     if step:
         parts, verdicts = [], []
@@ -197,7 +217,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             v = r["values"]
             verdicts.append(_faster(v["settling_pto_s"], v["settling_pd_s"], T))
             parts.append(
-                f"{reading_words('a', a, bandwidth_hz(res))}: PTO {_ms(v['settling_pto_s'])}, "
+                f"{reading_words('a', a, hz, short)}: PTO {_ms(v['settling_pto_s'])}, "
                 f"PD {_ms(v['settling_pd_s'])}"
             )
         answer = (
@@ -205,7 +225,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             if len(set(verdicts)) == 1
             else "depends on the reading of a: "
             + "; ".join(
-                f"{reading_words('a', a, bandwidth_hz(res))}: {w}"
+                f"{reading_words('a', a, hz, short)}: {w}"
                 for a, w in zip(step, verdicts, strict=True)
             )
         )
@@ -219,9 +239,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             if "pd" in by and "pto" in by:
                 pd, pto = by["pd"]["settling_2pct_s"], by["pto"]["settling_2pct_s"]
                 verdicts.append(_faster(pto, pd, T))
-                parts.append(
-                    f"overshoot <= {qty(t['bounds_mm'][name], 'mm')}: PTO {_ms(pto)}, PD {_ms(pd)}"
-                )
+                parts.append(f"overshoot <= {bound_words(t, name)}: PTO {_ms(pto)}, PD {_ms(pd)}")
         if parts:
             answer = verdicts[0] if len(set(verdicts)) == 1 else "; ".join(verdicts)
             rows.append(
@@ -247,12 +265,14 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
         pd_nd = (
             rob["margins"]["pd"]["linear_loop_a_ratio_stable"] if "pd" in rob["margins"] else None
         )
+        pto_words = (
+            "" if short else f"PTO linear loop stable for a_true / a_design {ratio_phrase(nd)}; "
+        )
         rows.append(
             [
                 "Tolerates a bandwidth other than the design value?",
                 f"a_true / a_design {ratio_phrase(nd)}" if nd else m["linear_loop_note"],
-                f"PTO linear loop stable for a_true / a_design {ratio_phrase(nd)}; PD "
-                f"{ratio_phrase(pd_nd)}",
+                f"{pto_words}PD{': a_true / a_design ' if short else ' '}{ratio_phrase(pd_nd)}",
             ]
         )
     loops = res["poles"]["loops"]
@@ -262,7 +282,7 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
             [
                 "Stability margins of the linear loops (sampled, nominal plant)?",
                 _thinner(lin, pd),
-                f"PTO linear zone: {_margins(lin)}; PD: {_margins(pd)}",
+                f"PTO linear zone: {_margins(lin, short)}; PD: {_margins(pd, short)}",
             ]
         )
     p = res["properties"]["pto"] if "pto" in res["properties"] else None
@@ -273,18 +293,18 @@ def engineer_rows(res: Mapping) -> list[list[str]]:
                 "Stride-overs, limit cycles, chattering (sampled grid)?",
                 ("none found" if clean else "found") + _proved_stride(res),
                 f"{p['states']} grid states: {p['stride_overs']} stride-overs, "
-                f"{p['limit_cycles']} limit cycles, {p['chattering']} chattering "
-                "(sampled: see the proofs for the continuum where they ran)",
+                f"{p['limit_cycles']} limit cycles, {p['chattering']} chattering"
+                + ("" if short else " (sampled: see the proofs for the continuum where they ran)"),
             ]
         )
-    rows.append(versus_row(res))
-    delay = tuned_delay_row(res)
+    rows.append(versus_row(res, short))
+    delay = tuned_delay_row(res, short)
     if delay:
         rows.append(delay)
     return rows
 
 
-def tuned_delay_row(res: Mapping) -> list[str] | None:
+def tuned_delay_row(res: Mapping, short: bool = False) -> list[str] | None:
     """Return the row on the tuned gains under computation delay (None: tuning skipped).
 
     Each law's linear loop at its fair tuning (``tuning.versus``, first reading of a),
@@ -295,6 +315,8 @@ def tuned_delay_row(res: Mapping) -> list[str] | None:
     ----------
     res : Mapping
         The results (:class:`ptoverify.report.results.Results`).
+    short : bool
+        The verdict table's short cells (the advice and the per-law words left out).
 
     Returns
     -------
@@ -312,116 +334,21 @@ def tuned_delay_row(res: Mapping) -> list[str] | None:
     def words(n: int) -> str:
         return "unstable even without delay" if n < 0 else plural(n, "sample")
 
-    short = [x for x in tuned if x["delay_margin_samples"] < 1]
+    unstable = [x for x in tuned if x["delay_margin_samples"] < 1]
     answer = (
         "yes: every tuned loop tolerates at least one sample"
-        if not short
+        if not unstable
         else "no: "
-        + ", ".join(law_name(x["law"]) for x in short)
-        + (" is" if len(short) == 1 else " are each")
-        + " unstable at the best tuning with one sample of delay (tune with the delay in "
-        "the loop, or compensate it)"
+        + ", ".join(law_name(x["law"]) for x in unstable)
+        + (" is" if len(unstable) == 1 else " are each")
+        + " unstable at the best tuning with one sample of delay"
+        + ("" if short else " (tune with the delay in the loop, or compensate it)")
     )
     evidence = "; ".join(
-        f"{law_name(x['law'])}: tolerates {words(x['delay_margin_samples'])}" for x in tuned
+        f"{law_name(x['law'])}: {'' if short else 'tolerates '}{words(x['delay_margin_samples'])}"
+        for x in tuned
     )
     return ["Do the tuned gains tolerate a one-sample computation delay?", answer, evidence]
-
-
-#: The question of the baselines' row.
-VERSUS_QUESTION = "Faster than fair-tuned PD, PTOS and the cascade P loop (step)?"
-
-
-def versus_verdict(diff: float | None, other: Mapping, pto: Mapping, sample: float) -> str:
-    """Return the PTO's verdict against one fair-tuned law: beats, ties, loses, or no verdict.
-
-    Parameters
-    ----------
-    diff : float or None
-        The PTO's settling minus the other law's [s] (None: one has no tuning).
-    other, pto : Mapping
-        The two tuned laws (``law``, ``infeasible``) of ``tuning.versus``.
-    sample : float
-        T [s]: a tie under :func:`ptoverify.verdict.time_order` (less than one sample apart).
-
-    Returns
-    -------
-    str
-        E.g. ``beats PTOS by 1.264 ms``.
-    """
-    name = law_name(other["law"])
-    if pto["infeasible"]:
-        return f"no verdict against {name} (no PTO gains meet the constraints)"
-    if other["infeasible"] or diff is None:
-        return f"no {name} gains meet the constraints"
-    order = time_order(diff, 0.0, sample)
-    if order == 0:
-        return f"ties {name} (less than one sample apart: {_ms(abs(diff))})"
-    return f"{'beats' if order < 0 else 'loses to'} {name} by {_ms(abs(diff))}"
-
-
-def _settling_words(name: str, description: str) -> str:
-    """Return a named settling definition as its band in words (the description if unknown)."""
-    from ptoverify.sim.settling import DEFINITIONS
-
-    d = DEFINITIONS.get(name)
-    return d.band_text() if d is not None else description
-
-
-def versus_row(res: Mapping) -> list[str]:
-    """Return the row saying whether the corrected PTO beats fair-tuned PD, PTOS, cascade P.
-
-    Read off ``tuning.versus`` (:func:`ptoverify.studies.versus.versus`): under each
-    reading of a, every law tuned by ``tune`` under the same overshoot bound; the
-    verdict per law and reading, with the settling times in ms under the named
-    definition, and each over N* T.
-
-    Parameters
-    ----------
-    res : Mapping
-        The results (:class:`ptoverify.report.results.Results`).
-
-    Returns
-    -------
-    list of str
-        ``[question, answer, evidence]``.
-    """
-    t = res["tuning"]
-    if t is None or "versus" not in t:
-        return [VERSUS_QUESTION, "not compared: the tuning was skipped", "no tuned results"]
-    v = t["versus"]
-    answers, evidence = [], []
-    for r in v["readings"]:
-        laws = {x["law"]: x for x in r["laws"]}
-        pto = laws["pto"]
-        verdicts = [  # in the laws' order (results.json sorts the keys of pto_minus)
-            versus_verdict(r["pto_minus"][x["law"]], x, pto, r["sample_time"])
-            for x in r["laws"]
-            if x["law"] != "pto"
-        ]
-        words = (
-            reading_words(
-                "a", {"2pi": "2pi*f", "hz": "f"}.get(r["reading"], r["reading"]), bandwidth_hz(res)
-            )
-            if len(v["readings"]) > 1
-            else f"a = {qty(r['a'], 'rad/s')} (the configuration's)"
-        )
-        answers.append(f"{words}: {', '.join(verdicts)}")
-        times = ", ".join(
-            f"{law_name(x['law'])} "
-            + (
-                "no tuning"
-                if x["infeasible"]
-                else f"{_ms(x['settling_s'])} ({fmt(x['ratio_nt'])} N*T, {fmt(x['ratio_tf'])} t_f*)"
-            )
-            for x in r["laws"]
-        )
-        evidence.append(
-            f"{words}, overshoot <= {qty(r['bound_mm'], 'mm')}: {times}; "
-            f"N*T = {_ms(r['nt_s'])}, t_f* = {_ms(r['tf_s'])}"
-        )
-    evidence.append(f"settled: {_settling_words(v['settling'], v['settling_description'])}")
-    return [VERSUS_QUESTION, "; ".join(answers), "; ".join(evidence)]
 
 
 def _proved_stride(res: Mapping) -> str:
@@ -445,7 +372,7 @@ def _thinner(lin: Mapping, pd: Mapping) -> str:
     return "mixed: see the margins of each loop"
 
 
-def _margins(loop: Mapping) -> str:
+def _margins(loop: Mapping, short: bool = False) -> str:
     """Gain margin [dB], phase margin [deg] and delay margin [samples] of one loop."""
     n = loop["delay_margin_samples"]
     delay = (
@@ -453,6 +380,10 @@ def _margins(loop: Mapping) -> str:
         if n < 0
         else f"tolerates {plural(n, 'sample')} of computation delay"
     )
+    if short:
+        return f"{qty(loop['gain_margin_db'], 'dB')}, {qty(loop['phase_margin_deg'], 'deg')}, " + (
+            "unstable without delay" if n < 0 else f"{plural(n, 'sample')} of delay"
+        )
     return (
         f"gain margin {qty(loop['gain_margin_db'], 'dB')}, phase margin "
         f"{qty(loop['phase_margin_deg'], 'deg')}, {delay}"

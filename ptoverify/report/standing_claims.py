@@ -7,7 +7,9 @@ in the reviewer's verdict table.
 Catalogue
 ---------
 READING_WORDS   how each reading dimension's value reads in words
+SHORT_WORDS     the same, shortened for the verdict table (:func:`short_legend` explains them)
 reading_words   one reading dimension's value in words (a by its value in rad/s)
+short_legend    what the verdict table's short reading words stand for
 claim_standing  holds / fails / depends, naming the readings it holds and fails with
 bandwidth_hz    the configuration's bandwidth [Hz], None when it gives a in rad/s
 """
@@ -22,7 +24,14 @@ from typing import Any
 from ptoverify.report.render import fmt, qty
 from ptoverify.report.words import plural
 
-__all__ = ["READING_WORDS", "reading_words", "claim_standing", "bandwidth_hz"]
+__all__ = [
+    "READING_WORDS",
+    "SHORT_WORDS",
+    "reading_words",
+    "short_legend",
+    "claim_standing",
+    "bandwidth_hz",
+]
 
 #: How each reading dimension of a claim reads in words.
 READING_WORDS: dict[str, dict[Any, str]] = {
@@ -40,8 +49,17 @@ READING_WORDS: dict[str, dict[Any, str]] = {
     "band": {},
 }
 
+#: The short words of the verdict table, where they differ from :data:`READING_WORDS`
+#: (:func:`short_legend` says what each stands for).
+SHORT_WORDS: dict[str, dict[Any, str]] = {
+    "pto": {"corrected": "corrected PTO", "printed": "printed PTO"},
+    "tracking": {"feed-forward": "FF", "none": "no FF", "error": "error law"},
+}
 
-def reading_words(dim: str, value: Any, bandwidth_hz: float | None = None) -> str:
+
+def reading_words(
+    dim: str, value: Any, bandwidth_hz: float | None = None, short: bool = False
+) -> str:
     """Return one reading dimension's value in words (``a = f (the bandwidth read as rad/s)``).
 
     Parameters
@@ -53,6 +71,9 @@ def reading_words(dim: str, value: Any, bandwidth_hz: float | None = None) -> st
     bandwidth_hz : float, optional
         The configuration's bandwidth [Hz]: a reading of a then names its value
         (``a = 2 pi x 30 = 188.5 rad/s``).
+    short : bool
+        The verdict table's short words (:data:`SHORT_WORDS`; a reading of a by its
+        value alone, ``a = 188.5 rad/s``), which :func:`short_legend` explains.
 
     Returns
     -------
@@ -64,7 +85,15 @@ def reading_words(dim: str, value: Any, bandwidth_hz: float | None = None) -> st
     'a = 2 pi x 30 Hz = 188.5 rad/s'
     >>> reading_words("a", "f", 30.0), reading_words("band", 0.05)
     ('a = 30 rad/s (30 Hz read as rad/s)', 'the 5 % band')
+    >>> reading_words("a", "f", 30.0, short=True), reading_words("tracking", "none", short=True)
+    ('a = 30 rad/s', 'no FF')
     """
+    if short:
+        if dim == "a" and bandwidth_hz is not None and value in ("2pi*f", "f"):
+            scale = 2 * math.pi if value == "2pi*f" else 1.0
+            return f"a = {qty(scale * bandwidth_hz, 'rad/s')}"
+        if value in SHORT_WORDS.get(dim, {}):
+            return SHORT_WORDS[dim][value]
     if dim == "a" and bandwidth_hz is not None and value in ("2pi*f", "f"):
         if value == "2pi*f":
             return f"a = 2 pi x {fmt(bandwidth_hz)} Hz = {qty(2 * math.pi * bandwidth_hz, 'rad/s')}"
@@ -83,7 +112,9 @@ def reading_words(dim: str, value: Any, bandwidth_hz: float | None = None) -> st
     return f"{dim} = {fmt(value)}"
 
 
-def claim_standing(claim: Mapping, bandwidth_hz: float | None = None) -> tuple[str, str]:
+def claim_standing(
+    claim: Mapping, bandwidth_hz: float | None = None, short: bool = False
+) -> tuple[str, str]:
     """Return ``(standing, condition)`` of one claim: holds, fails or depends.
 
     A claim that depends names the readings it holds under and those it fails
@@ -97,6 +128,8 @@ def claim_standing(claim: Mapping, bandwidth_hz: float | None = None) -> tuple[s
         ``reading`` dimensions and ``verdict``).
     bandwidth_hz : float, optional
         The configuration's bandwidth [Hz], to name the readings of a by value.
+    short : bool
+        Name the readings in the verdict table's short words (:func:`reading_words`).
 
     Returns
     -------
@@ -120,7 +153,7 @@ def claim_standing(claim: Mapping, bandwidth_hz: float | None = None) -> tuple[s
     holds, fails = _deciding(readings, ok)
 
     def say(cubes: list[dict[str, Any]]) -> str:
-        words = [[reading_words(d, v, bandwidth_hz) for d, v in c.items()] for c in cubes]
+        words = [[reading_words(d, v, bandwidth_hz, short) for d, v in c.items()] for c in cubes]
         if len(words) == 1:
             return " and ".join(words[0])
         return " or ".join(f"({' and '.join(w)})" if len(w) > 1 else w[0] for w in words)
@@ -217,6 +250,40 @@ def _merge(cubes: list[tuple], domains: list[list]) -> list[tuple]:
         chosen.append(best)
         left = {m for m in left if not covers(best, m)}
     return sorted(chosen, key=lambda p: min(order[m] for m in full if covers(p, m)))
+
+
+def short_legend(bandwidth_hz: float | None) -> str:
+    """Return what the verdict table's short reading words stand for, in one sentence.
+
+    Parameters
+    ----------
+    bandwidth_hz : float or None
+        The configuration's bandwidth [Hz] (None: a is given in rad/s, one reading).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> short_legend(30.0).split("; ")[0]
+    'a = 188.5 rad/s reads the bandwidth in Hz (2 pi x 30 Hz)'
+    """
+    parts = []
+    if bandwidth_hz is not None:
+        parts += [
+            f"{reading_words('a', '2pi*f', bandwidth_hz, short=True)} reads the bandwidth in Hz "
+            f"(2 pi x {fmt(bandwidth_hz)} Hz)",
+            f"{reading_words('a', 'f', bandwidth_hz, short=True)} reads {fmt(bandwidth_hz)} Hz "
+            "as rad/s",
+        ]
+    parts += [
+        f"{SHORT_WORDS[dim][v]}: {READING_WORDS[dim][v]}"
+        for dim in SHORT_WORDS
+        for v in SHORT_WORDS[dim]
+        if SHORT_WORDS[dim][v].lower() not in READING_WORDS[dim][v].lower()
+    ]
+    return "; ".join(parts)
 
 
 def bandwidth_hz(res: Mapping) -> float | None:

@@ -56,8 +56,8 @@ def plot_penalty(penalty: Mapping, axes) -> dict:
     left, right = axes
     s = _col(penalty["sizes_mm"])
     drawn: dict = {}
-    (drawn["t_f*"],) = left.loglog(s, 1e3 * _col(penalty["t_f_s"]), "k-", lw=1.0, label="t_f*")
-    (drawn["N* T"],) = left.loglog(s, 1e3 * _col(penalty["nt_s"]), "k:", lw=1.0, label="N* T")
+    (drawn["t_f*"],) = left.loglog(s, 1e3 * _col(penalty["t_f_s"]), "k-", lw=1.0, label="$t_f^*$")
+    (drawn["N* T"],) = left.loglog(s, 1e3 * _col(penalty["nt_s"]), "k:", lw=1.0, label="$N^* T$")
     for law, c in penalty["laws"].items():
         colour, label = LAW_COLOURS.get(law, ("grey", law_name(law)))
         (drawn[label],) = left.loglog(
@@ -68,7 +68,7 @@ def plot_penalty(penalty: Mapping, axes) -> dict:
     left.set_xlabel("move size [mm]")
     left.set_ylabel(f"settling time ({penalty['settling_definition']}) [ms]")
     right.set_xlabel("move size [mm]")
-    right.set_ylabel("settling / (N* T) [-]")
+    right.set_ylabel("settling / ($N^* T$) [-]")
     left.set_title(setting_words(penalty["setting"]), fontsize=9)
     right.set_title("ratio to the sampled limit (not settled: no point)", fontsize=9)
     for ax in axes:
@@ -124,8 +124,8 @@ def plot_design(design: Mapping, ax) -> dict:
     )  # fmt: skip
     ax.set_xticks(range(len(fs)), [f"{f:g}" for f in fs])
     ax.set_yticks(range(len(ts)), [f"{1e3 * t:g}" for t in ts])
-    ax.set_xlabel("bandwidth f [Hz] (a = 2 pi f)")
-    ax.set_ylabel("sample time T [ms]")
+    ax.set_xlabel(r"bandwidth $f$ [Hz] ($a = 2\pi f$)")
+    ax.set_ylabel("sample time $T$ [ms]")
     ax.set_title(
         "fastest law by median settling / (N* T); Z: PTO zone unusable or degenerate; "
         "D: PTO linear zone unstable with one sample of delay",

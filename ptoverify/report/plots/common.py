@@ -191,8 +191,8 @@ def folder(outdir: str | Path) -> Path:
 def finish(
     ax: Axes,
     title: str,
-    xlab: str = "position x1 [mm]",
-    ylab: str = "velocity x2 [mm/s]",
+    xlab: str = "position $x_1$ [mm]",
+    ylab: str = "velocity $x_2$ [mm/s]",
 ) -> None:
     """Label the axes (units in brackets), title them, add a grid and a legend.
 

@@ -65,7 +65,9 @@ def plot_du_map(
         cmap="inferno",
         norm=LogNorm(vmin=vmin, vmax=vmax),
     )
-    cbar = ax.figure.colorbar(drawn["mesh"], ax=ax, label="largest |u - u_ref| in cell [mm/s]")
+    cbar = ax.figure.colorbar(
+        drawn["mesh"], ax=ax, label=r"largest $|u - u_{\mathrm{ref}}|$ in cell [mm/s]"
+    )
     cbar.ax.axhline(tol, color="tab:cyan", lw=2)
     drawn["colorbar"] = cbar
     styles = {
@@ -86,8 +88,8 @@ def plot_du_map(
         )
     ax.set_xlim(du_map.x1_edges[0], du_map.x1_edges[-1])
     ax.set_ylim(du_map.x2_edges[0], du_map.x2_edges[-1])
-    ax.set_xlabel("position x1 [mm]")
-    ax.set_ylabel("velocity x2 [mm/s]")
+    ax.set_xlabel("position $x_1$ [mm]")
+    ax.set_ylabel("velocity $x_2$ [mm/s]")
     ax.set_title(
         f"|u - u_ref| ({du_map.name}); cyan tick: tolerance {tol:.3g} mm/s; grey: no state",
         fontsize=8,
@@ -124,16 +126,16 @@ def plot_conform_response(
             ref.t, ref.x1, color="tab:green", lw=1.2, ls="--", label="reference PTO (eq. 35)"
         )
         (drawn["r"],) = ax.plot(user.t, user.r, color="k", lw=0.8, ls=":", label="reference r")
-        ylab = "position x1 [mm]"
+        ylab = "position $x_1$ [mm]"
     else:
         (drawn["difference"],) = ax.plot(
             user.t, user.x1 - ref.x1, color="tab:red", lw=1.2, label="x1 (your law) - x1 (ref.)"
         )
-        ylab = "x1 difference [mm]"
+        ylab = "$x_1$ difference [mm]"
     finish(
         ax,
         f"{user.signal} response ({tracking(user)}), {quantity}",
-        xlab="time t [s]",
+        xlab="time $t$ [s]",
         ylab=ylab,
     )
     return drawn

@@ -52,9 +52,9 @@ _FIGNUM = {
     ("sine", "velocity"): 13,
 }
 _QUANT = {
-    "position": ("x1", "position x1 [mm]"),
-    "velocity": ("x2", "velocity x2 [mm/s]"),
-    "error": ("e", "error r - x1 [mm]"),
+    "position": ("x1", "position $x_1$ [mm]"),
+    "velocity": ("x2", "velocity $x_2$ [mm/s]"),
+    "error": ("e", "error $r - x_1$ [mm]"),
 }
 
 
@@ -111,7 +111,7 @@ def plot_response(
     finish(
         ax,
         f"{num}{first.signal} response: {quantity} ({tracking(first)}{plant})",
-        xlab="time t [s]",
+        xlab="time $t$ [s]",
         ylab=ylab,
     )
     return drawn

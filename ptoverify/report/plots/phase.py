@@ -85,7 +85,7 @@ def plot_fig2(plant: Plant, plus: Arcs, minus: Arcs, ax=None) -> dict:
         (drawn[lab],) = ax.plot(x1, x2, label=lab, **kw)
     span = max(float(np.max(np.abs(plus[0][0]))), float(np.max(np.abs(minus[0][0]))))
     ax.set_xlim(-span * 1.5, span * 1.5)
-    finish(ax, "Fig. 2: trajectories under +-w_max and the switching curve")
+    finish(ax, r"Fig. 2: trajectories under $\pm w_{\max}$ and the switching curve")
     return drawn
 
 
@@ -165,7 +165,7 @@ def plot_zones(zone: PTOZone, cfg: Config, ax=None) -> dict:
             neg,
             level_curve_x1(neg, a, w),
             level_curve_x1(neg, a, om),
-            label="switching zone S~_P, S~_N",
+            label=r"switching zone $\tilde S_P$, $\tilde S_N$",
             **fill,
         )
         ax.fill_betweenx(pos, level_curve_x1(pos, a, om), level_curve_x1(pos, a, w), **fill)
@@ -220,11 +220,13 @@ def plot_fig5(zone: PTOZone, cfg: Config, image: Arcs, ax=None) -> dict:
         neg,
         color="tab:purple",
         ls="--",
-        label="l~1 as printed (eq. 19)",
+        label=r"$\tilde l_1$ as printed (eq. 19)",
     )
-    drawn[line.get_label()] = line
-    (line,) = ax.plot(*image, color="tab:purple", label="image of l1 after T under -w_max")
-    drawn[line.get_label()] = line
+    drawn["l~1 as printed (eq. 19)"] = line
+    (line,) = ax.plot(
+        *image, color="tab:purple", label=r"image of $l_1$ after $T$ under $-w_{\max}$"
+    )
+    drawn["image of l1 after T under -w_max"] = line
     if 0 < zone.omega0 < w:
         label = f"l1* ({variant}, omega0 = {zone.omega0:.4g} mm/s)"
         level_curve(ax, a, zone.omega0, neg, drawn, label, color="tab:orange", lw=1.6)
@@ -236,7 +238,7 @@ def plot_fig5(zone: PTOZone, cfg: Config, image: Arcs, ax=None) -> dict:
     lim = _zone_xlim(cfg, zone.omega0)
     ax.set_xlim(-0.5 * lim, lim)
     ax.set_ylim(-1.05 * w, 0.05 * w)
-    finish(ax, f"Fig. 5: l1, l1* and l~1 ({variant})")
+    finish(ax, rf"Fig. 5: $l_1$, $l_1^*$ and $\tilde l_1$ ({variant})")
     return drawn
 
 
@@ -357,10 +359,16 @@ def plot_zone_geometry(
     (lines["l1"],) = ax.plot(l1, -s, "k-", lw=1.5, label="l1, l2 (eqs. 9, 11)")
     ax.plot(-l1, s, "k-", lw=1.5)
     (lines["l1*"],) = ax.plot(
-        l1s, -s, "--", color="tab:orange", label=f"l1*, l2* corrected, omega0 = {om:.4g} mm/s"
+        l1s,
+        -s,
+        "--",
+        color="tab:orange",
+        label=rf"$l_1^*$, $l_2^*$ corrected, $\omega_0$ = {om:.4g} mm/s",
     )
     ax.plot(-l1s, s, "--", color="tab:orange")
-    ax.fill_betweenx(-s, l1, l1s, color="tab:orange", alpha=0.15, label="zones S~_P, S~_N")
+    ax.fill_betweenx(
+        -s, l1, l1s, color="tab:orange", alpha=0.15, label=r"zones $\tilde S_P$, $\tilde S_N$"
+    )
     ax.fill_betweenx(s, -l1s, -l1, color="tab:orange", alpha=0.15)
     # printed curve (19): a x1 + x2 + w ln(1 - x2/w) = -2 a w T
     top = -printed.x20_tilde if np.isfinite(printed.x20_tilde) else w
@@ -384,8 +392,8 @@ def plot_zone_geometry(
             )
     ax.set_xlim(-xmax, xmax)
     ax.set_ylim(-1.1 * w, 1.1 * w)
-    ax.set_xlabel("position x1 [mm]")
-    ax.set_ylabel("velocity x2 [mm/s]")
+    ax.set_xlabel("position $x_1$ [mm]")
+    ax.set_ylabel("velocity $x_2$ [mm/s]")
     ax.set_title(f"{cfg.name}: switching zone, T = {T * 1e3:g} ms, a = {a:.4g} rad/s")
     ax.legend(fontsize=7, loc="upper right")
     ax.grid(True, alpha=0.3)

@@ -87,7 +87,7 @@ def plot_sweep(
     ax = new_axes(ax)
     ls = res.laws[law]
     ratio = ls.ratio_tf if which == "tf" else ls.ratio_nt
-    den = "t_f*" if which == "tf" else "N* T"
+    den = "$t_f^*$" if which == "tf" else "$N^* T$"
     box, st = DEFINITIONS["box-0p01mm"], res.settings
     named = (st.band, st.hold, st.velocity_band) == (box.band_mm, box.hold_s, None)
     definition = box.name if named else f"a {st.band:g} mm box"
@@ -131,8 +131,8 @@ def plot_sweep(
             label=_sweep_label(which, vmax if clipped else None),
             extend="max" if clipped else "neither",
         )
-    ax.set_xlabel("initial position x1 [mm]")
-    ax.set_ylabel("initial velocity x2 [mm/s]")
+    ax.set_xlabel("initial position $x_1$ [mm]")
+    ax.set_ylabel("initial velocity $x_2$ [mm/s]")
     ax.set_title(
         f"{law_name(law)}: settling ({definition}) / {den}; grey: never settles "
         f"({100 * (1 - ls.fraction_settled):.0f} %)",
@@ -150,7 +150,7 @@ def _floor_of(ratios: NDArray[np.float64]) -> float:
 
 def _sweep_label(which: str, clip: float | None = None) -> str:
     """Colour-bar label; says where the scale clips (the arrow's colour is every larger value)."""
-    text = f"settling time / {'t_f*' if which == 'tf' else 'N* T'} [-]"
+    text = f"settling time / {'$t_f^*$' if which == 'tf' else '$N^* T$'} [-]"
     return text if clip is None else f"{text}; clipped at {clip:.3g} (99th percentile)"
 
 
@@ -223,7 +223,7 @@ def save_sweep(res: SweepResult, outdir: str | Path) -> list[Path]:
 #: Quantities of the robustness heat maps: cell key, colour-bar label, file stem.
 ROBUST_MAPS = (
     ("limit_cycle_states", "states ending in a limit cycle [count]", "robust_limit_cycles"),
-    ("settling_ratio_nt", "worst settling / (N* T) [-]", "robust_settling_nt"),
+    ("settling_ratio_nt", "worst settling / ($N^* T$) [-]", "robust_settling_nt"),
 )
 
 
@@ -279,8 +279,8 @@ def plot_robust_map(
         ax.text(j, i, text, ha="center", va="center", fontsize=7, color="w" if dark else "k")
     ax.set_xticks(range(len(ars)), [f"{r:.3g}" for r in ars], fontsize=7)
     ax.set_yticks(range(len(wrs)), [f"{r:.3g}" for r in wrs], fontsize=7)
-    ax.set_xlabel("a_true / a_design [-]")
-    ax.set_ylabel("w_max,true / w_max [-]")
+    ax.set_xlabel(r"$a_{\mathrm{true}}/a_{\mathrm{design}}$ [-]")
+    ax.set_ylabel(r"$w_{\max,\mathrm{true}}/w_{\max}$ [-]")
     lag = f"a delay of {plural(delay, 'sample')}" if delay else "no delay"
     ax.set_title(f"{law_name(law)}, {lag}", fontsize=9)
     return {"map": mesh}
@@ -369,8 +369,8 @@ def plot_convergence(study: ConvergenceStudy, ax=None) -> dict:
         )
     ref = np.nanmax(study.rel_error[:, 0]) * (n / n[0]) ** -2.0
     (drawn["slope -2"],) = ax.loglog(n, ref, "k--", lw=0.8, label="slope -2")
-    ax.set_xlabel("collocation intervals N [-]")
-    ax.set_ylabel("|t_f - t_f*| / t_f* [-]")
+    ax.set_xlabel("collocation intervals $N$ [-]")
+    ax.set_ylabel(r"$|t_f - t_f^*|\,/\,t_f^*$ [-]")
     with np.errstate(invalid="ignore"):
         rises = bool(np.any(np.diff(study.rel_error, axis=1) > 0))
     ax.set_title(
@@ -421,8 +421,8 @@ def plot_switch_profiles(
     for at, ls, label in ((ts, "--", "switch (closed form)"), (tf, ":", "t_f* (closed form)")):
         drawn[label] = ax.axvline(at, color="k", lw=0.6, ls=ls, label=label)
     ax.set_xlim(max(0.0, ts - window * tf), min(ts + window * tf, 1.02 * tf))
-    ax.set_xlabel("time t [s]")
-    ax.set_ylabel("input u [mm/s]")
+    ax.set_xlabel("time $t$ [s]")
+    ax.set_ylabel("input $u$ [mm/s]")
     ax.set_title(f"collocation input near the switch, x0 = ({x1:g} mm, {x2:g} mm/s)")
     ax.grid(True, lw=0.3)
     ax.legend(fontsize=7)
@@ -478,9 +478,9 @@ def save_proof_map(proof: Any, path: str | Path) -> Path:
         rx = fig.add_subplot(1, 2, 2)
         rz = np.ma.masked_invalid(np.asarray(ratio, dtype=float).reshape(n2, n1))
         rm = rx.pcolormesh(e1, e2, rz, cmap="magma", shading="flat")
-        fig.colorbar(rm, ax=rx, label="certified samples to the target / N* [-]")
-        rx.set_xlabel("x1 [mm]")
-        rx.set_ylabel("x2 [mm/s]")
+        fig.colorbar(rm, ax=rx, label="certified samples to the target / $N^*$ [-]")
+        rx.set_xlabel("position $x_1$ [mm]")
+        rx.set_ylabel("velocity $x_2$ [mm/s]")
         rx.set_title("certified suboptimality (blank: unproven or near the origin)", fontsize=9)
     bound = np.asarray(proof.bound, dtype=float).reshape(n2, n1)
     z = np.ma.masked_invalid(bound)
@@ -491,7 +491,7 @@ def save_proof_map(proof: Any, path: str | Path) -> Path:
             e1, e2, np.ma.masked_where(~bad, np.ones_like(bound)), cmap="Reds", vmin=0, vmax=1
         )
     fig.colorbar(mesh, ax=ax, label="certified samples to the target ellipse [samples]")
-    ax.set_xlabel("x1 [mm]")
-    ax.set_ylabel("x2 [mm/s]")
+    ax.set_xlabel("position $x_1$ [mm]")
+    ax.set_ylabel("velocity $x_2$ [mm/s]")
     ax.set_title(f"{law_name(proof.law)}: certified bound per cell (red: unproven)")
     return write_png(fig, path)

@@ -111,8 +111,17 @@ CAPTIONS: dict[str, str] = {
 }
 
 
+#: Figures drawn at the single-panel size (:data:`ptoverify.report.plots.common.SIZE`),
+#: by key prefix: two of them share a row of the page (``Block.css`` ``half``).
+HALF_WIDTH = ("fig", "convergence", "collocation_switch", "tuning_pareto")
+
+
 def figure(figures: dict[str, str], key: str) -> list[Block]:
     """Return the figure ``key`` with its sentence caption (none when it was not drawn).
+
+    A single-panel figure (:data:`HALF_WIDTH`) is marked to share a row with its
+    neighbour, so that a pair (printed and corrected, with and without
+    feed-forward) sits side by side across the content width.
 
     Parameters
     ----------
@@ -125,7 +134,7 @@ def figure(figures: dict[str, str], key: str) -> list[Block]:
     -------
     list of Block
     """
-    return image(figures, key, CAPTIONS[key])
+    return image(figures, key, CAPTIONS[key], "half" if key.startswith(HALF_WIDTH) else "")
 
 
 # ------------------------------------------------------------------ verdict
@@ -141,14 +150,28 @@ def verdict(res: Any) -> list[Block]:
     -------
     list of Block
     """
-    from ptoverify.report.standing import TIE_NOTE, adoption, engineer_rows, reviewer_rows
+    from ptoverify.report.standing import (
+        TIE_NOTE,
+        adoption,
+        bandwidth_hz,
+        engineer_rows,
+        reviewer_rows,
+        versus_note,
+    )
+    from ptoverify.report.standing_claims import short_legend
 
+    note = versus_note(res)
     return [
         Block("p", text=adoption(res)),
-        table(["question (drive engineer)", "answer", "evidence"], engineer_rows(res)),
+        table(
+            ["question (drive engineer)", "answer", "evidence"],
+            engineer_rows(res, short=True),
+            css="verdict engineer",
+        ),
         table(
             ["claim of the paper (reviewer)", "standing", "condition", "paper", "measured"],
-            reviewer_rows(res),
+            reviewer_rows(res, short=True),
+            css="verdict reviewer",
         ),
         Block(
             "p",
@@ -156,8 +179,9 @@ def verdict(res: Any) -> list[Block]:
             "'depends': some do, and the condition names the readings it holds with and "
             "those it fails with. Readings: the bandwidth's a as 2 pi f or as f in rad/s, the "
             "settling band, the PTO's zone as printed or corrected, the tracking, the tuning "
-            "(see the Section 6 claims).",
+            f"(see the Section 6 claims). Short words: {short_legend(bandwidth_hz(res))}.",
         ),
+        *([Block("p", text=note)] if note else []),
         Block("p", text=TIE_NOTE),
     ]
 

@@ -241,6 +241,43 @@ def tilde_text(text: str) -> str:
     return _TILDE_TEXT.sub(r"x~\1", text)
 
 
+#: Plain-text spellings of a form that read as mathematics: relations, powers, Greek.
+_READABLE = (
+    ("<=", "\u2264"),
+    (">=", "\u2265"),
+    ("**", "^"),
+    ("omega_m", "\u03c9_m"),
+    ("omega_0", "\u03c9_0"),
+    ("omega_c", "\u03c9_c"),
+    ("lambda", "\u03bb"),
+)
+
+
+def readable(text: str) -> str:
+    """Write a form that has no MathML (words and formulas mixed) as readable plain text.
+
+    Parameters
+    ----------
+    text : str
+        A printed or derived form.
+
+    Returns
+    -------
+    str
+        The tilde drawn (:func:`tilde_text`), relations as signs, powers with a caret,
+        Greek letters by their symbol.
+
+    Examples
+    --------
+    >>> readable("x_l1(x2) <= x1, a**2 + omega_m")
+    'x_l1(x2) ≤ x1, a^2 + ω_m'
+    """
+    text = tilde_text(text)
+    for plain, shown in _READABLE:
+        text = text.replace(plain, shown)
+    return text
+
+
 def render_records(records: list) -> dict[str, dict[str, Any]]:
     """Render what the derivation sections show of each record (SymPy work, done once).
 
@@ -326,9 +363,7 @@ def errata(res: dict[str, Any], records: list, rendered: dict | None = None) -> 
                 if m:
                     body = _MATH.format(m + ("<mo>=</mo><mn>0</mn>" if zero else ""))
                 else:
-                    body = (
-                        f"<code>{html.escape(tilde_text(r[key]) + (' = 0' if zero else ''))}</code>"
-                    )
+                    body = html.escape(readable(r[key]) + (" = 0" if zero else ""))
                 forms.append(f'<tr><th>{label}</th><td><div class="eq">{body}</div></td></tr>')
         down = [i.split(":", 1) for i in r["inherits"]]
         lis = "".join(
@@ -433,7 +468,7 @@ def derivations(res: dict[str, Any], records: list, rendered: dict | None = None
 
         def cell(key: str, text: str, ml=ml) -> str:
             m = ml.get(key, "")
-            body = _MATH.format(m) if m else f"<code>{html.escape(text)}</code>"
+            body = _MATH.format(m) if m else html.escape(readable(text))
             return f'<div class="eq">{body}</div>'
 
         note = html.escape(r.note)
