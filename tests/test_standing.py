@@ -410,17 +410,20 @@ def test_versus_row_says_what_the_bound_is_and_why_it_differs_with_a(base):
     rs_ = t["versus"]["readings"]
     assert len(rs_) == 2
     rs_[0]["bound_mm"], rs_[1]["bound_mm"] = 0.0, 0.125
-    evidence = versus_row(results_view(data), short=True)[2]
-    assert evidence.startswith(f"overshoot bound = {meaning}, taken under each reading of a")
-    assert "so it differs with a): 0 mm at a = 188.5 rad/s, 0.125 mm at a = 30 rad/s" in evidence
+    text = versus_bound(results_view(data), short=True)
+    assert text.startswith(f"overshoot bound = {meaning}, taken under each reading of a")
+    assert "so it differs with a): 0 mm at a = 188.5 rad/s, 0.125 mm at a = 30 rad/s" in text
+    # the verdict shows the row short (times only) and, in the note right under its
+    # tables, the full row with the bound explained
+    from ptoverify.report.sections import verdict
+
+    assert "overshoot bound" not in versus_row(results_view(data), short=True)[2]
+    texts = [b.text for b in verdict(results_view(data))]
+    (note,) = [t_ for t_ in texts if t_.startswith("The fair-tuned comparison in full: ")]
+    assert "(so it differs with a): 0 mm at " in note and ", 0.125 mm at " in note
     rs_[1]["bound_mm"] = 0.0
     text = versus_bound(results_view(data))
     assert "the same under each" in text and "differs" not in text
-    # the verdict section shows the row short and the full row in its note
-    from ptoverify.report.sections import verdict
-
-    texts = [b.text for b in verdict(results_view(data))]
-    assert any(t_.startswith("The fair-tuned comparison in full: ") for t_ in texts)
 
 
 def test_short_verdict_words_are_explained_under_the_table(base):

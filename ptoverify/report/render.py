@@ -313,8 +313,8 @@ def md_cell(text: str) -> str:
     return text.replace("|", "\\|").replace("\n", " ")
 
 
-CSS = """body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;
-color:#222;line-height:1.4}table{border-collapse:collapse;margin:1em 0;font-size:.9em}
+CSS = """body{font-family:system-ui,sans-serif;max-width:1200px;margin:1em auto;padding:0 1em;
+color:#222;line-height:1.4}h1{font-size:1.15em;margin:.2em 0}table{border-collapse:collapse;margin:1em 0;font-size:.9em}
 th,td{border:1px solid #ccc;padding:.3em .5em;vertical-align:top;text-align:left}
 th{background:#f0f0f0}.pass,.verified,.reproduced{background:#e6f4e6}
 .fail,.erratum,.not-reproduced,.fails{background:#fbe3e3}.holds{background:#e6f4e6}
@@ -334,12 +334,12 @@ table.derivations th:nth-child(2),table.derivations td:nth-child(2){width:9em}
 table.derivations th:nth-child(5),table.derivations td:nth-child(5){width:22%}
 table.forms th{width:7em}
 td{overflow-wrap:break-word}table{max-width:100%}
-table.verdict{width:100%;table-layout:fixed;font-size:.8em;line-height:1.25;margin:.4em 0}
+table.verdict{width:100%;table-layout:fixed;font-size:.76em;line-height:1.2;margin:.3em 0}
 table.verdict th,table.verdict td{padding:.1em .35em}
 table.engineer th:nth-child(1){width:24%}table.engineer th:nth-child(2){width:32%}
 table.reviewer th:nth-child(1){width:40%}table.reviewer th:nth-child(2){width:4.6em}
 table.reviewer th:nth-child(4){width:5.6em}table.reviewer th:nth-child(5){width:15%}
-#verdict h2{margin-bottom:.3em}#verdict p{margin:.4em 0}
+#verdict h2{margin:.4em 0 .2em}#verdict p{margin:.3em 0}
 .figs{display:grid;grid-template-columns:repeat(2,minmax(0,1fr));gap:.5em 1em;margin:1em 0}
 .figs figure{margin:0;grid-column:1/-1}.figs figure.half{grid-column:auto}
 .figs figure.half img{width:100%}"""
@@ -405,7 +405,9 @@ def _html_blocks(blocks: list[Block]) -> list[str]:
     return out
 
 
-def render_html(sections: list[Section], title: str, intro: str = "") -> str:
+def render_html(
+    sections: list[Section], title: str, intro: str = "", *, lead: int = 0, downloads: str = ""
+) -> str:
     """Render the sections as one offline HTML page (MathML, escaped text).
 
     Parameters
@@ -416,6 +418,11 @@ def render_html(sections: list[Section], title: str, intro: str = "") -> str:
         Page title.
     intro : str
         A paragraph under the title; ``[text](href)`` becomes a link.
+    lead : int
+        How many sections come before the table of contents (the report's verdict,
+        so that its first screen is the verdict).
+    downloads : str
+        A paragraph under the table of contents (links as in ``intro``).
 
     Returns
     -------
@@ -435,9 +442,11 @@ def render_html(sections: list[Section], title: str, intro: str = "") -> str:
         f"<title>{html.escape(title)}</title><style>{CSS}</style></head><body>",
         f"<h1>{html.escape(title)}</h1>",
         f"<p>{_links(intro)}</p>" if intro else "",
-        f"<nav>{nav}</nav>",
     ]
-    for anchor, heading, blocks in sections:
+    for k, (anchor, heading, blocks) in enumerate(sections):
+        if k == lead:
+            parts.append(f"<nav>{nav}</nav>")
+            parts.append(f'<p class="downloads">{_links(downloads)}</p>' if downloads else "")
         parts.append(f'<section id="{anchor}"><h2>{html.escape(heading)}</h2>')
         parts += _html_blocks(blocks)
         parts.append("</section>")
@@ -485,7 +494,9 @@ def _md_code(text: str, anchor: str) -> str:
     return re.sub(r"`([^`]+)`", cut, text)
 
 
-def render_markdown(sections: list[Section], title: str, intro: str = "") -> str:
+def render_markdown(
+    sections: list[Section], title: str, intro: str = "", *, lead: int = 0, downloads: str = ""
+) -> str:
     """Render the sections as Markdown that reads on a code-hosting site.
 
     A table of contents links every section; equations are plain text, and an
@@ -501,6 +512,10 @@ def render_markdown(sections: list[Section], title: str, intro: str = "") -> str
         Page title.
     intro : str
         A paragraph under the title (the paper's title, the downloads).
+    lead : int
+        How many sections come before the table of contents (as :func:`render_html`).
+    downloads : str
+        A paragraph under the table of contents.
 
     Returns
     -------
@@ -516,16 +531,18 @@ def render_markdown(sections: list[Section], title: str, intro: str = "") -> str
     lines = [f"# {title}", ""]
     if intro:
         lines += [intro, ""]
-    lines += ["Contents:", ""]
-    lines += [f"- [{heading}](#{md_slug(heading)})" for _a, heading, _b in sections]
-    lines.append("")
+    contents = ["Contents:", ""]
+    contents += [f"- [{heading}](#{md_slug(heading)})" for _a, heading, _b in sections]
+    contents += ["", downloads, ""] if downloads else [""]
     # a link to a section's anchor goes to its heading's slug (what a code host makes)
     slugs = {a: md_slug(heading) for a, heading, _b in sections}
 
     def to_heading(m: re.Match) -> str:
         return f"](#{slugs.get(m.group(1), m.group(1))})"
 
-    for anchor, heading, blocks in sections:
+    for k, (anchor, heading, blocks) in enumerate(sections):
+        if k == lead:
+            lines += contents
         lines += [f"## {heading}", ""]
         for b in blocks:
             if b.kind in ("p", "raw"):

@@ -160,8 +160,8 @@ def versus_row(res: Mapping, short: bool = False) -> list[str]:
         The results (:class:`ptoverify.report.results.Results`).
     short : bool
         The verdict table's short cells: readings in short words, the evidence the
-        bound (:func:`versus_bound`) and the times alone (:func:`versus_note` has
-        the floors and the settling definition).
+        times alone (:func:`versus_note`, under the table, has the overshoot bound
+        and why it differs with a, the floors and the settling definition).
 
     Returns
     -------
@@ -173,8 +173,6 @@ def versus_row(res: Mapping, short: bool = False) -> list[str]:
         return [VERSUS_QUESTION, "not compared: the tuning was skipped", "no tuned results"]
     v = t["versus"]
     answers, evidence = [], []
-    if short:
-        evidence.append(versus_bound(res, short))
     for r in v["readings"]:
         laws = {x["law"]: x for x in r["laws"]}
         pto = laws["pto"]

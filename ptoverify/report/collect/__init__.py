@@ -48,7 +48,14 @@ from .settings import (
     Progress,
 )
 from .stages import POLE_GATES, PROOF_GATES, STAGES, SYMBOLIC_GATE
-from .write import build_sections, downloads_intro, results_view, stderr_progress, write_report
+from .write import (
+    build_sections,
+    downloads_intro,
+    render_pages,
+    results_view,
+    stderr_progress,
+    write_report,
+)
 
 __all__ = [
     "CONVERGENCE_INTERVALS",
@@ -67,6 +74,7 @@ __all__ = [
     "collect",
     "default_jobs",
     "downloads_intro",
+    "render_pages",
     "figure_inputs",
     "results_view",
     "stderr_progress",

@@ -19,8 +19,8 @@ if TYPE_CHECKING:
     from .settings import Progress
 
 
-def downloads_intro(traces: list[str]) -> str:
-    """Return the paragraph under the title: the paper verified and the files to download.
+def downloads_intro(traces: list[str]) -> tuple[str, str]:
+    """Return the paragraph under the title and the list of CSV traces to download.
 
     Parameters
     ----------
@@ -29,8 +29,10 @@ def downloads_intro(traces: list[str]) -> str:
 
     Returns
     -------
-    str
-        Markdown-style text with links (the HTML renders them as links too).
+    intro, downloads : str
+        Markdown-style text with links (the HTML renders them as links too): one
+        line under the title (``results.json``); what the report verifies and the
+        CSV traces, under the table of contents.
     """
     from ptoverify.report.words import law_name
 
@@ -39,13 +41,39 @@ def downloads_intro(traces: list[str]) -> str:
         return f"{law_name(law)}, {signal}" if law else stem
 
     links = "; ".join(f"[{words(Path(t).stem)}]({t})" for t in traces)
-    text = (
-        f'Verifies the PTO law of the paper "{PAPER_TITLE}" against its own equations, '
-        "exact minimum times and simulation. Every number below is computed; the paper's "
-        "values appear only as claims. Downloads: [results.json](results.json) (every number "
-        "of this report)"
+    intro = (
+        "Every number below is computed ([results.json](results.json) holds them all); the "
+        "paper's values appear only as claims."
     )
-    return text + (f"; CSV traces (t, r, x1, x2, e, u, region): {links}." if links else ".")
+    about = (
+        f'This report verifies the PTO law of the paper "{PAPER_TITLE}" against its own '
+        "equations, exact minimum times and simulation."
+    )
+    return intro, about + (f" CSV traces (t, r, x1, x2, e, u, region): {links}." if links else "")
+
+
+def render_pages(sections: list, title: str, traces: list[str]) -> tuple[str, str]:
+    """Render the report's HTML page and Markdown: the verdict first, then the contents.
+
+    Parameters
+    ----------
+    sections : list of (str, str, list of Block)
+        :func:`build_sections` (the verdict first).
+    title : str
+        Page title.
+    traces : list of str
+        The CSV traces written (relative paths), listed under the contents.
+
+    Returns
+    -------
+    html, markdown : str
+        ``index.html`` and ``report.md``.
+    """
+    intro, downloads = downloads_intro(traces)
+    return (
+        render_html(sections, title, intro, lead=1, downloads=downloads),
+        render_markdown(sections, title, intro, lead=1, downloads=downloads),
+    )
 
 
 def results_view(public: dict[str, Any]) -> Results:
@@ -186,15 +214,15 @@ def write_report(
             "generated": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         }
         title = f'Verification of "{PAPER_TITLE}" (configuration {cfg.name!r})'
-        intro = downloads_intro(res["_traces"])
         sections = build_sections(
             results_view(public), figures, res["_records"], res.get("_rendered")
         )
         (tmp / "results.json").write_text(
             json.dumps(public, indent=1, sort_keys=True, allow_nan=False) + "\n"
         )
-        (tmp / "index.html").write_text(render_html(sections, title, intro))
-        (tmp / "report.md").write_text(render_markdown(sections, title, intro))
+        page, md = render_pages(sections, title, res["_traces"])
+        (tmp / "index.html").write_text(page)
+        (tmp / "report.md").write_text(md)
         publish(tmp, out, config_hash=cfg.digest(), name=cfg.name, default=default)
         tmp = None
     finally:
