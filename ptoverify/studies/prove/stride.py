@@ -32,9 +32,24 @@ from ptoverify.model.zohmaps import StepMaps, affine_image
 from ptoverify.sim.simulate import simulate_batch
 from ptoverify.verdict import tie_band
 
-__all__ = ["stride_check", "StrideResult", "Counterexample", "find_counterexample"]
+__all__ = [
+    "stride_check",
+    "unsettled_cells",
+    "StrideResult",
+    "Counterexample",
+    "find_counterexample",
+    "REFINE_SPLIT",
+    "REFINE_DEPTH",
+    "REFINE_CAP",
+]
 
 _SPLIT = 8  #: a failing box is cut into _SPLIT x _SPLIT children (three halvings)
+#: Children of one refined box (:func:`stride_check`).
+REFINE_SPLIT = _SPLIT * _SPLIT
+#: Most halvings of a refined cell's sides (:func:`stride_check`'s ``depth``).
+REFINE_DEPTH = 24
+#: Most failing boxes of one cell carried to the next level (:func:`stride_check`'s ``cap``).
+REFINE_CAP = 256
 
 
 def _sides(spec: LawSpec, piece, u_lo, u_hi, maps: StepMaps, d: float, tol: float):
@@ -110,6 +125,30 @@ def _check(spec: LawSpec, cfg: Config, maps: StepMaps, boxes):
     return strict, relaxed
 
 
+def unsettled_cells(spec: LawSpec, cfg: Config, maps: StepMaps, boxes) -> np.ndarray:
+    """Return the cells the first no-stride-over check leaves open (they are refined).
+
+    Parameters
+    ----------
+    spec : LawSpec
+        The law.
+    cfg : Config
+        Configuration (the yardstick d [mm], the tie band).
+    maps : StepMaps
+        One-step map enclosures (the plant's a, or a ball of a).
+    boxes : tuple of ndarray
+        Cells (x1lo, x1hi, x2lo, x2hi) [mm], [mm/s].
+
+    Returns
+    -------
+    ndarray of bool
+        True where either reading is not proved on the whole cell:
+        :func:`stride_check` refines exactly these.
+    """
+    s, r = _check(spec, cfg, maps, boxes)
+    return ~s | ~r
+
+
 @dataclass(frozen=True)
 class StrideResult:
     """No stride-over per cell, after refinement.
@@ -150,7 +189,13 @@ def _split(b):
 
 
 def stride_check(
-    spec: LawSpec, cfg: Config, maps: StepMaps, boxes, *, depth: int = 24, cap: int = 256
+    spec: LawSpec,
+    cfg: Config,
+    maps: StepMaps,
+    boxes,
+    *,
+    depth: int = REFINE_DEPTH,
+    cap: int = REFINE_CAP,
 ) -> StrideResult:
     """Prove no stride-over per cell, refining failing cells.
 
@@ -183,7 +228,7 @@ def stride_check(
         Per-cell verdicts and gaps; leaves ordered by cell, then position.
     """
     n = boxes[0].size
-    s, r = _check(spec, cfg, maps, boxes)
+    s, r = _check(spec, cfg, maps, boxes)  # the cells of unsettled_cells fail here
     owner = np.arange(n)
     cur = boxes
     kept = []  # failing leaves no longer refined: (boxes, owner, strict fails, relaxed fails)
