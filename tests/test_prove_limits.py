@@ -233,3 +233,18 @@ def test_every_accepted_configuration_is_estimated_or_refused_in_one_line(
         assert w.cells <= MAX_PROOF_CELLS and w.estimate <= MAX_PROOF_WORK
         assert math.isfinite(w.estimate)
     assert time.perf_counter() - t0 < 10.0
+
+
+def test_report_refuses_an_over_limit_proof_before_any_stage(tmp_path, capsys):
+    """The report's proofs stage would run the refused proof: exit 2 at once, nothing written."""
+    from ptoverify.cli import main
+
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(PAPER_TOML.format(**AUDIT["R10"]))
+    out = tmp_path / "report"
+    t0 = time.perf_counter()
+    assert main(["report", "--config", str(cfg), "--out", str(out)]) == 2
+    assert time.perf_counter() - t0 < 15.0
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and f"{MAX_PROOF_WORK:,}" in err, err
+    assert not out.exists()
