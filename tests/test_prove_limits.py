@@ -22,8 +22,8 @@ from hypothesis import strategies as st
 
 import ptoverify.studies.prove.run as prove_run
 import ptoverify.studies.prove.stride as stride_mod
-from ptoverify.config import ConfigError, config_from_mapping, paper_config
-from ptoverify.errors import InputError
+from ptoverify.config import config_from_mapping, paper_config
+from ptoverify.errors import ConfigError, InputError
 from ptoverify.model.lawbox import law_spec
 from ptoverify.studies.prove import PROVE_LAWS, default_pieces
 from ptoverify.studies.prove.ball import Resolution
