@@ -9,7 +9,8 @@ What a proof's time and memory grow with (measured, :mod:`.ball`):
   (:func:`~ptoverify.studies.prove.stride.unsettled_cells`): each is cut into
   8 x 8 boxes, again and again; a cell that fails on an area costs
   1 + 64 + 64^2 box checks before the cap stops it, and holds its failing boxes
-  as leaves.  Where one sample carries a state across many cells (large a T)
+  as leaves (the refinement runs :data:`~ptoverify.studies.prove.stride.REFINE_CHUNK`
+  cells at a time, so its working memory is bounded per chunk).  Where one sample carries a state across many cells (large a T)
   or the yardstick d is 0, most cells near the switching curves stay open.
 
 The estimate is, per sub-interval of a, ``cells + refined x 4,160`` box
@@ -59,9 +60,10 @@ __all__ = [
 MAX_PROOF_CELLS = 400_000
 
 #: Most estimated box checks per sub-interval of a (``cells + refined x 4,160``).  At the
-#: paper's values ``to`` and ``pto-printed`` estimate 4.9 million (47 s, 1.2 GB); ``pto``
-#: 0.1, ``pd`` 0.65 and ``cascade-p`` 1.56 million.  Refused: a T = 20 (``to`` 80 million,
-#: passed 10 GB in 70 s) and every gain and d zero (``pto`` 12 million: 230 s, 2.7 GB).
+#: paper's values ``to`` and ``pto-printed`` estimate 4.9 million (47-138 s, 0.65 GB);
+#: ``pto`` 0.1, ``pd`` 0.65 and ``cascade-p`` 1.56 million.  Refused: a T = 20 (``to`` 80
+#: million, passed 10 GB in 70 s) and every gain and d zero (``pto`` 12 million: 230 s,
+#: 2.7 GB before the refinement ran in chunks).
 MAX_PROOF_WORK = 8_000_000
 
 #: Most sub-intervals of a (each is a whole proof): the widest ``[robustness] a_ratio``
