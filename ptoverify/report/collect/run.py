@@ -56,7 +56,8 @@ def collect(
     Raises
     ------
     InputError
-        An unknown ``skip`` stage or ``jobs`` < 1.
+        An unknown ``skip`` stage or ``jobs`` < 1, a ``[robustness]`` box or a proof
+        over its work limit (checked before any stage runs).
     """
     from ptoverify.errors import InputError
     from ptoverify.studies.checks import GATES, ROBUST_GATES, summarize
@@ -74,6 +75,11 @@ def collect(
         from .settings import ROBUST_SETTINGS
 
         check_box_work(cfg, RobustSettings(**ROBUST_SETTINGS))
+    from ptoverify.model.lawbox import law_spec
+    from ptoverify.studies.prove.run import Resolution, check_provable
+
+    for law in ("pto", "pd"):  # the proofs stage's work is bounded: say so before any stage
+        check_provable(cfg, Resolution(), law_spec(law, cfg))
     jobs = min(jobs or default_jobs(), len(names))
     done: dict[str, tuple[dict[str, Any], float]] = {}
 

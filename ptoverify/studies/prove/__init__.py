@@ -4,6 +4,7 @@
 - :mod:`.graph`: the graded cell grid, macro-step images, longest-path bounds.
 - :mod:`.stride`: no stride-over per cell (strict, relaxed), certified counterexamples.
 - :mod:`.run`: :func:`prove_law`, one law's properties.
+- :mod:`.work`: the proof's work, estimated from the configuration and checked up front.
 - :mod:`.certificate`: the certificate's arrays and its independent check.
 - :func:`run_prove`: every law, in-process or on a dask cluster; :class:`ProveRun`.
 - :func:`nominal_proof`: the corrected PTO's nominal proof, memoized for the gates.
@@ -18,9 +19,10 @@ from dataclasses import dataclass
 
 from ptoverify.config import Config
 from ptoverify.errors import InputError
-from ptoverify.model.lawbox import require_enclosure
+from ptoverify.model.lawbox import law_spec, require_enclosure
 from ptoverify.model.memo import memo
-from ptoverify.studies.prove.run import LawProof, Resolution, prove_law
+from ptoverify.studies.prove.run import LawProof, Resolution, check_provable, prove_law
+from ptoverify.studies.prove.work import sub_intervals
 
 __all__ = [
     "ProveRun",
@@ -194,8 +196,12 @@ def run_prove(
     for name in laws:  # before any work: a law without a certified enclosure is bad input
         require_enclosure(name)
     t0 = time.perf_counter()
-    mapper = _dask_mapper(dask) if dask else map
     n = pieces or default_pieces(a_interval)
+    res = res or Resolution()
+    a_lo, a_hi = a_interval or (cfg.plant.a, cfg.plant.a)
+    for name in laws:  # every law's work within the limits before any proof runs
+        check_provable(cfg, res, law_spec(name, cfg), sub_intervals(a_lo, a_hi, n), excursion)
+    mapper = _dask_mapper(dask) if dask else map
     proofs = tuple(
         prove_law(
             cfg,
@@ -210,7 +216,6 @@ def run_prove(
         )
         for name in laws
     )
-    a_lo, a_hi = a_interval or (cfg.plant.a, cfg.plant.a)
     backend = f"dask:{dask}" if dask else "in-process"
     return ProveRun(proofs, (a_lo, a_hi), excursion, backend, time.perf_counter() - t0)
 

@@ -96,7 +96,7 @@ def make_grid(
     w : float
         Saturation w_max [mm/s].
     fine_to : float
-        Cells of width h1 for |x1| <= fine_to [mm].
+        Cells of width h1 for |x1| <= fine_to [mm] (all of them when fine_to >= x1_end).
     h1 : float
         Fine cell width [mm].
     h2 : float
@@ -117,6 +117,7 @@ def make_grid(
     >>> float(g.e1[0]), float(g.e1[-1]), g.shape[1]
     (-50.0, 50.0, 60)
     """
+    fine_to = min(fine_to, x1_end)  # a fine strip wider than the envelope: all fine
     mid = 0.5 * (fine_to + x1_end)
     inner = _graded(fine_to, h1, h1_max, mid)
     # fine again towards the envelope's edge, where states really leave it

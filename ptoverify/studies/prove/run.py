@@ -37,6 +37,7 @@ from ptoverify.studies.prove.ball import (
 from ptoverify.studies.prove.graph import Grid
 from ptoverify.studies.prove.stride import Counterexample, find_counterexample
 from ptoverify.studies.prove.target import Target, make_target
+from ptoverify.studies.prove.work import check_proof_work, proof_work, sub_intervals
 
 __all__ = [
     "Resolution",
@@ -46,6 +47,7 @@ __all__ = [
     "prove_ball",
     "prove_law",
     "min_time_lower",
+    "check_provable",
 ]
 
 
@@ -384,12 +386,19 @@ def _counterexample(spec, cfg, balls, reading, tries: int = 3):
 MIN_CELLS_ACROSS = 100
 
 
-def check_provable(cfg: Config, res: Resolution) -> None:
+def check_provable(
+    cfg: Config,
+    res: Resolution,
+    spec=None,
+    pieces: list[tuple[float, float]] | None = None,
+    excursion: float = 0.0,
+) -> None:
     """Reject up front a configuration the proof grid cannot serve (one line, exit 2).
 
     The grid's cell sizes are absolute (``res``, in mm and mm/s); an envelope narrower
     than :data:`MIN_CELLS_ACROSS` of the finest cells, or a linear zone as wide as the
-    envelope, leaves no grid to prove on.
+    envelope, leaves no grid to prove on.  With the law, its estimated work
+    (:mod:`ptoverify.studies.prove.work`) must be within the stated limits.
 
     Parameters
     ----------
@@ -397,6 +406,12 @@ def check_provable(cfg: Config, res: Resolution) -> None:
         Configuration (position_range [mm], d [mm]).
     res : Resolution
         Grid settings (h1 [mm]).
+    spec : LawSpec, optional
+        The law; with it the proof's work is estimated and checked.
+    pieces : list of tuple of float, optional
+        Sub-intervals of a [rad/s] (default the nominal a).
+    excursion : float
+        Margin beyond the envelope [mm].
 
     Raises
     ------
@@ -413,6 +428,9 @@ def check_provable(cfg: Config, res: Resolution) -> None:
         raise InputError(
             f"prove: pto.d = {d:g} mm fills the envelope |x1| <= {r:g} mm (d must be smaller)"
         )
+    if spec is not None:
+        a = cfg.plant.a
+        check_proof_work(proof_work(cfg, spec, res, pieces or [(a, a)], excursion), cfg)
 
 
 def prove_law(
@@ -464,21 +482,16 @@ def prove_law(
     t0 = time.perf_counter()
     p = cfg.plant
     res = res or Resolution()
-    check_provable(cfg, res)
     spec = law_spec(name, cfg)
     lo, hi = a_interval or (p.a, p.a)
-    if hi > lo:
-        edges = np.geomspace(lo, hi, pieces + 1)
-        edges[0], edges[-1] = lo, hi  # exact ends
-    else:
-        edges = np.array([lo, lo])
+    check_provable(cfg, res, spec, sub_intervals(lo, hi, pieces), excursion)
     target = make_target(arb(p.a), p.a, p.sample_time, spec.g1, spec.g2, spec.d, p.w_max)
     if not math.isfinite(spec.d) or spec.d > 0:
         pass
     else:  # no linear zone (TO): no target
         target = Target(target.P, 0.0, False, "the law has no linear zone: no target ellipse")
     grid = law_grid(cfg, spec, res, excursion)
-    pieces = [(float(edges[q]), float(edges[q + 1])) for q in range(len(edges) - 1)]
+    pieces = sub_intervals(lo, hi, pieces)
     targets = [ball_target(cfg, spec, a0, a1, target) for a0, a1 in pieces]
     blocks = cell_blocks(grid.size, block_cells)
     jobs = [

@@ -32,9 +32,27 @@ from ptoverify.model.zohmaps import StepMaps, affine_image
 from ptoverify.sim.simulate import simulate_batch
 from ptoverify.verdict import tie_band
 
-__all__ = ["stride_check", "StrideResult", "Counterexample", "find_counterexample"]
+__all__ = [
+    "stride_check",
+    "unsettled_cells",
+    "StrideResult",
+    "Counterexample",
+    "find_counterexample",
+    "REFINE_SPLIT",
+    "REFINE_DEPTH",
+    "REFINE_CAP",
+    "REFINE_CHUNK",
+]
 
 _SPLIT = 8  #: a failing box is cut into _SPLIT x _SPLIT children (three halvings)
+#: Children of one refined box (:func:`stride_check`).
+REFINE_SPLIT = _SPLIT * _SPLIT
+#: Most halvings of a refined cell's sides (:func:`stride_check`'s ``depth``).
+REFINE_DEPTH = 24
+#: Most failing boxes of one cell carried to the next level (:func:`stride_check`'s ``cap``).
+REFINE_CAP = 256
+#: Cells refined together: at most 128 x 256 x 64 boxes (2.1 million) at a level.
+REFINE_CHUNK = 128
 
 
 def _sides(spec: LawSpec, piece, u_lo, u_hi, maps: StepMaps, d: float, tol: float):
@@ -110,6 +128,30 @@ def _check(spec: LawSpec, cfg: Config, maps: StepMaps, boxes):
     return strict, relaxed
 
 
+def unsettled_cells(spec: LawSpec, cfg: Config, maps: StepMaps, boxes) -> np.ndarray:
+    """Return the cells the first no-stride-over check leaves open (they are refined).
+
+    Parameters
+    ----------
+    spec : LawSpec
+        The law.
+    cfg : Config
+        Configuration (the yardstick d [mm], the tie band).
+    maps : StepMaps
+        One-step map enclosures (the plant's a, or a ball of a).
+    boxes : tuple of ndarray
+        Cells (x1lo, x1hi, x2lo, x2hi) [mm], [mm/s].
+
+    Returns
+    -------
+    ndarray of bool
+        True where either reading is not proved on the whole cell:
+        :func:`stride_check` refines exactly these.
+    """
+    s, r = _check(spec, cfg, maps, boxes)
+    return ~s | ~r
+
+
 @dataclass(frozen=True)
 class StrideResult:
     """No stride-over per cell, after refinement.
@@ -149,8 +191,41 @@ def _split(b):
     return tuple(v.ravel() for v in (lo1, hi1, lo2, hi2))
 
 
+def _refine(spec: LawSpec, cfg: Config, maps: StepMaps, cur, s, r, depth: int, cap: int):
+    """Refine the failing boxes of m cells (box i is cell i); return the kept leaves, the depth.
+
+    Each kept entry is (boxes, owner in 0..m-1, strict fails, relaxed fails).
+    """
+    m = cur[0].size
+    owner = np.arange(m)
+    kept = []
+    level = deepest = 0
+    while True:
+        bad = ~s | ~r
+        go = bad & (np.bincount(owner[bad], minlength=m)[owner] <= cap)
+        if level >= depth:
+            go[:] = False
+        stop = bad & ~go
+        kept.append((tuple(v[stop] for v in cur), owner[stop], ~s[stop], ~r[stop]))
+        if not go.any():
+            break
+        cur = _split(tuple(v[go] for v in cur))
+        owner = np.tile(owner[go], _SPLIT * _SPLIT)
+        s, r = _check(spec, cfg, maps, cur)
+        level += 3
+        deepest = level
+    return kept, deepest
+
+
 def stride_check(
-    spec: LawSpec, cfg: Config, maps: StepMaps, boxes, *, depth: int = 24, cap: int = 256
+    spec: LawSpec,
+    cfg: Config,
+    maps: StepMaps,
+    boxes,
+    *,
+    depth: int = REFINE_DEPTH,
+    cap: int = REFINE_CAP,
+    chunk: int = REFINE_CHUNK,
 ) -> StrideResult:
     """Prove no stride-over per cell, refining failing cells.
 
@@ -176,6 +251,8 @@ def stride_check(
         Most refinement levels.
     cap : int
         Most failing boxes of one cell carried to the next level.
+    chunk : int
+        Cells refined together (memory; the result does not depend on it).
 
     Returns
     -------
@@ -183,25 +260,16 @@ def stride_check(
         Per-cell verdicts and gaps; leaves ordered by cell, then position.
     """
     n = boxes[0].size
-    s, r = _check(spec, cfg, maps, boxes)
-    owner = np.arange(n)
-    cur = boxes
-    kept = []  # failing leaves no longer refined: (boxes, owner, strict fails, relaxed fails)
-    level = deepest = 0
-    while True:
-        bad = ~s | ~r
-        go = bad & (np.bincount(owner[bad], minlength=n)[owner] <= cap)
-        if level >= depth:
-            go[:] = False
-        stop = bad & ~go
-        kept.append((tuple(v[stop] for v in cur), owner[stop], ~s[stop], ~r[stop]))
-        if not go.any():
-            break
-        cur = _split(tuple(v[go] for v in cur))
-        owner = np.tile(owner[go], _SPLIT * _SPLIT)
-        s, r = _check(spec, cfg, maps, cur)
-        level += 3
-        deepest = level
+    s, r = _check(spec, cfg, maps, boxes)  # the cells of unsettled_cells fail here
+    cells = np.flatnonzero(~s | ~r)
+    # failing leaves no longer refined: (boxes, owner, strict fails, relaxed fails)
+    kept = [(tuple(v[:0] for v in boxes), cells[:0], s[:0], r[:0])]
+    deepest = 0
+    for at in range(0, cells.size, chunk):  # a chunk of cells at a time: bounded memory
+        c = cells[at : at + chunk]
+        part, level = _refine(spec, cfg, maps, tuple(v[c] for v in boxes), s[c], r[c], depth, cap)
+        kept += [(b, c[o], fs, fr) for b, o, fs, fr in part]
+        deepest = max(deepest, level)
     leaves = tuple(np.concatenate([k[0][q] for k in kept]) for q in range(4))
     owner = np.concatenate([k[1] for k in kept])
     fail_s = np.concatenate([k[2] for k in kept])
