@@ -124,6 +124,21 @@ def _omega_c(x1, x2, a, f):
         return np.abs(x2) / z
 
 
+_OMEGA0: list = [None, None]  # (cfg, omega0) of the last configuration seen
+
+
+def _omega0(cfg):
+    """omega0 of the corrected zone [mm/s], read once per configuration object.
+
+    A pure function of ``cfg`` (a frozen dataclass): the copy is called every
+    sample of a closed loop, and ``zone_for_law`` at each call cost more than
+    the law's own arithmetic.
+    """
+    if _OMEGA0[0] is not cfg:
+        _OMEGA0[:] = [cfg, zone_for_law(cfg, "corrected").omega0]
+    return _OMEGA0[1]
+
+
 def _pto(x1, x2, cfg, f):
     p, s = cfg.plant, cfg.pto
     a, w = p.a, p.w_max
@@ -133,7 +148,7 @@ def _pto(x1, x2, cfg, f):
     k1, k2 = (s.k2, s.k1) if "k_swapped" in f else (s.k1, s.k2)
     if "pd_gains" in f:
         k1, k2 = cfg.pd.kp, cfg.pd.kd
-    om = zone_for_law(cfg, "corrected").omega0
+    om = _omega0(cfg)
     om *= 1.1 if "omega0_up" in f else 0.9 if "omega0_down" in f else 1.0
     neg, nonneg = np.minimum(x2, 0.0), np.maximum(x2, 0.0)
     with np.errstate(all="ignore"):

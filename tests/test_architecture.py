@@ -581,16 +581,19 @@ def _other_imports(tree: ast.AST) -> set[str]:
     return out
 
 
-def third_party_private_uses(source: str, defined: set[str] | None = None) -> list[tuple[int, str]]:
+def third_party_private_uses(
+    source: str | ast.AST, defined: set[str] | None = None
+) -> list[tuple[int, str]]:
     """(line, what) of every use of a third-party private name or internal subclass.
 
     Besides what :class:`_PrivateUse` resolves, an ``obj._name`` read whose ``_name``
     nothing in ``defined`` (default: the source itself; for the repository, every
     module of the two packages) defines, on an object not reached from a standard
     library import, is flagged: it can only be another package's private name
-    (``ctx._im`` on an mpmath context passed in as a parameter).
+    (``ctx._im`` on an mpmath context passed in as a parameter).  ``source`` may be
+    the module's parsed tree.
     """
-    tree = ast.parse(source)
+    tree = source if isinstance(source, ast.AST) else ast.parse(source)
     checker = _PrivateUse()
     checker.visit(tree)
     found = set(checker.found)
@@ -610,11 +613,11 @@ def third_party_private_uses(source: str, defined: set[str] | None = None) -> li
 def private_offenders() -> dict[str, list[tuple[int, str]]]:
     """Repository-relative file -> its third-party private uses (files with any)."""
     paths = list(modules().values())
-    sources = {p: p.read_text() for p in paths}
-    defined = defined_names([ast.parse(src) for src in sources.values()])
+    trees = {p: ast.parse(p.read_text()) for p in paths}  # each module parsed once
+    defined = defined_names(list(trees.values()))
     out = {}
-    for path, src in sources.items():
-        found = third_party_private_uses(src, defined)
+    for path, tree in trees.items():
+        found = third_party_private_uses(tree, defined)
         if found:
             out[path.relative_to(ROOT).as_posix()] = found
     return out
@@ -659,18 +662,24 @@ def test_private_name_checker_on_synthetic_sources():
         assert third_party_private_uses(src) == [], src
 
 
-def test_no_third_party_private_names():
+@pytest.fixture(scope="module")
+def private_found() -> dict[str, list[tuple[int, str]]]:
+    """:func:`private_offenders` of the tree, computed once for the tests that read it."""
+    return private_offenders()
+
+
+def test_no_third_party_private_names(private_found):
     """No module of ptoverify/ or derivations/ reads a third-party private name or
     subclasses a third-party class; files still being fixed by others are listed in
     PENDING_PRIVATE; the plotting modules have none."""
-    found = private_offenders()
+    found = private_found
     assert not [f for f in found if f.startswith("ptoverify/report/plots")], found
     assert set(found) <= PENDING_PRIVATE, {f: found[f] for f in set(found) - PENDING_PRIVATE}
 
 
-def test_pending_private_files_still_offend():
+def test_pending_private_files_still_offend(private_found):
     """PENDING_PRIVATE only shrinks: a listed file that no longer offends is removed."""
-    fixed = sorted(PENDING_PRIVATE - set(private_offenders()))
+    fixed = sorted(PENDING_PRIVATE - set(private_found))
     assert fixed == [], f"remove from PENDING_PRIVATE: {fixed}"
 
 

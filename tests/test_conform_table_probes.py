@@ -38,14 +38,29 @@ def in_band(name, state):
 
 
 @pytest.fixture(scope="module")
-def emitted(tmp_path_factory):
-    """The states ``conform --emit-grid`` writes (x1 [mm], x2 [mm/s]), read back from the file."""
+def emitted_file(tmp_path_factory):
+    """The file ``conform --emit-grid`` writes (once per module: every test reads it only)."""
     path = tmp_path_factory.mktemp("emit") / "grid.csv"
     assert main(["conform", "--emit-grid", str(path)]) == 0
-    with open(path) as fh:
+    return path
+
+
+@pytest.fixture(scope="module")
+def emitted(emitted_file):
+    """The states ``conform --emit-grid`` writes (x1 [mm], x2 [mm/s]), read back from the file."""
+    with open(emitted_file) as fh:
         assert fh.readline().strip() == "x1,x2"
-    data = np.loadtxt(path, delimiter=",", skiprows=1)
-    return data[:, 0].copy(), data[:, 1].copy()
+    data = np.loadtxt(emitted_file, delimiter=",", skiprows=1)
+    x1, x2 = data[:, 0].copy(), data[:, 1].copy()
+    x1.flags.writeable = x2.flags.writeable = False  # shared by the module's tests
+    return x1, x2
+
+
+@pytest.fixture(scope="module")
+def emitted_rows(emitted_file):
+    """The data lines of the emitted file, as text (``x1,x2``), in file order."""
+    with open(emitted_file) as fh:
+        return fh.read().splitlines()[1:]
 
 
 def evaluate(law, x1, x2, cfg, batch=1000):
@@ -59,9 +74,16 @@ def evaluate(law, x1, x2, cfg, batch=1000):
 
 
 def write(path, x1, x2, u):
+    """Write the table x1, x2, u; each number as Python's repr (the shortest exact round trip)."""
+    return write_rows(path, [f"{a!r},{b!r}" for a, b in zip(x1.tolist(), x2.tolist())], u)
+
+
+def write_rows(path, rows, u):
+    """Write the table: each state's text ``x1,x2`` as given (the emitted file's), then ``u``."""
+    assert len(rows) == u.size
     with open(path, "w") as fh:
         fh.write("x1,x2,u\n")
-        np.savetxt(fh, np.stack([x1, x2, u], axis=1), fmt="%.17g", delimiter=",")
+        fh.writelines(f"{r},{v!r}\n" for r, v in zip(rows, u.tolist()))
     return path
 
 
@@ -128,10 +150,10 @@ def test_callable_route_probes_the_same_set(paper_cfg):
 
 
 # ------------------------------------------------------------------ the table route
-def test_reference_at_emitted_states_conforms(capsys, tmp_path, emitted, paper_cfg):
+def test_reference_at_emitted_states_conforms(capsys, tmp_path, emitted, paper_cfg, emitted_rows):
     x1, x2 = emitted
     u = evaluate(reference_law, x1, x2, paper_cfg)
-    code, data = conform_json(capsys, write(tmp_path / "ref.csv", x1, x2, u))
+    code, data = conform_json(capsys, write_rows(tmp_path / "ref.csv", emitted_rows, u))
     assert code == 0 and data["conforms"], data["failures"][:2]
     assert data["properties"]["coverage"]["status"] == "pass"
     assert data["agreement"]["coverage"]["missing"] == 0
@@ -139,11 +161,11 @@ def test_reference_at_emitted_states_conforms(capsys, tmp_path, emitted, paper_c
 
 
 @pytest.mark.parametrize("name", BANDS)
-def test_band_mutant_killed_through_table(capsys, tmp_path, emitted, paper_cfg, name):
+def test_band_mutant_killed_through_table(capsys, tmp_path, emitted, paper_cfg, emitted_rows, name):
     """5 % slow between grid columns: caught at the emitted random/band states."""
     x1, x2 = emitted
     u = evaluate(make_law([name]), x1, x2, paper_cfg)
-    code, data = conform_json(capsys, write(tmp_path / "m.csv", x1, x2, u))
+    code, data = conform_json(capsys, write_rows(tmp_path / "m.csv", emitted_rows, u))
     assert code == 1 and not data["conforms"]
     fail = next(f for f in data["failures"] if f["property"] == "agreement")
     assert in_band(name, fail["state"]), fail
@@ -162,11 +184,13 @@ def test_band_mutant_on_grid_only_is_insufficient_coverage(capsys, tmp_path, pap
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(set(MUTANTS) - set(BANDS)))
-def test_every_mutant_killed_through_table(capsys, tmp_path, emitted, paper_cfg, name):
+def test_every_mutant_killed_through_table(
+    capsys, tmp_path, emitted, paper_cfg, emitted_rows, name
+):
     """Memory faults show too: the batches make a stateful law disagree with itself."""
     x1, x2 = emitted
     u = evaluate(make_law([name]), x1, x2, paper_cfg)
-    code, data = conform_json(capsys, write(tmp_path / "m.csv", x1, x2, u))
+    code, data = conform_json(capsys, write_rows(tmp_path / "m.csv", emitted_rows, u))
     assert code == 1 and not data["conforms"], f"{name} ({MUTANTS[name]}) conforms by table"
     props = {f["property"] for f in data["failures"]}
     assert props & {"agreement", "odd-symmetry", "input-bound-grid"}, props
@@ -174,18 +198,20 @@ def test_every_mutant_killed_through_table(capsys, tmp_path, emitted, paper_cfg,
         assert "odd-symmetry" in props and "curve tie" in data["failures"][0]["detail"]
 
 
-def test_tie_asymmetry_killed_through_table(capsys, tmp_path, emitted, paper_cfg):
+def test_tie_asymmetry_killed_through_table(capsys, tmp_path, emitted, paper_cfg, emitted_rows):
     x1, x2 = emitted
     u = evaluate(make_law(["tie_asym"]), x1, x2, paper_cfg)
-    code, data = conform_json(capsys, write(tmp_path / "t.csv", x1, x2, u))
+    code, data = conform_json(capsys, write_rows(tmp_path / "t.csv", emitted_rows, u))
     assert code == 1 and [f["property"] for f in data["failures"]] == ["odd-symmetry"]
 
 
 @pytest.mark.parametrize("name", sorted(set(BENIGN) - {"faithful"}))
-def test_benign_variants_conform_through_table(capsys, tmp_path, emitted, paper_cfg, name):
+def test_benign_variants_conform_through_table(
+    capsys, tmp_path, emitted, paper_cfg, emitted_rows, name
+):
     x1, x2 = emitted
     u = evaluate(make_law([name]), x1, x2, paper_cfg)
-    code, data = conform_json(capsys, write(tmp_path / "b.csv", x1, x2, u))
+    code, data = conform_json(capsys, write_rows(tmp_path / "b.csv", emitted_rows, u))
     assert code == 0, data["failures"][:2]
 
 
@@ -238,12 +264,14 @@ def test_uniform_sample_leaves_cells_empty(capsys, tmp_path, paper_cfg):
 
 
 def test_dropping_a_region_is_insufficient_even_with_cells_filled(
-    capsys, tmp_path, emitted, paper_cfg
+    capsys, tmp_path, emitted, paper_cfg, emitted_rows
 ):
     x1, x2 = emitted
     keep = make_ref("pto", paper_cfg)(x1, x2)[1] != Region.ZONE_P
     u = reference_law(x1[keep], x2[keep], paper_cfg)
-    code, data = conform_json(capsys, write(tmp_path / "z.csv", x1[keep], x2[keep], u))
+    code, data = conform_json(
+        capsys, write_rows(tmp_path / "z.csv", [r for r, k in zip(emitted_rows, keep) if k], u)
+    )
     assert code == 1 and "ZONE_P 0 < 100" in data["properties"]["coverage"]["detail"]
 
 

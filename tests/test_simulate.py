@@ -352,5 +352,11 @@ def test_simulation_longer_than_the_sample_limit_is_bad_input(tmp_path, capsys, 
     assert main(["simulate", "--config", str(path), *extra]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "samples" in err and f"{MAX_SAMPLES:,}" in err
-    # within the limit it runs: the same plant for 1e-3 s (1e4 samples)
+
+
+def test_simulation_of_a_fine_sampled_plant_within_the_limit_runs(tmp_path, capsys):
+    """The plant of the test above for 1e-3 s (1e4 samples): within the limit it runs
+    (once, not once per rejected case)."""
+    path = tmp_path / "fine.toml"
+    path.write_text(FINE_SAMPLED)
     assert main(["simulate", "--config", str(path), "--step", "0.01", "--duration", "1e-3"]) == 0

@@ -7,8 +7,8 @@ import math
 
 import numpy as np
 import pytest
+from conftest import zoh_reference
 from scipy.linalg import expm
-from scipy.signal import cont2discrete
 
 from ptoverify import cli
 from ptoverify.config import config_from_mapping, load_config, paper_config
@@ -46,8 +46,8 @@ SLOW = config_from_mapping(
 
 
 def _spectral_radius(a, T, k1, k2):
-    A, B = np.array([[0.0, 1.0], [0.0, -a]]), np.array([[0.0], [a]])
-    Ad, Bd, *_ = cont2discrete((A, B, np.eye(2), np.zeros((2, 1))), T, method="zoh")
+    """Spectral radius of Ad - Bd K, (Ad, Bd) by scipy's ``cont2discrete`` (once per a, T)."""
+    Ad, Bd = zoh_reference(float(a), float(T))
     return np.abs(np.linalg.eigvals(Ad - Bd @ np.array([[k1, k2]]))).max()
 
 
