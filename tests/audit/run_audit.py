@@ -1811,6 +1811,10 @@ def main() -> int:
     """Run the audit; print the table; exit 1 if any case is a defect."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", action="append", default=[], help="substring of case names")
+    parser.add_argument(
+        "--group", action="append", default=[], help="group name (the part before the first '/')"
+    )
+    parser.add_argument("--exclude", action="append", default=[], help="substring of names to skip")
     parser.add_argument("--list", action="store_true", help="list the cases and exit")
     parser.add_argument("--md", help="also write the table as Markdown to this file")
     parser.add_argument("--keep", action="store_true", help="keep the work folders")
@@ -1831,6 +1835,10 @@ def main() -> int:
     cases = build_cases(tmpfs)
     if args.only:
         cases = [c for c in cases if any(s in c.name for s in args.only)]
+    if args.group:
+        cases = [c for c in cases if c.name.split("/", 1)[0] in args.group]
+    if args.exclude:
+        cases = [c for c in cases if not any(s in c.name for s in args.exclude)]
     if args.list:
         print("\n".join(c.name for c in cases))
         return 0
