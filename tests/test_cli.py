@@ -464,3 +464,13 @@ def test_written_files_respect_the_umask(capsys, tmp_path, umask_022, argv):
     assert code in (0, 1), err
     assert oct(f.stat().st_mode & 0o777) == oct(0o644), "mode is 0666 less the umask 022"
     assert [p.name for p in tmp_path.iterdir()] == ["out.file"], "no temporary left"
+
+
+@pytest.mark.parametrize("cmd", [["check"], ["conform", "--emit-grid", "g.csv"]])
+def test_junit_under_a_file_names_it_as_no_folder(capsys, tmp_path, cmd):
+    """Audit run 7: ``--junit afile/j.xml`` with ``afile`` a file said "does not exist"."""
+    (tmp_path / "afile").write_text("x")
+    code, out, err = run(capsys, *cmd, "--junit", str(tmp_path / "afile" / "j.xml"))
+    err = err.strip().splitlines()
+    assert code == 2 and out == "" and len(err) == 1
+    assert "is not a folder" in err[0] and (tmp_path / "afile").read_text() == "x"
