@@ -1248,6 +1248,9 @@ def build_cases(tmpfs: Path | None) -> list[Case]:  # noqa: C901 - a flat list o
             )
         )
     cases += run6_cases()
+    from run7_cases import run7_cases  # noqa: PLC0415 - it imports this module's names
+
+    cases += run7_cases(os.geteuid() == 0)
     return cases
 
 
