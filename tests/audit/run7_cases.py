@@ -575,7 +575,8 @@ def run7_cases(root: bool) -> list[Case]:  # noqa: C901 - a flat list of cases
             ("de",),
         ),
         "robust-sigterm-json": (
-            [PTO, "robust", "--law", "ptos", "--quiet", "--json"],
+            # all four laws: --law ptos alone ended in 4.7 s, before the signal (run 7)
+            [PTO, "robust", "--quiet", "--json"],
             5.0,
             signal.SIGTERM,
             (),
@@ -605,7 +606,8 @@ def run7_cases(root: bool) -> list[Case]:  # noqa: C901 - a flat list of cases
             ("rep",),
         ),
         "penalty-sigterm-out": (
-            [PTO, "penalty", "--count", "40", "--out", "pe"],
+            # --tuned: the untuned moves ended in 1.8 s, before the signal (run 7)
+            [PTO, "penalty", "--tuned", "--out", "pe"],
             3.0,
             signal.SIGTERM,
             ("pe",),
@@ -617,13 +619,26 @@ def run7_cases(root: bool) -> list[Case]:  # noqa: C901 - a flat list of cases
             ("pr",),
         ),
     }
+    # --dask local: a LocalCluster of 2 worker processes torn down by the signal
+    dask_local = {
+        "design-dask-local-sigint": (["design", "--laws", "pd", "--grid", "20"], signal.SIGINT),
+        "design-dask-local-sigterm": (["design", "--laws", "pd", "--grid", "20"], signal.SIGTERM),
+        "robust-dask-local-sigint": (["robust", "--law", "pd", "--quiet", "--json"], signal.SIGINT),
+        "prove-dask-local-sigterm": (
+            ["prove", "--law", "cascade-p", "--a-interval", "0.5,2", "--json"],
+            signal.SIGTERM,
+        ),
+    }
+    for name, (argv, s) in dask_local.items():
+        out = ["--out", "dl"] if argv[0] in ("design", "prove") else []
+        sig[name] = ([PTO, *argv, "--dask", "local", *out], 15.0, s, ("dl",))
     for name, (cmd, after, s, absent) in sig.items():
         add(
             Case(
                 f"signal/r7-{name}",
                 cmd,
                 (130,) if s == signal.SIGINT else (143,),
-                40,
+                after + 40,
                 signal_after=(after, s),
                 absent=absent,
                 one_line=False,
