@@ -1802,8 +1802,13 @@ def run_case(case: Case, base: Path) -> dict:
 
 
 def _default_signals() -> None:
-    """SIGINT as a terminal user has it (a shell's ``&`` job inherits it ignored)."""
+    """SIGINT and SIGHUP as a terminal user has them.
+
+    A shell's ``&`` job inherits SIGINT ignored, and an audit started under ``nohup``
+    SIGHUP (run 7: ``signal/conform-law-sighup`` then waited out the law's 300 s sleep).
+    """
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGHUP, signal.SIG_DFL)
 
 
 def _line_with(text: str, word: str) -> str:
