@@ -137,7 +137,7 @@ def test_dask_local_leaves_nothing_in_tmpdir(tmp_path, monkeypatch):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 def test_a_signal_during_dask_local_is_one_line_and_leaves_nothing(tmp_path, sig):
     """Audit run 7: SIGINT of ``design --dask local`` printed 170 lines of Dask tracebacks.
 
