@@ -5,6 +5,7 @@ answers garbage.  Both must end the run with exit 1 within the 10 s the README
 states; malformed addresses end it with exit 2 before any computation.
 """
 
+import json
 import os
 import signal
 import socket
@@ -122,18 +123,26 @@ def test_cli_against_a_silent_listener_is_exit_1_within_the_promise(command):
 
 
 @pytest.mark.slow
-def test_dask_local_leaves_nothing_in_tmpdir(tmp_path, monkeypatch):
-    """Audit run 7: every ``--dask local`` run left ``$TMPDIR/dask-scratch-space``."""
-    import tempfile
+def test_dask_local_leaves_nothing_in_tmpdir(tmp_path):
+    """Audit run 7: every ``--dask local`` run left ``$TMPDIR/dask-scratch-space``.
 
-    from ptoverify.studies.cluster import dask_map
-
+    Through the command line in its own process (a LocalCluster inside the test
+    process shares its event loops with the other tests).
+    """
     scratch = tmp_path / "tmp"
     scratch.mkdir()
-    monkeypatch.setenv("TMPDIR", str(scratch))
-    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
-    assert dask_map("local", abs, [-3, 2, -1]) == [3, 2, 1]
-    assert sorted(p.name for p in scratch.rglob("*")) == []
+    argv = ["design", "--dask", "local", "--sample-times", "0.002", "--bandwidths", "30"]
+    p = subprocess.run(
+        [sys.executable, "-m", "ptoverify", *argv, "--grid", "2", "--laws", "pd", "--json"],
+        cwd=tmp_path,
+        env=dict(os.environ, PYTHONPATH=str(ROOT), TMPDIR=str(scratch)),
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert p.returncode == 0, p.stderr
+    assert json.loads(p.stdout)["backend"] == "local"
+    assert sorted(q.name for q in scratch.rglob("*")) == []
 
 
 @pytest.mark.slow
