@@ -474,3 +474,19 @@ def test_junit_under_a_file_names_it_as_no_folder(capsys, tmp_path, cmd):
     err = err.strip().splitlines()
     assert code == 2 and out == "" and len(err) == 1
     assert "is not a folder" in err[0] and (tmp_path / "afile").read_text() == "x"
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [["--junit", "{d}/j.xml"], ["--tolerance", "1e-3"], ["--robust"], ["--delay", "1"]],
+    ids=["junit", "tolerance", "robust", "delay"],
+)
+def test_emit_grid_refuses_options_that_judge_nothing(capsys, tmp_path, extra):
+    """Audit run 7: ``--emit-grid`` with ``--junit`` or ``--tolerance`` ended 0, the option
+    ignored (no JUnit file); with ``--robust`` the message spoke of a table."""
+    extra = [a.format(d=tmp_path) for a in extra]
+    code, out, err = run(capsys, "conform", "--emit-grid", str(tmp_path / "g.csv"), *extra)
+    lines = err.strip().splitlines()
+    assert code == 2 and out == "" and len(lines) == 1, err
+    assert "--emit-grid writes the probe set only" in lines[0], err
+    assert list(tmp_path.iterdir()) == []

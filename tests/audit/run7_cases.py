@@ -253,6 +253,27 @@ def run7_cases(root: bool) -> list[Case]:  # noqa: C901 - a flat list of cases
                 absent=("g.csv",),
             )
         )
+    # --emit-grid with options that judge nothing: bad input, never ignored (D17)
+    for name, extra in {
+        "junit": ["--junit", "j.xml"],
+        "tolerance": ["--tolerance", "1e-3"],
+        "robust": ["--robust"],
+        "a-ratio": ["--a-ratio", "0.5"],
+    }.items():
+        add(
+            Case(
+                f"conform-ref/r7-emit-grid-with-{name}",
+                [PTO, "conform", "--emit-grid", "g.csv", *extra],
+                (2,),
+                20,
+                absent=("g.csv", "j.xml"),
+                check=lambda _w, _o, err: (
+                    None
+                    if "--emit-grid" in err
+                    else f"the message does not name --emit-grid: {err.strip()[:120]!r}"
+                ),
+            )
+        )
     # tables against a baseline
     add(
         Case(
