@@ -490,3 +490,25 @@ def test_emit_grid_refuses_options_that_judge_nothing(capsys, tmp_path, extra):
     assert code == 2 and out == "" and len(lines) == 1, err
     assert "--emit-grid writes the probe set only" in lines[0], err
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("argv", "flag"),
+    [
+        (["mintime", "--states", "{d}/s.csv", "--intervals", "50"], "--intervals"),
+        (["prove", "--check", "{d}/c.npz", "--law", "pd"], "--law"),
+        (["prove", "--check", "{d}/c.npz", "--a-interval", "0.9,1.1"], "--a-interval"),
+        (["prove", "--check", "{d}/c.npz", "--out", "{d}/pr"], "--out"),
+        (["prove", "--check", "{d}/c.npz", "--excursion", "1"], "--excursion"),
+    ],
+    ids=["mintime-states-intervals", "check-law", "check-a-interval", "check-out", "check-exc"],
+)
+def test_options_a_mode_ignores_are_bad_input(capsys, tmp_path, argv, flag):
+    """Audit run 7: these options were accepted and ignored (exit 0, nothing of them done)."""
+    (tmp_path / "s.csv").write_text("x1,x2\n1,0\n")
+    (tmp_path / "c.npz").write_bytes(b"")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    code, out, err = run(capsys, *[a.format(d=tmp_path) for a in argv])
+    lines = err.strip().splitlines()
+    assert code == 2 and out == "" and len(lines) == 1 and flag in lines[0], err
+    assert sorted(p.name for p in tmp_path.iterdir()) == before

@@ -535,6 +535,19 @@ def _cmd_prove(args: argparse.Namespace) -> int:
     if args.full and args.check is None:
         raise InputError("--full needs --check CERT (it steps a certificate's cells in arb)")
     if args.check is not None:
+        given = [
+            flag
+            for flag, on in (
+                ("--law", args.law),
+                ("--a-interval", args.a_interval is not None),
+                ("--excursion", args.excursion != 0.0),
+                ("--dask", args.dask is not None),
+                ("--out", args.out is not None),
+            )
+            if on
+        ]
+        if given:  # never ignored (audit run 7): the certificate carries its own law and box
+            raise InputError(f"--check re-verifies a certificate as it is: no {', '.join(given)}")
         import zipfile
 
         try:

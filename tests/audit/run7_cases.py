@@ -274,6 +274,25 @@ def run7_cases(root: bool) -> list[Case]:  # noqa: C901 - a flat list of cases
                 ),
             )
         )
+    # options a mode does not use: bad input, never ignored (D18)
+    for name, argv in {
+        "mintime-states-intervals": ["mintime", "--states", "s.csv", "--intervals", "50"],
+        "prove-check-law": ["prove", "--check", "c.npz", "--law", "pd"],
+        "prove-check-out": ["prove", "--check", "c.npz", "--out", "pr"],
+    }.items():
+        add(
+            Case(
+                f"cli/r7-ignored-{name}",
+                [PTO, *argv],
+                (2,),
+                20,
+                files={"s.csv": "x1,x2\n1,0\n", "c.npz": b""},
+                absent=("pr",),
+                check=lambda _w, _o, err, f=argv[-2]: (
+                    None if f in err else f"the message does not name {f}: {err.strip()[:120]!r}"
+                ),
+            )
+        )
     # tables against a baseline
     add(
         Case(
