@@ -466,7 +466,7 @@ def test_written_files_respect_the_umask(capsys, tmp_path, umask_022, argv):
     assert [p.name for p in tmp_path.iterdir()] == ["out.file"], "no temporary left"
 
 
-@pytest.mark.parametrize("cmd", [["check"], ["conform", "--emit-grid", "g.csv"]])
+@pytest.mark.parametrize("cmd", [["check"], ["conform", "--table", "t.csv"]])
 def test_junit_under_a_file_names_it_as_no_folder(capsys, tmp_path, cmd):
     """Audit run 7: ``--junit afile/j.xml`` with ``afile`` a file said "does not exist"."""
     (tmp_path / "afile").write_text("x")
