@@ -1194,13 +1194,13 @@ def build_cases(tmpfs: Path | None) -> list[Case]:  # noqa: C901 - a flat list o
     for name, argv, sig, expect in (
         (
             "sweep-sigterm",
-            ["sweep", "--grid", "60", "--out", "sw", "--quiet"],
+            ["sweep", "--grid", "200", "--out", "sw", "--quiet"],
             signal.SIGTERM,
             (143,),
         ),
         (
             "sweep-sigint",
-            ["sweep", "--grid", "60", "--out", "sw", "--quiet"],
+            ["sweep", "--grid", "200", "--out", "sw", "--quiet"],
             signal.SIGINT,
             (130,),
         ),
@@ -1226,7 +1226,7 @@ def build_cases(tmpfs: Path | None) -> list[Case]:  # noqa: C901 - a flat list o
                 "30",
                 "60",
                 "--grid",
-                "40",
+                "100",  # 40 ended in 3.5 s, before the signal, on a quiet machine (run 7)
                 "--out",
                 "de",
             ],
