@@ -442,7 +442,7 @@ def config_from_mapping(data: dict[str, Any]) -> Config:
         pto=PTOSettings(d=pto["d"], k1=pto["k1"], k2=pto["k2"]),
         bandwidth_hz=bandwidth_hz,
         robustness=robustness_from_mapping(data.get("robustness", {}), plant),
-        ptos=PTOSGains(**_baseline_table(data, "ptos", plant["sample_time"])),
+        ptos=PTOSGains(**_ptos_table(data, a, plant["w_max"], plant["sample_time"])),
         cascade=CascadeGains(**_baseline_table(data, "cascade", plant["sample_time"])),
         conform=conform_limits_from_mapping(data.get("conform", {})),
     )
@@ -453,6 +453,25 @@ _BASELINE_KEYS = {
     "ptos": {"alpha": (0.0, 1.0, False, True), "k": (0.0, None, True, True)},
     "cascade": {"kp": (0.0, None, True, False)},
 }
+
+
+def _ptos_table(data: dict[str, Any], a: float, w_max: float, T: float) -> dict[str, float]:  # noqa: N803
+    """Validate ``[ptos]``; also that its linear-region edge 2 a w_max / (alpha k^2) is finite.
+
+    With alpha k^2 so small that Workman's k1 = alpha k^2 / 2 [1/s^2] underflows (or the
+    edge y_l = a w_max / k1 [mm] overflows), no PTOS law exists to compute: the keys are
+    named (audit run 7).
+    """
+    out = _baseline_table(data, "ptos", T)
+    alpha, k = out.get("alpha", PTOSGains.alpha), out.get("k", a)
+    k1 = alpha * k * k / 2.0
+    if not (k1 > 0.0 and math.isfinite(a * w_max / k1)):
+        raise ConfigError(
+            f"config keys 'ptos.alpha' and 'ptos.k' (alpha = {alpha!r}, k = {k!r} 1/s) give a "
+            "PTOS linear region |x1| <= 2 a w_max / (alpha k^2) that is not a finite number "
+            "(alpha k^2 underflows): raise them"
+        )
+    return out
 
 
 def _baseline_table(data: dict[str, Any], name: str, T: float) -> dict[str, float]:  # noqa: N803

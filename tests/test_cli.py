@@ -465,3 +465,51 @@ def test_written_files_respect_the_umask(capsys, tmp_path, umask_022, argv):
     assert code in (0, 1), err
     assert oct(f.stat().st_mode & 0o777) == oct(0o644), "mode is 0666 less the umask 022"
     assert [p.name for p in tmp_path.iterdir()] == ["out.file"], "no temporary left"
+
+
+@pytest.mark.parametrize("cmd", [["check"], ["conform", "--table", "t.csv"]])
+def test_junit_under_a_file_names_it_as_no_folder(capsys, tmp_path, cmd):
+    """Audit run 7: ``--junit afile/j.xml`` with ``afile`` a file said "does not exist"."""
+    (tmp_path / "afile").write_text("x")
+    code, out, err = run(capsys, *cmd, "--junit", str(tmp_path / "afile" / "j.xml"))
+    err = err.strip().splitlines()
+    assert code == 2 and out == "" and len(err) == 1
+    assert "is not a folder" in err[0] and (tmp_path / "afile").read_text() == "x"
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [["--junit", "{d}/j.xml"], ["--tolerance", "1e-3"], ["--robust"], ["--delay", "1"]],
+    ids=["junit", "tolerance", "robust", "delay"],
+)
+def test_emit_grid_refuses_options_that_judge_nothing(capsys, tmp_path, extra):
+    """Audit run 7: ``--emit-grid`` with ``--junit`` or ``--tolerance`` ended 0, the option
+    ignored (no JUnit file); with ``--robust`` the message spoke of a table."""
+    extra = [a.format(d=tmp_path) for a in extra]
+    code, out, err = run(capsys, "conform", "--emit-grid", str(tmp_path / "g.csv"), *extra)
+    lines = err.strip().splitlines()
+    assert code == 2 and out == "" and len(lines) == 1, err
+    assert "--emit-grid writes the probe set only" in lines[0], err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("argv", "flag"),
+    [
+        (["mintime", "--states", "{d}/s.csv", "--intervals", "50"], "--intervals"),
+        (["prove", "--check", "{d}/c.npz", "--law", "pd"], "--law"),
+        (["prove", "--check", "{d}/c.npz", "--a-interval", "0.9,1.1"], "--a-interval"),
+        (["prove", "--check", "{d}/c.npz", "--out", "{d}/pr"], "--out"),
+        (["prove", "--check", "{d}/c.npz", "--excursion", "1"], "--excursion"),
+    ],
+    ids=["mintime-states-intervals", "check-law", "check-a-interval", "check-out", "check-exc"],
+)
+def test_options_a_mode_ignores_are_bad_input(capsys, tmp_path, argv, flag):
+    """Audit run 7: these options were accepted and ignored (exit 0, nothing of them done)."""
+    (tmp_path / "s.csv").write_text("x1,x2\n1,0\n")
+    (tmp_path / "c.npz").write_bytes(b"")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    code, out, err = run(capsys, *[a.format(d=tmp_path) for a in argv])
+    lines = err.strip().splitlines()
+    assert code == 2 and out == "" and len(lines) == 1 and flag in lines[0], err
+    assert sorted(p.name for p in tmp_path.iterdir()) == before

@@ -5,7 +5,9 @@ answers garbage.  Both must end the run with exit 1 within the 10 s the README
 states; malformed addresses end it with exit 2 before any computation.
 """
 
+import json
 import os
+import signal
 import socket
 import subprocess
 import sys
@@ -118,3 +120,59 @@ def test_cli_against_a_silent_listener_is_exit_1_within_the_promise(command):
         listener.close()
     assert code == 1 and out == "" and "cannot reach the Dask scheduler" in err, err
     assert took < PROMISED_S, f"exit after {took:.1f} s"
+
+
+@pytest.mark.slow
+def test_dask_local_leaves_nothing_in_tmpdir(tmp_path):
+    """Audit run 7: every ``--dask local`` run left ``$TMPDIR/dask-scratch-space``.
+
+    Through the command line in its own process (a LocalCluster inside the test
+    process shares its event loops with the other tests).
+    """
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    argv = ["design", "--dask", "local", "--sample-times", "0.002", "--bandwidths", "30"]
+    p = subprocess.run(
+        [sys.executable, "-m", "ptoverify", *argv, "--grid", "2", "--laws", "pd", "--json"],
+        cwd=tmp_path,
+        env=dict(os.environ, PYTHONPATH=str(ROOT), TMPDIR=str(scratch)),
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert p.returncode == 0, p.stderr
+    assert json.loads(p.stdout)["backend"] == "local"
+    assert sorted(q.name for q in scratch.rglob("*")) == []
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_a_signal_during_dask_local_is_one_line_and_leaves_nothing(tmp_path, sig):
+    """Audit run 7: SIGINT of ``design --dask local`` printed 170 lines of Dask tracebacks.
+
+    The workers' heartbeat to a closed scheduler and the client's abandoned waits were
+    logged on stderr before ``interrupted``; SIGTERM printed the workers' tracebacks.
+    """
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    argv = ["design", "--dask", "local", "--laws", "pd", "--grid", "20", "--out", "de"]
+    p = subprocess.Popen(
+        [sys.executable, "-m", "ptoverify", *argv],
+        cwd=tmp_path,
+        env=dict(os.environ, PYTHONPATH=str(ROOT), TMPDIR=str(scratch)),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not any(scratch.iterdir()):
+        time.sleep(0.2)  # the cluster's scratch folder: the workers are starting
+    time.sleep(4.0)
+    p.send_signal(sig)
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == (130 if sig == signal.SIGINT else 143), err
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("ptoverify: error:"), err[-2000:]
+    assert out == "" and not (tmp_path / "de").exists()
+    assert sorted(p.name for p in scratch.rglob("*")) == []

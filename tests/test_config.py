@@ -181,6 +181,32 @@ def test_integers_beyond_the_float_range_are_bad_input(tmp_path, old, new, key):
         load_config(f)
 
 
+@pytest.mark.parametrize(
+    "table",
+    ["[ptos]\nk = 1e-300", "[ptos]\nalpha = 5e-324", "[ptos]\nalpha = 1e-200\nk = 1e-60"],
+)
+def test_ptos_whose_linear_edge_is_not_finite_is_bad_input(tmp_path, table):
+    """A [ptos] with alpha k^2 / 2 underflowing names both keys (audit run 7).
+
+    ``k = 1e-300`` (0 < k accepted) made ``ptos_design`` divide by zero: an internal
+    error of ``simulate --law ptos``, ``design`` and ``conform --reference ptos``.
+    """
+    f = tmp_path / "c.toml"
+    f.write_text(GOOD + table + "\n")
+    text = f.read_text()
+    alpha = float(text.split("alpha = ")[1].split()[0]) if "alpha" in text else 0.9
+    k = float(text.split("k = ")[1].split()[0]) if "\nk = " in text else 60 * math.pi
+    assert alpha * k * k / 2 == 0.0 or not math.isfinite(60 * math.pi * 300 / (alpha * k * k / 2))
+    with pytest.raises(ConfigError, match=r"ptos\.alpha.*ptos\.k"):
+        load_config(f)
+
+
+def test_ptos_with_a_tiny_but_finite_edge_term_is_accepted(tmp_path):
+    f = tmp_path / "c.toml"
+    f.write_text(GOOD + "[ptos]\nalpha = 1e-300\n")  # y_l = 2 w / (alpha a): about 3e300 mm
+    assert load_config(f).ptos.alpha == 1e-300
+
+
 def test_digest_changes_with_every_value():
     cfg = paper_config()
     base = cfg.digest()

@@ -216,3 +216,34 @@ def test_ptos_table_filling_the_lattice_is_covered(tmp_path, capsys):
     assert main(["conform", "--table", half, "--reference", "ptos", "--json"]) == 1
     out = json.loads(capsys.readouterr().out)
     assert out["properties"]["coverage"]["status"] == "fail"
+
+
+@pytest.mark.parametrize(
+    ("table", "name"),
+    [
+        ({"cascade": {"kp": 0.0}}, "cascade-p"),  # u = sat(0 x1): no clip anywhere
+        ({"cascade": {"kp": 1e-300}}, "cascade-p"),  # clip starts 3e302 mm out
+        ({"ptos": {"alpha": 1e-300}}, "ptos"),  # y_l about 3e300 mm
+    ],
+)
+def test_baseline_edge_beyond_the_envelope_is_the_envelope(table, name):
+    # audit run 7: [cascade] kp = 0 (accepted) made linear_edge divide by zero, an internal
+    # error of `conform --reference cascade-p` and of `--emit-grid`
+    cfg = with_reference(config_from_mapping({**PAPER_MAPPING, **table}), name)
+    R, w = cfg.plant.position_range, cfg.plant.w_max
+    assert linear_edge(cfg) == R
+    g1, g2 = conformance_grid(cfg)
+    assert np.isfinite(g1).all() and np.isfinite(g2).all()
+    # the whole envelope is in the linear region: the reference is the linear law there
+    x1 = np.linspace(-R, R, 11)
+    u, _ = reference(cfg)(x1, np.zeros_like(x1))
+    assert np.all(np.abs(u) < w)
+
+
+def test_cli_emit_grid_with_zero_cascade_gain(tmp_path):
+    cfgfile = tmp_path / "c.toml"
+    cfgfile.write_text(_paper_toml() + "\n[cascade]\nkp = 0\n")
+    out = tmp_path / "g.csv"
+    p = _cli("--emit-grid", str(out), "--reference", "cascade-p", config=cfgfile)
+    assert p.returncode == 0, p.stderr
+    assert "internal error" not in p.stderr and out.stat().st_size > 0

@@ -48,8 +48,8 @@ def _add_mintime(sub) -> None:
     p.add_argument(
         "--intervals",
         type=positive_int,
-        default=100,
-        help="collocation intervals N (default 100, at most 2000)",
+        default=None,
+        help="collocation intervals N (default 100, at most 2000; not with --states)",
     )
     p.set_defaults(handler=_cmd_mintime)
 
@@ -59,6 +59,8 @@ def _mintime_states(args: argparse.Namespace, cfg: Config) -> int:
 
     if args.x1 is not None:
         raise InputError("give either X1 X2 or --states, not both")
+    if args.intervals is not None:  # never ignored (audit run 7)
+        raise InputError("--intervals sets the collocation of one state; --states runs no solver")
     if args.out is not None and args.json:
         raise InputError("--out and --json are alternatives")
     cols = mintime_states(args.states, cfg)
@@ -93,9 +95,10 @@ def _cmd_mintime(args: argparse.Namespace) -> int:
         raise InputError("--out needs --states")
     if args.x1 is None or args.x2 is None:
         raise InputError("mintime needs X1 X2 or --states IN.csv")
-    if args.intervals > 2000:
-        raise InputError(f"--intervals must be at most 2000, got {args.intervals}")
-    result = verified_mintime(args.x1, args.x2, cfg, intervals=args.intervals).to_json()
+    intervals = 100 if args.intervals is None else args.intervals
+    if intervals > 2000:
+        raise InputError(f"--intervals must be at most 2000, got {intervals}")
+    result = verified_mintime(args.x1, args.x2, cfg, intervals=intervals).to_json()
     if args.json:
         print_json(result)
     else:

@@ -138,5 +138,7 @@ def _check_junit(args: argparse.Namespace) -> None:
     path = Path(args.junit)
     if args.junit.strip() == "" or path.is_dir():
         raise InputError(f"--junit must name a file, got {args.junit!r}")
-    if not path.absolute().parent.is_dir():
-        raise InputError(f"--junit '{args.junit}': folder '{path.parent}' does not exist")
+    parent = path.absolute().parent
+    if not parent.is_dir():
+        why = "is not a folder" if parent.exists() else "does not exist"
+        raise InputError(f"--junit '{args.junit}': folder '{path.parent}' {why}")

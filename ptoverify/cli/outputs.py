@@ -236,6 +236,8 @@ def _conform_perturbations(args: argparse.Namespace, cfg) -> tuple:
             "--velocity-noise, --seed and --a-ratio"
         )
     found = robust_box(cfg) if args.robust else (() if one is None else (one,))
+    if found and args.emit_grid:
+        raise InputError("--emit-grid writes the probe set only: no --precision or perturbation")
     if found and not args.law:
         raise InputError("closed loops under perturbation need --law (a table has no closed loop)")
     return found
@@ -256,6 +258,16 @@ def _cmd_conform(args: argparse.Namespace) -> int:
         from ptoverify.conform.reflaw import with_reference
 
         cfg = with_reference(cfg, args.reference)
+    if args.emit_grid:  # options that judge nothing there are bad input, never ignored (run 7)
+        unused = [
+            f
+            for f, v in (("--tolerance", args.tolerance), ("--junit", args.junit))
+            if v is not None
+        ]
+        if unused:
+            raise InputError(
+                f"--emit-grid writes the probe set only: {' and '.join(unused)} judge nothing"
+            )
     rtol = conform.DEFAULT_RTOL if args.tolerance is None else args.tolerance
     if not 0 < rtol < 1:
         raise InputError(f"--tolerance must be in (0, 1), got {rtol:g}")

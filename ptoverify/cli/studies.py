@@ -535,6 +535,11 @@ def _cmd_prove(args: argparse.Namespace) -> int:
     if args.full and args.check is None:
         raise InputError("--full needs --check CERT (it steps a certificate's cells in arb)")
     if args.check is not None:
+        used = {"--law": args.law, "--a-interval": args.a_interval, "--dask": args.dask}
+        used |= {"--out": args.out, "--excursion": args.excursion or None}
+        if any(v is not None for v in used.values()):  # never ignored (audit run 7)
+            names = ", ".join(f for f, v in used.items() if v is not None)
+            raise InputError(f"--check re-verifies a certificate as it is: no {names}")
         import zipfile
 
         try:

@@ -109,7 +109,9 @@ def linear_edge(cfg: Config) -> float:
     """Return the half-width [mm] of the reference's linear region |x1| <= edge.
 
     The PTO's d, PTOS's y_l (:func:`ptoverify.model.baselines.ptos_design`), or
-    w_max / kp for the cascade P loop (where its clip starts at rest).
+    w_max / kp for the cascade P loop (where its clip starts at rest).  A baseline's
+    edge beyond the envelope is position_range (the whole envelope is linear; with
+    ``[cascade] kp = 0`` there is no edge at all, audit run 7).
 
     Parameters
     ----------
@@ -130,10 +132,12 @@ def linear_edge(cfg: Config) -> float:
     from ptoverify.model.baselines import cascade_gain, ptos_design
 
     name = cfg.conform.reference
+    R = cfg.plant.position_range  # noqa: N806
     if name == "ptos":
-        return ptos_design(cfg).y_l
+        return min(ptos_design(cfg).y_l, R)
     if name == "cascade-p":
-        return cfg.plant.w_max / cascade_gain(cfg)
+        kp = cascade_gain(cfg)
+        return R if kp * R <= cfg.plant.w_max else cfg.plant.w_max / kp
     return cfg.pto.d
 
 
