@@ -57,6 +57,7 @@ from ptoverify.errors import InputError, PtoverifyError
 from ptoverify.outfiles import (
     ENVIRONMENT_ERRNOS,
     GuardedStream,
+    check_writable,
     current_umask,
     guarded_std_streams,
     os_error,
@@ -76,6 +77,7 @@ __all__ = [
     "remove_stale",
     "os_error",
     "write_atomic",
+    "check_writable",
     "current_umask",
     "GuardedStream",
     "guarded_std_streams",

@@ -23,6 +23,7 @@ from ptoverify.errors import InputError
 __all__ = [
     "os_error",
     "write_atomic",
+    "check_writable",
     "current_umask",
     "GuardedStream",
     "guarded_std_streams",
@@ -74,6 +75,56 @@ def current_umask() -> int:
     return mask
 
 
+def _replaceable_mode(path: Path) -> None:
+    """Raise unless ``path`` is absent or a regular file, link or folder (never a device)."""
+    try:
+        mode = path.lstat().st_mode
+    except FileNotFoundError:
+        return
+    except OSError as exc:
+        raise os_error(exc, path) from None
+    if not (stat.S_ISREG(mode) or stat.S_ISLNK(mode) or stat.S_ISDIR(mode)):
+        raise InputError(
+            f"cannot write '{path}': it exists and is not a regular file "
+            "(a device, FIFO or socket is never replaced); name a file"
+        )
+
+
+def check_writable(path: str | Path) -> None:
+    """Check, before any computation, that :func:`write_atomic` can write ``path``.
+
+    The same checks as the write itself, on an empty probe: the name is not a
+    device, FIFO or socket, and a temporary file can really be created (then
+    removed) in its folder (``os.access`` says yes to root on a read-only mount).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to be written later.
+
+    Raises
+    ------
+    InputError
+        As :func:`write_atomic` would raise it (nothing is left behind).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     check_writable(Path(d) / "out.xml")
+    ...     sorted(os.listdir(d))
+    []
+    """
+    path = Path(path)
+    _replaceable_mode(path)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name[:200]}.", dir=path.parent or ".")
+    except OSError as exc:
+        raise os_error(exc, path) from None
+    os.close(fd)
+    Path(tmp).unlink(missing_ok=True)
+
+
 def write_atomic(path: str | Path, text: str) -> None:
     """Write a text file atomically (temp file in the same folder, then rename).
 
@@ -95,17 +146,7 @@ def write_atomic(path: str | Path, text: str) -> None:
         ``--csv /dev/full`` replaced the device node with a regular file).
     """
     path = Path(path)
-    try:
-        mode = path.lstat().st_mode
-    except FileNotFoundError:
-        mode = None
-    except OSError as exc:
-        raise os_error(exc, path) from None
-    if mode is not None and not (stat.S_ISREG(mode) or stat.S_ISLNK(mode) or stat.S_ISDIR(mode)):
-        raise InputError(
-            f"cannot write '{path}': it exists and is not a regular file "
-            "(a device, FIFO or socket is never replaced); name a file"
-        )
+    _replaceable_mode(path)
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name[:200]}.", dir=path.parent or ".")
     except OSError as exc:

@@ -2,6 +2,7 @@
 
 import json
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 from ptoverify.cli import main
 from ptoverify.conform.junit import conform_verdicts, junit_xml
@@ -139,3 +140,18 @@ def test_not_run_is_skipped_only_when_asked():
     assert (
         cases["cl"][0] == "skipped" and suite.get("errors") == "0" and suite.get("skipped") == "1"
     )
+
+
+def test_junit_unwritable_folder_refused_before_any_gate(monkeypatch, capsys):
+    # /sys refuses new files even to root (os.access would say yes to root): the probe
+    # must really create one; no gate may run first (audit run 7: 18 s of gates, then exit 2)
+    import ptoverify.studies.checks as checks
+
+    def no_gates(*a, **k):
+        raise AssertionError("a gate ran before the --junit folder was probed")
+
+    monkeypatch.setattr(checks, "run_checks", no_gates)
+    assert main(["check", "--junit", "/sys/ptoverify-junit.xml"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "/sys/ptoverify-junit.xml" in err[0]
+    assert not Path("/sys/ptoverify-junit.xml").exists()

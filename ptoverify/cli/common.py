@@ -12,6 +12,7 @@ from typing import Any
 
 from ptoverify.config import Config, load_config
 from ptoverify.errors import InputError
+from ptoverify.outdir import check_writable
 from ptoverify.outdir import write_atomic as _write_atomic
 
 
@@ -142,3 +143,4 @@ def _check_junit(args: argparse.Namespace) -> None:
     if not parent.is_dir():
         why = "is not a folder" if parent.exists() else "does not exist"
         raise InputError(f"--junit '{args.junit}': folder '{path.parent}' {why}")
+    check_writable(path)  # a read-only folder fails here, not after the gates ran
