@@ -448,10 +448,38 @@ def test_pool_stage_error_keeps_its_type_and_names_the_stage():
     from ptoverify.report.collect.pool import _run_in_pool
 
     with pytest.raises(KeyError) as info:
-        _run_in_pool(["no such stage"], paper_config(), None, 1, lambda *a: None)
+        _run_in_pool(["no such stage"], paper_config(), None, 2, lambda *a: None)
     assert "no such stage" in str(info.value)
     notes = getattr(info.value, "__notes__", [])
     assert any("no such stage" in n and "worker process" in n for n in notes), notes
+
+
+def test_pool_stage_error_in_this_process_names_the_stage():
+    """The last of the jobs is this process: its stage's error names the stage and where."""
+    from ptoverify.report.collect.pool import _run_in_pool
+
+    ran = []
+    with pytest.raises(KeyError) as info:  # the worker takes "poles", this process the other
+        _run_in_pool(["poles", "not a stage"], paper_config(), None, 2, lambda n, r: ran.append(n))
+    notes = getattr(info.value, "__notes__", [])
+    assert any("not a stage" in n and "this process" in n for n in notes), notes
+
+
+def test_pool_checks_before_any_stage():
+    """``before`` raising (a work limit) stops the run before any stage starts or finishes."""
+    from ptoverify.errors import InputError
+    from ptoverify.report.collect.pool import _run_in_pool
+
+    ran = []
+
+    def refuse():
+        raise InputError("over the limit")
+
+    with pytest.raises(InputError, match="over the limit"):
+        _run_in_pool(
+            ["poles", "proofs"], paper_config(), None, 2, lambda n, r: ran.append(n), refuse
+        )
+    assert ran == []
 
 
 def _descendants(pid: int) -> set[int]:

@@ -14,7 +14,7 @@ from .stages import _run_stage
 
 
 def default_jobs() -> int:
-    """Worker processes ``collect`` uses by default: the CPUs this process may use.
+    """Return the processes ``collect`` uses by default (this one and its workers): the CPUs.
 
     Measured on this project's 2-core machine, idle (issue 23, final merge): the
     report took 28.2 s of wall time with ``--jobs 2`` against about 53 s with
@@ -77,50 +77,120 @@ def _sigint_ignored_at_spawn() -> Iterator[None]:
         signal.signal(signal.SIGINT, previous)
 
 
+def _warm_up() -> None:
+    """Import, as a worker's first task, what every stage uses (the parent checks meanwhile)."""
+    import numpy  # noqa: F401
+    import scipy.optimize  # noqa: F401
+
+    import ptoverify.sim.simulate  # noqa: F401
+    import ptoverify.studies.properties  # noqa: F401
+
+
 def _run_in_pool(
     names: list[str],
     cfg: Config,
     figdir: Path | None,
     jobs: int,
     finished: Callable[[str, tuple[dict[str, Any], float]], None],
+    before: Callable[[], None] | None = None,
 ) -> None:
-    """Run the stages in ``jobs`` worker processes; ``finished(name, result)`` as each ends.
+    """Run the stages in this process and ``jobs - 1`` workers; ``finished(name, result)`` as each ends.
 
-    The pool is a :class:`concurrent.futures.ProcessPoolExecutor` of spawned
+    The workers are a :class:`concurrent.futures.ProcessPoolExecutor` of spawned
     processes (fresh interpreters: no fork of solver or BLAS state).  Like every
     spawned pool, it imports the caller's main module in each worker: a script that
     calls :func:`collect` or :func:`write_report` with ``jobs`` > 1 needs the
-    ``if __name__ == "__main__":`` guard.  The stages are submitted longest first.
+    ``if __name__ == "__main__":`` guard.  This process is the last of the
+    ``jobs``: it has the imports and the configuration already, so one spawn and
+    one interpreter's start-up fewer.  ``names`` come longest first; the workers take
+    stages from the front (a feeder thread hands an idle worker the next at once),
+    this process from the back, until they meet.
+
+    ``before`` (the work-limit checks) runs once the workers are spawned and
+    importing, and before any stage starts: if it raises, no stage runs.
     A stage's exception is raised here with its type (an ``InputError`` stays one)
-    and a note naming the stage (the worker's traceback is its ``__cause__``).
-    When the run ends early (a stage's error, Ctrl-C, SIGTERM), the stages not
-    started are cancelled and the workers are terminated, so none goes on writing
-    into ``figdir``.  Where no pool can be made, the stages run in this process.
+    and a note naming the stage and where it ran (the worker's traceback is its
+    ``__cause__``).  When the run ends early (a stage's error, Ctrl-C, SIGTERM),
+    the stages not started are cancelled and the workers are terminated, so none
+    goes on writing into ``figdir``.  Where no pool can be made, the stages run in
+    this process.
     """
     import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    import threading
+    from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 
     ctx = multiprocessing.get_context("spawn")
     others = set(multiprocessing.active_children())
+    queue = list(names)
     try:
-        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_setup)
-    except OSError:  # no semaphores or pipes here: the stages run in this process
-        for name in names:
+        if jobs < 2:
+            raise OSError("one process: no workers")
+        pool = ProcessPoolExecutor(max_workers=jobs - 1, mp_context=ctx, initializer=_worker_setup)
+    except OSError:  # one process, or no semaphores or pipes here: the stages run in this process
+        if before is not None:
+            before()
+        for name in queue:
             finished(name, _run_stage(name, cfg, figdir))
         return
+    lock = threading.Lock()  # guards queue, running, failed, and calls of finished
+    running: dict[Future, str] = {}
+    failed: list[BaseException] = []
+    stop = threading.Event()
+
+    def submit_front() -> None:  # with the lock held
+        while queue and len(running) < jobs - 1 and not failed and not stop.is_set():
+            name = queue.pop(0)
+            running[pool.submit(_run_stage, name, cfg, figdir)] = name
+
+    def feeder() -> None:  # hands each idle worker the next stage as soon as it is free
+        while not stop.is_set():
+            with lock:
+                pending = list(running)
+            if not pending:
+                return
+            done, _ = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
+            with lock:
+                for future in done:
+                    name = running.pop(future)
+                    exc = future.exception()
+                    if exc is not None:
+                        exc.add_note(f"in report stage '{name}' (worker process)")
+                        failed.append(exc)
+                    else:
+                        finished(name, future.result())
+                if not failed:
+                    submit_front()
+
     with pool:
         try:
             with _sigint_ignored_at_spawn():
-                futures = {pool.submit(_run_stage, name, cfg, figdir): name for name in names}
-            for future in as_completed(futures):
-                name = futures[future]
+                for _ in range(jobs - 1):  # spawns the workers; they import while we check
+                    pool.submit(_warm_up)
+            if before is not None:
+                before()
+            with lock:
+                submit_front()
+            thread = threading.Thread(target=feeder, name="ptoverify-report-feeder", daemon=True)
+            thread.start()
+            while True:
+                with lock:
+                    if failed:
+                        raise failed[0]
+                    if not queue:
+                        break
+                    name = queue.pop()
                 try:
-                    result = future.result()
+                    result = _run_stage(name, cfg, figdir)
                 except Exception as exc:
-                    exc.add_note(f"in report stage '{name}' (worker process)")
+                    exc.add_note(f"in report stage '{name}' (this process)")
                     raise
-                finished(name, result)
+                with lock:
+                    finished(name, result)
+            thread.join()
+            if failed:
+                raise failed[0]
         except BaseException:
+            stop.set()
             pool.shutdown(wait=False, cancel_futures=True)
             workers = [p for p in multiprocessing.active_children() if p not in others]
             for process in workers:

@@ -27,10 +27,10 @@ def collect(
     """Compute every result of the report, each once, and draw its figures.
 
     The stages (:data:`STAGES`) are independent: with ``jobs`` > 1 they run in
-    a pool of fresh Python processes (spawned: no fork of solver or BLAS
-    state), longest first, each drawing its own figures into ``figdir``; with
-    ``jobs`` = 1 they run here, one after the other.  Both give the same
-    results.
+    this process and ``jobs`` - 1 fresh Python processes (spawned: no fork of
+    solver or BLAS state), the workers taking the longest first, each stage
+    drawing its own figures into ``figdir``; with ``jobs`` = 1 they run here, one
+    after the other.  Both give the same results.
 
     Parameters
     ----------
@@ -43,7 +43,8 @@ def collect(
     figdir : Path, optional
         Folder the figures are drawn into (none are drawn without it).
     jobs : int, optional
-        Worker processes (default :func:`default_jobs`, at most one per stage).
+        Processes, this one included (default :func:`default_jobs`, at most one per
+        stage).
 
     Returns
     -------
@@ -68,18 +69,20 @@ def collect(
     if jobs is not None and jobs < 1:
         raise InputError(f"--jobs must be at least 1, got {jobs}")
     names = [n for n in _STAGE_FUNCTIONS if n not in {_SKIP_STAGE[s] for s in skip}]
-    if "robust" not in skip:  # the box's work is bounded: say so before any stage runs
-        from ptoverify.studies.robust import RobustSettings
-        from ptoverify.studies.robust.maps import check_box_work
 
-        from .settings import ROBUST_SETTINGS
+    def check_work() -> None:  # the robustness box and the proofs are bounded: say so first
+        if "robust" not in skip:
+            from ptoverify.studies.robust.maps import RobustSettings, check_box_work
 
-        check_box_work(cfg, RobustSettings(**ROBUST_SETTINGS))
-    from ptoverify.model.lawbox import law_spec
-    from ptoverify.studies.prove.run import Resolution, check_provable
+            from .settings import ROBUST_SETTINGS
 
-    for law in ("pto", "pd"):  # the proofs stage's work is bounded: say so before any stage
-        check_provable(cfg, Resolution(), law_spec(law, cfg))
+            check_box_work(cfg, RobustSettings(**ROBUST_SETTINGS))
+        from ptoverify.model.lawbox import law_spec
+        from ptoverify.studies.prove.run import Resolution, check_provable
+
+        for law in ("pto", "pd"):
+            check_provable(cfg, Resolution(), law_spec(law, cfg))
+
     jobs = min(jobs or default_jobs(), len(names))
     done: dict[str, tuple[dict[str, Any], float]] = {}
 
@@ -88,11 +91,14 @@ def collect(
         if progress:
             progress(name, len(done) / len(names))
 
+    if figdir is not None:  # every stage draws into it, whichever starts first
+        figdir.mkdir(parents=True, exist_ok=True)
     if jobs == 1:
+        check_work()
         for name in names:
             finished(name, _run_stage(name, cfg, figdir))
-    else:
-        _run_in_pool(names, cfg, figdir, jobs, finished)
+    else:  # the workers start while the work is checked; no stage starts before
+        _run_in_pool(names, cfg, figdir, jobs, finished, before=check_work)
 
     out: dict[str, Any] = {"derivations": None, "robust": None, "tuning": None, "charts": None}
     files: list[Path] = []
