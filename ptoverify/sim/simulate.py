@@ -40,6 +40,8 @@ from ptoverify.model.laws import Law
 from ptoverify.sim.reference import SIGNALS, Reference, reference
 
 __all__ = [
+    "RUN_BYTES",
+    "chunk_states",
     "TRACKING",
     "Reference",
     "reference",
@@ -396,6 +398,41 @@ def _loop(
         X2[k + 1] = X2[k] - dv
         X1[k + 1] = X1[k] + uk * T + dv / a
     return X1, X2, U, R
+
+
+#: Most bytes of one trajectory array [bytes] a study that only reduces trajectories (counts,
+#: maxima) lets one run allocate.  Below glibc's largest dynamic mmap threshold (32 MiB), a
+#: freed run's arrays are reused by the next run instead of being mapped afresh: fresh
+#: memory is zeroed by the kernel, 2 MiB at a time where NumPy asks for huge pages, and
+#: that cost 12 s of the report's tuning stage in whole-grid runs (issue 23, measured).
+RUN_BYTES = 24 * 2**20
+
+
+def chunk_states(steps: int, run_bytes: int = RUN_BYTES) -> int:
+    """Return how many states one run of ``steps`` samples may hold (at least 1).
+
+    Each state's trajectory does not depend on the others in its batch, so a study
+    that reduces trajectories may simulate its states in runs of this size and
+    add the results up: the same numbers, in less fresh memory.
+
+    Parameters
+    ----------
+    steps : int
+        Samples per trajectory.
+    run_bytes : int
+        Most bytes of one (steps + 1, n) float64 array [bytes].
+
+    Returns
+    -------
+    int
+        States per run.
+
+    Examples
+    --------
+    >>> chunk_states(1167), chunk_states(10**9)
+    (2693, 1)
+    """
+    return max(1, int(run_bytes) // (8 * (int(steps) + 1)))
 
 
 Segment = tuple[Law, ArrayLike, ArrayLike, Mismatch | None]

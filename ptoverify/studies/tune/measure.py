@@ -22,7 +22,7 @@ from ptoverify.model.memo import memo
 from ptoverify.model.mintime import discrete_min_steps_batch, min_time
 from ptoverify.model.poles import spectral_radii
 from ptoverify.sim.exact import settling_and_overshoot
-from ptoverify.sim.simulate import simulate_batch
+from ptoverify.sim.simulate import chunk_states, simulate_batch
 from ptoverify.studies.properties import (
     default_steps,
     initial_grid,
@@ -469,11 +469,14 @@ def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
     fn = make_law(law, cfg)
     x1, x2, _ = initial_grid(cfg)
     steps = default_steps(cfg)
-    res = simulate_batch(fn, cfg.plant, x1, x2, steps)
-    cycles = int(oscillating(res.x1[-max(20, steps // 4) :], LIMIT_CYCLE_BAND).sum())
-    if law != "pto":
-        return cycles, 0
-    return cycles, int(stride_over_counts(res.x1, res.x2, res.region, cfg).sum())
+    cycles = strides = 0
+    size = chunk_states(steps)
+    for s in range(0, x1.size, size):  # each state's trajectory is its own: counts add up
+        res = simulate_batch(fn, cfg.plant, x1[s : s + size], x2[s : s + size], steps)
+        cycles += int(oscillating(res.x1[-max(20, steps // 4) :], LIMIT_CYCLE_BAND).sum())
+        if law == "pto":
+            strides += int(stride_over_counts(res.x1, res.x2, res.region, cfg).sum())
+    return cycles, strides
 
 
 def grid_checked(cfg: Config, law: str, c: Candidate) -> Candidate:
