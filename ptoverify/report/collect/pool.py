@@ -102,9 +102,9 @@ def _run_in_pool(
     calls :func:`collect` or :func:`write_report` with ``jobs`` > 1 needs the
     ``if __name__ == "__main__":`` guard.  This process is the last of the
     ``jobs``: it has the imports and the configuration already, so one spawn and
-    one interpreter's start-up fewer.  ``names`` come longest first; the workers take
-    stages from the front (a feeder thread hands an idle worker the next at once),
-    this process from the back, until they meet.
+    one interpreter's start-up fewer.  ``names`` come longest first, and whichever
+    process is free takes the next (a feeder thread hands an idle worker its next
+    stage at once): the longest-first list schedule.
 
     ``before`` (the work-limit checks) runs once the workers are spawned and
     importing, and before any stage starts: if it raises, no stage runs.
@@ -178,7 +178,7 @@ def _run_in_pool(
                         raise failed[0]
                     if not queue:
                         break
-                    name = queue.pop()
+                    name = queue.pop(0)
                 try:
                     result = _run_stage(name, cfg, figdir)
                 except Exception as exc:
