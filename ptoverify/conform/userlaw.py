@@ -190,7 +190,10 @@ def check_output(value: Any, state: tuple[float, float], n: int | None = None) -
     InputError
         A non-number (bool, complex, string, bytes, object) or a wrong shape.
     """
-    where = f"at state ({state[0]!r}, {state[1]!r})"
+
+    def where() -> str:  # formatted only for a message (two reprs per call add up)
+        return f"at state ({state[0]!r}, {state[1]!r})"
+
     if n is None:
         real = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
             value, (bool, np.bool_)
@@ -200,7 +203,7 @@ def check_output(value: Any, state: tuple[float, float], n: int | None = None) -
         if not real:
             shape = f" (shape {np.shape(value)})" if np.ndim(value) else ""
             raise InputError(
-                f"the law returned {type(value).__name__}{shape} {where}; expected one real "
+                f"the law returned {type(value).__name__}{shape} {where()}; expected one real "
                 "number u [mm/s] (int or float; bool, complex, str and objects are rejected)"
             )
         return np.asarray(value, dtype=float)
@@ -211,7 +214,7 @@ def check_output(value: Any, state: tuple[float, float], n: int | None = None) -
     if arr.dtype.kind not in _REAL_KINDS:
         raise InputError(
             f"the law returned {type(value).__name__} of dtype {arr.dtype} for {n} states "
-            f"from {where}; expected real numbers (integer or floating dtype)"
+            f"from {where()}; expected real numbers (integer or floating dtype)"
         )
     if arr.shape != (n,):
         raise InputError(f"the law returned shape {arr.shape} for {n} states")
@@ -298,7 +301,7 @@ class UserLaw:
         x2 = np.array(x2, dtype=float).ravel()
         first = (float(x1[0]), float(x2[0])) if x1.size else (math.nan, math.nan)
         if self.mode == "scalar":
-            u = np.array([self._one(float(a), float(b)) for a, b in zip(x1, x2)], dtype=float)
+            u = np.array([self._one(a, b) for a, b in zip(x1.tolist(), x2.tolist())], dtype=float)
             self._check_cfg(first)
             return u
         self.calls += 1

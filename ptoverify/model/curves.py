@@ -73,7 +73,7 @@ def _direct_or_series(x: ArrayLike, direct, radius: float, coef: Array) -> Array
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         out = direct(np.atleast_1d(x)).reshape(x.shape)  # a fresh array
     near = np.abs(x) < radius
-    if near.any():  # (no series values: nothing to overwrite)
+    if np.count_nonzero(near):  # (no series values: nothing to overwrite)
         out[near] = _series(x[near], coef)
     return out
 
@@ -339,9 +339,9 @@ def root_k(m: ArrayLike) -> Array:
     u = np.zeros(mm.shape)
     pos, neg = mm > 0, mm < 0
     with np.errstate(all="ignore"):  # each branch on the states it serves, if any
-        if pos.any():
+        if np.count_nonzero(pos):
             u[pos] = _u_of_m_positive(mm[pos])
-        if neg.any():
+        if np.count_nonzero(neg):
             u[neg] = _u_of_m_negative(mm[neg])
     z = np.expm1(u)
     z = np.where(mm == 0.0, 0.0, z)

@@ -104,17 +104,23 @@ class Law:
         return u.reshape(x1.shape), region.reshape(x1.shape)
 
 
+#: Region codes as int8 scalars: ``np.where`` on them gives int8 arrays directly.
+_BANG_P, _BANG_N = np.int8(Region.BANG_P), np.int8(Region.BANG_N)
+_ZONE_P, _ZONE_N = np.int8(Region.ZONE_P), np.int8(Region.ZONE_N)
+_LINEAR, _SATURATED = np.int8(Region.LINEAR), np.int8(Region.SATURATED)
+
+
 def _bang(sigma: NDArray[np.float64], x2: NDArray[np.float64], w: float):
     """Time-optimal input from the switching function: S_P u l1 -> +w, S_N u l2 -> -w."""
     pos = (sigma < 0) | ((sigma == 0) & (x2 < 0))  # on the curve: the sign of x2 decides
-    region = np.where(pos, Region.BANG_P, Region.BANG_N).astype(np.int8)
-    return np.where(pos, w, -w), region
+    return np.where(pos, w, -w), np.where(pos, _BANG_P, _BANG_N)
 
 
 def _origin(x1, x2, u, region):
     """Set u = 0, region ORIGIN at the origin (in place); return (u, region)."""
     origin = (x1 == 0) & (x2 == 0)
-    u[origin], region[origin] = 0.0, Region.ORIGIN
+    if np.count_nonzero(origin):
+        u[origin], region[origin] = 0.0, Region.ORIGIN
     return u, region
 
 
@@ -142,7 +148,7 @@ def saturate_linear(v: NDArray[np.float64], w: float):
     ([1.0, -300.0], ['LINEAR', 'SATURATED'])
     """
     with np.errstate(invalid="ignore"):
-        region = np.where(np.abs(v) > w, Region.SATURATED, Region.LINEAR).astype(np.int8)
+        region = np.where(np.abs(v) > w, _SATURATED, _LINEAR)
     return np.minimum(np.maximum(v, -w), w), region  # np.clip(v, -w, w)
 
 
@@ -200,11 +206,12 @@ def _pto_block(a: float, w: float) -> Callable:
         u = np.empty(x1.shape)
         region = np.empty(x1.shape, dtype=np.int8)
         lin = np.abs(x1) < dd
-        if lin.any():  # S_L, eq. (34)
+        n_lin = np.count_nonzero(lin)
+        if n_lin:  # S_L, eq. (34)
             g1l, g2l = _at(g1, lin), _at(g2, lin)
             u[lin], region[lin] = _pd_input(x1[lin], x2[lin], g1l, g2l, w)
-        out = ~lin
-        if out.any():
+        if n_lin < lin.size:
+            out = ~lin
             u[out], region[out] = _outside_linear(x1[out], x2[out], _at(lv, out), a, w)
         return _origin(x1, x2, u, region)
 
@@ -225,18 +232,18 @@ def _outside_linear(y1, y2, lv, a: float, w: float):
     sig = level_residual(y1, y2, a, w)  # switching function, eqs. (9), (11)
     u, region = _bang(sig, y2, w)  # eq. (12)
     # zone candidates: between l1 and l2 (x2 and sigma of opposite signs), with a zone
-    cand = np.flatnonzero((np.sign(y2) * np.sign(sig) < 0) & ~np.isnan(lv))
+    cand = np.nonzero((np.sign(y2) * np.sign(sig) < 0) & ~np.isnan(lv))[0]  # y2 is 1-D
     if cand.size:
         c1, c2, lc = y1[cand], y2[cand], _at(lv, cand)
         r0 = level_residual(c1, c2, a, lc)  # on or inside l1* (l2*), eqs. (13), (14)
         zp = (c2 < 0) & (r0 <= 0)
         inz = zp | ((c2 > 0) & (r0 >= 0))
-        if inz.any():
+        if np.count_nonzero(inz):
             # omega_c clipped to [level, w_max], eqs. (28)-(33)
             wc = np.minimum(np.maximum(omega_c(c1[inz], c2[inz], a), _at(lc, inz)), w)
             idx, zpi = cand[inz], zp[inz]
             u[idx] = np.where(zpi, wc, -wc)
-            region[idx] = np.where(zpi, Region.ZONE_P, Region.ZONE_N)
+            region[idx] = np.where(zpi, _ZONE_P, _ZONE_N)
     return u, region
 
 
