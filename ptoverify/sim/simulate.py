@@ -388,12 +388,14 @@ def _loop(
     U, R = np.empty((steps + 1, n)), np.empty((steps + 1, n), dtype=np.int8)
     X1[0], X2[0] = x1, x2
     cols, delayed = np.arange(n), bool(np.any(delay))
+    lo = -w
     for k in range(steps + 1):
         y1 = q * np.rint(X1[k] / q) if q > 0 else X1[k]
         U[k], R[k] = controller(k, y1, X2[k] + noise[k] if noisy else X2[k])
         if k == steps:
             break
-        uk = np.clip(U[np.maximum(k - delay, 0), cols] if delayed else U[k], -w, w)
+        # clipped to the true limit (np.clip's arithmetic, without its per-call dispatch)
+        uk = np.minimum(np.maximum(U[np.maximum(k - delay, 0), cols] if delayed else U[k], lo), w)
         dv = (X2[k] - uk) * g  # plant.flow: x1 + u T + (x2 - u) g / a, x2 - (x2 - u) g
         X2[k + 1] = X2[k] - dv
         X1[k + 1] = X1[k] + uk * T + dv / a
