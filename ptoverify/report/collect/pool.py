@@ -16,11 +16,11 @@ from .stages import _run_stage
 def default_jobs() -> int:
     """Return the processes ``collect`` uses by default (this one and its workers): the CPUs.
 
-    Measured on this project's 2-core machine, idle (issue 23, final merge): the
-    report took 28.2 s of wall time with ``--jobs 2`` against about 53 s with
-    ``--jobs 1`` (the stages' times add up to 53 s), so the pool earns its place.
-    An earlier measurement at a load average of 3-17 (other sessions running)
-    showed no gain: on a busy machine pass ``--jobs 1``.
+    Measured on this project's 2-core machine (issue 23, 2026-12-03, load about 2 from
+    the report itself): the report took 47.3-47.5 s of wall time with ``--jobs 2``
+    (this process and one worker) against 75.4 s with ``--jobs 1``, so the pool earns
+    its place (1.59x).  On a busy machine (other sessions running) the gain shrinks:
+    pass ``--jobs 1`` there.
 
     Returns
     -------
