@@ -40,8 +40,8 @@ def _add_report(sub) -> None:
         metavar="N",
         type=int,
         default=None,
-        help="worker processes for the report's independent stages (default: the CPUs "
-        "available; 1 runs every stage in this process). The results do not depend on it",
+        help="processes for the report's independent stages, this one included (default: "
+        "the CPUs available; 1 runs every stage in this process). The results do not depend on it",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     p.set_defaults(handler=_cmd_report)

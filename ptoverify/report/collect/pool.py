@@ -143,6 +143,13 @@ def _run_in_pool(
             running[pool.submit(_run_stage, name, cfg, figdir)] = name
 
     def feeder() -> None:  # hands each idle worker the next stage as soon as it is free
+        try:
+            feed()
+        except BaseException as exc:  # noqa: BLE001 - raised in the main thread
+            with lock:
+                failed.append(exc)
+
+    def feed() -> None:
         while not stop.is_set():
             with lock:
                 pending = list(running)
