@@ -358,6 +358,40 @@ def test_settling_and_overshoot_are_those_of_exact_metrics():
     assert seen_nan
 
 
+def test_settling_and_overshoot_of_many_responses_are_each_alone():
+    """Responses measured side by side give each response's own values bit for bit (laws
+    whose responses settle, never settle and overshoot, every signal); a response with a
+    non-finite sample is refused as it is alone, and so are responses on different grids."""
+    from dataclasses import replace
+
+    from ptoverify.studies.tune import tuned_config
+
+    cfgs = [
+        CFG,
+        tuned_config(CFG, "pd", {"kp": 2900.0, "kd": 0.0}),
+        tuned_config(CFG, "pd", {"kp": 12.0, "kd": 3.9}),
+        tuned_config(CFG, "pto", {"d": 0.3, "k1": 2500.0, "k2": 0.05}),
+    ]
+    for sig in ("step", "ramp", "sine"):
+        runs = [
+            simulate(make_law(law, c), c.plant, sig) for c in cfgs for law in ("to", "pd", "pto")
+        ]
+        many = exact.settling_and_overshoot_many(runs, CFG.plant)
+        for res, got in zip(runs, many, strict=True):
+            alone = exact.settling_and_overshoot(res, CFG.plant, res.reference)
+            assert set(got) == set(alone)
+            for k, v in alone.items():
+                assert (math.isnan(v) and math.isnan(got[k])) or v == got[k], (sig, k)
+    bad = replace(runs[0], x1=np.where(np.arange(runs[0].x1.size) == 3, np.nan, runs[0].x1))
+    with pytest.raises(InputError, match="non-finite"):
+        exact.settling_and_overshoot(bad, CFG.plant)
+    with pytest.raises(InputError, match="non-finite"):
+        exact.settling_and_overshoot_many([runs[1], bad], CFG.plant)
+    short = simulate(make_law("pd", CFG), CFG.plant, "sine", duration=0.1)
+    with pytest.raises(InputError, match="one sample grid"):
+        exact.settling_and_overshoot_many([runs[0], short], CFG.plant)
+
+
 @pytest.mark.parametrize("sig", ["step", "sine"])
 def test_json_metrics_follow_design_keys(sig):
     import json

@@ -287,6 +287,48 @@ def test_single_trajectory_is_the_batch_on_one_state(paper_cfg):
         assert np.array_equal(res.u[:-1], b.u[:, 0]), name
 
 
+@pytest.mark.parametrize("tracking", ["feedforward", "none", "error"])
+def test_loops_side_by_side_are_each_loop_alone(paper_cfg, tracking):
+    """simulate_loops() with one gain set per loop gives, per loop, every array simulate()
+    gives for the law built from that gain set alone, bit for bit (all laws with gains,
+    each Section 6 reference; PTO gain sets at several d, so zones differ per loop)."""
+    from ptoverify.model.laws import with_state_gains
+    from ptoverify.sim.simulate import simulate_loops
+    from ptoverify.studies.tune import tuned_config
+
+    rng = np.random.default_rng(3)
+    sets = {
+        "pd": [{"kp": float(10 ** rng.uniform(1, 3.4)), "kd": float(rng.uniform(0, 4))}],
+        "pto": [
+            {"d": d, "k1": float(10 ** rng.uniform(1, 3.4)), "k2": float(rng.uniform(0, 5))}
+            for d in (0.3, 0.5, 2.0)
+        ],
+        "ptos": [{"alpha": float(rng.uniform(0.05, 1)), "k": float(10 ** rng.uniform(1, 3))}],
+        "cascade-p": [{"kp": float(10 ** rng.uniform(0, 3))}],
+    }
+    for law, gs in sets.items():
+        gs = gs * 2 if len(gs) == 1 else gs  # at least two loops
+        gs = [
+            dict(g, **{k: v * (1 + 0.1 * i) for k, v in g.items() if k != "d"})
+            for i, g in enumerate(gs)
+        ]
+        per_state = {k: np.array([g[k] for g in gs]) for k in gs[0]}
+        for signal in ("step", "ramp", "sine"):
+            runs = simulate_loops(
+                with_state_gains(law, paper_cfg, per_state),
+                paper_cfg.plant,
+                len(gs),
+                signal,
+                tracking=tracking,
+            )
+            for g, got in zip(gs, runs, strict=True):
+                one = make_law(law, tuned_config(paper_cfg, law, g))
+                want = simulate(one, paper_cfg.plant, signal, tracking=tracking)
+                for k, v in want.columns().items():
+                    assert np.array_equal(v, got.columns()[k]), (law, signal, g, k)
+                assert (got.reference, got.tracking) == (want.reference, want.tracking)
+
+
 def test_segments_merged_per_law_equal_each_segment_alone():
     """simulate_parts runs segments of one law as one batch: bit for bit each alone."""
     from ptoverify.config import paper_config

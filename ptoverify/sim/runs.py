@@ -4,6 +4,7 @@ Catalogue
 ---------
 SimulationRun   a simulated closed loop with the law's note and its summary figures
 run_simulation  simulate a named law on a step, ramp or sine reference
+run_loops       the same for loops of one law object side by side (many gain sets)
 """
 
 from __future__ import annotations
@@ -15,11 +16,18 @@ import numpy as np
 
 from ptoverify.config import Config, Plant
 from ptoverify.errors import InputError
-from ptoverify.model.laws import make_law
+from ptoverify.model.laws import Law, make_law
 from ptoverify.sim.exact import exact_metrics
-from ptoverify.sim.simulate import SimResult, reference, simulate
+from ptoverify.sim.simulate import SimResult, reference, simulate_loops
 
-__all__ = ["SimulationRun", "run_simulation", "check_samples", "MAX_DURATION_S", "MAX_SAMPLES"]
+__all__ = [
+    "SimulationRun",
+    "run_simulation",
+    "run_loops",
+    "check_samples",
+    "MAX_DURATION_S",
+    "MAX_SAMPLES",
+]
 
 
 #: Longest simulated time accepted from a user [s].
@@ -178,6 +186,67 @@ def run_simulation(
     >>> run.summary()["samples"]
     6
     """
+    ref = _checked_reference(cfg, signal, duration, step, ramp_speed, ramp_to, amplitude, frequency)
+    return _runs(cfg, make_law(law, cfg), 1, ref, duration, feedforward)[0]
+
+
+def run_loops(
+    cfg: Config,
+    law: Law,
+    loops: int,
+    signal: str,
+    *,
+    duration: float | None = None,
+    feedforward: bool = True,
+) -> list[SimulationRun]:
+    """Simulate ``loops`` closed loops of one law object side by side (:func:`run_simulation`'s path).
+
+    :func:`run_simulation` is this with the named law and one loop: the same checks
+    of the duration, the same simulation (:func:`ptoverify.sim.simulate.simulate_loops`,
+    each loop's response the one it gives alone).  For measuring many gain sets of
+    a law at once (a law with one gain set per loop,
+    :func:`ptoverify.model.laws.with_state_gains`).
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (the plant).
+    law : Law
+        The law, for ``loops`` states (loop i is state i).
+    loops : int
+        Number of loops, >= 1.
+    signal : str
+        Reference (``step``, ``ramp``, ``sine``; Section 6's).
+    duration : float, optional
+        Simulated time [s], as :func:`run_simulation`.
+    feedforward : bool
+        Feed the reference velocity forward.
+
+    Returns
+    -------
+    list of SimulationRun
+        One per loop, in order.
+
+    Raises
+    ------
+    InputError
+        A duration :func:`run_simulation` refuses.
+    """
+    ref = _checked_reference(cfg, signal, duration, None, None, None, None, None)
+    return _runs(cfg, law, loops, ref, duration, feedforward)
+
+
+def _checked_reference(
+    cfg: Config,
+    signal: str,
+    duration: float | None,
+    step: float | None,
+    ramp_speed: float | None,
+    ramp_to: float | None,
+    amplitude: float | None,
+    frequency: float | None,
+):
+    """Return the reference of :func:`run_simulation`'s arguments, after its checks."""
     if duration is not None:
         if not 0 < duration <= MAX_DURATION_S:
             raise InputError(f"--duration must be in (0, {MAX_DURATION_S:g}] s, got {duration:g}")
@@ -200,6 +269,12 @@ def run_simulation(
         else f"the {signal}'s default duration {ref.duration:g} s"
     )
     check_samples(ref.duration if duration is None else duration, cfg.plant.sample_time, what)
-    fn = make_law(law, cfg)
-    res = simulate(fn, cfg.plant, ref, duration=duration, feedforward=feedforward)
-    return SimulationRun(res, fn.note, cfg.plant)
+    return ref
+
+
+def _runs(
+    cfg: Config, fn: Law, loops: int, ref, duration: float | None, feedforward: bool
+) -> list[SimulationRun]:
+    """Simulate ``loops`` loops of ``fn`` on ``ref``: the simulation of :func:`run_simulation`."""
+    results = simulate_loops(fn, cfg.plant, loops, ref, duration=duration, feedforward=feedforward)
+    return [SimulationRun(res, fn.note, cfg.plant) for res in results]

@@ -48,6 +48,7 @@ __all__ = [
     "SIGNALS",
     "SimResult",
     "simulate",
+    "simulate_loops",
     "BatchResult",
     "Mismatch",
     "simulate_batch",
@@ -165,6 +166,62 @@ def simulate(
     >>> res.reference.frequency, res.reference.duration
     (2.0, 2.5)
     """
+    return simulate_loops(
+        law, plant, 1, signal, duration=duration, tracking=tracking, feedforward=feedforward
+    )[0]
+
+
+def simulate_loops(
+    law: Law,
+    plant: Plant,
+    loops: int,
+    signal: str | Reference = "step",
+    *,
+    duration: float | None = None,
+    tracking: str | None = None,
+    feedforward: bool | None = None,
+) -> list[SimResult]:
+    """Simulate ``loops`` closed loops side by side, each tracking the reference from rest.
+
+    :func:`simulate` is this with one loop.  The law is evaluated on the states of
+    all loops at once, loop i being state i of its batch (a law with one gain set
+    per state, :func:`ptoverify.model.laws.with_state_gains`, drives loop i with gain
+    set i).  Every step of the loop is elementwise over the states, so each loop's
+    response is the one :func:`simulate` gives for it alone.
+
+    Parameters
+    ----------
+    law : Law
+        Feedback law for ``loops`` states.
+    plant : Plant
+        Plant and sample time.
+    loops : int
+        Number of loops, >= 1.
+    signal : str or Reference
+        ``step``, ``ramp``, ``sine`` (Section 6) or any :class:`Reference`.
+    duration : float, optional
+        Simulated time [s]; default the reference's.
+    tracking : str, optional
+        ``feedforward`` (default), ``none`` or ``error`` (module docstring).
+    feedforward : bool, optional
+        Older spelling of ``tracking`` (see :func:`simulate`).
+
+    Returns
+    -------
+    list of SimResult
+        One response per loop, in order (their ``t``, ``r`` and ``r_dot`` are one
+        shared array each).
+
+    Examples
+    --------
+    >>> from ptoverify.config import paper_config
+    >>> from ptoverify.model.laws import with_state_gains
+    >>> cfg = paper_config()
+    >>> law = with_state_gains("pd", cfg, {"kp": [100.0, 200.0], "kd": [0.1, 0.2]})
+    >>> a, b = simulate_loops(law, cfg.plant, 2, "step")
+    >>> bool(a.x1[10] < b.x1[10])
+    True
+    """
     if feedforward is not None:
         if tracking is not None:
             raise TypeError("give tracking or feedforward, not both")
@@ -172,6 +229,8 @@ def simulate(
     tracking = "feedforward" if tracking is None else tracking
     if tracking not in TRACKING:
         raise InputError(f"unknown tracking '{tracking}' (choose from {', '.join(TRACKING)})")
+    if loops < 1:
+        raise InputError(f"loops must be >= 1, got {loops}")
     ref = reference(signal) if isinstance(signal, str) else signal
     if duration is not None:
         ref = replace(ref, duration=float(duration))
@@ -187,21 +246,26 @@ def simulate(
         v, region = law.vector(y1 - r[k], y2 - e2_off[k])
         return np.clip(v + u_add[k], -w, w), region
 
-    X1, X2, U, R = _loop(controller, plant, np.zeros(1), np.zeros(1), n, Mismatch())
-    x1 = X1[:, 0].copy()
-    return SimResult(
-        law.name,
-        ref,
-        tracking,
-        t,
-        r,
-        r_dot,
-        x1,
-        X2[:, 0].copy(),
-        r - x1,
-        U[:, 0].copy(),
-        R[:, 0].copy(),
-    )
+    X1, X2, U, R = _loop(controller, plant, np.zeros(loops), np.zeros(loops), n, Mismatch())
+    out = []
+    for j in range(loops):
+        x1 = X1[:, j].copy()
+        out.append(
+            SimResult(
+                law.name,
+                ref,
+                tracking,
+                t,
+                r,
+                r_dot,
+                x1,
+                X2[:, j].copy(),
+                r - x1,
+                U[:, j].copy(),
+                R[:, j].copy(),
+            )
+        )
+    return out
 
 
 @dataclass(frozen=True)

@@ -45,7 +45,12 @@ from ptoverify.sim.events import grid_rise_time, linear_zone_time, rise_time, si
 from ptoverify.sim.flow import Signal, Trajectory, as_signal
 
 from .batch import BatchSettling, settling_times_batch
-from .response import exact_metrics, metrics_from_arrays, settling_and_overshoot
+from .response import (
+    exact_metrics,
+    metrics_from_arrays,
+    settling_and_overshoot,
+    settling_and_overshoot_many,
+)
 from .types import (
     METRIC_KEYS,
     PHASE_TOL_DEG,
@@ -79,5 +84,6 @@ __all__ = [
     "exact_metrics",
     "metrics_from_arrays",
     "settling_and_overshoot",
+    "settling_and_overshoot_many",
     "settling_times_batch",
 ]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -165,7 +166,7 @@ def _core(tr: Trajectory, sig: Signal, band: float, step_fraction: float | None)
     d2 = _named(SettlingDefinition("custom", "fraction band", band_fraction=frac))
     d01 = _named(SettlingDefinition("custom", "tight band", band_mm=band))
     ov = overshoot(tr, float(sig.r(tr.t[-1]))) if sig.kind in ("step", "ramp") else None
-    nan = np.full(1, math.nan)
+    nan = np.full(1 if tr.x1.ndim == 1 else tr.x1.shape[1], math.nan)
     set2 = settling_time(tr, sig, d2) if sig.amplitude != 0 else Settling(d2, nan, nan, math.nan)
     return set2, settling_time(tr, sig, d01), ov
 
@@ -196,7 +197,8 @@ def settling_and_overshoot(
     The values of ``exact_metrics(res, plant, reference).exact()`` for these keys,
     bit for bit (the same computation, without the sample-grid readings, the rise
     time, the phase and the accuracy bounds): for callers that measure many
-    responses and need only these (the tuning's candidates).
+    responses and need only these (the tuning's candidates).  It is
+    :func:`settling_and_overshoot_many` of the one response.
 
     Parameters
     ----------
@@ -229,16 +231,69 @@ def settling_and_overshoot(
     >>> all(v == full[k] for k, v in settling_and_overshoot(res, cfg.plant).items())
     True
     """
+    return settling_and_overshoot_many(
+        [res], plant, reference, band=band, step_fraction=step_fraction
+    )[0]
+
+
+def settling_and_overshoot_many(
+    results: Sequence[Any],
+    plant: Any,
+    reference: Any = None,
+    *,
+    band: float = TIGHT_BAND,
+    step_fraction: float = STEP_FRACTION,
+) -> list[dict[str, float]]:
+    """:func:`settling_and_overshoot` of responses on one sample grid, measured side by side.
+
+    The responses are the columns of one batch trajectory; every step of the
+    evaluation is per column (the settling times' root finding stops each
+    column on its own), so each value is the one its response gives alone.
+
+    Parameters
+    ----------
+    results : sequence of object
+        Responses with arrays ``t`` [s] (one grid for all), ``x1`` [mm], ``x2``
+        [mm/s], ``u`` [mm/s] (see :func:`exact_metrics`).
+    plant : Plant or float
+        Has ``a`` [rad/s], or is a.
+    reference : Signal, Reference-like or tuple, optional
+        The reference of every response; default the first response's (see
+        :func:`exact_metrics`).
+    band : float
+        Tight settling band [mm].
+    step_fraction : float
+        Classical band as a fraction of the reference's size |amplitude| [-].
+
+    Returns
+    -------
+    list of dict
+        Per response, in order: as :func:`settling_and_overshoot`.
+
+    Raises
+    ------
+    InputError
+        Sample grids that differ, or a response that :func:`settling_and_overshoot`
+        refuses (non-finite samples).
+    """
+    first = results[0]
     if reference is None:
-        reference = getattr(res, "reference", None) or _infer(res)
+        reference = getattr(first, "reference", None) or _infer(first)
+    t = np.asarray(first.t, dtype=float)
+    if any(not np.array_equal(np.asarray(r.t, dtype=float), t) for r in results[1:]):
+        raise InputError("settling_and_overshoot_many: the responses need one sample grid")
     a = plant if isinstance(plant, (int, float)) else plant.a
-    tr = Trajectory.from_samples(res.t, res.x1, res.x2, res.u, float(a))
+    x1, x2, u = (np.column_stack([getattr(r, k) for r in results]) for k in ("x1", "x2", "u"))
+    tr = Trajectory.from_samples(t, x1, x2, u, float(a))
     set2, set01, ov = _core(tr, as_signal(reference), band, step_fraction)
-    return {
-        "overshoot_mm": math.nan if ov is None else float(ov.value[0]),
-        "settling_2pct_s": float(set2.time[0]),
-        "settling_0p01mm_s": float(set01.time[0]),
-    }
+    return [
+        {
+            "overshoot_mm": math.nan if ov is None else float(ov.value[j]),
+            "settling_2pct_s": float(set2.time[j]),
+            "settling_0p01mm_s": float(set01.time[j]),
+        }
+        for j in range(len(results))
+    ]
 
 
 class _Accuracy:
