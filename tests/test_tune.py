@@ -301,7 +301,7 @@ def test_grid_counts_are_the_gate_properties(monkeypatch):
     from ptoverify.config import Config, PDGains, Plant, PTOSettings
     from ptoverify.model.laws import pto_law
     from ptoverify.studies import tune as tune_mod
-    from ptoverify.studies.tune import measure as measure_mod
+    from ptoverify.studies.tune import grid as grid_mod
 
     for cfg, law in ((CFG, "pto"), (CFG, "pd"), (CFG, "to")):
         lp = law_properties(make_law(law, cfg), cfg)
@@ -311,7 +311,7 @@ def test_grid_counts_are_the_gate_properties(monkeypatch):
     assert tune_mod.grid_counts(CFG, "to")[0] > 0, "the sampled TO law chatters"
     # a PTO without its zone on plants where that strides over (the gate's own failing
     # case), on grids that are and are not exactly symmetric
-    monkeypatch.setattr(measure_mod, "make_law", lambda name, c: pto_law(c, None))
+    monkeypatch.setattr(grid_mod, "make_law", lambda name, c: pto_law(c, None))
     for position_range in (20.0, 25.0):
         stride_cfg = Config(
             "stride",
@@ -370,6 +370,55 @@ def test_screen_agrees_with_the_simulate_json_path(law, d):
         ):
             assert (math.isnan(a) and math.isnan(b)) or a == pytest.approx(b, abs=1e-12)
     assert feasible > 0
+
+
+@pytest.mark.parametrize("law", ["pd", "pto", "ptos", "cascade-p"])
+def test_evaluate_batch_is_each_gain_set_on_the_simulate_json_path(law, monkeypatch):
+    """Gain sets evaluated side by side are each what evaluate() gives alone, and every
+    measured number is that of the simulate --json path (response_metrics) bit for bit:
+    over the whole search box (unstable loops, overshoots past the bound, PTO d values
+    with different zones), on the step and (PD, PTO) the ramp; the memo and the fallback
+    that measures each response alone give the same candidates."""
+    from ptoverify.studies.tune import measure as tune_mod
+
+    rng = np.random.default_rng(11)
+    box = tune_mod.BOUNDS[law]
+    batch = []
+    for i in range(24):
+        g = {}
+        for k, (lo, hi) in box.items():
+            u = rng.uniform()
+            g[k] = float(lo * (hi / lo) ** u if k in tune_mod.LOG_GAINS else lo + (hi - lo) * u)
+        if "d" in g:
+            g["d"] = (0.3, 0.8, 2.0)[i % 3]
+        batch.append(g)
+    batch.append(dict(batch[0]))  # a repeat
+    for signal in ("step", "ramp") if law in ("pd", "pto") else ("step",):
+        opts = {"signal": signal, "max_overshoot": 0.05}
+        got = tune_mod.evaluate_batch(CFG, law, batch, **opts)
+        measured = 0
+        for g, c in zip(batch, got, strict=True):
+            assert c.to_json() == tune_mod.evaluate(CFG, law, g, **opts).to_json()
+            if c.reason == "sampled linear loop unstable":
+                continue
+            m = tune_mod.response_metrics(tune_mod.tuned_config(CFG, law, g), law, signal)
+            for k in ("overshoot_mm", "settling_2pct_s", "settling_0p01mm_s"):
+                v = getattr(c, k)
+                assert (math.isnan(v) and math.isnan(m[k])) or v == m[k], (g, signal, k)
+            measured += 1
+        assert measured > 0
+        memo: dict = {}
+        first = tune_mod.evaluate_batch(CFG, law, batch, **opts, memo=memo)
+        again = tune_mod.evaluate_batch(CFG, law, batch, **opts, memo=memo)
+        assert [c.to_json() for c in first] == [c.to_json() for c in again]
+        assert [c.to_json() for c in first] == [c.to_json() for c in got]
+
+    def refuse(*args, **kwargs):
+        raise InputError("one response refused")
+
+    monkeypatch.setattr(tune_mod, "settling_and_overshoot_many", refuse)
+    alone = tune_mod.evaluate_batch(CFG, law, batch, **opts)
+    assert [c.to_json() for c in alone] == [c.to_json() for c in got]
 
 
 def test_side_by_side_searches_are_the_searches_one_by_one(monkeypatch):

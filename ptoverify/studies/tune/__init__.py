@@ -2,8 +2,9 @@
 
 PD (kp, kd), PTO (d, k1, k2) and the baselines PTOS (alpha, k) and cascade P (kp).
 
-measure   one set of gains: Candidate, tuned_config, response_metrics (the
-          ``simulate --json`` path), evaluate, worst_ratio_nt, grid_counts
+measure   gain sets: Candidate, tuned_config, response_metrics (the
+          ``simulate --json`` path), evaluate (and evaluate_batch), worst_ratio_nt
+grid      grid_counts, grid_checked: limit cycles and stride-overs on the gates' grid
 screen    many gain sets' step responses in one simulation (the search's screen)
 search    tune: SciPy's differential evolution (searches side by side through
           ptoverify.sim.lockstep.run_together), a compass polish, the checks;
@@ -15,14 +16,13 @@ fair      fair_tunings: the laws tuned under shared overshoot bounds (FairTuning
 
 from ptoverify.studies.tune.fair import FAIR_BOUNDS, FairTunings, TuneBudget, fair_tunings
 from ptoverify.studies.tune.fronts import FrontGap, front_gap, pareto_front
+from ptoverify.studies.tune.grid import LIMIT_CYCLE_BAND, grid_counts
 from ptoverify.studies.tune.measure import (
     BOUNDS,
-    LIMIT_CYCLE_BAND,
     OBJECTIVES,
     WORST_GRID,
     Candidate,
     evaluate,
-    grid_counts,
     response_metrics,
     tuned_config,
     worst_ratio_nt,

@@ -1,8 +1,8 @@
 """Measuring one set of gains: the response, the constraints, the worst settling / N*T.
 
 Every candidate :func:`ptoverify.studies.tune.tune` reports is measured here, on the
-``simulate --json`` path (:func:`response_metrics`); the grid properties
-(:func:`grid_counts`) on the gates' grid, every state simulated.
+``simulate --json`` path (:func:`response_metrics`); the grid properties in
+:mod:`ptoverify.studies.tune.grid`.
 """
 
 from __future__ import annotations
@@ -21,14 +21,7 @@ from ptoverify.model.laws import make_law, with_state_gains
 from ptoverify.model.memo import memo
 from ptoverify.model.mintime import discrete_min_steps_batch, min_time
 from ptoverify.model.poles import spectral_radii
-from ptoverify.sim.exact import settling_and_overshoot
-from ptoverify.sim.simulate import chunk_states, simulate_batch
-from ptoverify.studies.properties import (
-    default_steps,
-    initial_grid,
-    oscillating,
-    stride_over_counts,
-)
+from ptoverify.sim.exact import settling_and_overshoot, settling_and_overshoot_many
 from ptoverify.studies.sweep import SweepSettings, grid_states, settling_times
 
 OBJECTIVES = ("settling_2pct", "settling_0p01mm", "worst_ratio_nt")
@@ -54,14 +47,13 @@ __all__ = [
     "BOUNDS",
     "PENALTY",
     "WORST_GRID",
-    "LIMIT_CYCLE_BAND",
     "LOG_GAINS",
     "Candidate",
     "tuned_config",
     "response_metrics",
     "worst_ratio_nt",
     "evaluate",
-    "grid_counts",
+    "evaluate_batch",
 ]
 
 
@@ -194,17 +186,39 @@ def response_metrics(cfg: Config, law: str, signal: str) -> dict[str, float]:
     return {k: math.nan if v is None else float(v) for k, v in m.items()}
 
 
-def _settling_overshoot(cfg: Config, law: str, signal: str) -> dict[str, float]:
-    """Overshoot and settling times of :func:`response_metrics`, bit for bit.
+def _settling_overshoot(
+    cfg: Config, law: str, batch: Sequence[dict[str, float]], signal: str
+) -> list[dict[str, float] | InputError]:
+    """Overshoot and settling times of :func:`response_metrics` per gain set, bit for bit.
 
-    The same simulation and the same exact evaluation
-    (:func:`ptoverify.sim.exact.settling_and_overshoot`), without the rise time and the
-    sample-grid readings that a candidate does not carry.
+    Its simulation (:func:`ptoverify.sim.runs.run_loops`, the loops side by side with
+    :func:`~ptoverify.model.laws.with_state_gains`: each entry is ``make_law``'s law of its
+    gains) and its exact evaluation, each response as alone
+    (:func:`ptoverify.sim.exact.settling_and_overshoot_many`); an InputError in the place
+    of a response that evaluation refuses.
     """
-    from ptoverify.sim.runs import run_simulation
+    from ptoverify.sim.runs import run_loops
 
-    res = run_simulation(cfg, law, signal).result  # the very path of simulate --json
-    return settling_and_overshoot(res, cfg.plant, res.reference)
+    per_state = {k: np.array([g[k] for g in batch], dtype=float) for k in BOUNDS[law]}
+    fn = with_state_gains(law, cfg, per_state)
+    runs = [r.result for r in run_loops(cfg, fn, len(batch), signal)]
+    try:
+        return settling_and_overshoot_many(runs, cfg.plant)
+    except InputError:  # some response refused (non-finite samples): each on its own
+        return [_or_error(settling_and_overshoot, res, cfg.plant) for res in runs]
+
+
+def _refused(gains: dict[str, float], reason: str) -> Candidate:
+    """Return the infeasible candidate of gains that cannot be measured, with why."""
+    return Candidate(gains, math.inf, math.nan, math.nan, math.nan, False, reason=reason)
+
+
+def _or_error(fn: Callable, *args: Any) -> Any:
+    """Return ``fn(*args)``, or the InputError it raises."""
+    try:
+        return fn(*args)
+    except InputError as exc:
+        return exc
 
 
 #: Default state grid of :func:`worst_ratio_nt` (n1 x n2 over the envelope).  Even
@@ -362,6 +376,8 @@ def evaluate(
 ) -> Candidate:
     """Evaluate one set of gains under the cheap constraints (not the grid properties).
 
+    :func:`evaluate_batch` of the one gain set.
+
     Parameters
     ----------
     cfg : Config
@@ -387,121 +403,121 @@ def evaluate(
     Candidate
         The candidate (``verified`` False).
     """
-    tcfg = tuned_config(cfg, law, gains)
-    p = cfg.plant
-    nan = math.nan
-    if spectral_radii(p.a, p.sample_time, *linear_gains(cfg, law, gains))[0] >= 1.0:
-        return Candidate(
-            gains, math.inf, nan, nan, nan, False, reason="sampled linear loop unstable"
-        )
-    omega0 = None
-    try:
-        if law == "pto":
-            from ptoverify.model.zones import zone_for_law
-
-            z = zone_for_law(tcfg, "corrected")
-            omega0 = float(z.omega0) if z.omega0 is not None else None
-        if memo is None:
-            m = _settling_overshoot(tcfg, law, signal)
-        else:
-            k = (signal, gains_key(gains))
-            if k not in memo:
-                memo[k] = _settling_overshoot(tcfg, law, signal)
-            m = memo[k]
-    except InputError as exc:
-        return Candidate(gains, math.inf, nan, nan, nan, False, reason=str(exc))
-    if max_overshoot is not None and not m["overshoot_mm"] <= max_overshoot:
-        value = math.inf
-        reason = f"overshoot {m['overshoot_mm']:.4g} mm > {max_overshoot:.4g} mm"
-    else:
-        reason = ""
-        if objective == "worst_ratio_nt":
-            value = (worst_ratio or worst_ratio_nt)(tcfg, law)
-        else:
-            value = m[f"{objective}_s"]
-        if not math.isfinite(value):
-            reason, value = "does not settle", math.inf
-    return Candidate(
-        gains,
-        value,
-        m["settling_2pct_s"],
-        m["settling_0p01mm_s"],
-        m["overshoot_mm"],
-        not reason,
-        reason=reason,
-        omega0=omega0,
-    )
+    return evaluate_batch(
+        cfg,
+        law,
+        [gains],
+        signal=signal,
+        objective=objective,
+        max_overshoot=max_overshoot,
+        worst_ratio=worst_ratio,
+        memo=memo,
+    )[0]
 
 
-LIMIT_CYCLE_BAND = 1e-3  # [mm]
+def evaluate_batch(
+    cfg: Config,
+    law: str,
+    batch: Sequence[dict[str, float]],
+    *,
+    signal: str = "step",
+    objective: str = "settling_2pct",
+    max_overshoot: float | None = None,
+    worst_ratio: Callable[[Config, str], float] | None = None,
+    memo: dict | None = None,
+) -> list[Candidate]:
+    """Evaluate gain sets under the cheap constraints, their responses in one simulation.
 
-
-def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
-    """Limit cycles and stride-overs of ``law`` on the gates' grid.
-
-    The two counts of :func:`ptoverify.studies.properties.law_properties` that the tuning's
-    constraints need, from the same pieces (its grid, horizon, simulation,
-    limit-cycle test over the last quarter of the horizon, and the stride-overs of
-    its crossing masks as :func:`ptoverify.studies.properties.stride_over_counts` counts
-    them), without the other properties; the stride-overs are counted for the PTO
-    only (0 for other laws).
-
-    Every state of the grid is simulated.
-
-    Parameters
-    ----------
-    cfg : Config
-        Configuration the law is built from.
-    law : str
-        Law name.
-
-    Returns
-    -------
-    limit_cycles, stride_overs : int
-        States that end in a sustained oscillation; transitions that stride over l1/l2.
-
-    Examples
-    --------
-    >>> from ptoverify.config import paper_config
-    >>> grid_counts(paper_config(), "pd")
-    (0, 0)
-    """
-    fn = make_law(law, cfg)
-    x1, x2, _ = initial_grid(cfg)
-    steps = default_steps(cfg)
-    cycles = strides = 0
-    size = chunk_states(steps)
-    for s in range(0, x1.size, size):  # each state's trajectory is its own: counts add up
-        res = simulate_batch(fn, cfg.plant, x1[s : s + size], x2[s : s + size], steps)
-        cycles += int(oscillating(res.x1[-max(20, steps // 4) :], LIMIT_CYCLE_BAND).sum())
-        if law == "pto":
-            strides += int(stride_over_counts(res.x1, res.x2, res.region, cfg).sum())
-    return cycles, strides
-
-
-def grid_checked(cfg: Config, law: str, c: Candidate) -> Candidate:
-    """Check the grid properties of a candidate (no limit cycle; PTO: no stride-over).
+    Each gain set is judged on its own (stability of the sampled linear loop, the
+    PTO's zone for its d, the response's overshoot and settling); the responses of
+    those that get that far are simulated side by side (:func:`_settling_overshoot`),
+    each the ``simulate --json`` response of its gains alone, so every candidate is
+    the one its gains give alone.
 
     Parameters
     ----------
     cfg : Config
         Base configuration.
     law : str
-        ``pd`` or ``pto``.
-    c : Candidate
-        The candidate.
+        A key of :data:`BOUNDS`.
+    batch : sequence of dict
+        The gain sets (see :func:`tuned_config`).
+    signal : str
+        Reference of the responses.
+    objective : str
+        One of :data:`OBJECTIVES`.
+    max_overshoot : float, optional
+        Overshoot bound [mm].
+    worst_ratio : callable, optional
+        ``f(cfg, law) -> worst settling / N*T`` for ``objective="worst_ratio_nt"``;
+        default :func:`worst_ratio_nt` on its default grid.
+    memo : dict, optional
+        Keeps the response metrics by (signal, gains), for evaluations that may repeat.
 
     Returns
     -------
-    Candidate
-        ``c`` marked ``verified``, infeasible with the reason where a property fails.
+    list of Candidate
+        One per gain set, in order (``verified`` False).
     """
-    cycles, strides = grid_counts(tuned_config(cfg, law, c.gains), law)
-    bad = []
-    if cycles:
-        bad.append(f"{cycles} limit cycles on the gate grid")
-    if strides:
-        bad.append(f"{strides} stride-overs on the gate grid")
-    if bad:
-        return dataclasses.replace(c, feasible=False, verified=True, reason="; ".join(bad))
-    return dataclasses.replace(c, verified=True)
+    p = cfg.plant
+    out: list[Candidate | None] = [None] * len(batch)
+    tcfgs: dict[int, Config] = {}
+    omega0s: dict[int, float | None] = {}
+    for i, gains in enumerate(batch):
+        tcfg = tuned_config(cfg, law, gains)
+        if spectral_radii(p.a, p.sample_time, *linear_gains(cfg, law, gains))[0] >= 1.0:
+            out[i] = _refused(gains, "sampled linear loop unstable")
+            continue
+        omega0 = None
+        if law == "pto":
+            from ptoverify.model.zones import zone_for_law
+
+            try:
+                z = zone_for_law(tcfg, "corrected")
+            except InputError as exc:
+                out[i] = _refused(gains, str(exc))
+                continue
+            omega0 = float(z.omega0) if z.omega0 is not None else None
+        tcfgs[i], omega0s[i] = tcfg, omega0
+    keys = {i: (signal, gains_key(batch[i])) for i in tcfgs}
+    known = {} if memo is None else memo
+    todo = list({keys[i]: i for i in tcfgs if keys[i] not in known}.values())  # first of each
+    metrics: dict[tuple, dict[str, float] | InputError] = {}
+    if todo:
+        try:
+            ms = _settling_overshoot(cfg, law, [batch[i] for i in todo], signal)
+        except InputError as exc:  # the simulation's checks (the same for every gain set)
+            metrics.update((keys[i], exc) for i in todo)
+        else:
+            new = {keys[i]: m for i, m in zip(todo, ms, strict=True)}
+            metrics.update(new)
+            if memo is not None:  # (a refused response is not kept: evaluate kept none)
+                memo.update((k, m) for k, m in new.items() if not isinstance(m, InputError))
+    for i, tcfg in tcfgs.items():
+        gains = batch[i]
+        m = metrics[keys[i]] if keys[i] in metrics else known[keys[i]]
+        if isinstance(m, InputError):
+            out[i] = _refused(gains, str(m))
+            continue
+        if max_overshoot is not None and not m["overshoot_mm"] <= max_overshoot:
+            value = math.inf
+            reason = f"overshoot {m['overshoot_mm']:.4g} mm > {max_overshoot:.4g} mm"
+        else:
+            reason = ""
+            if objective == "worst_ratio_nt":
+                value = (worst_ratio or worst_ratio_nt)(tcfg, law)
+            else:
+                value = m[f"{objective}_s"]
+            if not math.isfinite(value):
+                reason, value = "does not settle", math.inf
+        out[i] = Candidate(
+            gains,
+            value,
+            m["settling_2pct_s"],
+            m["settling_0p01mm_s"],
+            m["overshoot_mm"],
+            not reason,
+            reason=reason,
+            omega0=omega0s[i],
+        )
+    return out  # type: ignore[return-value]

@@ -8,7 +8,7 @@ constraints for every law:
   (spectral radius < 1 on the ZOH plant);
 * no limit cycle, and for the PTO no stride-over, from any state of the gates'
   grid (:func:`ptoverify.studies.properties.law_properties`, 101 x 101 + 200 states;
-  :func:`grid_counts` computes just these two counts, the same way).
+  :func:`~ptoverify.studies.tune.grid.grid_counts` computes just these two counts, the same way).
 
 The PTO's omega0 always comes from the corrected construction for the
 candidate's d (:func:`ptoverify.model.zones.corrected_zone`); a d for which no zone can
@@ -60,6 +60,7 @@ from ptoverify.errors import InfeasibleError, InputError
 from ptoverify.sim.lockstep import run_together
 from ptoverify.sim.simulate import reference
 from ptoverify.studies.tune.fronts import pareto_front
+from ptoverify.studies.tune.grid import grid_checked
 from ptoverify.studies.tune.measure import (
     BOUNDS,
     LOG_GAINS,
@@ -68,9 +69,8 @@ from ptoverify.studies.tune.measure import (
     PENALTY,
     WORST_GRID,
     Candidate,
-    evaluate,
+    evaluate_batch,
     gains_key,
-    grid_checked,
     tuned_config,
     worst_ratios,
 )
@@ -457,30 +457,39 @@ def tune_checked(
                     screened_candidate(cfg, law, g, r, **opts, ratio=q)
                     for g, r, q in zip(gs_new, raws, ratios, strict=True)
                 ]
-            else:  # evaluated one by one on the simulate --json path
-                cs = [evaluate(cfg, law, g, signal=signal, **opts) for g in new.values()]
+            else:  # evaluated on the simulate --json path, the batch side by side
+                cs = evaluate_batch(cfg, law, list(new.values()), signal=signal, **opts)
             seen.update(zip(new, cs, strict=True))
         return [seen[key(g)] for g in gs]
 
     measured: dict[tuple, Candidate] = {}
 
-    def canonical(c: Candidate) -> Candidate:
-        """Return the candidate measured on the simulate --json path (what tune reports)."""
-        k = key(c.gains)
-        if screen is None:  # the search measured it on that path already
-            return c
-        if k not in measured:
-            measured[k] = evaluate(
+    def canonical_many(cs: list[Candidate]) -> list[Candidate]:
+        """Return the candidates measured on the simulate --json path (what tune reports).
+
+        Those not measured there yet are measured side by side (:func:`evaluate_batch`:
+        each as it is alone).
+        """
+        if screen is None:  # the search measured them on that path already
+            return cs
+        new = {key(c.gains): c.gains for c in cs if key(c.gains) not in measured}
+        if new:
+            vs = evaluate_batch(
                 cfg,
                 law,
-                c.gains,
+                list(new.values()),
                 signal=signal,
                 objective=objective,
                 max_overshoot=max_overshoot,
                 worst_ratio=worst_ratio,
                 memo=remeasured,
             )
-        return measured[k]
+            measured.update(zip(new, vs, strict=True))
+        return [measured[key(c.gains)] for c in cs]
+
+    def canonical(c: Candidate) -> Candidate:
+        """Return the candidate measured on the simulate --json path (what tune reports)."""
+        return canonical_many([c])[0]
 
     keys = tuple(k for k in BOUNDS[law] if k != "d")
     if law != "pto":
@@ -551,7 +560,8 @@ def tune_checked(
     # the front over the evaluated candidates, less those the grid check rejected, with
     # its members' numbers measured on the simulate --json path
     pool = pareto_front([c for c in seen.values() if c.feasible or not c.verified])
-    front = pareto_front([c if c.verified else canonical(c) for c in pool])
+    remeasure = iter(canonical_many([c for c in pool if not c.verified]))
+    front = pareto_front([c if c.verified else next(remeasure) for c in pool])
     return TuneResult(
         law=law,
         signal=signal,
