@@ -9,9 +9,11 @@ to a candidate.
 from __future__ import annotations
 
 import dataclasses
+import threading
 
 from ptoverify.config import Config
 from ptoverify.model.laws import make_law
+from ptoverify.model.memo import memo
 from ptoverify.sim.simulate import chunk_states, simulate_batch
 from ptoverify.studies.properties import (
     default_steps,
@@ -37,7 +39,9 @@ def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
     them), without the other properties; the stride-overs are counted for the PTO
     only (0 for other laws).
 
-    Every state of the grid is simulated.
+    Every state of the grid is simulated, once per configuration and law (memoized:
+    tunings under two bounds often reach the same candidate; the side-by-side
+    searches run in threads, so one computes it while the other waits).
 
     Parameters
     ----------
@@ -57,6 +61,15 @@ def grid_counts(cfg: Config, law: str) -> tuple[int, int]:
     >>> grid_counts(paper_config(), "pd")
     (0, 0)
     """
+    with _ONE_AT_A_TIME:  # (the threads share the GIL: waiting costs no parallelism)
+        return _grid_counts(cfg, law)
+
+
+_ONE_AT_A_TIME = threading.Lock()
+
+
+@memo(maxsize=64)
+def _grid_counts(cfg: Config, law: str) -> tuple[int, int]:
     fn = make_law(law, cfg)
     x1, x2, _ = initial_grid(cfg)
     steps = default_steps(cfg)
