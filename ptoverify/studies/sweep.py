@@ -63,7 +63,7 @@ from ptoverify.model.mintime import discrete_min_steps_batch, min_time
 from ptoverify.sim.exact import BatchSettling
 from ptoverify.sim.flow import Trajectory
 from ptoverify.sim.settling import DEFINITIONS, SettlingDefinition, settling_time
-from ptoverify.sim.simulate import simulate_batch
+from ptoverify.sim.simulate import chunk_states, simulate_batch
 from ptoverify.studies.grids import even_points, grid_states
 
 __all__ = [
@@ -265,9 +265,6 @@ class SweepResult:
         }
 
 
-#: States simulated at once by default (about 20 MB of trajectories at 384 samples).
-CHUNK = 2048
-
 #: Most samples per trajectory (horizon) a sweep may simulate: 80 x the paper's (about
 #: 620).  The hold is fixed in seconds (0.05 s), so a fine sample time (T = 1e-7 s: 5e5
 #: samples of hold) would otherwise run without bound.
@@ -283,7 +280,7 @@ def settling_times(
     band: float,
     velocity_band: float,
     hold: float,
-    chunk: int = CHUNK,
+    chunk: int | None = None,
 ) -> BatchSettling:
     """Settling times of ``law`` from each state, between samples and on the grid.
 
@@ -306,9 +303,12 @@ def settling_times(
         Half-widths of the settled box [mm], [mm/s].
     hold : float
         Shortest settled tail [s].
-    chunk : int
+    chunk : int, optional
         At most this many states simulated at once (memory: about 25 bytes x
-        chunk x steps).
+        chunk x steps); default :func:`ptoverify.sim.simulate.chunk_states` of the
+        horizon (at most 24 MiB per trajectory array: the next chunk reuses the
+        memory of the last; 2,048 states, which the sweep used before, cost it
+        about 40 % more CPU in per-sample overhead).
 
     Returns
     -------
@@ -317,6 +317,7 @@ def settling_times(
         from which every later sample is in the box [s]; NaN where not settled.
     """
     box = sweep_definition(plant, band, velocity_band, hold)
+    chunk = chunk_states(steps) if chunk is None else chunk
     ts, tg = np.empty(x1.size), np.empty(x1.size)
     acc = 0.0
     t = np.arange(steps + 1) * plant.sample_time
@@ -498,7 +499,7 @@ def run_sweep(
             continue
         t1 = time.perf_counter()
         settle[name] = settling_times(
-            law, plant, X1.ravel(), X2.ravel(), steps, s.band, vband, s.hold, CHUNK
+            law, plant, X1.ravel(), X2.ravel(), steps, s.band, vband, s.hold
         )
         secs[name] = time.perf_counter() - t1
         timings[f"simulate_{name}"] = secs[name]
