@@ -276,7 +276,8 @@ def plot_robust_map(
     for (i, j), v in np.ndenumerate(z):
         text = missing if not np.isfinite(v) else f"{v:.3g}"
         dark = np.isfinite(v) and v > 0.6 * top
-        ax.text(j, i, text, ha="center", va="center", fontsize=7, color="w" if dark else "k")
+        colour = "w" if dark else "k"  # (inside its cell: no part of the layout)
+        ax.text(j, i, text, ha="center", va="center", fontsize=7, color=colour, in_layout=False)
     ax.set_xticks(range(len(ars)), [f"{r:.3g}" for r in ars], fontsize=7)
     ax.set_yticks(range(len(wrs)), [f"{r:.3g}" for r in wrs], fontsize=7)
     ax.set_xlabel(r"$a_{\mathrm{true}}/a_{\mathrm{design}}$ [-]")

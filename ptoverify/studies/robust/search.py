@@ -30,7 +30,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import differential_evolution
-from scipy.stats import qmc
 
 from ptoverify.config import Config
 from ptoverify.errors import InputError
@@ -141,6 +140,8 @@ def _initial(
     cfg: Config, prop: str, delay: int, starts: list[Start], size: int, rng
 ) -> NDArray[np.float64]:
     """Return the first population (size, 4): grid worst cells of ``delay``, then an LHS."""
+    from scipy.stats import qmc  # here: scipy.stats costs 0.4 s to import, and only this uses it
+
     lo, hi = _box_bounds(cfg, prop)
     pop = lo + (hi - lo) * qmc.LatinHypercube(d=4, rng=rng).random(size)
     mine = [g for g in starts if g.delay_samples == delay]
