@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ptoverify.config import Config
+from ptoverify.config import Config, Plant
 from ptoverify.model.curves import level_curve_x1, level_residual, level_term, root_22
+from ptoverify.model.memo import memo
 from ptoverify.model.plant import flow
 from ptoverify.verdict import tie_band
 
@@ -23,33 +24,80 @@ def _l1star_x1(x2: NDArray[np.float64], a: float, omega0: ArrayLike) -> NDArray[
     """x1 on l1* at velocity x2 < 0 (eq. 13); omega0 <= 0 gives the limit x1 = -x2 / a."""
     omega0 = np.asarray(omega0, dtype=float)
     with np.errstate(all="ignore"):
+        if np.all(omega0 <= 0.0):  # the limit everywhere (smallest_d): no curve to evaluate
+            return np.broadcast_to(-x2 / a, np.broadcast_shapes(x2.shape, omega0.shape))
         return np.where(
             omega0 <= 0.0, -x2 / a, level_curve_x1(x2, a, np.where(omega0 <= 0.0, 1.0, omega0))
         )
 
 
-def _source_intervals(cfg: Config, omega0: ArrayLike, x2: NDArray[np.float64], d: float):
+def _source_intervals(
+    cfg: Config,
+    omega0: ArrayLike,
+    x2: NDArray[np.float64],
+    d: float,
+    l2: NDArray[np.float64] | None = None,
+):
     """Left/right ends of the source x1-intervals at each velocity (u = -w_max, |x1| >= d).
 
     Returns two intervals (lo, hi) per velocity, of the broadcast shape of
     ``omega0`` [mm/s] and ``x2`` [mm/s] for the first (right of l1*, x1 >= d) and
-    of ``x2`` for the second (l2 <= x1 <= -d); an empty one has lo > hi.
+    of ``x2`` for the second (l2 <= x1 <= -d); an empty one has lo > hi.  ``l2``:
+    :func:`_velocity_terms`' x1 on l2 at ``x2`` when the caller has it.
     """
     a, w = cfg.plant.a, cfg.plant.w_max
     neg = x2 < 0
     l1s = np.where(neg, _l1star_x1(np.where(neg, x2, -1.0), a, np.minimum(omega0, w)), 0.0)
     lo_a = np.where(neg, np.maximum(l1s, d), d)  # right piece: x1 >= d
-    return (lo_a, np.inf), _l2_sources(cfg, x2, d)
+    return (lo_a, np.inf), _l2_sources(cfg, x2, d, l2)
 
 
-def _l2_sources(cfg: Config, x2: NDArray[np.float64], d: float):
+def _l2_sources(
+    cfg: Config, x2: NDArray[np.float64], d: float, l2: NDArray[np.float64] | None = None
+):
     """Return the left piece of the sources, l2 <= x1 <= -d (free of omega0)."""
     pos = x2 > 0
-    with np.errstate(all="ignore"):
-        l2 = level_curve_x1(np.where(pos, x2, 1.0), cfg.plant.a, cfg.plant.w_max)
+    if l2 is None:
+        l2 = _l2_x1(cfg.plant, x2)
     lo_b = np.where(pos & (l2 <= -d), l2, np.inf)
     hi_b = np.full_like(x2, -d)
     return lo_b, hi_b
+
+
+def _l2_x1(plant: Plant, x2: NDArray[np.float64]) -> NDArray[np.float64]:
+    """x1 on l2 at the velocities x2 > 0 (others: at x2 = 1, unused) [mm]."""
+    with np.errstate(all="ignore"):
+        return level_curve_x1(np.where(x2 > 0, x2, 1.0), plant.a, plant.w_max)
+
+
+def _velocity_terms(plant: Plant, x2: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
+    """Return what :func:`principle_margin` reads off the velocity alone (no omega0, no d).
+
+    (c1, term, l2): the landing after one sample under -w_max is F1 = x1 + c1 with
+    sigma(F) = a F1 + term, and l2's x1 at ``x2`` (:func:`_l2_x1`).
+    """
+    a, w = plant.a, plant.w_max
+    c1, f2 = flow(0.0, x2, -w, plant.sample_time, a)  # F1 = x1 + c1, F2 = f2
+    with np.errstate(all="ignore"):
+        term = level_term(f2, w)  # sigma(F) = a F1 + term: the part that is x1-free
+    return c1, term, _l2_x1(plant, x2)
+
+
+#: The even velocities of :func:`_worst_margins` (their number).
+EVEN_POINTS = 4001
+
+
+@memo(maxsize=64)
+def _even_velocities(plant: Plant) -> tuple[NDArray[np.float64], ...]:
+    """Return the :data:`EVEN_POINTS` even velocities over [-w_max, w_max] and their terms.
+
+    Once per plant (read-only arrays): x2 and :func:`_velocity_terms` of it.
+    """
+    x2 = np.linspace(-plant.w_max, plant.w_max, EVEN_POINTS)
+    out = (x2, *_velocity_terms(plant, x2))
+    for arr in out:
+        arr.setflags(write=False)
+    return out
 
 
 def principle_margin(
@@ -59,7 +107,7 @@ def principle_margin(
     *,
     reading: str = "strict",
     d: float | None = None,
-    points: int = 4001,
+    points: int = EVEN_POINTS,
 ) -> NDArray[np.float64]:
     """Worst landing residual of the principle at each velocity, exact in x1.
 
@@ -78,7 +126,8 @@ def principle_margin(
     d : float, optional
         Linear-zone half-width [mm]; default ``cfg.pto.d``.
     points : int
-        Number of velocities when ``x2`` is not given.
+        Number of velocities when ``x2`` is not given (the default grid and what
+        depends on its velocities alone are computed once per plant).
 
     Returns
     -------
@@ -90,17 +139,24 @@ def principle_margin(
         alone (the landing after one sample, the l2 side) is computed on ``x2``
         and broadcast, the l1* side on the broadcast shape.
     """
-    if reading not in READINGS:
-        raise ValueError(f"reading must be one of {READINGS}")
-    a, w = cfg.plant.a, cfg.plant.w_max
-    d = cfg.pto.d if d is None else d
+    w = cfg.plant.w_max
     if x2 is None:
+        if points == EVEN_POINTS:  # the default grid: its velocity terms are kept per plant
+            x2, *terms = _even_velocities(cfg.plant)
+            return _margin_at(cfg, omega0, x2, terms, reading, d)
         x2 = np.linspace(-w, w, points)
     x2 = np.asarray(x2, dtype=float)
-    c1, f2 = flow(0.0, x2, -w, cfg.plant.sample_time, a)  # F1 = x1 + c1, F2 = f2
-    with np.errstate(all="ignore"):
-        term = level_term(f2, w)  # sigma(F) = a F1 + term: the part that is x1-free
-    (lo_a, hi_a), (lo_b, hi_b) = _source_intervals(cfg, omega0, x2, d)
+    return _margin_at(cfg, omega0, x2, _velocity_terms(cfg.plant, x2), reading, d)
+
+
+def _margin_at(cfg: Config, omega0, x2, terms, reading: str, d: float | None):
+    """:func:`principle_margin` at velocities ``x2`` whose :func:`_velocity_terms` are given."""
+    if reading not in READINGS:
+        raise ValueError(f"reading must be one of {READINGS}")
+    a = cfg.plant.a
+    d = cfg.pto.d if d is None else d
+    c1, term, l2 = terms
+    (lo_a, hi_a), (lo_b, hi_b) = _source_intervals(cfg, omega0, x2, d, l2)
     return np.minimum(
         _side_margin(lo_a, hi_a, c1, term, a, d, reading),
         _side_margin(lo_b, hi_b, c1, term, a, d, reading),
@@ -140,7 +196,7 @@ def _kinks_many(cfg: Config, omegas: NDArray[np.float64], d: float) -> list[list
     if d > 0:
         zone = (omegas > 0) & (omegas < w)
         ys = root_22(a * d / omegas[zone]) if zone.any() else np.empty(0)
-        y_l2 = w * float(root_22(a * d / w))
+        y_l2 = _l2_kink(a, w, d)
         it = iter(ys)
         for lst, om, inside in zip(out, omegas.tolist(), zone.tolist(), strict=True):
             if inside:
@@ -151,13 +207,24 @@ def _kinks_many(cfg: Config, omegas: NDArray[np.float64], d: float) -> list[list
     return [[v for v in lst if -w <= v <= w] for lst in out]
 
 
+@memo(maxsize=256)
+def _l2_kink(a: float, w: float, d: float) -> float:
+    """Velocity [mm/s] where l2 meets x1 = -d: w_max y, h(y) = a d / w_max (free of omega0)."""
+    return w * float(root_22(a * d / w))
+
+
 def _worst_margin(cfg: Config, omega0: float, reading: str, d: float | None = None) -> float:
     """Dense worst margin over |x2| <= w_max [mm/s] (:func:`_worst_margins` of one omega0)."""
     return _worst_margins(cfg, np.array([float(omega0)]), reading, d)[0]
 
 
 def _worst_margins(
-    cfg: Config, omegas: NDArray[np.float64], reading: str, d: float | None = None
+    cfg: Config,
+    omegas: NDArray[np.float64],
+    reading: str,
+    d: float | None = None,
+    *,
+    floor: float = -np.inf,
 ) -> list[float]:
     """Dense worst margin over |x2| <= w_max for each omega0 of an array [mm/s].
 
@@ -166,29 +233,37 @@ def _worst_margins(
     around each of the 8 lowest local minima of the even grid.  The even grids of
     all omega0 are one broadcast :func:`principle_margin` call and the refinement
     points (different per omega0) one elementwise call.
+
+    An omega0 whose even grid already falls below ``floor`` [mm/s] is not refined
+    (the refinement can only lower its minimum): its value is that of the even grid,
+    below ``floor`` as its worst margin is, which is all a test ``>= floor`` reads.
     """
     w = cfg.plant.w_max
     d = cfg.pto.d if d is None else d
     omegas = np.asarray(omegas, dtype=float).ravel()
-    x2 = np.linspace(-w, w, 4001)
-    M = principle_margin(cfg, omegas[:, None], x2, reading=reading, d=d)
+    x2 = _even_velocities(cfg.plant)[0]  # principle_margin's default velocities
+    M = principle_margin(cfg, omegas[:, None], reading=reading, d=d)
+    lows = M.min(axis=1)
+    refine = np.flatnonzero(~(lows < floor))  # (NaN rows refined as before)
     step = x2[1] - x2[0]
     is_min = (M[:, 1:-1] <= M[:, :-2]) & (M[:, 1:-1] <= M[:, 2:])
-    kinks = _kinks_many(cfg, omegas, d)
+    kinks = _kinks_many(cfg, omegas[refine], d)
     fines = []
-    for k in range(omegas.size):
+    for k, kink in zip(refine.tolist(), kinks, strict=True):
         loc = np.flatnonzero(is_min[k]) + 1
         loc = loc[np.argsort(M[k][loc])[:8]]
         bands = np.linspace(x2[loc] - step, x2[loc] + step, 201, axis=1).ravel()
-        fines.append(np.clip(np.concatenate([np.array(kinks[k]), bands]), -w, w))
+        fines.append(np.clip(np.concatenate([np.array(kink), bands]), -w, w))
+    out = [float(v) for v in lows]
+    if not fines:
+        return out
     sizes = np.array([f.size for f in fines])
     pts = np.concatenate(fines)
-    fm = principle_margin(cfg, np.repeat(omegas, sizes), pts, reading=reading, d=d)
+    fm = principle_margin(cfg, np.repeat(omegas[refine], sizes), pts, reading=reading, d=d)
     ends = np.cumsum(sizes)
-    return [
-        float(min(M[k].min(), fm[end - n : end].min(initial=np.inf)))
-        for k, (n, end) in enumerate(zip(sizes.tolist(), ends.tolist(), strict=True))
-    ]
+    for k, n, end in zip(refine.tolist(), sizes.tolist(), ends.tolist(), strict=True):
+        out[k] = float(min(M[k].min(), fm[end - n : end].min(initial=np.inf)))
+    return out
 
 
 def principle_violations(
