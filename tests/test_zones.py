@@ -313,3 +313,62 @@ def test_corrected_zone_names_y_star_and_z_star_as_the_paper():
     assert z.y_star < z.z_star
     # l1* passes through (d, x~20): its level curve at x2 = x~20 is at x1 = d
     assert_allclose(level_curve_x1(z.x20_tilde, a, z.omega0), d, rtol=1e-9, err_msg="x1 [mm]")
+
+
+@pytest.mark.parametrize("name", ["paper", "a30", "d1"])
+@pytest.mark.parametrize("reading", ["strict", "lenient"])
+def test_feasibility_floor_changes_no_decision(name, reading):
+    """A worst-margin test against a floor skips refining the omega0 whose even grid is
+    already below it: every decision is that of the full worst margin, and every omega0
+    it refines has the full worst margin (scan of the construction, both readings)."""
+    from ptoverify.model.zones.margins import _tol, _worst_margins
+
+    cfg = CONFIGS[name]
+    w = cfg.plant.w_max
+    omegas = np.concatenate([[0.0], np.geomspace(1e-4 * w, w, 100), np.linspace(w / 200, w, 100)])
+    tol = _tol(cfg)
+    full = np.array(_worst_margins(cfg, omegas, reading))
+    floored = np.array(_worst_margins(cfg, omegas, reading, floor=-tol))
+    assert np.array_equal(full >= -tol, floored >= -tol)
+    kept = floored >= -tol
+    assert kept.any()
+    if reading == "strict":  # (under the lenient reading these plants meet it everywhere)
+        assert (~kept).any(), "some omega0 of the scan fails, so the floor skips some"
+    assert np.array_equal(full[kept], floored[kept])
+
+
+def _edge_one_halving_at_a_time(cfg, reading, good, bad):
+    """The edge bisection as written before issue 23: one halving per evaluation."""
+    from ptoverify.model.zones.corrected import _feasible_many
+    from ptoverify.model.zones.margins import _tol, _worst_margins
+
+    w = cfg.plant.w_max
+    for _ in range(60):
+        mid = 0.5 * (good + bad)
+        ok = _worst_margins(cfg, np.array([mid]), reading)[0] >= -_tol(cfg)  # no floor
+        assert ok == _feasible_many(cfg, np.array([mid]), reading, _tol(cfg))[0]
+        good, bad = (mid, bad) if ok else (good, mid)
+        if abs(good - bad) <= 1e-10 * w:
+            break
+    return good
+
+
+@pytest.mark.parametrize("name", ["paper", "a30", "d1"])
+def test_feasible_interval_edges_are_the_one_halving_bisection(name):
+    """The construction's interval edges (two halvings per evaluation) are those of the
+    bisection one halving at a time, bit for bit, from the scan's bracketing points."""
+    cfg = CONFIGS[name]
+    w, scan = cfg.plant.w_max, 200
+    grid = np.unique(
+        np.concatenate([np.geomspace(1e-4 * w, w, scan // 2), np.linspace(w / scan, w, scan // 2)])
+    )
+    z = cz(name)
+    assert z.feasible_intervals, "the configuration has a feasible omega0"
+    for lo, hi in z.feasible_intervals:
+        for edge, inside in ((lo, True), (hi, False)):
+            if edge in (0.0, w):
+                continue
+            # the scan's neighbours of the edge: the feasible one and the infeasible one
+            j = int(np.searchsorted(grid, edge))
+            good, bad = (grid[j], grid[j - 1]) if inside else (grid[j - 1], grid[j])
+            assert _edge_one_halving_at_a_time(cfg, "strict", float(good), float(bad)) == edge
