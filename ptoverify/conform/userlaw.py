@@ -43,7 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ptoverify.config import Config
-from ptoverify.conform.agreement import failure
+from ptoverify.conform.findings import failure
 from ptoverify.errors import InputError
 
 __all__ = [
