@@ -6,6 +6,8 @@ wrong constant each.  They run through the command line (``ptoverify.cli.main`` 
 this process; each law in its isolated child, as ``ptoverify conform`` runs it).
 """
 
+import contextlib
+import io
 import json
 import math
 from pathlib import Path
@@ -54,6 +56,21 @@ def cli(capsys, monkeypatch):
     return run
 
 
+@pytest.fixture(scope="module")
+def ptos_report(tmp_path_factory):
+    """``conform --law examples/my_baselines.py:ptos --reference ptos --json --report DIR``, once.
+
+    Read by the command line test of ``ptos`` and by the report test: ``--report`` adds
+    a folder, not another verdict.  Returns (exit code, stdout, stderr, DIR).
+    """
+    review = tmp_path_factory.mktemp("ptos") / "review"
+    argv = ["--law", f"{EXAMPLE}:ptos", "--reference", "ptos", "--json", "--report", str(review)]
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(["conform", *argv])
+    return code, out.getvalue(), err.getvalue(), review
+
+
 @pytest.mark.parametrize(
     "fn, ref, conforms",
     [
@@ -63,8 +80,12 @@ def cli(capsys, monkeypatch):
         ("cascade_p_hz", "cascade-p", False),
     ],
 )
-def test_examples_through_the_command_line(cli, fn, ref, conforms):
-    p = cli("--law", f"examples/my_baselines.py:{fn}", "--reference", ref)
+def test_examples_through_the_command_line(cli, request, fn, ref, conforms):
+    if fn == "ptos":  # the run the report test reads too
+        code, out, err, _ = request.getfixturevalue("ptos_report")
+        p = SimpleNamespace(returncode=code, stdout=out, stderr=err)
+    else:
+        p = cli("--law", f"examples/my_baselines.py:{fn}", "--reference", ref)
     assert p.returncode == (0 if conforms else 1), p.stderr
     data = json.loads(p.stdout)
     assert data["conforms"] is conforms and data["reference"] == ref
@@ -175,19 +196,8 @@ def test_config_table_selects_the_reference(tmp_path, capsys):
         assert out["reference"] == "cascade-p" and out["conforms"] is (code == 0)
 
 
-def test_report_names_the_baseline(tmp_path, capsys):
-    out = tmp_path / "review"
-    code = main(
-        [
-            "conform",
-            "--law",
-            str(EXAMPLE) + ":ptos",
-            "--reference",
-            "ptos",
-            "--report",
-            str(out),
-        ]
-    )
+def test_report_names_the_baseline(ptos_report):
+    code, _, _, out = ptos_report
     assert code == 0
     md = (out / "report.md").read_text()
     assert "reference ptos law" in md and "| reference law | ptos |" in md.replace("  ", " ")
