@@ -200,6 +200,36 @@ def test_law_writing_to_the_frozen_config_is_a_finding(paper_cfg):
     assert "cfg.plant.w_max" in failures[0]["detail"]
 
 
+def test_configuration_sent_to_the_law_hashes_as_one_built_there(paper_cfg):
+    """The law's process gets the configuration as a pickle (copy likewise): a hash the
+    judging process remembered is not sent (a string's hash differs between processes);
+    the copy computes its own, equal to that of an equal configuration, and is equal."""
+    import copy
+    import pickle
+    import subprocess as sp
+
+    from ptoverify.config import paper_config
+
+    h = hash(paper_cfg)  # remembered from here on
+    for other in (pickle.loads(pickle.dumps(paper_cfg)), copy.deepcopy(paper_cfg)):
+        assert other == paper_cfg and hash(other) == h == hash(paper_config())
+        assert {paper_cfg: 1}[other] == 1
+    # in another process (its own string hashes): the unpickled copy hashes as one built there
+    code = (
+        "import pickle, sys\nfrom ptoverify.config import paper_config\n"
+        "c = pickle.loads(sys.stdin.buffer.read())\n"
+        "print(c == paper_config(), hash(c) == hash(paper_config()), {paper_config(): 1}[c])"
+    )
+    p = sp.run(
+        [sys.executable, "-c", code],
+        input=pickle.dumps(paper_cfg),
+        capture_output=True,
+        env=dict(os.environ, PYTHONPATH=str(ROOT), PYTHONHASHSEED="random"),
+        timeout=60,
+    )
+    assert p.stdout.split() == [b"True", b"True", b"1"], p.stderr[-500:]
+
+
 # ------------------------------------------------------------------ tables
 @pytest.mark.parametrize(
     "text, words",
