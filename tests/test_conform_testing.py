@@ -37,7 +37,7 @@ from ptoverify.testing import assert_conforms
 
 CASES = {
     "os_exit_0": ("os._exit(0)", "{}", "exited with code 0"),
-    "hang": ("time.sleep(10_000)", "{'timeout': 4}", "timeout"),
+    "hang": ("time.sleep(10_000)", "{'timeout': 2.5}", "timeout"),
     "memory": ("bytearray(64 << 30)", "{}", "MemoryError"),
     "pytest_skip": ("pytest.skip('not today')", "{}", "Skipped"),
     # audit R2: a KeyboardInterrupt from the law is the law's, not the user pressing Ctrl-C
