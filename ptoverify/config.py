@@ -73,6 +73,54 @@ DESIGN_BANDWIDTHS_HZ: tuple[float, ...] = (8.0, 15.0, 30.0, 60.0, 100.0)  # a T 
 DESIGN_GRID = 10  #: envelope states per axis of a design point (even: the origin is off the grid)
 
 
+_HASH_KEY = "_hash"  #: instance key of a remembered hash (not a field: eq, repr, asdict skip it)
+
+
+def _hash_once(cls: type) -> type:
+    """Make a frozen dataclass compute its hash once per instance.
+
+    The dataclass's own hash (of the tuple of its fields) is remembered in the
+    instance the first time it is asked for: the fields of a frozen dataclass do
+    not change, and a configuration is a memo key (:mod:`ptoverify.model.memo`)
+    and a law's ``functools.lru_cache`` key at every call, where hashing the
+    nested fields again cost more than the law.  Equality, ``repr``,
+    :func:`dataclasses.asdict` and :func:`dataclasses.replace` see only the
+    fields.  The remembered value is left out of the state that :mod:`pickle`
+    and :mod:`copy` take (a string's hash differs between processes), so an
+    unpickled configuration computes its own.
+
+    Parameters
+    ----------
+    cls : type
+        A frozen dataclass (``@dataclass(frozen=True)`` already applied).
+
+    Returns
+    -------
+    type
+        ``cls`` with ``__hash__`` and ``__getstate__`` replaced.
+    """
+    field_hash = cls.__hash__
+
+    def __hash__(self) -> int:
+        try:
+            return self.__dict__[_HASH_KEY]
+        except KeyError:
+            value = field_hash(self)
+            object.__setattr__(self, _HASH_KEY, value)
+            return value
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = dict(self.__dict__)
+        state.pop(_HASH_KEY, None)
+        return state
+
+    __hash__.__doc__ = field_hash.__doc__
+    cls.__hash__ = __hash__
+    cls.__getstate__ = __getstate__
+    return cls
+
+
+@_hash_once
 @dataclass(frozen=True)
 class Plant:
     """Plant of eq. (1), sampled with zero-order hold.
@@ -100,6 +148,7 @@ class Plant:
         return self.sample_time
 
 
+@_hash_once
 @dataclass(frozen=True)
 class PDGains:
     """Gains of the PD law u = kp (r - x1) - kd x2.
@@ -116,6 +165,7 @@ class PDGains:
     kd: float = 1.15
 
 
+@_hash_once
 @dataclass(frozen=True)
 class PTOSettings:
     """Settings of the PTO law, eq. (35).
@@ -135,6 +185,7 @@ class PTOSettings:
     k2: float = 3.6
 
 
+@_hash_once
 @dataclass(frozen=True)
 class PTOSGains:
     """Settings of the PTOS baseline (table ``[ptos]``, optional).
@@ -152,6 +203,7 @@ class PTOSGains:
     k: float | None = None
 
 
+@_hash_once
 @dataclass(frozen=True)
 class CascadeGains:
     """Gain of the cascade P baseline (table ``[cascade]``, optional).
@@ -166,6 +218,7 @@ class CascadeGains:
     kp: float | None = None
 
 
+@_hash_once
 @dataclass(frozen=True)
 class Config:
     """A full configuration: plant, PD gains and PTO settings.

@@ -2,11 +2,14 @@
 ``conform --law`` in double precision (conforms), single precision judged as a float64
 function (does not, and why) and single precision under ``--precision float32`` (conforms)."""
 
+import contextlib
+import io
 import json
 import shutil
 from pathlib import Path
 
 import pytest
+from test_conform_report import check_complete, check_map_is_the_agreement, check_responses
 
 from ptoverify.cli import main
 
@@ -25,14 +28,41 @@ def _conform(capsys, func, tmp_path, *extra):
     return code, json.loads(capsys.readouterr().out), junit
 
 
+@pytest.fixture(scope="module")
+def double_build(tmp_path_factory):
+    """One ``conform --json --junit --report`` of the double build, read by two tests.
+
+    ``--report`` adds a folder, not another verdict (the report's run judges as
+    ``conform`` does); returns (exit code, JSON result, JUnit file, report folder).
+    """
+    tmp = tmp_path_factory.mktemp("c_double")
+    junit, review = tmp / "pto.xml", tmp / "review"
+    argv = ["--json", "--junit", str(junit), "--report", str(review)]
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        code = main(["conform", "--law", f"{SPEC}:pto", *argv])
+    return code, json.loads(out.getvalue()), junit, review
+
+
 @pytest.mark.slow
-def test_c_double_build_conforms(capsys, tmp_path):
-    code, res, junit = _conform(capsys, "pto", tmp_path)
+def test_c_double_build_conforms(double_build):
+    code, res, junit, _ = double_build
     assert code == 0 and res["conforms"], res["failures"]
     assert res["agreement"]["max_abs_du"] <= 1e-9 * 300.0, "double C port differs beyond round-off"
     assert junit.read_text().count("<testcase") == len(res["properties"]) + len(
         res["agreement"]["regions"]
     )
+
+
+@pytest.mark.slow
+def test_c_law_report(double_build, paper_cfg):
+    """The double build's report: complete, conforming, the map and the responses."""
+    code, _, _, review = double_build
+    assert code == 0
+    res = check_complete(review)
+    assert res["conform"]["conforms"] is True
+    check_map_is_the_agreement(res)
+    check_responses(res, paper_cfg, agree_mm=1e-9)
 
 
 @pytest.mark.slow

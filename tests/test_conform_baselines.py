@@ -2,15 +2,16 @@
 
 The implementations judged are examples/my_baselines.py: scalar copies written
 from the equations (not from the suite's code), two correct and two with one
-wrong constant each.  They run through the real command line.
+wrong constant each.  They run through the command line (``ptoverify.cli.main`` in
+this process; each law in its isolated child, as ``ptoverify conform`` runs it).
 """
 
+import contextlib
+import io
 import json
 import math
-import os
-import subprocess
-import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -35,16 +36,39 @@ def _example():
     return mod
 
 
-def _cli(*argv, config=None):
-    extra = [] if config is None else ["--config", str(config)]
-    return subprocess.run(
-        [sys.executable, "-m", "ptoverify", "conform", *argv, *extra, "--json"],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=ROOT,
-        env=dict(os.environ, PYTHONPATH=str(ROOT)),
-    )
+@pytest.fixture
+def cli(capsys, monkeypatch):
+    """``ptoverify conform ... --json`` through ``ptoverify.cli.main``, run from the checkout.
+
+    In this process (the law still runs in its isolated child): the command line is
+    what is tested here, not the interpreter's start-up.  Returns the exit code,
+    stdout and stderr as ``returncode``, ``stdout``, ``stderr``.
+    """
+    monkeypatch.chdir(ROOT)  # the specs name examples/my_baselines.py relative to it
+
+    def run(*argv, config=None):
+        extra = [] if config is None else ["--config", str(config)]
+        capsys.readouterr()
+        code = main(["conform", *argv, *extra, "--json"])
+        out, err = capsys.readouterr()
+        return SimpleNamespace(returncode=code, stdout=out, stderr=err)
+
+    return run
+
+
+@pytest.fixture(scope="module")
+def ptos_report(tmp_path_factory):
+    """``conform --law examples/my_baselines.py:ptos --reference ptos --json --report DIR``, once.
+
+    Read by the command line test of ``ptos`` and by the report test: ``--report`` adds
+    a folder, not another verdict.  Returns (exit code, stdout, stderr, DIR).
+    """
+    review = tmp_path_factory.mktemp("ptos") / "review"
+    argv = ["--law", f"{EXAMPLE}:ptos", "--reference", "ptos", "--json", "--report", str(review)]
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(["conform", *argv])
+    return code, out.getvalue(), err.getvalue(), review
 
 
 @pytest.mark.parametrize(
@@ -56,8 +80,12 @@ def _cli(*argv, config=None):
         ("cascade_p_hz", "cascade-p", False),
     ],
 )
-def test_examples_through_the_command_line(fn, ref, conforms):
-    p = _cli("--law", f"examples/my_baselines.py:{fn}", "--reference", ref)
+def test_examples_through_the_command_line(cli, request, fn, ref, conforms):
+    if fn == "ptos":  # the run the report test reads too
+        code, out, err, _ = request.getfixturevalue("ptos_report")
+        p = SimpleNamespace(returncode=code, stdout=out, stderr=err)
+    else:
+        p = cli("--law", f"examples/my_baselines.py:{fn}", "--reference", ref)
     assert p.returncode == (0 if conforms else 1), p.stderr
     data = json.loads(p.stdout)
     assert data["conforms"] is conforms and data["reference"] == ref
@@ -125,16 +153,16 @@ def test_baseline_probes_crowd_its_edge_and_have_no_ties():
         assert near.mean() > 0.2  # the n/4 edge band sits at the baseline's edge
 
 
-def test_reference_is_bad_input_when_unknown(tmp_path):
+def test_reference_is_bad_input_when_unknown(cli, tmp_path):
     with pytest.raises(InputError, match="--reference"):
         with_reference(paper_config(), "pd")
     with pytest.raises(ConfigError, match="conform.reference"):
         config_from_mapping({**PAPER_MAPPING, "conform": {"reference": "xyz"}})
-    p = _cli("--law", "examples/my_baselines.py:ptos", "--reference", "xyz")
+    p = cli("--law", "examples/my_baselines.py:ptos", "--reference", "xyz")
     assert p.returncode == 2 and p.stdout == "" and "ptoverify: error:" in p.stderr
     cfgfile = tmp_path / "c.toml"
     cfgfile.write_text(_paper_toml() + '\n[conform]\nreference = "xyz"\n')
-    p = _cli("--law", "examples/my_baselines.py:ptos", config=cfgfile)
+    p = cli("--law", "examples/my_baselines.py:ptos", config=cfgfile)
     assert p.returncode == 2 and "conform.reference" in p.stderr and p.stdout == ""
 
 
@@ -168,19 +196,8 @@ def test_config_table_selects_the_reference(tmp_path, capsys):
         assert out["reference"] == "cascade-p" and out["conforms"] is (code == 0)
 
 
-def test_report_names_the_baseline(tmp_path, capsys):
-    out = tmp_path / "review"
-    code = main(
-        [
-            "conform",
-            "--law",
-            str(EXAMPLE) + ":ptos",
-            "--reference",
-            "ptos",
-            "--report",
-            str(out),
-        ]
-    )
+def test_report_names_the_baseline(ptos_report):
+    code, _, _, out = ptos_report
     assert code == 0
     md = (out / "report.md").read_text()
     assert "reference ptos law" in md and "| reference law | ptos |" in md.replace("  ", " ")
@@ -240,10 +257,10 @@ def test_baseline_edge_beyond_the_envelope_is_the_envelope(table, name):
     assert np.all(np.abs(u) < w)
 
 
-def test_cli_emit_grid_with_zero_cascade_gain(tmp_path):
+def test_cli_emit_grid_with_zero_cascade_gain(cli, tmp_path):
     cfgfile = tmp_path / "c.toml"
     cfgfile.write_text(_paper_toml() + "\n[cascade]\nkp = 0\n")
     out = tmp_path / "g.csv"
-    p = _cli("--emit-grid", str(out), "--reference", "cascade-p", config=cfgfile)
+    p = cli("--emit-grid", str(out), "--reference", "cascade-p", config=cfgfile)
     assert p.returncode == 0, p.stderr
     assert "internal error" not in p.stderr and out.stat().st_size > 0

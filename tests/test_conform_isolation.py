@@ -31,11 +31,12 @@ def cli(*argv, timeout=HARD_S):
 
 
 def law_file(tmp_path, body):
+    """Write the law; only a law that calls the reference imports it (the rest load no more)."""
+    head = "import os, time, signal\n"
+    if "reference_law" in body:
+        head += "from ptoverify.conform.gate import reference_law\n"
     path = tmp_path / "law.py"
-    path.write_text(
-        "import os, time, signal\nfrom ptoverify.conform.gate import reference_law\n"
-        + textwrap.dedent(body)
-    )
+    path.write_text(head + textwrap.dedent(body))
     return f"{path}:f"
 
 

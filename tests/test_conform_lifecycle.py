@@ -21,15 +21,18 @@ ROOT = Path(__file__).resolve().parents[1]
 PROC = Path("/proc")
 pytestmark = pytest.mark.skipif(not PROC.is_dir(), reason="needs /proc to find processes")
 
+#: ``{marker}``: a file the law creates when it starts looping (outside the run's TMPDIR);
+#: it loops from its fourth call on, in the mode detection (what it answered before is moot)
 LOOPING = """\
-from ptoverify.conform.gate import reference_law
+from pathlib import Path
 n = [0]
 def f(x1, x2, cfg):
     n[0] += 1
     if n[0] > 3:
+        Path({marker!r}).touch()
         while True:
             pass
-    return reference_law(x1, x2, cfg)
+    return 0.0
 """
 
 FORKING = """\
@@ -102,9 +105,10 @@ def wait_for(predicate, limit: float) -> bool:
 
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM, signal.SIGINT])
 def test_killed_conform_leaves_no_process_and_no_file(tmp_path, sig):
+    marker = tmp_path / "looping"
     proc, tag, tmpdir = start(
         tmp_path,
-        LOOPING,
+        LOOPING.format(marker=str(marker)),
         "--timeout",
         "600",
         stdout=subprocess.DEVNULL,
@@ -113,7 +117,8 @@ def test_killed_conform_leaves_no_process_and_no_file(tmp_path, sig):
     try:
         # the law's child is up and looping (CPU time grows) before the kill
         assert wait_for(lambda: len(tagged(tag)) >= 2, 60), "the law's process never started"
-        time.sleep(1.5)
+        assert wait_for(marker.exists, 60), "the law never started looping"
+        time.sleep(0.3)
         proc.send_signal(sig)
         proc.wait(10)
         left = [] if wait_for(lambda: not tagged(tag), 5.0) else tagged(tag)

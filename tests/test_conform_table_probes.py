@@ -7,6 +7,8 @@ written with columns x1, x2, u, then ``conform --table`` through
 ``ptoverify.cli.main``.
 """
 
+import contextlib
+import io
 import json
 
 import numpy as np
@@ -14,6 +16,7 @@ import pytest
 from pto_mutants import BENIGN, MUTANTS, make_law
 
 from ptoverify.cli import main
+from ptoverify.config import paper_config
 from ptoverify.conform import agreement as agreement_mod
 from ptoverify.conform.agreement import (
     LATTICE,
@@ -93,6 +96,31 @@ def conform_json(capsys, table):
     return code, json.loads(out)
 
 
+@pytest.fixture(scope="module")
+def mutant_table(tmp_path_factory, emitted, emitted_rows):
+    """``judge(name)``: (exit code, JSON) of ``conform --table`` of a variant's table.
+
+    The variant of ``tests/pto_mutants.py`` evaluated at the emitted states (as
+    firmware does), the table written from the emitted rows; each variant judged
+    once per module (two tests read the tie-asymmetry mutant's verdict).
+    """
+    done, cfg = {}, paper_config()
+
+    def judge(name):
+        if name not in done:
+            x1, x2 = emitted
+            u = evaluate(make_law([name]), x1, x2, cfg)
+            path = write_rows(tmp_path_factory.mktemp("table") / f"{name}.csv", emitted_rows, u)
+            out = io.StringIO()
+            with contextlib.redirect_stdout(out):
+                code = main(["conform", "--table", str(path), "--json"])
+            path.unlink()  # 10 MB each
+            done[name] = code, json.loads(out.getvalue())
+        return done[name]
+
+    return judge
+
+
 # ------------------------------------------------------------------ the probe set
 def test_emitted_file_is_the_probe_set(emitted, paper_cfg):
     """Grid, 100,000 random states and the band, in that order, exactly (repr round trip)."""
@@ -161,11 +189,9 @@ def test_reference_at_emitted_states_conforms(capsys, tmp_path, emitted, paper_c
 
 
 @pytest.mark.parametrize("name", BANDS)
-def test_band_mutant_killed_through_table(capsys, tmp_path, emitted, paper_cfg, emitted_rows, name):
+def test_band_mutant_killed_through_table(mutant_table, name):
     """5 % slow between grid columns: caught at the emitted random/band states."""
-    x1, x2 = emitted
-    u = evaluate(make_law([name]), x1, x2, paper_cfg)
-    code, data = conform_json(capsys, write_rows(tmp_path / "m.csv", emitted_rows, u))
+    code, data = mutant_table(name)
     assert code == 1 and not data["conforms"]
     fail = next(f for f in data["failures"] if f["property"] == "agreement")
     assert in_band(name, fail["state"]), fail
@@ -184,13 +210,9 @@ def test_band_mutant_on_grid_only_is_insufficient_coverage(capsys, tmp_path, pap
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(set(MUTANTS) - set(BANDS)))
-def test_every_mutant_killed_through_table(
-    capsys, tmp_path, emitted, paper_cfg, emitted_rows, name
-):
+def test_every_mutant_killed_through_table(mutant_table, name):
     """Memory faults show too: the batches make a stateful law disagree with itself."""
-    x1, x2 = emitted
-    u = evaluate(make_law([name]), x1, x2, paper_cfg)
-    code, data = conform_json(capsys, write_rows(tmp_path / "m.csv", emitted_rows, u))
+    code, data = mutant_table(name)
     assert code == 1 and not data["conforms"], f"{name} ({MUTANTS[name]}) conforms by table"
     props = {f["property"] for f in data["failures"]}
     assert props & {"agreement", "odd-symmetry", "input-bound-grid"}, props
@@ -198,20 +220,14 @@ def test_every_mutant_killed_through_table(
         assert "odd-symmetry" in props and "curve tie" in data["failures"][0]["detail"]
 
 
-def test_tie_asymmetry_killed_through_table(capsys, tmp_path, emitted, paper_cfg, emitted_rows):
-    x1, x2 = emitted
-    u = evaluate(make_law(["tie_asym"]), x1, x2, paper_cfg)
-    code, data = conform_json(capsys, write_rows(tmp_path / "t.csv", emitted_rows, u))
+def test_tie_asymmetry_killed_through_table(mutant_table):
+    code, data = mutant_table("tie_asym")
     assert code == 1 and [f["property"] for f in data["failures"]] == ["odd-symmetry"]
 
 
 @pytest.mark.parametrize("name", sorted(set(BENIGN) - {"faithful"}))
-def test_benign_variants_conform_through_table(
-    capsys, tmp_path, emitted, paper_cfg, emitted_rows, name
-):
-    x1, x2 = emitted
-    u = evaluate(make_law([name]), x1, x2, paper_cfg)
-    code, data = conform_json(capsys, write_rows(tmp_path / "b.csv", emitted_rows, u))
+def test_benign_variants_conform_through_table(mutant_table, name):
+    code, data = mutant_table(name)
     assert code == 0, data["failures"][:2]
 
 

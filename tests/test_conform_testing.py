@@ -1,9 +1,14 @@
 """``ptoverify.testing.assert_conforms`` is isolated like the CLI (issue 27, item 2).
 
-Each case writes a user's test file that calls ``assert_conforms`` on a hostile
-law and runs a real inner pytest on it in a subprocess (with a hard timeout):
-the inner test must FAIL with a clear message, never pass, skip or hang, and
-the inner run must go on to its end (its summary line is printed).
+A user's test file holds one test per hostile law, each calling ``assert_conforms``
+on it, and a last test that passes; one real inner pytest runs that file in a
+subprocess (with a hard timeout).  Each case's inner test must FAIL with a clear
+message (in its own failure report), never pass, skip or hang, and the inner run
+must go on to its end: every hostile test failed, the last one passed, the
+summary line printed.  One inner run for all the cases (a module fixture) rather
+than one per case: each law still runs in its own child process, and a law that
+broke the run (a ``KeyboardInterrupt`` or ``pytest.skip`` reaching the inner
+pytest, an exit of it) would now also show as the other cases missing.
 """
 
 import os
@@ -21,17 +26,18 @@ from ptoverify.errors import InputError
 ROOT = Path(__file__).resolve().parents[1]
 HARD_S = 120  #: limit of one inner pytest run [s]
 
+#: the user's imports; each law imports the reference where it calls it, after its hostile
+#: statement, so a law's process loads the reference only if the law gets that far
 HEADER = """\
 import os, time
 import numpy as np
 import pytest
-from ptoverify.conform.gate import reference_law
 from ptoverify.testing import assert_conforms
 """
 
 CASES = {
     "os_exit_0": ("os._exit(0)", "{}", "exited with code 0"),
-    "hang": ("time.sleep(10_000)", "{'timeout': 4}", "timeout"),
+    "hang": ("time.sleep(10_000)", "{'timeout': 2.5}", "timeout"),
     "memory": ("bytearray(64 << 30)", "{}", "MemoryError"),
     "pytest_skip": ("pytest.skip('not today')", "{}", "Skipped"),
     # audit R2: a KeyboardInterrupt from the law is the law's, not the user pressing Ctrl-C
@@ -44,25 +50,33 @@ CASES = {
 }
 
 
-def inner_pytest(tmp_path: Path, statement: str, kwargs: str) -> subprocess.CompletedProcess:
-    test = tmp_path / "test_user_law.py"
-    test.write_text(
-        HEADER
-        + textwrap.dedent(
+def user_test_file(names) -> str:
+    """The user's test file: for each case a law and a test gating it, then a passing test."""
+    body = HEADER
+    for name in names:
+        statement, kwargs, _ = CASES[name]
+        body += textwrap.dedent(
             f"""
-            def law(x1, x2, cfg):
+
+            def law_{name}(x1, x2, cfg):
                 {statement}
+                from ptoverify.conform.gate import reference_law
                 return reference_law(x1, x2, cfg)
 
-            def test_law_conforms():
-                assert_conforms(law, **{kwargs})
-
-            def test_the_run_goes_on():
-                assert True
+            def test_law_conforms_{name}():
+                assert_conforms(law_{name}, **{kwargs})
             """
         )
-    )
-    return subprocess.run(
+    return body + "\n\ndef test_the_run_goes_on():\n    assert True\n"
+
+
+@pytest.fixture(scope="module")
+def inner_run(tmp_path_factory):
+    """One inner pytest over every case: (exit code, output, failure report per test name)."""
+    tmp_path = tmp_path_factory.mktemp("inner")
+    test = tmp_path / "test_user_law.py"
+    test.write_text(user_test_file(sorted(CASES)))
+    p = subprocess.run(
         [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-rfEs", str(test)],
         capture_output=True,
         text=True,
@@ -70,6 +84,12 @@ def inner_pytest(tmp_path: Path, statement: str, kwargs: str) -> subprocess.Comp
         cwd=tmp_path,
         env=dict(os.environ, PYTHONPATH=str(ROOT)),
     )
+    out = p.stdout + p.stderr
+    # pytest's failure reports: "____ test_name ____" up to the next one or the summary
+    heads = list(re.finditer(r"^_{3,} (test_\w+) _{3,}$", p.stdout, re.M))
+    ends = [m.start() for m in heads[1:]] + [p.stdout.find("short test summary info")]
+    reports = {m.group(1): p.stdout[m.end() : end] for m, end in zip(heads, ends)}
+    return p.returncode, out, reports
 
 
 FAST = ("os_exit_0", "pytest_skip", "keyboard_interrupt")  #: the rest is marked slow
@@ -78,14 +98,16 @@ FAST = ("os_exit_0", "pytest_skip", "keyboard_interrupt")  #: the rest is marked
 @pytest.mark.parametrize(
     "name", [n if n in FAST else pytest.param(n, marks=pytest.mark.slow) for n in sorted(CASES)]
 )
-def test_hostile_law_fails_the_users_test(tmp_path, name):
-    statement, kwargs, words = CASES[name]
-    p = inner_pytest(tmp_path, statement, kwargs)
-    out = p.stdout + p.stderr
-    assert p.returncode == 1, f"inner pytest exit {p.returncode}:\n{out[-2000:]}"
-    assert re.search(r"1 failed, 1 passed in", out), out[-2000:]
-    assert "FAILED test_user_law.py::test_law_conforms" in out, out[-2000:]
-    assert "does not conform" in out and words in out, out[-3000:]
+def test_hostile_law_fails_the_users_test(inner_run, name):
+    code, out, reports = inner_run
+    _, _, words = CASES[name]
+    assert code == 1, f"inner pytest exit {code}:\n{out[-2000:]}"
+    assert re.search(rf"\b{len(CASES)} failed, 1 passed in", out), out[-2000:]
+    assert f"FAILED test_user_law.py::test_law_conforms_{name}" in out, out[-2000:]
+    report = reports.get(f"test_law_conforms_{name}", "")
+    # the AssertionError's message: its "E" lines (not the source pytest shows above them)
+    message = "\n".join(line for line in report.splitlines() if line.startswith("E "))
+    assert "does not conform" in message and words in message, report[-3000:] or out[-3000:]
 
 
 def module_level(x1, x2, cfg):

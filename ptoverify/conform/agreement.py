@@ -203,6 +203,7 @@ def agreement(
     rtol: float = DEFAULT_RTOL,
     *,
     precision: str = "float64",
+    keep: dict | None = None,
 ) -> tuple[dict, list[dict]]:
     """Compare u with the reference law, region by region.
 
@@ -219,6 +220,9 @@ def agreement(
     precision : str
         ``float64``, or ``float32``: the reference at the state rounded to
         float32, float32 ties excluded (:mod:`ptoverify.conform.precision`).
+    keep : dict, optional
+        Receives ``reference``: (u_ref, region, tie) of :func:`reference_values` at
+        the states (the report's maps read them instead of computing them again).
 
     Returns
     -------
@@ -232,6 +236,8 @@ def agreement(
     w = cfg.plant.w_max
     tol = rtol * w
     u_ref, reg, tie = reference_values(x1, x2, cfg, precision=precision)
+    if keep is not None:
+        keep["reference"] = (u_ref, reg, tie)
     du = np.abs(u - u_ref)
     judged = ~tie
     bad = judged & (du > tol)

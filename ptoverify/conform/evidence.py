@@ -474,15 +474,20 @@ class ConformEvidence:
 
 
 def _maps(
-    states, cfg: Config, bounds: Boundaries, tol: float, precision: str = "float64"
+    states, cfg: Config, bounds: Boundaries, tol: float, precision: str = "float64", values=None
 ) -> tuple[list[DuMap], int, int]:
-    """Both maps from the judged states (ties excluded, as the agreement does)."""
+    """Both maps from the judged states (ties excluded, as the agreement does).
+
+    ``values``: the agreement's (u_ref, region, tie) at those states, if it kept them.
+    """
     if states is None:
         x1 = x2 = du = np.zeros(0)
         excluded = 0
     else:
         x1, x2, u = (np.asarray(s, dtype=float) for s in states)
-        u_ref, _, tie = reference_values(x1, x2, cfg, _CHUNK, precision)
+        if values is None:
+            values = reference_values(x1, x2, cfg, _CHUNK, precision)
+        u_ref, _, tie = values
         du = np.abs(u - u_ref)
         excluded = int(tie.sum())
         x1, x2, du = x1[~tie], x2[~tie], du[~tie]
@@ -558,7 +563,9 @@ def conform_with_evidence(
             settle_note = "not computed" + (f": {prop.detail}" if prop is not None else "")
     bounds = boundaries(cfg)
     tol = rtol * cfg.plant.w_max
-    maps, judged, excluded = _maps(keep.get("states"), cfg, bounds, tol, precision)
+    maps, judged, excluded = _maps(
+        keep.get("states"), cfg, bounds, tol, precision, keep.get("reference")
+    )
     settling = settling_summary(keep["settling"]) if "settling" in keep else None
     evidence = ConformEvidence(
         maps,

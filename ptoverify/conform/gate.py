@@ -288,8 +288,9 @@ class _Options:
 def _judge(user, failures: list[dict], cfg: Config, opt: _Options, keep=None):
     """Evaluate every property in order; returns (props, agreement, timings, runs).
 
-    ``keep`` (a dict) receives the judged states ``states`` = (x1, x2, u) and the
-    per-state ``settling`` (:func:`settling_states`) when they were computed.
+    ``keep`` (a dict) receives the judged states ``states`` = (x1, x2, u), the
+    reference's values there ``reference`` (:func:`agreement`) and the per-state
+    ``settling`` (:func:`settling_states`) when they were computed.
     """
     props: dict[str, Verdict] = {}
     agree: dict = {"pass": False, "detail": "not run"}
@@ -364,7 +365,7 @@ def _judge(user, failures: list[dict], cfg: Config, opt: _Options, keep=None):
         x1, x2, u = np.concatenate(xs), np.concatenate(ys), np.concatenate(us)
         if keep is not None:
             keep["states"] = (x1, x2, u)
-        agree, f = agreement(x1, x2, u, cfg, opt.rtol, precision=opt.precision)
+        agree, f = agreement(x1, x2, u, cfg, opt.rtol, precision=opt.precision, keep=keep)
         agree["sources"] = sources
         agree["gap"] = largest_gap(x1, x2, cfg)
         failures += f
@@ -509,7 +510,8 @@ def conform_spec(
         As :func:`conform_callable`.
     keep : dict, optional
         Receives the evidence behind the verdict: ``states`` (x1, x2, u of every
-        judged state), ``settling`` (:func:`settling_states`), and what ``after``
+        judged state), ``reference`` (u_ref, region, tie there), ``settling``
+        (:func:`settling_states`), and what ``after``
         returned (``after``) or why it could not run (``after_error``).
     after : callable, optional
         ``after(law)`` is called with the live isolated law once every property

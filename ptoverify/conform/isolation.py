@@ -312,6 +312,7 @@ class IsolatedLaw:
         finally:
             child.close()
         self._closed = False
+        self._busy = True  # loading, or a call sent and its answer not read yet
         try:
             _send_pickle(self._sock, ("init", list(sys.path), spec, cfg))
         except OSError:
@@ -336,6 +337,7 @@ class IsolatedLaw:
             The child hung, crashed or exited while loading.
         """
         head, _ = self._recv("loading the law and detecting its mode", self.timeout, 0)
+        self._busy = False
         if head.get("kind") == "input":
             raise InputError(str(head.get("message")))
         if head.get("kind") != "ready":
@@ -391,6 +393,7 @@ class IsolatedLaw:
         what = (
             f"a call of {x1.size} states from ({x1[0]:.6g}, {x2[0]:.6g})" if x1.size else "a call"
         )
+        self._busy = True
         try:
             _send_pickle(self._sock, ("call", x1, x2))
         except OSError:
@@ -398,6 +401,7 @@ class IsolatedLaw:
         self.calls += 1 if self.mode == "vectorized" else x1.size
         per_state = _CALL_PER_STATE_S * max(1.0, self.timeout / DEFAULT_TIMEOUT_S)
         head, u = self._recv(what, CALL_BASE_S + per_state * x1.size, x1.size)
+        self._busy = False
         kind = head.get("kind")
         if kind == "ok":
             if u is None and x1.size == 0:
@@ -441,12 +445,17 @@ class IsolatedLaw:
             pass
 
     def close(self) -> str:
-        """Stop the child and return what the law printed (stdout and stderr)."""
+        """Stop the child and return what the law printed (stdout and stderr).
+
+        A child that answered its last call is asked to stop and given 2 s; one
+        still loading or inside a call (the wait for it was interrupted: Ctrl-C,
+        SIGTERM) cannot read the request, so it is killed at once.
+        """
         if self._closed:
             return ""
         self._closed = True
         try:
-            if self._alive():
+            if self._alive() and not self._busy:
                 _send_pickle(self._sock, ("stop",))
                 self._proc.wait(2.0)
         except (OSError, subprocess.TimeoutExpired):

@@ -28,6 +28,7 @@ from ptoverify.config import Config
 from ptoverify.conform.reflaw import linear_edge, omega0_ref, tie_band
 from ptoverify.errors import InputError
 from ptoverify.model.curves import level_curve_x1, root_22
+from ptoverify.model.memo import memo
 
 __all__ = [
     "N_RANDOM",
@@ -54,6 +55,11 @@ MATCH_TOL = 1e-6  #: a table state matches a probe within this fraction of R, w_
 def conformance_grid(cfg: Config, n: int = 61, n_curve: int = 121) -> tuple[NDArray, NDArray]:
     """States dense near every curve, boundary, the origin and |x2| = w_max.
 
+    Built once per (configuration, ``n``, ``n_curve``) in a process
+    (:mod:`ptoverify.model.memo`): every conformance, the determinism states, the
+    probe set and a table's coverage read the same grid.  The arrays are
+    read-only (shared).
+
     An ``n`` x ``n`` background over |x1| <= position_range, |x2| <= w_max, plus,
     for ``n_curve`` speeds |x2| (geometric from 1e-6 w_max, and linear):
 
@@ -78,8 +84,14 @@ def conformance_grid(cfg: Config, n: int = 61, n_curve: int = 121) -> tuple[NDAr
     -------
     x1, x2 : ndarray
         States [mm], [mm/s], inside the envelope, duplicates removed, symmetric
-        under x -> -x.
+        under x -> -x; read-only.
     """
+    return _conformance_grid(cfg, int(n), int(n_curve))
+
+
+@memo(maxsize=16)
+def _conformance_grid(cfg: Config, n: int, n_curve: int) -> tuple[NDArray, NDArray]:
+    """Build :func:`conformance_grid` (memoized; read-only arrays)."""
     p = cfg.plant
     a, w, R, d = p.a, p.w_max, p.position_range, linear_edge(cfg)
     band = tie_band(cfg)
@@ -133,7 +145,9 @@ def conformance_grid(cfg: Config, n: int = 61, n_curve: int = 121) -> tuple[NDAr
     keep = (np.abs(x1) <= R) & (np.abs(x2) <= w)
     x1, x2 = np.concatenate([x1[keep], -x1[keep]]), np.concatenate([x2[keep], -x2[keep]])
     pts = np.unique(np.stack([x1, x2], axis=1), axis=0)
-    return pts[:, 0].copy(), pts[:, 1].copy()
+    x1, x2 = pts[:, 0].copy(), pts[:, 1].copy()
+    x1.flags.writeable = x2.flags.writeable = False  # shared by every caller (memo)
+    return x1, x2
 
 
 def random_states(cfg: Config, n: int = N_RANDOM) -> tuple[NDArray, NDArray]:

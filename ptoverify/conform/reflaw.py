@@ -2,7 +2,8 @@
 
 Part of ``ptoverify conform`` (:mod:`ptoverify.conform.gate` has the command's
 decisions): the reference law, the float64 curve tie band, omega0 of the
-reference's switching zone and the failure entry every property reports.
+reference's switching zone, and (re-exported from :mod:`ptoverify.conform.findings`) the
+failure entry every property reports.
 
 The reference is ``make_law(cfg.conform.reference, cfg)``: the corrected PTO
 (``pto``, default) or a baseline (``ptos``, ``cascade-p``,
@@ -21,6 +22,7 @@ from dataclasses import replace
 
 from ptoverify import verdict
 from ptoverify.config import Config
+from ptoverify.conform.findings import failure
 from ptoverify.conform_limits import CONFORM_REFERENCES
 from ptoverify.errors import InputError
 from ptoverify.model.laws import Law, make_law
@@ -178,29 +180,3 @@ def omega0_ref(cfg: Config) -> float | None:
     z = zone_for_law(cfg, "corrected")
     ok = z.usable and not z.degenerate and 0.0 < z.omega0 < cfg.plant.w_max
     return float(z.omega0) if ok else None
-
-
-def failure(prop: str, state, detail: str, **extra) -> dict:
-    """Return a failure entry: property, state [x1, x2], detail (and extra keys).
-
-    Parameters
-    ----------
-    prop : str
-        The property (or ``evaluation``, ``isolation``).
-    state : sequence of 2 floats
-        The first state that shows it, x1 [mm], x2 [mm/s].
-    detail : str
-        What failed.
-    **extra
-        More keys (``sample``, ``at``).
-
-    Returns
-    -------
-    dict
-    """
-    return {
-        "property": prop,
-        "state": [float(state[0]), float(state[1])],
-        "detail": detail,
-        **extra,
-    }

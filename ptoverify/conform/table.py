@@ -31,6 +31,7 @@ from ptoverify.conform.closedloop import CLOSED_PROPERTIES
 from ptoverify.conform.reflaw import has_curves
 from ptoverify.conform.result import ConformResult, agreement_verdict, input_bound
 from ptoverify.model.laws import Region
+from ptoverify.model.memo import memo
 from ptoverify.verdict import FAIL, NOT_RUN, PASS, Verdict
 
 __all__ = ["MIN_PER_REGION", "conform_table"]
@@ -38,12 +39,22 @@ __all__ = ["MIN_PER_REGION", "conform_table"]
 MIN_PER_REGION = 100  #: judged table states per reference region (the origin: 1)
 
 
-def _coverage(agree: dict, cov: dict, cfg: Config) -> Verdict:
-    """Judge coverage: the probe set held, or the lattice filled and every region populated."""
+@memo(maxsize=8)
+def _needed_regions(cfg: Config) -> tuple[str, ...]:
+    """Return the reference's regions a table must populate: those it has on the grid.
+
+    A baseline: only its regions of positive area (those the lattice states meet).
+    """
     need = region_counts(*conformance_grid(cfg), cfg)
     if not has_curves(cfg):  # a baseline: only its regions of positive area (module docstring)
         lattice = region_counts(*random_states(cfg, LATTICE * LATTICE), cfg)
         need = {k: v for k, v in need.items() if k in lattice}
+    return tuple(need)
+
+
+def _coverage(agree: dict, cov: dict, cfg: Config) -> Verdict:
+    """Judge coverage: the probe set held, or the lattice filled and every region populated."""
+    need = _needed_regions(cfg)
     have = {k: v["points"] - v["excluded"] for k, v in agree["regions"].items()}
     short = []
     for name in need:
@@ -132,7 +143,8 @@ def conform_table(
     rtol : float
         Agreement tolerance relative to w_max.
     keep : dict, optional
-        Receives ``states`` = (x1, x2, u), the table's states and values.
+        Receives ``states`` = (x1, x2, u), the table's states and values, and
+        ``reference`` = (u_ref, region, tie) there (:func:`agreement`).
     precision : str
         ``float64`` or ``float32`` (:mod:`ptoverify.conform.precision`).
 
@@ -150,7 +162,7 @@ def conform_table(
     t_read = time.perf_counter() - t0
     if keep is not None:
         keep["states"] = (x1, x2, u)
-    agree, failures = agreement(x1, x2, u, cfg, rtol, precision=precision)
+    agree, failures = agreement(x1, x2, u, cfg, rtol, precision=precision, keep=keep)
     agree["sources"] = {"table": int(x1.size)}
     cov = table_coverage(x1, x2, cfg)
     agree["coverage"] = {k: v for k, v in cov.items() if k != "grid_rows"}

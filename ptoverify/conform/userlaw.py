@@ -43,7 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ptoverify.config import Config
-from ptoverify.conform.agreement import failure
+from ptoverify.conform.findings import failure
 from ptoverify.errors import InputError
 
 __all__ = [
@@ -278,20 +278,33 @@ class UserLaw:
             hit = _changed(self.cfg, self._pristine)
             raise LawFault(state, f"the law changed its configuration argument ({hit})")
 
-    def _one(self, x1: float, x2: float) -> float:
-        self.calls += 1
-        try:
-            value = self.fn(x1, x2, self.cfg)
-        except BaseException as exc:  # noqa: BLE001 - anything the user code raises is a finding
-            raise self._fault(exc, (x1, x2), "") from None
-        u = float(check_output(value, (x1, x2)))
-        if not math.isfinite(u):
-            raise LawFault((x1, x2), f"the law returned u = {u!r}")
-        return u
+    def _loop(self, x1: list[float], x2: list[float]) -> list[float]:
+        """Call the law state by state (Python floats); u in order, LawFault at the first bad one.
+
+        One loop with the law and its configuration held in locals: a scalar law is
+        called some 10^5 times per conformance, so the wrapper's cost per call
+        counts.  A Python ``float`` is what :func:`check_output` accepts as it is;
+        anything else the law returns goes through it.
+        """
+        fn, cfg, isfinite = self.fn, self.cfg, math.isfinite
+        out: list[float] = []
+        append = out.append
+        for a, b in zip(x1, x2):
+            self.calls += 1
+            try:
+                value = fn(a, b, cfg)
+            except BaseException as exc:  # noqa: BLE001 - anything the user code raises is a finding
+                raise self._fault(exc, (a, b), "") from None
+            if type(value) is not float:
+                value = float(check_output(value, (a, b)))
+            if not isfinite(value):
+                raise LawFault((a, b), f"the law returned u = {value!r}")
+            append(value)
+        return out
 
     def scalar(self, x1: float, x2: float) -> float:
         """Evaluate at one state; LawFault on exception, non-finite u or a changed cfg."""
-        u = self._one(float(x1), float(x2))
+        u = self._loop([float(x1)], [float(x2)])[0]
         self._check_cfg((x1, x2))
         return u
 
@@ -301,7 +314,7 @@ class UserLaw:
         x2 = np.array(x2, dtype=float).ravel()
         first = (float(x1[0]), float(x2[0])) if x1.size else (math.nan, math.nan)
         if self.mode == "scalar":
-            u = np.array([self._one(a, b) for a, b in zip(x1.tolist(), x2.tolist())], dtype=float)
+            u = np.array(self._loop(x1.tolist(), x2.tolist()), dtype=float)
             self._check_cfg(first)
             return u
         self.calls += 1
