@@ -278,21 +278,6 @@ def test_proof_gates_pass_at_the_paper_values():
     assert [v.status for v in verdicts] == ["pass", "pass"], verdicts
 
 
-@pytest.mark.slow
-def test_dask_local_equals_in_process():
-    """The sub-intervals on a LocalCluster give the in-process result exactly."""
-    from ptoverify.studies.prove import run_prove
-
-    cfg = paper_config()
-    a = cfg.plant.a
-    kw = dict(laws=("pd",), a_interval=(0.99 * a, 1.01 * a), pieces=2, n_random=100, res=COARSE)
-    here = run_prove(cfg, **kw)
-    there = run_prove(cfg, dask="local", **kw)
-    np.testing.assert_array_equal(here.proofs[0].bound, there.proofs[0].bound)
-    assert here.proofs[0].to_json()["properties"] == there.proofs[0].to_json()["properties"]
-    assert there.backend == "dask:local"
-
-
 def test_omega0_one_percent_larger_does_not_prove(monkeypatch):
     """The conformance mutant omega0 x 1.01 fails on a sliver at the zone's corner: no proof."""
     import ptoverify.studies.prove.run as prove_run

@@ -210,17 +210,20 @@ def test_cell_blocks_give_the_whole_grid_result_exactly():
 
 
 @pytest.mark.slow
-def test_dask_cell_blocks_equal_in_process():
-    """Sub-intervals x blocks of cells on a LocalCluster: the in-process result exactly."""
+def test_dask_cell_blocks_equal_in_process(dask_scheduler):
+    """Sub-intervals, whole and in blocks of cells, on a LocalCluster: the in-process result
+    exactly (the cluster is ``conftest.dask_scheduler``, shared with the other --dask tests;
+    this test also holds ``test_prove``'s former whole-sub-interval comparison)."""
     from ptoverify.studies.prove import run_prove
 
     cfg = paper_config()
     coarse = Resolution(h1=0.2, h2=20.0, h1_max=5.0, h_edge=0.5, steps=40)  # ~2,000 cells
     kw = dict(laws=("pd",), a_interval=(0.99 * A0, 1.01 * A0), pieces=2, n_random=100, res=coarse)
     here = run_prove(cfg, **kw)
-    there = run_prove(cfg, dask="local", block_cells=700, **kw)
-    _same(here.proofs[0], there.proofs[0])
-    assert there.backend == "dask:local"
+    for blocks in (None, 700):  # one job per sub-interval (the cluster's default), or 3 each
+        there = run_prove(cfg, dask=dask_scheduler, block_cells=blocks, **kw)
+        _same(here.proofs[0], there.proofs[0])
+        assert there.backend == f"dask:{dask_scheduler}"
 
 
 def test_min_time_lower_bound_is_below_the_closed_form_minimum_time():

@@ -188,22 +188,18 @@ def test_dask_local_equals_in_process(small_config):
 
 
 @pytest.mark.slow
-def test_dask_scheduler_address_gives_the_same_maps(small_config):
-    """A real LocalCluster (2 worker processes) reached by its tcp:// address."""
-    from dask.distributed import LocalCluster
-
+def test_dask_scheduler_address_gives_the_same_maps(small_config, dask_scheduler):
+    """A real LocalCluster (2 worker processes, ``conftest.dask_scheduler``) reached by its
+    tcp:// address."""
     argv = ["robust", "--config", small_config, "--law", "pd", "--law", "pto-printed", *FAST,
             "--generations", "0", "--json"]  # fmt: skip
     code, here, err = _run(argv)
     assert code == 0, err
-    with LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
-    ) as cluster:
-        assert cluster.scheduler_address.startswith("tcp://")
-        code, there, err = _run([*argv, "--dask", cluster.scheduler_address])
+    assert dask_scheduler.startswith("tcp://")
+    code, there, err = _run([*argv, "--dask", dask_scheduler])
     assert code == 0, err
     here, there = json.loads(here), json.loads(there)
-    assert there["backend"] == cluster.scheduler_address
+    assert there["backend"] == dask_scheduler
     assert here["maps"] == there["maps"] and here["worst"] == there["worst"]
 
 
