@@ -103,8 +103,8 @@ def test_connect_is_time_boxed(garbage):
     try:
         t = time.monotonic()
         with pytest.raises(ClusterError, match="cannot reach the Dask scheduler"):
-            connect(listener.address, timeout=2.0)
-        assert time.monotonic() - t < 2.0 + 6.0  # the box, plus the import of dask under load
+            connect(listener.address, timeout=1.0)
+        assert time.monotonic() - t < 1.0 + 6.0  # the box, plus the import of dask under load
     finally:
         listener.close()
 
@@ -166,9 +166,10 @@ def test_a_signal_during_dask_local_is_one_line_and_leaves_nothing(tmp_path, sig
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     deadline = time.monotonic() + 60
-    while time.monotonic() < deadline and not any(scratch.iterdir()):
-        time.sleep(0.2)  # the cluster's scratch folder: the workers are starting
-    time.sleep(4.0)
+    while time.monotonic() < deadline and len(list(scratch.glob("*/*/worker-*/"))) < 2:
+        time.sleep(0.1)  # the workers' folders in the cluster's scratch space: they start
+    # then the chart's tasks run on them (5.4 s more on a quiet machine): signal mid-way
+    time.sleep(2.0)
     p.send_signal(sig)
     out, err = p.communicate(timeout=60)
     assert p.returncode == (130 if sig == signal.SIGINT else 143), err
