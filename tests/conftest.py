@@ -13,7 +13,6 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
-from scipy.signal import cont2discrete  # noqa: E402
 
 from derivations.common import PlantNumbers  # noqa: E402
 from ptoverify.config import Config, PDGains, Plant, PTOSettings, paper_config  # noqa: E402
@@ -109,6 +108,8 @@ def zoh_reference(a: float, T: float) -> tuple[np.ndarray, np.ndarray]:  # noqa:
     per (a, T) and returned read-only (the same matrices every call; the
     sample-by-sample reference simulations call this per sample).
     """
+    from scipy.signal import cont2discrete  # here: scipy.signal is not imported to collect
+
     A = np.array([[0.0, 1.0], [0.0, -a]])
     B = np.array([[0.0], [a]])
     Ad, Bd, *_ = cont2discrete((A, B, np.eye(2), np.zeros((2, 1))), T, method="zoh")
