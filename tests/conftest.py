@@ -21,37 +21,6 @@ from ptoverify.config import Config, PDGains, Plant, PTOSettings, paper_config  
 collect_ignore = ["audit"]
 
 
-@pytest.fixture(scope="session")
-def dask_scheduler(tmp_path_factory) -> str:
-    """The ``tcp://`` address of one real LocalCluster (2 single-threaded worker processes).
-
-    Every command reaches Dask through ``studies.cluster.dask_map``, which for an address
-    uses the scheduler there and for ``local`` starts its own cluster of the same kind
-    and then does the same; the equality tests of ``design``, ``prove`` and ``robust``
-    share this cluster instead of starting one each (about 1.5 s and 2 s of CPU apiece).
-    ``--dask local`` itself is run by ``test_robust_cli`` (in-process) and
-    ``test_cluster`` (the command line, its scratch space and its signals).
-    """
-    import logging
-
-    import dask
-    from dask.distributed import LocalCluster
-
-    scratch = tmp_path_factory.mktemp("dask-scratch")
-    with dask.config.set({"temporary-directory": str(scratch)}):
-        cluster = LocalCluster(
-            n_workers=2,
-            threads_per_worker=1,
-            processes=True,
-            # an HTTP port of its own: 8787, Dask's default, stays free for the
-            # clusters that ``--dask local`` starts while this one runs
-            dashboard_address="127.0.0.1:0",
-            silence_logs=logging.CRITICAL,
-        )
-    with cluster:
-        yield cluster.scheduler_address
-
-
 @pytest.fixture
 def paper_cfg() -> Config:
     return paper_config()
@@ -176,3 +145,41 @@ def cell_states(grid, bound: np.ndarray, per_cell: int, seed: int):
     x1 = np.concatenate([c1.ravel(), x1lo + f1 * (x1hi - x1lo)])
     x2 = np.concatenate([c2.ravel(), x2lo + f2 * (x2hi - x2lo)])
     return x1, x2, np.concatenate([node.ravel(), np.repeat(bound, per_cell)])
+
+
+#: A small configuration for ``ptoverify robust`` (a 5 mm envelope, so a short horizon):
+#: ``test_robust_cli`` and ``test_dask`` run the command on it.
+ROBUST_SMALL = """\
+name = "small"
+[plant]
+bandwidth_hz = 30.0
+w_max = 300.0
+sample_time = 0.002
+position_range = 5.0
+[pd]
+kp = 356.0
+kd = 1.15
+[pto]
+d = 0.5
+k1 = 323.0
+k2 = 3.6
+[robustness]
+a_ratio = [0.9, 1.25]
+w_max_ratio = [0.95, 1.0]
+delay_samples = [0, 1]
+"""
+
+
+def assert_same_proof(p, q) -> None:
+    """Two proofs of one law are equal array by array: bounds, stride verdicts, gaps and
+    leaves, images and macro-steps of every sub-interval, and the properties' JSON."""
+    np.testing.assert_array_equal(p.bound, q.bound)
+    for bp, bq in zip(p.balls, q.balls, strict=True):
+        for name in ("strict", "relaxed", "strict_gap", "relaxed_gap"):
+            np.testing.assert_array_equal(getattr(bp.stride, name), getattr(bq.stride, name))
+        for u, v in zip(bp.stride.leaves, bq.stride.leaves, strict=True):
+            np.testing.assert_array_equal(u, v)
+        for u, v in zip(bp.image, bq.image, strict=True):
+            np.testing.assert_array_equal(u, v)
+        np.testing.assert_array_equal(bp.k, bq.k)
+    assert p.to_json()["properties"] == q.to_json()["properties"]

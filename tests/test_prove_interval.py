@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import cell_states
+from conftest import assert_same_proof, cell_states
 from flint import arb, arb_mat, ctx
 
 from ptoverify.config import paper_config
@@ -183,19 +183,6 @@ def test_interval_gate_passes_at_the_paper_box_and_fails_closed(monkeypatch, pro
     assert v.status == UNVERIFIED and "injected" in v.detail
 
 
-def _same(p, q):
-    np.testing.assert_array_equal(p.bound, q.bound)
-    for bp, bq in zip(p.balls, q.balls, strict=True):
-        for name in ("strict", "relaxed", "strict_gap", "relaxed_gap"):
-            np.testing.assert_array_equal(getattr(bp.stride, name), getattr(bq.stride, name))
-        for u, v in zip(bp.stride.leaves, bq.stride.leaves, strict=True):
-            np.testing.assert_array_equal(u, v)
-        for u, v in zip(bp.image, bq.image, strict=True):
-            np.testing.assert_array_equal(u, v)
-        np.testing.assert_array_equal(bp.k, bq.k)
-    assert p.to_json()["properties"] == q.to_json()["properties"]
-
-
 def test_cell_blocks_give_the_whole_grid_result_exactly():
     """Blocks of cells proved apart, then joined: equal to one block (pto, two sub-intervals)."""
     from ptoverify.studies.prove.run import prove_law
@@ -205,25 +192,8 @@ def test_cell_blocks_give_the_whole_grid_result_exactly():
     kw = dict(a_interval=(A0, 1.03 * A0), pieces=2, n_random=0, res=coarse)
     whole = prove_law(cfg, "pto", **kw)
     split = prove_law(cfg, "pto", block_cells=701, **kw)
-    _same(whole, split)
+    assert_same_proof(whole, split)
     assert whole.property("no-stride-over-strict").status == "refuted"  # leaves were compared
-
-
-@pytest.mark.slow
-def test_dask_cell_blocks_equal_in_process(dask_scheduler):
-    """Sub-intervals, whole and in blocks of cells, on a LocalCluster: the in-process result
-    exactly (the cluster is ``conftest.dask_scheduler``, shared with the other --dask tests;
-    this test also holds ``test_prove``'s former whole-sub-interval comparison)."""
-    from ptoverify.studies.prove import run_prove
-
-    cfg = paper_config()
-    coarse = Resolution(h1=0.2, h2=20.0, h1_max=5.0, h_edge=0.5, steps=40)  # ~2,000 cells
-    kw = dict(laws=("pd",), a_interval=(0.99 * A0, 1.01 * A0), pieces=2, n_random=100, res=coarse)
-    here = run_prove(cfg, **kw)
-    for blocks in (None, 700):  # one job per sub-interval (the cluster's default), or 3 each
-        there = run_prove(cfg, dask=dask_scheduler, block_cells=blocks, **kw)
-        _same(here.proofs[0], there.proofs[0])
-        assert there.backend == f"dask:{dask_scheduler}"
 
 
 def test_min_time_lower_bound_is_below_the_closed_form_minimum_time():

@@ -13,29 +13,12 @@ import math
 import socket
 
 import pytest
+from conftest import ROBUST_SMALL
 
 from ptoverify.cli import main
 from ptoverify.studies.robust import LAWS, PROPERTIES
 
-SMALL = """\
-name = "small"
-[plant]
-bandwidth_hz = 30.0
-w_max = 300.0
-sample_time = 0.002
-position_range = 5.0
-[pd]
-kp = 356.0
-kd = 1.15
-[pto]
-d = 0.5
-k1 = 323.0
-k2 = 3.6
-[robustness]
-a_ratio = [0.9, 1.25]
-w_max_ratio = [0.95, 1.0]
-delay_samples = [0, 1]
-"""
+SMALL = ROBUST_SMALL
 FAST = ["--grid", "3", "--generations", "3", "--population", "8", "--quiet"]
 
 
@@ -190,22 +173,6 @@ def test_dask_local_equals_in_process(small_config):
     here, there = json.loads(here), json.loads(there)
     assert there["backend"] == "local"
     assert _without_run_facts(here) == _without_run_facts(there)
-
-
-@pytest.mark.slow
-def test_dask_scheduler_address_gives_the_same_maps(small_config, dask_scheduler):
-    """A real LocalCluster (2 worker processes, ``conftest.dask_scheduler``) reached by its
-    tcp:// address."""
-    argv = ["robust", "--config", small_config, "--law", "pd", "--law", "pto-printed", *FAST,
-            "--generations", "0", "--json"]  # fmt: skip
-    code, here, err = _run(argv)
-    assert code == 0, err
-    assert dask_scheduler.startswith("tcp://")
-    code, there, err = _run([*argv, "--dask", dask_scheduler])
-    assert code == 0, err
-    here, there = json.loads(here), json.loads(there)
-    assert there["backend"] == dask_scheduler
-    assert here["maps"] == there["maps"] and here["worst"] == there["worst"]
 
 
 def test_every_law_is_studied_by_default(small_config):
