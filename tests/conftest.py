@@ -13,7 +13,6 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
-from scipy.signal import cont2discrete  # noqa: E402
 
 from derivations.common import PlantNumbers  # noqa: E402
 from ptoverify.config import Config, PDGains, Plant, PTOSettings, paper_config  # noqa: E402
@@ -78,6 +77,8 @@ def zoh_reference(a: float, T: float) -> tuple[np.ndarray, np.ndarray]:  # noqa:
     per (a, T) and returned read-only (the same matrices every call; the
     sample-by-sample reference simulations call this per sample).
     """
+    from scipy.signal import cont2discrete  # here: scipy.signal is not imported to collect
+
     A = np.array([[0.0, 1.0], [0.0, -a]])
     B = np.array([[0.0], [a]])
     Ad, Bd, *_ = cont2discrete((A, B, np.eye(2), np.zeros((2, 1))), T, method="zoh")
@@ -102,3 +103,83 @@ def plant_numbers(cfg: Config) -> PlantNumbers:
     return PlantNumbers(
         a=p.a, w_max=p.w_max, T=p.sample_time, d=cfg.pto.d, k1=cfg.pto.k1, k2=cfg.pto.k2
     )
+
+
+def cell_states(grid, bound: np.ndarray, per_cell: int, seed: int):
+    """States that cover every cell of a proof's grid, each with the bound it must meet.
+
+    Every node of the grid (the four corners of each cell, closed cells: a node is
+    held to the least bound of the cells it closes) and ``per_cell`` seeded states
+    uniform inside every cell (held to that cell's bound).  Uniform states over the
+    envelope leave the grid's fine cells with few or none (a million of them miss
+    5,585 of the 44,416 proved cells of the paper's nominal proof); these reach every
+    cell, at its corners, where its enclosure's extremes are taken.  Measured on that
+    proof: with 4 per cell (225,000 states) some state attains its cell's bound in
+    14,819 cells, so a bound one sample too low there fails the check; a million
+    uniform states attain it in 9,877 cells (14,888 for both sets together).
+
+    Parameters
+    ----------
+    grid : Grid
+        The proof's cells (cell index j * n1 + i).
+    bound : ndarray
+        Certified bound per cell [samples] (inf: unproven).
+    per_cell : int
+        Seeded states inside each cell.
+    seed : int
+        Seed of the inside states.
+
+    Returns
+    -------
+    x1, x2, bound : ndarray
+        States [mm], [mm/s] and the bound of each (inf: no proved cell holds it).
+    """
+    n1, n2 = grid.shape
+    pad = np.full((n2 + 2, n1 + 2), np.inf)
+    pad[1:-1, 1:-1] = bound.reshape(n2, n1)
+    node = np.minimum.reduce([pad[:-1, :-1], pad[:-1, 1:], pad[1:, :-1], pad[1:, 1:]])
+    c1, c2 = np.meshgrid(grid.e1, grid.e2)  # node (i, j) at (e1[i], e2[j])
+    x1lo, x1hi, x2lo, x2hi = (np.repeat(v, per_cell) for v in grid.boxes())
+    rng = np.random.default_rng(seed)
+    f1, f2 = rng.uniform(0.0, 1.0, (2, x1lo.size))
+    x1 = np.concatenate([c1.ravel(), x1lo + f1 * (x1hi - x1lo)])
+    x2 = np.concatenate([c2.ravel(), x2lo + f2 * (x2hi - x2lo)])
+    return x1, x2, np.concatenate([node.ravel(), np.repeat(bound, per_cell)])
+
+
+#: A small configuration for ``ptoverify robust`` (a 5 mm envelope, so a short horizon):
+#: ``test_robust_cli`` and ``test_dask`` run the command on it.
+ROBUST_SMALL = """\
+name = "small"
+[plant]
+bandwidth_hz = 30.0
+w_max = 300.0
+sample_time = 0.002
+position_range = 5.0
+[pd]
+kp = 356.0
+kd = 1.15
+[pto]
+d = 0.5
+k1 = 323.0
+k2 = 3.6
+[robustness]
+a_ratio = [0.9, 1.25]
+w_max_ratio = [0.95, 1.0]
+delay_samples = [0, 1]
+"""
+
+
+def assert_same_proof(p, q) -> None:
+    """Two proofs of one law are equal array by array: bounds, stride verdicts, gaps and
+    leaves, images and macro-steps of every sub-interval, and the properties' JSON."""
+    np.testing.assert_array_equal(p.bound, q.bound)
+    for bp, bq in zip(p.balls, q.balls, strict=True):
+        for name in ("strict", "relaxed", "strict_gap", "relaxed_gap"):
+            np.testing.assert_array_equal(getattr(bp.stride, name), getattr(bq.stride, name))
+        for u, v in zip(bp.stride.leaves, bq.stride.leaves, strict=True):
+            np.testing.assert_array_equal(u, v)
+        for u, v in zip(bp.image, bq.image, strict=True):
+            np.testing.assert_array_equal(u, v)
+        np.testing.assert_array_equal(bp.k, bq.k)
+    assert p.to_json()["properties"] == q.to_json()["properties"]

@@ -2,7 +2,7 @@
 
 References: scipy's ZOH discretization (``conftest.zoh_reference``) for the
 linear-loop margins, the sweep's own settling for one point, and the in-process
-run for the dask run (a real LocalCluster, 2 worker processes).
+run for the process pool (on a cluster: ``test_dask``).
 """
 
 import json
@@ -16,7 +16,6 @@ from ptoverify.cli import main
 from ptoverify.config import paper_config
 from ptoverify.errors import InputError
 from ptoverify.studies.design import (
-    dask_design_runner,
     design_chart,
     design_point,
     point_config,
@@ -101,18 +100,6 @@ def test_cli_bad_input(argv, msg, capsys):
     assert main(["design", *argv]) == 2
     err = capsys.readouterr().err
     assert err.startswith("ptoverify: error:") and msg in err and err.count("\n") == 1
-
-
-@pytest.mark.slow
-def test_dask_local_equals_in_process(tmp_path, capsys):
-    """2 x 2 chart: a real 2-worker LocalCluster gives exactly the in-process result."""
-    args = dict(laws=("pd", "pto", "ptos", "cascade-p"), grid=4)
-    here = design_chart(CFG, [0.002, 0.004], [30.0, 60.0], **args)
-    there = design_chart(CFG, [0.002, 0.004], [30.0, 60.0], runner=dask_design_runner("local"),
-                         backend="local", **args)  # fmt: skip
-    a, b = here.to_json(timings=False), there.to_json(timings=False)
-    assert a["points"] == b["points"]
-    assert there.backend == "local"
 
 
 def test_cli_json_and_out(tmp_path, capsys):

@@ -6,7 +6,6 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-from scipy.signal import cont2discrete
 
 from ptoverify.cli import main
 from ptoverify.model.laws import Region, make_law
@@ -114,6 +113,8 @@ def test_summarize_on_simulations(paper_cfg):
 
 def _closed_loop_pd(cfg):
     """Sampled PD loop x+ = Acl x + Bd v, ZOH by scipy's cont2discrete (independent of plant.py)."""
+    from scipy.signal import cont2discrete
+
     a, T = cfg.plant.a, cfg.plant.sample_time
     Ad, Bd, *_ = cont2discrete(
         (np.array([[0.0, 1.0], [0.0, -a]]), np.array([[0.0], [a]]), np.eye(2), np.zeros((2, 1))),

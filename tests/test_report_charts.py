@@ -34,15 +34,36 @@ def _cli(capsys, *argv):
     return json.loads(out)
 
 
+#: The chart's corners, middle and the paper's cell (3 x 3 of its 5 x 5 cells): every law is
+#: fastest somewhere on it, and it has cells whose zone is unusable, degenerate, and whose
+#: loop is unstable under one sample of delay (each point is computed on its own, so its
+#: cells are those of the whole chart).
+SUB_SAMPLE_TIMES = (0.0005, 0.002, 0.008)
+SUB_BANDWIDTHS_HZ = (5.0, 30.0, 100.0)
+
+
 @pytest.fixture(scope="module")
 def chart():
-    return design_results(CFG)
+    """``design_results`` on the 3 x 3 sub-chart (the module's axes replaced for the call)."""
+    import ptoverify.report.charts as charts
+
+    assert set(SUB_SAMPLE_TIMES) <= set(CHART_SAMPLE_TIMES)
+    assert set(SUB_BANDWIDTHS_HZ) <= set(CHART_BANDWIDTHS_HZ)
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(charts, "CHART_SAMPLE_TIMES", SUB_SAMPLE_TIMES)
+        m.setattr(charts, "CHART_BANDWIDTHS_HZ", SUB_BANDWIDTHS_HZ)
+        res = design_results(CFG)
+    sm = res["summary"]
+    assert len(sm["fastest"]) == len(CHART_LAWS), "every law fastest somewhere"
+    assert sm["pto_zone_unusable"] and sm["pto_zone_degenerate"] and sm["pto_delay_unstable"]
+    return res
 
 
 @pytest.mark.slow
 def test_chart_cells_equal_ptoverify_design(chart, capsys):
     """Two cells of the coarse chart (one of them the paper's point) against the command."""
-    assert len(chart["points"]) == len(CHART_SAMPLE_TIMES) * len(CHART_BANDWIDTHS_HZ) <= 30
+    assert len(CHART_SAMPLE_TIMES) * len(CHART_BANDWIDTHS_HZ) <= 30
+    assert len(chart["points"]) == len(SUB_SAMPLE_TIMES) * len(SUB_BANDWIDTHS_HZ)
     for t, f in ((0.002, 30.0), (0.008, 5.0)):
         got = next(p for p in chart["points"] if (p["sample_time"], p["bandwidth_hz"]) == (t, f))
         res = _cli(capsys, "design", "--sample-times", str(t), "--bandwidths", str(f),

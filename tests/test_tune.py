@@ -93,8 +93,14 @@ def test_constraints_hold_when_resimulated_independently():
     assert law_properties(make_law("pd", cfg), cfg, n1=41, n2=41, rest=40).limit_cycles == 0
 
 
-def test_tuned_config_round_trips_through_toml(tmp_path):
-    r = tune(CFG, "pd", "step", maxiter=5)
+@pytest.fixture(scope="module")
+def pd_tuned():
+    """One short PD search on the paper's plant (two tests read it; tune is deterministic)."""
+    return tune(CFG, "pd", "step", maxiter=5)
+
+
+def test_tuned_config_round_trips_through_toml(tmp_path, pd_tuned):
+    r = pd_tuned
     path = tmp_path / "tuned.toml"
     path.write_text(r.toml())
     loaded = load_config(path)
@@ -105,8 +111,8 @@ def test_tuned_config_round_trips_through_toml(tmp_path):
     assert m["overshoot_mm"] == r.best.overshoot_mm
 
 
-def test_pareto_front_is_nondominated():
-    r = tune(CFG, "pd", "step", maxiter=5)
+def test_pareto_front_is_nondominated(pd_tuned):
+    r = pd_tuned
     front = r.front
     assert front, "an empty front"
     for a in front:

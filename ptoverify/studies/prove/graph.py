@@ -185,21 +185,21 @@ def constant_input(spec: LawSpec, box) -> np.ndarray:
     out = np.where(inside & (v_min > w), w, out)
     out = np.where(inside & (v_max < -w), -w, out)
     if np.isfinite(d):
-        for sign in (1.0, -1.0):
-            far = (x1lo >= d) if sign > 0 else (x1hi <= -d)
-            idx = np.flatnonzero(far)
-            if idx.size == 0:
-                continue
-            # u = -sign w on the whole piece iff certified at the corner nearest the curves
-            c1 = x1lo[idx] if sign > 0 else x1hi[idx]
-            c2 = x2lo[idx] if sign > 0 else x2hi[idx]
-            lo, hi = sigma_point(spec, c1, c2, spec.omega0 if spec.has_zone else w)
+        # u = -w right of the zone (x1 >= d), +w left of it, iff certified at the corner
+        # nearest the curves; both sides in one enclosure per curve (elementwise)
+        right, left = np.flatnonzero(x1lo >= d), np.flatnonzero(x1hi <= -d)
+        nr = right.size
+        if nr + left.size:
+            c1 = np.concatenate([x1lo[right], x1hi[left]])
+            c2 = np.concatenate([x2lo[right], x2hi[left]])
             s_lo, s_hi = sigma_point(spec, c1, c2, w)
-            if sign > 0:  # -w needs sigma_w > 0 and, with a zone, sigma_omega0 > 0
-                ok = (s_lo > 0) & (lo > 0)
-            else:
-                ok = (s_hi < 0) & (hi < 0)
-            out[idx] = np.where(ok, -sign * w, out[idx])
+            # with a zone the curve of level omega0 as well; without, the level is w_max
+            lo, hi = sigma_point(spec, c1, c2, spec.omega0) if spec.has_zone else (s_lo, s_hi)
+            # -w needs sigma_w > 0 and, with a zone, sigma_omega0 > 0 (+w: both < 0)
+            ok = (s_lo[:nr] > 0) & (lo[:nr] > 0)
+            out[right] = np.where(ok, -w, out[right])
+            ok = (s_hi[nr:] < 0) & (hi[nr:] < 0)
+            out[left] = np.where(ok, w, out[left])
     return out
 
 
@@ -336,22 +336,31 @@ def longest_path(starts, succ, k, in_target, to_target, exits) -> np.ndarray:
     bound[to_target] = k[to_target]
     bound[in_target] = 0.0
     resolved = np.isfinite(bound)
-    pending = np.flatnonzero(~resolved & ~exits)
     counts = starts[1:] - starts[:-1]
-    while pending.size:
-        c = counts[pending]
-        owner = np.repeat(np.arange(pending.size), c)
-        idx = np.repeat(starts[pending] - np.cumsum(c) + c, c) + np.arange(c.sum())
-        s = succ[idx]
-        unresolved = np.zeros(pending.size, dtype=np.intp)
-        np.add.at(unresolved, owner, ~resolved[s])
-        worst = np.full(pending.size, -np.inf)
-        np.maximum.at(worst, owner, bound[s])
-        ready = (unresolved == 0) & (c > 0)
-        if not ready.any():
+    # Levels of the successor graph (Kahn's order): a cell is done when its last
+    # unresolved successor is; each edge is visited once to count, once to take its
+    # maximum, and once to be released (not once per level for every pending cell).
+    pending = ~resolved & ~exits & (counts > 0)
+    owner = np.repeat(np.arange(n), counts)
+    live = pending[owner] & ~resolved[succ]  # edges still to wait for
+    src, dst = owner[live], succ[live]
+    left = np.bincount(src, minlength=n)  # unresolved successors of each pending cell
+    order = np.argsort(dst, kind="stable")
+    preds = src[order]  # the waiting cells, grouped by the successor they wait for
+    pstart = np.zeros(n + 1, dtype=np.intp)
+    np.cumsum(np.bincount(dst, minlength=n), out=pstart[1:])
+    ready = np.flatnonzero(pending & (left == 0))
+    while ready.size:
+        c = counts[ready]
+        seg = np.cumsum(c) - c
+        idx = np.repeat(starts[ready] - seg, c) + np.arange(seg[-1] + c[-1])
+        bound[ready] = k[ready] + np.maximum.reduceat(bound[succ[idx]], seg)
+        pc = pstart[ready + 1] - pstart[ready]
+        if not pc.any():
             break
-        done = pending[ready]
-        bound[done] = k[done] + worst[ready]
-        resolved[done] = True
-        pending = pending[~ready]
+        pseg = np.cumsum(pc) - pc
+        waiting = preds[np.repeat(pstart[ready] - pseg, pc) + np.arange(pc.sum())]
+        left -= np.bincount(waiting, minlength=n)
+        waiting = np.unique(waiting)
+        ready = waiting[left[waiting] == 0]
     return bound

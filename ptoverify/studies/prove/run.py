@@ -247,10 +247,15 @@ def simulate_to_target(cfg: Config, name: str, target: Target, x1, x2, a: float,
     (p11, p12), (_, p22) = target.P
     level = target.c * (1 + 1e-9)
     first = np.full(x1.size, np.inf)
-    y1, y2 = x1.copy(), x2.copy()
+    # only the states not yet inside are stepped on (the law and the step act per state)
+    live, y1, y2 = np.arange(x1.size), x1.copy(), x2.copy()
     for k in range(steps + 1):
         inside = p11 * y1 * y1 + 2 * p12 * y1 * y2 + p22 * y2 * y2 <= level
-        first = np.where(np.isinf(first) & inside, k, first)
+        first[live[inside]] = k
+        out = ~inside
+        live, y1, y2 = live[out], y1[out], y2[out]
+        if not live.size:
+            break
         u, _r = law(y1, y2)
         y1, y2 = step(y1, y2, u, plant)
     return first
