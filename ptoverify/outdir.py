@@ -68,6 +68,7 @@ __all__ = [
     "MARKER",
     "OutputBusy",
     "Terminated",
+    "Interrupted",
     "check_target",
     "make_temp",
     "publish",
@@ -100,9 +101,24 @@ class Terminated(BaseException):
     """The process received SIGTERM (raised by :func:`sigterm_raises`)."""
 
 
+class Interrupted(KeyboardInterrupt):
+    """The process received SIGINT, Ctrl-C (raised by :func:`sigterm_raises`).
+
+    A KeyboardInterrupt (every handler of one catches it), but not Python's own:
+    CPython remembers a ``KeyboardInterrupt`` (exactly that type) that ends code
+    run from a string (``exec`` of source text, as ``dataclasses`` and
+    ``collections.namedtuple`` do when a module is imported), even when a caller
+    catches it, and a ``python -m`` run then ends by SIGINT instead of its exit
+    code (130).
+    """
+
+
 @contextlib.contextmanager
 def sigterm_raises() -> Iterator[None]:
-    """Raise :class:`Terminated` on SIGTERM inside the block (main thread only).
+    """Raise :class:`Terminated` on SIGTERM and :class:`Interrupted` on SIGINT in the block.
+
+    Main thread only.  SIGINT is taken over only where Python's default handler
+    has it (an ignored SIGINT, as in a background job, stays ignored).
 
     Examples
     --------
@@ -113,14 +129,22 @@ def sigterm_raises() -> Iterator[None]:
         yield
         return
 
-    def handler(signum, frame):
+    def on_term(signum, frame):
         raise Terminated()
 
-    previous = signal.signal(signal.SIGTERM, handler)
+    def on_int(signum, frame):
+        raise Interrupted()
+
+    previous = signal.signal(signal.SIGTERM, on_term)
+    previous_int = signal.getsignal(signal.SIGINT)
+    if previous_int is signal.default_int_handler:
+        signal.signal(signal.SIGINT, on_int)
     try:
         yield
     finally:
         signal.signal(signal.SIGTERM, previous)
+        if previous_int is signal.default_int_handler:
+            signal.signal(signal.SIGINT, previous_int)
 
 
 def _existing_ancestor(path: Path) -> Path:

@@ -1,5 +1,6 @@
 import json
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -248,6 +249,75 @@ def test_internal_error_is_exit_1_one_line_not_bad_input(capsys, monkeypatch):
     assert len(lines) == 1, err
     assert lines[0].startswith("ptoverify: internal error: ZeroDivisionError: division by zero")
     assert "--debug" in lines[0] and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    "signal_exc, code, words",
+    [(KeyboardInterrupt, 130, "interrupted"), ("terminated", 143, "terminated (SIGTERM)")],
+)
+def test_an_import_failed_by_a_signal_is_the_signal(capsys, monkeypatch, signal_exc, code, words):
+    """Ctrl-C or SIGTERM while a compiled module initializes comes back as its ImportError
+    (pybind11's "initialization failed", the signal its cause): the run was stopped (130, 143),
+    not an internal error; a chain without a signal stays an internal error."""
+    import ptoverify.studies.groundtruth as gt
+    from ptoverify.outdir import Terminated
+
+    cause = Terminated() if signal_exc == "terminated" else signal_exc()
+
+    def stopped(*args, **kwargs):
+        try:
+            raise cause
+        except BaseException as exc:
+            raise ImportError("initialization failed") from exc
+
+    monkeypatch.setattr(gt, "min_time", stopped)
+    got, out, err = run(capsys, "mintime", "5", "0", "--json")
+    assert (got, out, err) == (
+        code,
+        "",
+        f"ptoverify: error: {words}" + ("; nothing written\n" if code == 143 else "\n"),
+    )
+
+    def unrelated(*args, **kwargs):
+        try:
+            raise ValueError("a bug's first error")
+        except ValueError as exc:
+            raise ImportError("initialization failed") from exc
+
+    monkeypatch.setattr(gt, "min_time", unrelated)
+    got, _, err = run(capsys, "mintime", "5", "0", "--json")
+    assert got == 1 and err.startswith("ptoverify: internal error: ImportError"), err
+
+
+def test_ctrl_c_inside_source_text_exec_is_exit_130(tmp_path):
+    """Ctrl-C that lands inside code run from source text (``exec`` of a string, as
+    ``dataclasses`` does at every import) is exit 130 under ``python -m`` too.
+
+    CPython remembers a plain KeyboardInterrupt that ends a string's code, even when it
+    is caught, and a ``-m`` run then dies by SIGINT (returncode -2) after its handler
+    printed and returned 130: the report's Ctrl-C test saw it about once in ten runs.
+    A real SIGINT, raised by the process itself while a string is executed."""
+    code = (
+        "import os, signal, sys\n"
+        "import importlib\n"
+        "m = importlib.import_module('ptoverify.cli.main')\n"
+        "def handler(args):\n"
+        "    exec('import os, signal\\nos.kill(os.getpid(), signal.SIGINT)\\n'"
+        " + 'for _ in range(10**6): pass\\n', {})\n"
+        "    return 0\n"
+        "class P:\n"
+        "    def parse_args(self, argv):\n"
+        "        import argparse\n"
+        "        return argparse.Namespace(handler=handler, debug=False)\n"
+        "m.build_parser = P\n"
+        "sys.exit(m.main(['mintime', '0', '0']))\n"
+    )
+    (tmp_path / "fake_cli.py").write_text(code)
+    proc = subprocess.run(
+        [sys.executable, "-m", "fake_cli"], capture_output=True, text=True, cwd=tmp_path, timeout=60
+    )
+    assert proc.returncode == 130, (proc.returncode, proc.stderr)
+    assert proc.stderr == "ptoverify: error: interrupted\n"
 
 
 @pytest.mark.parametrize("where", ["before", "after"])

@@ -131,9 +131,8 @@ def _run(argv: list[str]) -> int:
             code = int(args.handler(args))
         sys.stdout.flush()  # a write that fails shows here, inside the handlers below
         return code
-    except Terminated:
-        _say("error: terminated (SIGTERM); nothing written")
-        return 143
+    except Terminated as exc:
+        return _stopped(exc)
     except OutputBusy as exc:
         _say(f"error: {_one_line(exc)}")
         return 1
@@ -143,9 +142,8 @@ def _run(argv: list[str]) -> int:
     except InputError as exc:
         _say(f"error: {_one_line(exc)}")
         return 2
-    except KeyboardInterrupt:
-        _say("error: interrupted")
-        return 130
+    except KeyboardInterrupt as exc:
+        return _stopped(exc)
     except BrokenPipeError as exc:  # not through the guarded streams: the verdict is unknown
         _say(f"error: a pipe closed before the run ended ({_one_line(exc)}); no verdict")
         return 1
@@ -158,7 +156,35 @@ def _run(argv: list[str]) -> int:
         return _internal(exc, debug)
 
 
+def _signal_cause(exc: BaseException) -> BaseException | None:
+    """Return the Ctrl-C or SIGTERM an exception was raised from, or None.
+
+    A signal that lands while a compiled module initializes comes back as that
+    module's ImportError (pybind11: "initialization failed"), the interrupt
+    its cause: the run was interrupted, it did not fail.
+    """
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, (KeyboardInterrupt, Terminated)):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return None
+
+
+def _stopped(signal: BaseException) -> int:
+    """Say that the run was stopped by SIGTERM or Ctrl-C; return 143 or 130."""
+    if isinstance(signal, Terminated):
+        _say("error: terminated (SIGTERM); nothing written")
+        return 143
+    _say("error: interrupted")
+    return 130
+
+
 def _internal(exc: Exception, debug: bool) -> int:
+    cause = _signal_cause(exc)
+    if cause is not None:
+        return _stopped(cause)
     if debug:
         raise exc
     _say(
