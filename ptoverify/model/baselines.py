@@ -184,10 +184,11 @@ def ptos_law(cfg: Config, *, alpha: float | None = None, k: float | None = None)
     (-300.0, 6)
     """
     p = ptos_design(cfg, alpha=alpha, k=k)
-    block = partial(_ptos_input, a=cfg.plant.a, w=cfg.plant.w_max)
+    numbers = _ptos_numbers(p.alpha, p.k, cfg.plant.a, cfg.plant.w_max)
+    w = cfg.plant.w_max
 
     def vector(x1, x2):
-        return block(x1, x2, p.alpha, p.k)
+        return _ptos_input(x1, x2, *numbers, w=w)
 
     note = (
         f"PTOS alpha = {p.alpha:g}, k = {p.k:.6g} 1/s, A = a w_max = {p.A:.6g} mm/s^2, "
@@ -197,21 +198,25 @@ def ptos_law(cfg: Config, *, alpha: float | None = None, k: float | None = None)
     return Law("ptos", vector, None, cfg.plant.w_max, note)
 
 
-def _ptos_input(x1, x2, alpha, k, *, a: float, w: float):
-    """PTOS input and region (module docstring); alpha [-], k [1/s] floats or one per state.
+def _ptos_numbers(alpha, k, a: float, w: float) -> tuple:
+    """Return the numbers :func:`_ptos_input` reads, of alpha [-] and k [1/s] (floats or arrays).
 
-    The numbers of :func:`ptos_design` (k1, y_l, slope, offset, gain, kv) with the
+    (y_l, slope, 2 alpha A, offset, -gain, kv): those of :func:`ptos_design` with the
     same arithmetic, so a per-state entry equals the law built from its gains bit
-    for bit.
+    for bit; computed once per law, not at every sample.
     """
     A = a * w  # noqa: N806 - Workman's symbol
     k1 = alpha * k * k / 2.0
-    y_l, slope, offset, gain, kv = A / k1, k1 / k, A / k, k / a, k / a - 1.0
+    return A / k1, k1 / k, 2.0 * alpha * A, A / k, -(k / a), k / a - 1.0
+
+
+def _ptos_input(x1, x2, y_l, slope, c, offset, neg_gain, kv, *, w: float):
+    """PTOS input and region (module docstring) from :func:`_ptos_numbers`."""
     ax = np.abs(x1)
     lin = ax <= y_l
     with np.errstate(invalid="ignore"):
-        prof = np.where(lin, slope * ax, np.sqrt(2.0 * alpha * A * ax) - offset)  # f(|x1|) >= 0
-    u, region = saturate_linear(-gain * np.copysign(prof, x1) - kv * x2, w)
+        prof = np.where(lin, slope * ax, np.sqrt(c * ax) - offset)  # f(|x1|) >= 0
+    u, region = saturate_linear(neg_gain * np.copysign(prof, x1) - kv * x2, w)
     branch = ~lin & (region == Region.LINEAR)
     if branch.any():
         region[branch] = np.where(u[branch] > 0, Region.ZONE_P, Region.ZONE_N)
@@ -236,8 +241,9 @@ def ptos_state_gains(cfg: Config, gains: dict) -> Law:
     g = (np.asarray(gains["alpha"], dtype=float), np.asarray(gains["k"], dtype=float))
     if g[0].shape != g[1].shape:
         raise InputError("per-state gains: alpha and k need one shape")
-    block = partial(_ptos_input, a=cfg.plant.a, w=cfg.plant.w_max)
-    return _state_gains_law("ptos", block, g, cfg.plant.w_max)
+    w = cfg.plant.w_max
+    numbers = _ptos_numbers(*g, cfg.plant.a, w)
+    return _state_gains_law("ptos", partial(_ptos_input, w=w), numbers, w)
 
 
 def cascade_state_gains(cfg: Config, gains: dict) -> Law:

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.colors import ListedColormap
 
-from ptoverify.report.plots.common import folder, save_drawing
+from ptoverify.report.plots.common import folder, inner_legend, save_drawing
 from ptoverify.report.words import law_name, setting_words
 
 __all__ = ["plot_penalty", "plot_design", "save_charts", "save_penalty", "LAW_COLOURS"]
@@ -73,7 +73,7 @@ def plot_penalty(penalty: Mapping, axes) -> dict:
     right.set_title("ratio to the sampled limit (not settled: no point)", fontsize=9)
     for ax in axes:
         ax.grid(True, which="both", lw=0.3)
-    left.legend(fontsize=7)
+    inner_legend(left, fontsize=7)
     return drawn
 
 
@@ -117,7 +117,8 @@ def plot_design(design: Mapping, ax) -> dict:
         rho = pto["radius_delay1"] if pto is not None else None
         if isinstance(rho, (int, float)) and rho >= 1.0:
             marks += "D"
-        ax.text(j, i, f"{short}\n{lead} {marks}".strip(), ha="center", va="center", fontsize=7)
+        label = f"{short}\n{lead} {marks}".strip()  # in its cell: no part of the layout
+        ax.text(j, i, label, ha="center", va="center", fontsize=7, in_layout=False)
     ax.imshow(
         code, cmap=ListedColormap(colours), vmin=-0.5, vmax=len(laws) + 0.5, aspect="auto",
         alpha=0.55,

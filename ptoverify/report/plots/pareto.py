@@ -6,7 +6,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ptoverify.report.plots.common import new_axes
+from ptoverify.report.plots.common import inner_legend, new_axes
 from ptoverify.report.words import law_name
 
 __all__ = ["plot_pareto"]
@@ -99,7 +99,7 @@ def plot_pareto(tuning: Mapping, ax=None) -> dict:
             )  # fmt: skip
     ax.set_xlabel("overshoot, between samples [mm]")
     ax.set_ylabel("2 % settling time of the step [ms]")
-    ax.legend(list(drawn.values()), list(drawn), fontsize=6, loc="upper right")
+    inner_legend(ax, list(drawn.values()), list(drawn), fontsize=6, loc="upper right")
     ax.grid(alpha=0.3)
     _front_difference_inset(tuning["fronts_gap"], ax)
     return drawn

@@ -24,6 +24,7 @@ from ptoverify.report.plots.common import (
     REGION_STYLE,
     Arcs,
     finish,
+    inner_legend,
     level_curve,
     new_axes,
     switching_curves,
@@ -280,7 +281,7 @@ def plot_fig6(zone: PTOZone, cfg: Config, batch: BatchResult, law: str, ax=None)
         f"Fig. 6: {law_name(law)} from ({x1[0]:g} mm, {x2[0]:g} mm/s), region of each sample",
         fontsize=9,
     )
-    ax.legend(fontsize=6, loc="lower left")
+    inner_legend(ax, fontsize=6, loc="lower left")
     return drawn
 
 
@@ -395,6 +396,6 @@ def plot_zone_geometry(
     ax.set_xlabel("position $x_1$ [mm]")
     ax.set_ylabel("velocity $x_2$ [mm/s]")
     ax.set_title(f"{cfg.name}: switching zone, T = {T * 1e3:g} ms, a = {a:.4g} rad/s")
-    ax.legend(fontsize=7, loc="upper right")
+    inner_legend(ax, fontsize=7, loc="upper right")
     ax.grid(True, alpha=0.3)
     return {"figure": fig, "ax": ax, "lines": lines, "zone": zone, "printed": printed}

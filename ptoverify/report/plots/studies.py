@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 
 from ptoverify.report.plots.common import (
     folder,
+    inner_legend,
     new_axes,
     new_figure,
     save_figure,
@@ -118,7 +119,8 @@ def plot_sweep(
             colors="white",
             linewidths=0.6,
         )
-        ax.clabel(drawn["contours"], fmt="%g", fontsize=6)
+        for label in ax.clabel(drawn["contours"], fmt="%g", fontsize=6):
+            label.set_in_layout(False)  # on lines inside the axes: no part of the layout
     wr = ls.worst_state_tf if which == "tf" else ls.worst_state_nt
     worst = ls.worst_ratio_tf if which == "tf" else ls.worst_ratio_nt
     if math.isfinite(wr[0]):
@@ -139,7 +141,7 @@ def plot_sweep(
         fontsize=8,
     )
     if "worst" in drawn:
-        ax.legend(fontsize=7, loc="upper right")
+        inner_legend(ax, fontsize=7, loc="upper right")
     return drawn
 
 
@@ -380,7 +382,7 @@ def plot_convergence(study: ConvergenceStudy, ax=None) -> dict:
         fontsize=9,
     )
     ax.grid(True, which="both", lw=0.3)
-    ax.legend(fontsize=7)
+    inner_legend(ax, fontsize=7)
     return drawn
 
 
@@ -426,7 +428,7 @@ def plot_switch_profiles(
     ax.set_ylabel("input $u$ [mm/s]")
     ax.set_title(f"collocation input near the switch, x0 = ({x1:g} mm, {x2:g} mm/s)")
     ax.grid(True, lw=0.3)
-    ax.legend(fontsize=7)
+    inner_legend(ax, fontsize=7)
     return drawn
 
 
