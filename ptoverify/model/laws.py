@@ -118,9 +118,11 @@ def _bang(sigma: NDArray[np.float64], x2: NDArray[np.float64], w: float):
 
 def _origin(x1, x2, u, region):
     """Set u = 0, region ORIGIN at the origin (in place); return (u, region)."""
-    origin = (x1 == 0) & (x2 == 0)
-    if np.count_nonzero(origin):
-        u[origin], region[origin] = 0.0, Region.ORIGIN
+    zero = x1 == 0
+    if np.count_nonzero(zero):  # (x2 read only where some x1 is 0)
+        origin = zero & (x2 == 0)
+        if np.count_nonzero(origin):
+            u[origin], region[origin] = 0.0, Region.ORIGIN
     return u, region
 
 
@@ -198,21 +200,24 @@ def _pto_block(a: float, w: float) -> Callable:
 
     ``block(x1, x2, g1, g2, dd, lv)``: linear gains k1 [1/s], k2 [-], linear-zone
     half-width d [mm], switching-zone level [mm/s] (NaN: no zone), each a float or
-    one per state.  Each branch is evaluated on the states it acts on (masks);
-    the linear zone first, as it takes precedence.
+    one per state.  Each branch is evaluated on the states it acts on (masks, or
+    the whole batch where one branch acts on every state: the same elementwise
+    arithmetic); the linear zone first, as it takes precedence.
     """
 
     def block(x1, x2, g1, g2, dd, lv):
-        u = np.empty(x1.shape)
-        region = np.empty(x1.shape, dtype=np.int8)
         lin = np.abs(x1) < dd
         n_lin = np.count_nonzero(lin)
-        if n_lin:  # S_L, eq. (34)
-            g1l, g2l = _at(g1, lin), _at(g2, lin)
-            u[lin], region[lin] = _pd_input(x1[lin], x2[lin], g1l, g2l, w)
-        if n_lin < lin.size:
-            out = ~lin
-            u[out], region[out] = _outside_linear(x1[out], x2[out], _at(lv, out), a, w)
+        if n_lin == lin.size:  # every state in S_L (a settled batch): no gathering
+            return _origin(x1, x2, *_pd_input(x1, x2, g1, g2, w))
+        if not n_lin:  # none in S_L
+            return _origin(x1, x2, *_outside_linear(x1, x2, lv, a, w))
+        u = np.empty(x1.shape)
+        region = np.empty(x1.shape, dtype=np.int8)
+        # S_L, eq. (34)
+        u[lin], region[lin] = _pd_input(x1[lin], x2[lin], _at(g1, lin), _at(g2, lin), w)
+        out = ~lin
+        u[out], region[out] = _outside_linear(x1[out], x2[out], _at(lv, out), a, w)
         return _origin(x1, x2, u, region)
 
     return block
@@ -231,8 +236,14 @@ def _outside_linear(y1, y2, lv, a: float, w: float):
     """
     sig = level_residual(y1, y2, a, w)  # switching function, eqs. (9), (11)
     u, region = _bang(sig, y2, w)  # eq. (12)
+    one_level = isinstance(lv, float)  # one level for every state (a configuration's law)
+    if one_level and math.isnan(lv):  # no zone at all (to): no candidates
+        return u, region
     # zone candidates: between l1 and l2 (x2 and sigma of opposite signs), with a zone
-    cand = np.nonzero((np.sign(y2) * np.sign(sig) < 0) & ~np.isnan(lv))[0]  # y2 is 1-D
+    between = np.sign(y2) * np.sign(sig) < 0
+    if not one_level:
+        between &= ~np.isnan(lv)
+    cand = np.nonzero(between)[0]  # y2 is 1-D
     if cand.size:
         c1, c2, lc = y1[cand], y2[cand], _at(lv, cand)
         r0 = level_residual(c1, c2, a, lc)  # on or inside l1* (l2*), eqs. (13), (14)
