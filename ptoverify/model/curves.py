@@ -107,7 +107,9 @@ def h(r: ArrayLike) -> Array:
 def _h_direct(r: Array) -> Array:
     """Return r - log1p(r), and its limit +inf at r = +inf (where it reads inf - inf)."""
     out = r - np.log1p(r)
-    out[r == np.inf] = np.inf
+    top = r == np.inf
+    if np.count_nonzero(top):
+        out[top] = np.inf
     return out
 
 

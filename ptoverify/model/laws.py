@@ -118,9 +118,11 @@ def _bang(sigma: NDArray[np.float64], x2: NDArray[np.float64], w: float):
 
 def _origin(x1, x2, u, region):
     """Set u = 0, region ORIGIN at the origin (in place); return (u, region)."""
-    origin = (x1 == 0) & (x2 == 0)
-    if np.count_nonzero(origin):
-        u[origin], region[origin] = 0.0, Region.ORIGIN
+    zero = x1 == 0
+    if np.count_nonzero(zero):  # (x2 read only where some x1 is 0)
+        origin = zero & (x2 == 0)
+        if np.count_nonzero(origin):
+            u[origin], region[origin] = 0.0, Region.ORIGIN
     return u, region
 
 
@@ -198,8 +200,9 @@ def _pto_block(a: float, w: float) -> Callable:
 
     ``block(x1, x2, g1, g2, dd, lv)``: linear gains k1 [1/s], k2 [-], linear-zone
     half-width d [mm], switching-zone level [mm/s] (NaN: no zone), each a float or
-    one per state.  Each branch is evaluated on the states it acts on (masks);
-    the linear zone first, as it takes precedence.
+    one per state.  Each branch is evaluated on the states it acts on (masks: one
+    way for every batch, whichever branches act); the linear zone first, as it
+    takes precedence.
     """
 
     def block(x1, x2, g1, g2, dd, lv):
@@ -231,8 +234,14 @@ def _outside_linear(y1, y2, lv, a: float, w: float):
     """
     sig = level_residual(y1, y2, a, w)  # switching function, eqs. (9), (11)
     u, region = _bang(sig, y2, w)  # eq. (12)
+    one_level = isinstance(lv, float)  # one level for every state (a configuration's law)
+    if one_level and math.isnan(lv):  # no zone at all (to): no candidates
+        return u, region
     # zone candidates: between l1 and l2 (x2 and sigma of opposite signs), with a zone
-    cand = np.nonzero((np.sign(y2) * np.sign(sig) < 0) & ~np.isnan(lv))[0]  # y2 is 1-D
+    between = np.sign(y2) * np.sign(sig) < 0
+    if not one_level:
+        between &= ~np.isnan(lv)
+    cand = np.nonzero(between)[0]  # y2 is 1-D
     if cand.size:
         c1, c2, lc = y1[cand], y2[cand], _at(lv, cand)
         r0 = level_residual(c1, c2, a, lc)  # on or inside l1* (l2*), eqs. (13), (14)

@@ -354,26 +354,30 @@ def _last_exit(tr: Trajectory, sig: Signal, band: float, order: int, T: float): 
     m, k = x1.shape
     slope = sig.slope(t0 + 0.5 * h)[:, None]
     amp, w = sig.amplitude * (sig.kind == "sine"), sig.omega
-    x1_end = np.concatenate([x1[1:], tr.x1[-1:]])
-    x2_end = np.concatenate([x2[1:], tr.x2[-1:]])
+    sampled = x1.shape[0] == tr.x1.shape[0] - 1  # no cut: each interval ends at a sample
+
+    def at_ends(x, full):  # the state at each interval's end (the next interval's start)
+        return full[1:] if sampled else np.concatenate([x[1:], full[-1:]])
+
     if order == 1:
-        e_start, e_end = sig.r(t0)[:, None] - x1, sig.r(t0 + h)[:, None] - x1_end
+        e_start, e_end = sig.r(t0)[:, None] - x1, sig.r(t0 + h)[:, None] - at_ends(x1, tr.x1)
         e_last = float(sig.r(tr.t[-1])) - tr.x1[-1]
     else:  # e' jumps where the ramp ends: the end of an interval is its left limit
         e_start = slope + amp * w * np.cos(w * t0)[:, None] - x2
-        e_end = slope + amp * w * np.cos(w * (t0 + h))[:, None] - x2_end
+        e_end = slope + amp * w * np.cos(w * (t0 + h))[:, None] - at_ends(x2, tr.x2)
         e_last = float(sig.r_dot(tr.t[-1])) - tr.x2[-1]
     ended = np.abs(e_last) > band
-    outs = (np.abs(e_start) > band) | (np.abs(e_end) > band)
+    abs_start = np.abs(e_start)
+    outs = (abs_start > band) | (np.abs(e_end) > band)
     rows = np.arange(m)[:, None]
     L = np.where(outs.any(axis=0), m - 1 - outs[::-1].argmax(axis=0), -1)
     cand = rows == L[None, :]
     if sig.kind == "sine":
         cand |= rows > L[None, :]
     elif order == 1:
-        d_start, d_end = slope - x2, slope - x2_end
+        d_start, d_end = slope - x2, slope - at_ends(x2, tr.x2)
         with np.errstate(invalid="ignore"):
-            reach = np.abs(e_start) + h[:, None] * np.abs(d_start) >= band * (1.0 - 1e-9)
+            reach = abs_start + h[:, None] * np.abs(d_start) >= band * (1.0 - 1e-9)
             cand |= (rows > L[None, :]) & (d_start * d_end < 0.0) & reach
     ci, cc = np.nonzero(cand)  # row-major: by interval, then column
     last = np.full(k, float(tr.t[0]))

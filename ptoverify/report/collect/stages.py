@@ -162,10 +162,10 @@ POLE_GATES = ("pd-sampled-stable", "linear-zone-sampled-stable")
 PROOF_GATES = ("proof-no-stride-over", "proof-reach")
 
 
-#: The report's stages, longest first as measured (issue 23, 2026-12-03: in a pool of two,
-#: tuning 28 s, robustness 16, sweep 13, charts 13, figures 8, closed loop 7, derivations 6,
-#: proofs 5, ground truth 2, poles 1): the order the processes take them in, so the longest
-#: starts first and the short ones fill in at the end.
+#: The report's stages, longest first as measured (issue 23, 2026-12-07: CPU in one process,
+#: imports done: tuning 8.4 s, robustness 6.2, sweep 5.2, charts 5.0, figures 4.0, closed
+#: loop 2.8, derivations 2.8, proofs 2.8, ground truth 1.3, poles 0.2): the order the
+#: processes take them in, so the longest starts first and the short ones fill in at the end.
 _STAGE_FUNCTIONS: dict[str, Callable[[Config, Path | None], dict[str, Any]]] = {
     "tuning": _stage_tuning,
     "robustness": _stage_robust,

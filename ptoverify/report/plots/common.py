@@ -132,7 +132,7 @@ def write_png(fig: Figure, path: str | Path) -> Path:
             # the layout once, then no engine: savefig would otherwise traverse the
             # whole figure once more (a draw with rendering disabled) just to run it
             engine.execute(fig)
-            fig.set_layout_engine(None)
+            fig.set_layout_engine("none")  # not None: that reads the rcParams
         fig.savefig(path, format="png", dpi=DPI, pil_kwargs=PNG_OPTIONS)
     return Path(path)
 
