@@ -8,7 +8,9 @@ with the file line and column named.
 from __future__ import annotations
 
 import csv
+import io
 import math
+from operator import itemgetter
 from pathlib import Path
 
 import numpy as np
@@ -84,12 +86,12 @@ def read_columns(
     if not lines:
         raise InputError(f"{what} '{path}' has a header but no rows")
     width = max(idx) + 1
-    for r, i in zip(rows, lines, strict=True):
-        if len(r) < width:
-            raise InputError(f"{what} '{path}' line {i}: missing field (need {need})")
+    if min(map(len, rows)) < width:
+        k = next(k for k, r in enumerate(rows) if len(r) < width)
+        raise InputError(f"{what} '{path}' line {lines[k]}: missing field (need {need})")
     cols = []
     for name, j in zip(names, idx, strict=True):
-        text = [r[j] for r in rows]
+        text = list(map(itemgetter(j), rows))
         try:
             v = np.array(text, dtype=float)
         except ValueError:
@@ -109,6 +111,8 @@ def read_columns(
 MAX_HEADER = 1 << 16
 #: Longest data line accepted [characters] (a row of a few numbers needs < 100).
 MAX_LINE = 1 << 12
+#: Characters read at a time (a few MB of memory for the block and its lines).
+CHUNK = 1 << 20
 
 
 def _header(path, head: str, what: str) -> list[str]:
@@ -137,37 +141,56 @@ def _header(path, head: str, what: str) -> list[str]:
 
 
 def _rows(fh, path, what: str) -> tuple[list[list[str]], list[int]]:
-    """Read the data rows line by line, rejecting NUL bytes and overlong lines at once.
+    """Read the data rows, a block of :data:`CHUNK` characters at a time.
 
-    One :func:`csv.reader` parses the checked, non-blank lines; a row that would
-    span lines (a quoted line break) is malformed.
+    Lines end as :func:`open` with ``newline=""`` reads them (at a line feed, a
+    carriage return and line feed, or a carriage return).  NUL bytes and overlong lines are rejected in the block they are in
+    (so a binary file is refused after one block, in bounded memory); blank lines
+    are skipped; one :func:`csv.reader` parses the rest, and a row that would span
+    lines (a quoted line break) is malformed.  Returns the rows and the file line
+    of each (the header is line 1).
     """
-    lines: list[int] = []
+    lines: list[str] = []
+    carry = ""  # the block's last line, while its end is not read yet
+    while True:
+        block = fh.read(CHUNK)
+        text = carry + block
+        if not text:
+            break
+        parts = io.StringIO(text, newline="").readlines()
+        carry = parts.pop() if block and not parts[-1].endswith("\n") else ""
+        if "\x00" in text or max(map(len, parts), default=0) >= MAX_LINE or len(carry) >= MAX_LINE:
+            _reject_line([*parts, carry], len(lines) + 2, path, what)
+        lines += parts
+    if any(map(str.isspace, lines)):  # blank lines: skipped, still counted
+        number = [n for n, t in enumerate(lines, 2) if not t.isspace()]
+        lines = [t for t in lines if not t.isspace()]
+    else:
+        number = list(range(2, len(lines) + 2))
+    reader = csv.reader(lines)
+    rows = list(reader)
+    if reader.line_num != len(rows):  # a row took more than one line: name the first
+        reader = csv.reader(lines)
+        k = next(k for k, _ in enumerate(reader) if reader.line_num != k + 1)
+        raise InputError(f"{what} '{path}' line {number[k]}: a quoted field spans lines")
+    return rows, number
 
-    def checked():
-        line = 1
-        while True:
-            text = fh.readline(MAX_LINE)
-            if not text:
-                return
-            line += 1
-            if "\x00" in text:
-                raise InputError(f"{what} '{path}' line {line}: NUL bytes; not a CSV text file")
-            if len(text) >= MAX_LINE and not text.endswith("\n"):
-                raise InputError(
-                    f"{what} '{path}' line {line}: longer than {MAX_LINE} characters "
-                    "(a row holds a few numbers)"
-                )
-            if text.strip():
-                lines.append(line)
-                yield text
 
-    rows = []
-    for row in csv.reader(checked()):
-        if len(rows) + 1 != len(lines):
-            raise InputError(f"{what} '{path}' line {lines[len(rows)]}: a quoted field spans lines")
-        rows.append(row)
-    return rows, lines
+def _reject_line(lines: list[str], first: int, path, what: str) -> None:
+    """Reject the first of ``lines`` (file line ``first`` on) with NUL bytes or too long.
+
+    As a reader of at most :data:`MAX_LINE` characters at a time sees them: a
+    line is too long when its end is not within its first MAX_LINE characters,
+    and NUL bytes count where they are within those.
+    """
+    for n, t in enumerate(lines, first):
+        if "\x00" in t[:MAX_LINE]:
+            raise InputError(f"{what} '{path}' line {n}: NUL bytes; not a CSV text file")
+        if len(t) > MAX_LINE or (len(t) == MAX_LINE and not t.endswith("\n")):
+            raise InputError(
+                f"{what} '{path}' line {n}: longer than {MAX_LINE} characters "
+                "(a row holds a few numbers)"
+            )
 
 
 def _to_float(text: str) -> float:

@@ -104,3 +104,82 @@ def test_read_round_trips(tmp_path, paper_cfg):
     got = read_table(table, paper_cfg)
     for a, b in zip(got, (x1, x2, u)):
         assert np.array_equal(a, b), "round trip through repr is exact"
+
+
+@pytest.mark.parametrize("chunk", [1, 2, 7, 64, 1 << 20])
+@pytest.mark.parametrize("seed", range(4))
+def test_blocks_read_as_one_file(monkeypatch, tmp_path, chunk, seed):
+    """Any block size reads as :mod:`csv` reads the whole file at once.
+
+    Random tables with LF, CR LF and CR line ends, blank and white-space lines,
+    extra columns and spaces around numbers; the reference is ``csv.reader`` over
+    the file opened with ``newline=""`` (its blank rows dropped, file lines from
+    its ``line_num``).  A block size of 1 and 2 splits every CR LF pair.
+    """
+    import csv
+
+    import ptoverify.tables as tables
+
+    rng = np.random.default_rng(seed)
+    ends = ["\n", "\r\n", "\r"]
+    text = "x2,x1,u,note" + ends[rng.integers(3)]
+    for _ in range(200):
+        end = ends[rng.integers(3)]
+        kind = rng.integers(6)
+        if kind == 0:
+            text += end
+        elif kind == 1:
+            text += "  \t" + end
+        else:
+            a, b, c = (rng.normal(size=3) * 10.0 ** rng.integers(-3, 4, size=3)).tolist()
+            text += f" {a!r},{b!r} ,{c!r},x{kind}{end}"
+    if rng.integers(2):
+        text = text.rstrip("\r\n")  # no end on the last line
+    path = tmp_path / "t.csv"
+    path.write_bytes(text.encode())
+    monkeypatch.setattr(tables, "CHUNK", chunk)
+    (x1, x2, u), lines = tables.read_columns(path, ("x1", "x2", "u"))
+    want, numbers = [], []
+    with open(path, newline="") as fh:
+        reader = csv.reader(fh)
+        next(reader)
+        start = reader.line_num + 1
+        for row in reader:
+            if any(f.strip() for f in row):
+                want.append([float(f) for f in row[:3]])
+                numbers.append(start)
+            start = reader.line_num + 1
+    want = np.array(want)
+    assert np.array_equal(x1, want[:, 1]) and np.array_equal(x2, want[:, 0])
+    assert np.array_equal(u, want[:, 2]) and lines.tolist() == numbers
+
+
+LONG = " " * 4090 + "1"  #: a field of 4091 characters: with ",2,3" and LF, MAX_LINE
+
+
+@pytest.mark.parametrize("chunk", [3, 1 << 20])
+@pytest.mark.parametrize(
+    "body, words",
+    [
+        ('1,2,3\n4,"5\n6",7\n', "line 3: a quoted field spans lines"),
+        ("1,2,3\n\n4,5\n", "line 4: missing field"),
+        ("1,2,3\n" + LONG + ",2,3\n", None),  # MAX_LINE characters with its LF
+        ("1,2,3\n" + LONG + "5,2,3\n", "line 3: longer than 4096"),
+        ("1,2,3\n" + LONG + "5,2,3", "line 3: longer than 4096"),  # at the end of the file
+        ("1,2,3\n" + LONG + ",2,3\r\n", "line 3: longer than 4096"),
+        ("1,2,3\n1,\x002,3\n", "line 3: NUL bytes"),
+        ("1,2,3\n" + "9" * 5000 + "\x00\n", "line 3: longer than 4096"),  # NUL past the limit
+    ],
+)
+def test_line_checks_hold_across_blocks(monkeypatch, tmp_path, chunk, body, words):
+    import ptoverify.tables as tables
+
+    path = tmp_path / "t.csv"
+    path.write_text("x1,x2,u\n" + body, newline="")
+    monkeypatch.setattr(tables, "CHUNK", chunk)
+    if words is None:
+        (x1, _, _), lines = tables.read_columns(path, ("x1", "x2", "u"))
+        assert lines.tolist() == [2, 3] and x1[1] == 1.0
+    else:
+        with pytest.raises(InputError, match=words):
+            tables.read_columns(path, ("x1", "x2", "u"))

@@ -2,9 +2,14 @@
 
 Every table here is built as a firmware team would: ``conform --emit-grid``
 through the CLI, the law (the reference, or a mutant of ``tests/pto_mutants.py``)
-evaluated at the emitted states in file order, in batches of 1000 rows, the CSV
-written with columns x1, x2, u, then ``conform --table`` through
-``ptoverify.cli.main``.
+evaluated at the emitted states in file order, in batches of 1000 rows.  The
+reference, the band mutants and the tables of the coverage rule are written as
+CSV (columns x1, x2, u) and judged by ``conform --table`` through
+``ptoverify.cli.main``.  The other mutants' values are judged by
+:func:`ptoverify.conform.table.judge_table`, the judgement ``conform --table``
+makes after reading the file, at the emitted states: the CSV round trip is exact
+(every number written as its repr), which
+:func:`test_judging_in_memory_is_judging_the_file` checks on a mutant.
 """
 
 import contextlib
@@ -27,7 +32,9 @@ from ptoverify.conform.agreement import (
     table_coverage,
     tie_band,
 )
+from ptoverify.cli.common import to_jsonable
 from ptoverify.conform.gate import conform_callable, reference_law
+from ptoverify.conform.table import judge_table
 from ptoverify.model.curves import level_curve_x1
 from ptoverify.model.laws import Region
 from ptoverify.model.laws import make_law as make_ref
@@ -98,25 +105,32 @@ def conform_json(capsys, table):
 
 @pytest.fixture(scope="module")
 def mutant_table(tmp_path_factory, emitted, emitted_rows):
-    """``judge(name)``: (exit code, JSON) of ``conform --table`` of a variant's table.
+    """``judge(name)``: (exit code, JSON) of the table of a variant, as ``conform --table``.
 
     The variant of ``tests/pto_mutants.py`` evaluated at the emitted states (as
-    firmware does), the table written from the emitted rows; each variant judged
-    once per module (two tests read the tie-asymmetry mutant's verdict).
+    firmware does); ``judge(name, cli=True)`` writes the table from the emitted
+    rows and runs ``conform --table --json``, ``judge(name)`` judges the same
+    values with :func:`judge_table` and formats them as ``--json`` does.  Each
+    variant judged once per route and module.
     """
     done, cfg = {}, paper_config()
 
-    def judge(name):
-        if name not in done:
+    def judge(name, cli=False):
+        if (name, cli) not in done:
             x1, x2 = emitted
             u = evaluate(make_law([name]), x1, x2, cfg)
-            path = write_rows(tmp_path_factory.mktemp("table") / f"{name}.csv", emitted_rows, u)
-            out = io.StringIO()
-            with contextlib.redirect_stdout(out):
-                code = main(["conform", "--table", str(path), "--json"])
-            path.unlink()  # 10 MB each
-            done[name] = code, json.loads(out.getvalue())
-        return done[name]
+            if cli:
+                path = write_rows(tmp_path_factory.mktemp("table") / f"{name}.csv", emitted_rows, u)
+                out = io.StringIO()
+                with contextlib.redirect_stdout(out):
+                    code = main(["conform", "--table", str(path), "--json"])
+                path.unlink()  # 10 MB each
+                done[name, cli] = code, json.loads(out.getvalue())
+            else:
+                r = judge_table(x1, x2, u, cfg, source=f"{name}.csv")
+                data = json.loads(json.dumps(to_jsonable(r.to_json()), allow_nan=False))
+                done[name, cli] = (0 if r.conforms else 1), data
+        return done[name, cli]
 
     return judge
 
@@ -191,7 +205,7 @@ def test_reference_at_emitted_states_conforms(capsys, tmp_path, emitted, paper_c
 @pytest.mark.parametrize("name", BANDS)
 def test_band_mutant_killed_through_table(mutant_table, name):
     """5 % slow between grid columns: caught at the emitted random/band states."""
-    code, data = mutant_table(name)
+    code, data = mutant_table(name, cli=True)
     assert code == 1 and not data["conforms"]
     fail = next(f for f in data["failures"] if f["property"] == "agreement")
     assert in_band(name, fail["state"]), fail
@@ -223,6 +237,16 @@ def test_every_mutant_killed_through_table(mutant_table, name):
 def test_tie_asymmetry_killed_through_table(mutant_table):
     code, data = mutant_table("tie_asym")
     assert code == 1 and [f["property"] for f in data["failures"]] == ["odd-symmetry"]
+
+
+@pytest.mark.parametrize("name", ["slow_band_x1", "tie_asym"])
+def test_judging_in_memory_is_judging_the_file(mutant_table, name):
+    """The file route and :func:`judge_table` give the same verdict, failures and figures."""
+    (code, data), (code_cli, data_cli) = mutant_table(name), mutant_table(name, cli=True)
+    assert code == code_cli == 1
+    for key in ("timings_s", "target"):
+        data.pop(key), data_cli.pop(key)
+    assert data == data_cli
 
 
 @pytest.mark.parametrize("name", sorted(set(BENIGN) - {"faithful"}))

@@ -142,7 +142,7 @@ from ptoverify.conform.result import (
     input_bound,
     summary_line,
 )
-from ptoverify.conform.table import MIN_PER_REGION, conform_table
+from ptoverify.conform.table import MIN_PER_REGION, conform_table, judge_table
 from ptoverify.conform.userlaw import (
     DEFAULT_TIMEOUT_S,
     LawFault,
@@ -173,6 +173,7 @@ __all__ = [
     "conform_callable",
     "conform_spec",
     "conform_table",
+    "judge_table",
     "format_result",
     "summary_line",
     "DEFAULT_RTOL",

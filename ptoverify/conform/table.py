@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ptoverify.config import Config
 from ptoverify.conform.agreement import (
@@ -34,7 +35,7 @@ from ptoverify.model.laws import Region
 from ptoverify.model.memo import memo
 from ptoverify.verdict import FAIL, NOT_RUN, PASS, Verdict
 
-__all__ = ["MIN_PER_REGION", "conform_table"]
+__all__ = ["MIN_PER_REGION", "conform_table", "judge_table"]
 
 MIN_PER_REGION = 100  #: judged table states per reference region (the origin: 1)
 
@@ -134,6 +135,9 @@ def conform_table(
 ) -> ConformResult:
     """Judge a table x1, x2, u (CSV) against the reference where it has points.
 
+    Reads the file (:func:`ptoverify.conform.agreement.read_table`), then
+    :func:`judge_table`.
+
     Parameters
     ----------
     path : str or Path
@@ -151,8 +155,7 @@ def conform_table(
     Returns
     -------
     ConformResult
-        ``coverage``, ``agreement``, ``input-bound-grid`` and ``odd-symmetry``
-        (at mirrored grid states); closed-loop properties ``not_run``.
+        As :func:`judge_table`, with the time the read took.
     """
     from ptoverify.conform.precision import check_precision
 
@@ -160,6 +163,54 @@ def conform_table(
     t0 = time.perf_counter()
     x1, x2, u = read_table(path, cfg)
     t_read = time.perf_counter() - t0
+    return judge_table(
+        x1, x2, u, cfg, source=str(path), rtol=rtol, keep=keep, precision=precision, t_read=t_read
+    )
+
+
+def judge_table(
+    x1: NDArray[np.float64],
+    x2: NDArray[np.float64],
+    u: NDArray[np.float64],
+    cfg: Config,
+    *,
+    source: str = "table",
+    rtol: float = DEFAULT_RTOL,
+    keep: dict | None = None,
+    precision: str = "float64",
+    t_read: float = 0.0,
+) -> ConformResult:
+    """Judge a table's values u at its states (x1, x2), as ``conform --table`` does.
+
+    Parameters
+    ----------
+    x1, x2 : ndarray
+        The table's states [mm], [mm/s], in row order.
+    u : ndarray
+        The implementation's value at each state [mm/s].
+    cfg : Config
+        Configuration.
+    source : str
+        What the table is, for the result (the file name for ``--table``).
+    rtol : float
+        Agreement tolerance relative to w_max.
+    keep : dict, optional
+        As :func:`conform_table`.
+    precision : str
+        ``float64`` or ``float32`` (:mod:`ptoverify.conform.precision`).
+    t_read : float
+        Time the table took to read [s], for ``timings_s``.
+
+    Returns
+    -------
+    ConformResult
+        ``coverage``, ``agreement``, ``input-bound-grid`` and ``odd-symmetry``
+        (at mirrored grid states); closed-loop properties ``not_run``.
+    """
+    from ptoverify.conform.precision import check_precision
+
+    check_precision(precision)
+    t0 = time.perf_counter() - t_read
     if keep is not None:
         keep["states"] = (x1, x2, u)
     agree, failures = agreement(x1, x2, u, cfg, rtol, precision=precision, keep=keep)
@@ -182,7 +233,7 @@ def conform_table(
     return ConformResult(
         ok,
         "table",
-        str(path),
+        source,
         f"table of {x1.size} states",
         agree,
         props,

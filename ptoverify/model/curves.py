@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.special import lambertw
 
 __all__ = [
     "h",
@@ -248,6 +247,10 @@ def level_curve_x1(x2: ArrayLike, a: float, omega: ArrayLike) -> Array:
 
 
 def _lambertw_real(x: Array, branch: int) -> Array:
+    # imported here: scipy.special costs ~0.15 s of import, which a process that
+    # only evaluates laws (a conform child, the CLI's argument errors) never needs
+    from scipy.special import lambertw
+
     with np.errstate(all="ignore"):
         return np.real(lambertw(x, branch))
 
