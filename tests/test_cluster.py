@@ -205,8 +205,8 @@ def test_a_signal_during_dask_local_is_one_line_and_leaves_nothing(tmp_path, sig
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline and len(list(scratch.glob("*/*/worker-*/"))) < 2:
         time.sleep(0.1)  # the workers' folders in the cluster's scratch space: they start
-    # then the chart's tasks run on them (5.4 s more on a quiet machine): signal mid-way
-    time.sleep(2.0)
+    # then the chart's tasks run on them (5.4 s more on a quiet machine): signal early on
+    time.sleep(1.0)
     p.send_signal(sig)
     out, err = p.communicate(timeout=60)
     assert p.returncode == (130 if sig == signal.SIGINT else 143), err

@@ -149,8 +149,7 @@ def saturate_linear(v: NDArray[np.float64], w: float):
     >>> u.tolist(), [Region(k).name for k in r]
     ([1.0, -300.0], ['LINEAR', 'SATURATED'])
     """
-    with np.errstate(invalid="ignore"):
-        region = np.where(np.abs(v) > w, _SATURATED, _LINEAR)
+    region = np.where(np.abs(v) > w, _SATURATED, _LINEAR)  # (a NaN compares False, silently)
     return np.minimum(np.maximum(v, -w), w), region  # np.clip(v, -w, w)
 
 

@@ -244,7 +244,7 @@ def simulate_loops(
 
     def controller(k: int, y1: NDArray, y2: NDArray) -> tuple[NDArray, NDArray]:
         v, region = law.vector(y1 - r[k], y2 - e2_off[k])
-        return np.clip(v + u_add[k], -w, w), region
+        return np.minimum(np.maximum(v + u_add[k], -w), w), region  # np.clip(., -w, w)
 
     X1, X2, U, R = _loop(controller, plant, np.zeros(loops), np.zeros(loops), n, Mismatch())
     out = []

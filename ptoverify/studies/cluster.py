@@ -204,7 +204,10 @@ def dask_map(address: str, fn: Any, jobs: list) -> list:
                 n_workers=2,
                 threads_per_worker=1,
                 processes=True,
-                dashboard_address=None,
+                # the scheduler serves HTTP whatever this says: a port of its own, as
+                # Dask's default 8787 may be another cluster's ("Port 8787 is already in
+                # use" was a three-line warning on the command's stderr)
+                dashboard_address="127.0.0.1:0",
                 # the workers' own logs (a heartbeat to a scheduler closed by SIGINT or
                 # SIGTERM logs a traceback) stay off the command's stderr; a task's
                 # exception still reaches gather (audit run 7)
