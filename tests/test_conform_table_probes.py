@@ -21,6 +21,7 @@ import pytest
 from pto_mutants import BENIGN, MUTANTS, make_law
 
 from ptoverify.cli import main
+from ptoverify.cli.common import to_jsonable
 from ptoverify.config import paper_config
 from ptoverify.conform import agreement as agreement_mod
 from ptoverify.conform.agreement import (
@@ -32,7 +33,6 @@ from ptoverify.conform.agreement import (
     table_coverage,
     tie_band,
 )
-from ptoverify.cli.common import to_jsonable
 from ptoverify.conform.gate import conform_callable, reference_law
 from ptoverify.conform.table import judge_table
 from ptoverify.model.curves import level_curve_x1
