@@ -65,6 +65,8 @@ def read_columns(
     if not p.is_file():
         why = "does not exist" if not p.exists() else "is not a regular file"
         raise InputError(f"{what} '{path}' {why}")
+    cols: list[list[NDArray[np.float64]]] = [[] for _ in names]
+    numbers: list[NDArray[np.int64]] = []
     try:
         with open(p, newline="", encoding="utf-8") as fh:
             header = _header(path, fh.readline(MAX_HEADER), what)
@@ -76,35 +78,57 @@ def read_columns(
                         f"(need {need})"
                     )
             idx = [header.index(name) for name in names]
-            rows, lines = _rows(fh, path, what)
+            width, where = max(idx) + 1, f"{what} '{path}'"
+            number: list[int] = []  # the file line of each line read and not converted yet
+            rows: list[list[str]] = []
+
+            def convert() -> None:  # the rows read so far, into the columns
+                if min(map(len, rows)) < width:
+                    k = next(k for k, r in enumerate(rows) if len(r) < width)
+                    raise InputError(f"{where} line {number[k]}: missing field (need {need})")
+                for col, name, j in zip(cols, names, idx, strict=True):
+                    col.append(_column(rows, j, number, where, name))
+                numbers.append(np.array(number[: len(rows)], dtype=np.int64))
+                del number[: len(rows)]
+                rows.clear()
+
+            reader = csv.reader(_lines(fh, number, path, what))
+            done = 0  # rows converted
+            for row in reader:
+                rows.append(row)
+                if reader.line_num != done + len(rows):  # this row took more than one line
+                    k = len(rows) - 1
+                    raise InputError(f"{where} line {number[k]}: a quoted field spans lines")
+                if len(rows) == BATCH:
+                    done += len(rows)
+                    convert()
+            if rows:
+                convert()
     except OSError as exc:
         raise InputError(f"cannot read {what} '{path}': {exc.strerror or exc}") from None
     except UnicodeDecodeError as exc:
         raise InputError(f"cannot read {what} '{path}': not UTF-8 text ({exc.reason})") from None
     except csv.Error as exc:
         raise InputError(f"{what} '{path}': malformed CSV: {exc}") from None
-    if not lines:
+    if not numbers:
         raise InputError(f"{what} '{path}' has a header but no rows")
-    width = max(idx) + 1
-    if min(map(len, rows)) < width:
-        k = next(k for k, r in enumerate(rows) if len(r) < width)
-        raise InputError(f"{what} '{path}' line {lines[k]}: missing field (need {need})")
-    cols = []
-    for name, j in zip(names, idx, strict=True):
-        text = list(map(itemgetter(j), rows))
-        try:
-            v = np.array(text, dtype=float)
-        except ValueError:
-            v = np.array([_to_float(t) for t in text])
-        bad = np.flatnonzero(~np.isfinite(v))
-        if bad.size:
-            k = int(bad[0])
-            raise InputError(
-                f"{what} '{path}' line {lines[k]}: column {name} = {text[k].strip()!r} "
-                "is not a finite number"
-            )
-        cols.append(v)
-    return tuple(cols), np.array(lines, dtype=np.int64)
+    return tuple(np.concatenate(c) for c in cols), np.concatenate(numbers)
+
+
+def _column(rows: list[list[str]], j: int, number: list[int], where: str, name: str) -> NDArray:
+    """Field ``j`` of every row as floats; InputError naming the first that is not finite."""
+    text = list(map(itemgetter(j), rows))
+    try:
+        v = np.array(text, dtype=float)
+    except ValueError:
+        v = np.array([_to_float(t) for t in text])
+    bad = np.flatnonzero(~np.isfinite(v))
+    if bad.size:
+        k = int(bad[0])
+        raise InputError(
+            f"{where} line {number[k]}: column {name} = {text[k].strip()!r} is not a finite number"
+        )
+    return v
 
 
 #: Longest header line read [characters].
@@ -113,6 +137,8 @@ MAX_HEADER = 1 << 16
 MAX_LINE = 1 << 12
 #: Characters read at a time (a few MB of memory for the block and its lines).
 CHUNK = 1 << 20
+#: Rows converted to floats at a time (the text in memory is this many rows and a block).
+BATCH = 1 << 16
 
 
 def _header(path, head: str, what: str) -> list[str]:
@@ -140,40 +166,34 @@ def _header(path, head: str, what: str) -> list[str]:
     return header
 
 
-def _rows(fh, path, what: str) -> tuple[list[list[str]], list[int]]:
-    """Read the data rows, a block of :data:`CHUNK` characters at a time.
+def _lines(fh, number: list[int], path, what: str):
+    """Yield the data lines, reading a block of :data:`CHUNK` characters at a time.
 
     Lines end as :func:`open` with ``newline=""`` reads them (at a line feed, a
-    carriage return and line feed, or a carriage return).  NUL bytes and overlong lines are rejected in the block they are in
-    (so a binary file is refused after one block, in bounded memory); blank lines
-    are skipped; one :func:`csv.reader` parses the rest, and a row that would span
-    lines (a quoted line break) is malformed.  Returns the rows and the file line
-    of each (the header is line 1).
+    carriage return and line feed, or a carriage return).  NUL bytes and overlong
+    lines are rejected in the block they are in (so a binary file is refused
+    after one block, in bounded memory); blank lines are skipped.  The file line
+    of each line yielded is appended to ``number`` (the header is line 1) before
+    the block's lines are yielded.
     """
-    lines: list[str] = []
-    carry = ""  # the block's last line, while its end is not read yet
+    carry, first = "", 2  # the block's last line while its end is not read; its number
     while True:
         block = fh.read(CHUNK)
         text = carry + block
         if not text:
-            break
-        parts = io.StringIO(text, newline="").readlines()
-        carry = parts.pop() if block and not parts[-1].endswith("\n") else ""
-        if "\x00" in text or max(map(len, parts), default=0) >= MAX_LINE or len(carry) >= MAX_LINE:
-            _reject_line([*parts, carry], len(lines) + 2, path, what)
-        lines += parts
-    if any(map(str.isspace, lines)):  # blank lines: skipped, still counted
-        number = [n for n, t in enumerate(lines, 2) if not t.isspace()]
-        lines = [t for t in lines if not t.isspace()]
-    else:
-        number = list(range(2, len(lines) + 2))
-    reader = csv.reader(lines)
-    rows = list(reader)
-    if reader.line_num != len(rows):  # a row took more than one line: name the first
-        reader = csv.reader(lines)
-        k = next(k for k, _ in enumerate(reader) if reader.line_num != k + 1)
-        raise InputError(f"{what} '{path}' line {number[k]}: a quoted field spans lines")
-    return rows, number
+            return
+        lines = io.StringIO(text, newline="").readlines()
+        carry = lines.pop() if block and not lines[-1].endswith("\n") else ""
+        if "\x00" in text or max(map(len, lines), default=0) >= MAX_LINE or len(carry) >= MAX_LINE:
+            _reject_line([*lines, carry], first, path, what)
+        if any(map(str.isspace, lines)):  # blank lines: skipped, still counted
+            number.extend(n for n, t in enumerate(lines, first) if not t.isspace())
+            kept = [t for t in lines if not t.isspace()]
+        else:
+            number.extend(range(first, first + len(lines)))
+            kept = lines
+        first += len(lines)
+        yield from kept
 
 
 def _reject_line(lines: list[str], first: int, path, what: str) -> None:

@@ -88,11 +88,15 @@ def test_state_far_outside_envelope_is_bad_input(capsys, tmp_path, value):
 
 
 def test_error_line_named_across_chunks(monkeypatch, tmp_path):
+    import ptoverify.tables as tables
+
     rows = ["x1,x2,u"] + [f"{i * 0.01},0.0,0.0" for i in range(30)]
-    rows[23] = "0.5,abc,0.0"  # line 24 of the file, in the fourth chunk
+    rows[23] = "0.5,abc,0.0"  # line 24 of the file, in the fourth batch of 7 rows
     rows.insert(10, "")  # a blank line still counts as a line
     table = tmp_path / "t.csv"
     table.write_text("\n".join(rows) + "\n")
+    monkeypatch.setattr(tables, "CHUNK", 64)  # blocks of 64 characters: 4-5 lines each
+    monkeypatch.setattr(tables, "BATCH", 7)
     with pytest.raises(InputError, match=r"line 25: column x2 = 'abc'"):
         read_table(table)
 
@@ -106,10 +110,10 @@ def test_read_round_trips(tmp_path, paper_cfg):
         assert np.array_equal(a, b), "round trip through repr is exact"
 
 
-@pytest.mark.parametrize("chunk", [1, 2, 7, 64, 1 << 20])
+@pytest.mark.parametrize("chunk, batch", [(1, 1), (2, 5), (7, 1), (64, 5), (1 << 20, 1 << 16)])
 @pytest.mark.parametrize("seed", range(4))
-def test_blocks_read_as_one_file(monkeypatch, tmp_path, chunk, seed):
-    """Any block size reads as :mod:`csv` reads the whole file at once.
+def test_blocks_read_as_one_file(monkeypatch, tmp_path, chunk, batch, seed):
+    """Any block size and batch of rows reads as :mod:`csv` reads the whole file at once.
 
     Random tables with LF, CR LF and CR line ends, blank and white-space lines,
     extra columns and spaces around numbers; the reference is ``csv.reader`` over
@@ -138,6 +142,7 @@ def test_blocks_read_as_one_file(monkeypatch, tmp_path, chunk, seed):
     path = tmp_path / "t.csv"
     path.write_bytes(text.encode())
     monkeypatch.setattr(tables, "CHUNK", chunk)
+    monkeypatch.setattr(tables, "BATCH", batch)
     (x1, x2, u), lines = tables.read_columns(path, ("x1", "x2", "u"))
     want, numbers = [], []
     with open(path, newline="") as fh:
@@ -163,11 +168,15 @@ LONG = " " * 4090 + "1"  #: a field of 4091 characters: with ",2,3" and LF, MAX_
     [
         ('1,2,3\n4,"5\n6",7\n', "line 3: a quoted field spans lines"),
         ("1,2,3\n\n4,5\n", "line 4: missing field"),
-        ("1,2,3\n" + LONG + ",2,3\n", None),  # MAX_LINE characters with its LF
+        ("1,2,3\n" + LONG + ",2,3\n", [1.0, 1.0]),  # MAX_LINE characters with its LF
         ("1,2,3\n" + LONG + "5,2,3\n", "line 3: longer than 4096"),
         ("1,2,3\n" + LONG + "5,2,3", "line 3: longer than 4096"),  # at the end of the file
         ("1,2,3\n" + LONG + ",2,3\r\n", "line 3: longer than 4096"),
         ("1,2,3\n1,\x002,3\n", "line 3: NUL bytes"),
+        ('1,2,3\n4,5,6,"a\n7,8,9\n', "line 3: a quoted field spans lines"),
+        ('1,2,3,5"\n4,5,6\n', [1.0, 4.0]),  # a quote inside an unquoted field is text (csv)
+        ("1,2\n", "line 2: missing field"),
+        ("1,2,3\n4,x,6\n", "line 3: column x2 = 'x' is not a finite number"),
         ("1,2,3\n" + "9" * 5000 + "\x00\n", "line 3: longer than 4096"),  # NUL past the limit
     ],
 )
@@ -177,9 +186,9 @@ def test_line_checks_hold_across_blocks(monkeypatch, tmp_path, chunk, body, word
     path = tmp_path / "t.csv"
     path.write_text("x1,x2,u\n" + body, newline="")
     monkeypatch.setattr(tables, "CHUNK", chunk)
-    if words is None:
+    if isinstance(words, list):  # read: the x1 column
         (x1, _, _), lines = tables.read_columns(path, ("x1", "x2", "u"))
-        assert lines.tolist() == [2, 3] and x1[1] == 1.0
+        assert lines.tolist() == [2, 3] and x1.tolist() == words
     else:
         with pytest.raises(InputError, match=words):
             tables.read_columns(path, ("x1", "x2", "u"))

@@ -29,7 +29,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import differential_evolution
 
 from ptoverify.config import Config
 from ptoverify.errors import InputError
@@ -166,6 +165,8 @@ def _search_job(
     seed = [box.seed, PROPERTIES.index(prop), delay]  # one stream per search
 
     def job(ev: Callable[[list[Probe]], list[dict[str, NDArray]]]) -> dict[str, Any]:
+        from scipy.optimize import differential_evolution  # here: 0.5 s of import otherwise
+
         rng = np.random.default_rng(seed)
         found: dict[str, Any] = {
             p: {"value": -math.inf, "z": None, "delay": delay} for p in PROPERTIES

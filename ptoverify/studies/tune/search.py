@@ -53,7 +53,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.optimize import differential_evolution
 
 from ptoverify.config import Config
 from ptoverify.errors import InfeasibleError, InputError
@@ -194,6 +193,8 @@ def _de(space: _Space, seed: int, maxiter: int, popsize: int) -> None:
     (scipy's ``vectorized=True``, which implies ``updating="deferred"``: a
     generation's trials are all made from the population before it).
     """
+    from scipy.optimize import differential_evolution  # here: 0.5 s of import otherwise
+
     differential_evolution(
         space.f,
         [tuple(b) for b in space.bounds],
