@@ -164,20 +164,31 @@ def test_dask_local_leaves_nothing_in_tmpdir(tmp_path):
     """Audit run 7: every ``--dask local`` run left ``$TMPDIR/dask-scratch-space``.
 
     Through the command line in its own process (a LocalCluster inside the test
-    process shares its event loops with the other tests).
+    process shares its event loops with the other tests).  Dask's default HTTP
+    port 8787 is held meanwhile (by this test, or by whoever holds it already): the
+    scheduler takes a port of its own and the command's stderr stays empty (it
+    was a three-line "Port 8787 is already in use" warning).
     """
+    import socket
+
     scratch = tmp_path / "tmp"
     scratch.mkdir()
     argv = ["design", "--dask", "local", "--sample-times", "0.002", "--bandwidths", "30"]
-    p = subprocess.run(
-        [sys.executable, "-m", "ptoverify", *argv, "--grid", "2", "--laws", "pd", "--json"],
-        cwd=tmp_path,
-        env=dict(os.environ, PYTHONPATH=str(ROOT), TMPDIR=str(scratch)),
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert p.returncode == 0, p.stderr
+    with socket.socket() as held:
+        try:
+            held.bind(("", 8787))
+            held.listen()
+        except OSError:
+            pass  # taken already: the same case
+        p = subprocess.run(
+            [sys.executable, "-m", "ptoverify", *argv, "--grid", "2", "--laws", "pd", "--json"],
+            cwd=tmp_path,
+            env=dict(os.environ, PYTHONPATH=str(ROOT), TMPDIR=str(scratch)),
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
+    assert p.returncode == 0 and p.stderr == "", p.stderr
     assert json.loads(p.stdout)["backend"] == "local"
     assert sorted(q.name for q in scratch.rglob("*")) == []
 
