@@ -93,14 +93,12 @@ def read_columns(
                 rows.clear()
 
             reader = csv.reader(_lines(fh, number, path, what))
-            done = 0  # rows converted
-            for row in reader:
+            for n_rows, row in enumerate(reader, 1):
                 rows.append(row)
-                if reader.line_num != done + len(rows):  # this row took more than one line
+                if reader.line_num != n_rows:  # this row took more than one line
                     k = len(rows) - 1
                     raise InputError(f"{where} line {number[k]}: a quoted field spans lines")
                 if len(rows) == BATCH:
-                    done += len(rows)
                     convert()
             if rows:
                 convert()
