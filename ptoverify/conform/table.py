@@ -159,7 +159,7 @@ def conform_table(
     """
     from ptoverify.conform.precision import check_precision
 
-    check_precision(precision)
+    check_precision(precision)  # before the read (judge_table checks it too, for its own callers)
     t0 = time.perf_counter()
     x1, x2, u = read_table(path, cfg)
     t_read = time.perf_counter() - t0

@@ -247,8 +247,8 @@ def level_curve_x1(x2: ArrayLike, a: float, omega: ArrayLike) -> Array:
 
 
 def _lambertw_real(x: Array, branch: int) -> Array:
-    # imported here: scipy.special costs ~0.15 s of import, which a process that
-    # only evaluates laws (a conform child, the CLI's argument errors) never needs
+    # imported here: scipy.special costs a process 0.2-0.4 s of import (and ~0.1 s at
+    # its exit), which one that never reaches a root (the CLI's argument errors) skips
     from scipy.special import lambertw
 
     with np.errstate(all="ignore"):
